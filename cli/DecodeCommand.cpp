@@ -1,0 +1,27 @@
+// `vdbdag decode IN.ssvdag -o OUT.vdb`
+#include <fmt/core.h>
+
+#include "cli/Commands.h"
+#include "src/pipeline/GridCodec.h"
+#include "src/util/Progress.h"
+#include "vdb_bridge/VdbExport.h"
+
+namespace vdbdag::cli {
+
+void addDecodeCommand(CLI::App& app, int& exitCode) {
+    struct Options { std::string input, output; };
+    auto opt = std::make_shared<Options>();
+    CLI::App* cmd = app.add_subcommand("decode", "Decode an .ssvdag file back into a .vdb file");
+    cmd->add_option("input", opt->input, "input .ssvdag file")->required();
+    cmd->add_option("-o,--output", opt->output, "output .vdb file")->required();
+    cmd->callback([opt, &exitCode] {
+        const format::SsvdagScene scene = format::readSceneFile(opt->input);
+        Progress progress("decode", scene.grids.size());
+        const Volume volume = pipeline::decodeScene(scene, [&](size_t i, size_t) { progress.set(i); });
+        progress.finish();
+        bridge::exportVdb(volume, opt->output);
+        exitCode = 0;
+    });
+}
+
+} // namespace vdbdag::cli

@@ -1,0 +1,73 @@
+// See SceneReport.h.
+#include "cli/SceneReport.h"
+
+#include <fmt/core.h>
+
+namespace vdbdag::cli {
+
+nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> fileBytes, const std::string& name) {
+    using nlohmann::json;
+    const auto sections = format::summarizeContainer(fileBytes, name);
+    json report{{"file", name}, {"bytes", fileBytes.size()}, {"grids", json::array()}};
+    uint64_t fileLevelBytes = fileBytes.size();
+    for (size_t g = 0; g < scene.grids.size(); ++g) {
+        const format::EncodedGrid& grid = scene.grids[g];
+        json j{{"index", g},
+               {"name", grid.record.name},
+               {"class", grid.record.gridClass},
+               {"value_type", valueTypeName(grid.record.valueType)},
+               {"active_voxels", grid.activeVoxels},
+               {"encoding", grid.symmetry ? "SSVDAG" : "SVDAG"},
+               {"root_log2_size", grid.dag.log2Size},
+               {"root_origin", grid.dag.origin},
+               {"levels", json::array()},
+               {"sections", json::array()}};
+        const auto& st = grid.stats;
+        for (size_t i = 0; i < st.svoNodes.size(); ++i) {
+            json level{{"node_size", uint64_t(1) << (i + 2)}, {"svo_nodes", st.svoNodes[i]}, {"stored_nodes", st.storedNodes[i]}};
+            if (st.hasSvdag) level["svdag_nodes"] = st.svdagNodes[i];
+            j["levels"].push_back(level);
+        }
+        uint64_t gridBytes = 0;
+        for (const auto& s : sections) {
+            if (s.kind == format::SectionKind::FileInfo || s.grid != g) continue;
+            j["sections"].push_back({{"kind", format::sectionKindName(s.kind)}, {"stored_bytes", s.storedBytes},
+                                     {"raw_bytes", s.rawBytes}, {"compressed", s.compressed}});
+            gridBytes += s.storedBytes;
+        }
+        fileLevelBytes -= std::min(fileLevelBytes, gridBytes);
+        j["stored_bytes"] = gridBytes;
+        j["traceable_bytes"] = grid.dag.byteSize();
+        j["bits_per_active_voxel"] = grid.activeVoxels ? 8.0 * double(gridBytes) / double(grid.activeVoxels) : 0.0;
+        report["grids"].push_back(j);
+    }
+    report["container_overhead_bytes"] = fileLevelBytes;
+    return report;
+}
+
+std::string formatSceneReport(const nlohmann::json& r) {
+    std::string out = fmt::format("{}: {} bytes, {} grid(s)\n", r["file"].get<std::string>(), r["bytes"].get<uint64_t>(), r["grids"].size());
+    for (const auto& g : r["grids"]) {
+        out += fmt::format("grid {} '{}' ({}, {}): {} active voxels, {}, root 2^{} at ({}, {}, {})\n", g["index"].get<size_t>(),
+                           g["name"].get<std::string>(), g["value_type"].get<std::string>(), g["class"].get<std::string>(),
+                           g["active_voxels"].get<uint64_t>(), g["encoding"].get<std::string>(), g["root_log2_size"].get<int>(),
+                           g["root_origin"][0].get<int64_t>(), g["root_origin"][1].get<int64_t>(), g["root_origin"][2].get<int64_t>());
+        if (!g["levels"].empty()) {
+            out += fmt::format("  {:>10} {:>12} {:>12} {:>12}\n", "node size", "SVO nodes", "SVDAG nodes", g["encoding"].get<std::string>() + " nodes");
+            for (size_t i = g["levels"].size(); i-- > 0;) {
+                const auto& l = g["levels"][i];
+                out += fmt::format("  {:>10} {:>12} {:>12} {:>12}\n", l["node_size"].get<uint64_t>(), l["svo_nodes"].get<uint64_t>(),
+                                   l.contains("svdag_nodes") ? std::to_string(l["svdag_nodes"].get<uint64_t>()) : std::string("-"),
+                                   l["stored_nodes"].get<uint64_t>());
+            }
+        }
+        for (const auto& s : g["sections"])
+            out += fmt::format("  section {:<14} {:>12} bytes{}\n", s["kind"].get<std::string>(), s["stored_bytes"].get<uint64_t>(),
+                               s["compressed"].get<bool>() ? fmt::format(" (zstd, {} raw)", s["raw_bytes"].get<uint64_t>()) : std::string());
+        out += fmt::format("  total {} bytes in file ({:.4f} bits/active voxel), {} bytes traceable in memory\n", g["stored_bytes"].get<uint64_t>(),
+                           g["bits_per_active_voxel"].get<double>(), g["traceable_bytes"].get<uint64_t>());
+    }
+    return out;
+}
+
+} // namespace vdbdag::cli

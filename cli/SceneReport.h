@@ -1,0 +1,19 @@
+// Builds the `info` report (text and JSON) of an encoded scene: per grid the
+// per-level node counts (SVO, SVDAG, stored DAG), bytes per section and bits
+// per active voxel. Shared by `info` on .ssvdag files and on .vdb files
+// (which are encoded in memory first).
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "src/format/SsvdagFile.h"
+
+namespace vdbdag::cli {
+
+nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> fileBytes, const std::string& name);
+std::string formatSceneReport(const nlohmann::json& report);
+
+} // namespace vdbdag::cli

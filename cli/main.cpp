@@ -1,0 +1,35 @@
+// Entry point of the `vdbdag` command: OpenVDB volumes <-> SSVDAG files.
+// Errors are printed as one line "vdbdag: <message>" with a non-zero exit.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/Commands.h"
+#include "src/util/Error.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"vdbdag: compress OpenVDB volumes into symmetry-aware sparse voxel DAGs (.ssvdag) and back"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "vdbdag 0.1.0");
+    int exitCode = 0;
+    vdbdag::cli::addEncodeCommand(app, exitCode);
+    vdbdag::cli::addDecodeCommand(app, exitCode);
+    vdbdag::cli::addInfoCommand(app, exitCode);
+    vdbdag::cli::addVerifyCommand(app, exitCode);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const vdbdag::Error& e) {
+        std::fprintf(stderr, "vdbdag: %s\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "vdbdag: out of memory\n");
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "vdbdag: %s\n", e.what());
+        return 1;
+    }
+    return exitCode;
+}

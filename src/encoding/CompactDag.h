@@ -1,0 +1,70 @@
+// The compact, traceable encoding of an SSVDAG (SSVDAG paper §4.3). The
+// exact word layout is documented at the top of CompactDag.cpp, beside the
+// code that writes it. This is both the in-memory layout the tracers walk and
+// (zstd-compressed) what the .ssvdag file stores.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "src/dag/ReducedDag.h"
+#include "src/volume/GridTopology.h"
+
+namespace vdbdag::encoding {
+
+struct CompactDag {
+    std::array<int64_t, 3> origin{0, 0, 0};  // index coordinate of the root cube's minimum corner
+    uint8_t log2Size = 0;                    // 0: empty grid (no nodes at all)
+    uint8_t rootReflection = 0;              // reflection applied to the root node
+    // Start of each inner level in `inner` (16-bit words), root level first:
+    // levelStart[i] holds nodes of size 2^(log2Size - i); log2Size - 2 entries.
+    std::vector<uint64_t> levelStart;
+    std::vector<uint16_t> inner;   // all inner levels, root level first
+    std::vector<uint64_t> leaves;  // 4^3 bricks, bit x + 4y + 16z
+
+    bool empty() const { return log2Size == 0; }
+    size_t innerLevelCount() const { return levelStart.size(); }
+    uint64_t levelEnd(size_t i) const { return i + 1 < levelStart.size() ? levelStart[i + 1] : inner.size(); }
+    uint64_t byteSize() const { return inner.size() * 2 + leaves.size() * 8 + levelStart.size() * 8; }
+};
+
+// Lays out `dag` with the nodes of each level ordered by reference count
+// (descending; ties by node index, so the result is deterministic). Throws
+// vdbdag::Error if an offset does not fit the 30-bit pointer format.
+CompactDag encodeCompact(const dag::ReducedDag& dag);
+
+// Checks that every header, pointer and offset is in range, that pointers
+// land on node starts of the next level, that the root level holds one node
+// and that no node is empty. Throws vdbdag::Error("<what>: ...").
+void validateCompact(const CompactDag& dag, const std::string& what);
+
+// Decoded size, computed bottom-up without decoding (saturating at 2^64-1).
+struct DecodedSize {
+    uint64_t activeVoxels = 0;
+    uint64_t emittedBricks = 0;  // partial bricks a decode emits
+    uint64_t emittedTiles = 0;   // fully active nodes a decode emits as tiles
+};
+DecodedSize decodedSize(const CompactDag& dag);
+
+// Walks every instance of a validated DAG with the mirror masks applied and
+// calls `brick` for each partially active 4^3 brick and `tile` for each
+// maximal fully active cube (never expanded into voxels). Coordinates are
+// index coordinates of the minimum corner.
+using BrickVisitor = std::function<void(int64_t x, int64_t y, int64_t z, uint64_t mask)>;
+using TileVisitor = std::function<void(int64_t x, int64_t y, int64_t z, unsigned log2Size)>;
+void visitInstances(const CompactDag& dag, const BrickVisitor& brick, const TileVisitor& tile);
+
+// Convenience: the whole topology (tiles as tiles). Coordinates must fit int32.
+GridTopology decodeTopology(const CompactDag& dag);
+
+// Parsing helpers shared with the tracers.
+struct ChildPointer {
+    uint64_t offset;     // in words of the next level (16-bit inner / 64-bit leaf words)
+    unsigned reflection;
+};
+// Number of 16-bit words a node occupies, from its header.
+unsigned nodeWordCount(uint16_t header);
+
+} // namespace vdbdag::encoding

@@ -1,0 +1,65 @@
+// The .ssvdag container: magic, format version, a table of typed sections
+// (each with its stored size, raw size, codec and xxh3-64 checksum), then the
+// section payloads; little-endian throughout; zstd at rest by default.
+// The reader validates every size, offset and checksum before it uses it, and
+// never allocates more than the file's size can justify. The byte layout is
+// documented in SsvdagContainer.cpp beside the code that writes it.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace vdbdag::format {
+
+// Section kinds. A file holds a section only when the scene needs it
+// (DESIGN.md invariant 3). Unknown kinds are rejected by readers that need
+// them and skipped by those that do not.
+enum class SectionKind : uint32_t {
+    FileInfo = 1,       // whole-file facts (grid count, writer version)
+    GridInfo = 2,       // per grid: name, class, value type, origin, depth, affine
+    VdbDescriptor = 3,  // per grid: OpenVDB stream of an empty copy of the grid (opaque)
+    DagLevels = 4,      // per grid: level table of the compact encoding
+    DagInner = 5,       // per grid: inner-node 16-bit words
+    DagLeaves = 6,      // per grid: 64-bit 4^3 leaves
+    DagStats = 7,       // per grid: per-level SVO / SVDAG / SSVDAG node counts
+};
+const char* sectionKindName(SectionKind kind);
+
+struct Section {
+    SectionKind kind{};
+    uint32_t grid = 0;          // grid index the section belongs to (0 for file-level)
+    std::vector<uint8_t> data;  // raw (uncompressed) payload
+};
+
+// What a reader learns about a section without decoding it (for `info`).
+struct SectionSummary {
+    SectionKind kind{};
+    uint32_t grid = 0;
+    bool compressed = false;
+    uint64_t storedBytes = 0;  // bytes in the file
+    uint64_t rawBytes = 0;     // bytes once restored in memory
+};
+
+struct ContainerOptions {
+    bool compress = true;  // zstd each section; kept raw if zstd does not shrink it
+    int zstdLevel = 9;
+};
+
+// Serialises sections into the container bytes.
+std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const ContainerOptions& options = {});
+
+// Parses and validates container bytes; throws vdbdag::Error with a one-line
+// message starting with `sourceName` on any truncation, corruption, checksum
+// mismatch or implausible size.
+std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName);
+
+// Validates the header and table only (no payload decompression) and returns
+// the section summaries.
+std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, const std::string& sourceName);
+
+// Reads a whole file into memory (throws Error naming the file if missing or
+// unreadable).
+std::vector<uint8_t> readFileBytes(const std::string& path);
+
+} // namespace vdbdag::format

@@ -1,0 +1,42 @@
+// The content of an .ssvdag file: per grid its header (GridRecord without
+// voxels), its compact DAG and its build statistics, mapped onto container
+// sections (SsvdagContainer.h). Reading validates every section and the DAG
+// itself before returning, so callers can walk the DAG without checks.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "src/encoding/CompactDag.h"
+#include "src/format/SsvdagContainer.h"
+#include "src/volume/GridRecord.h"
+
+namespace vdbdag::format {
+
+// Per level s = 2..log2Size (index s-2): node counts of the sparse voxel
+// octree, of the plain SVDAG (0 when not computed) and of the stored DAG.
+struct DagStats {
+    std::vector<uint64_t> svoNodes, svdagNodes, storedNodes;
+    bool hasSvdag = false;
+};
+
+struct EncodedGrid {
+    GridRecord record;          // name, class, type, transform, descriptor; topology left empty
+    uint64_t activeVoxels = 0;  // tiles counted as their voxels
+    bool symmetry = true;       // SSVDAG (true) or plain SVDAG
+    encoding::CompactDag dag;
+    DagStats stats;
+};
+
+struct SsvdagScene {
+    std::vector<EncodedGrid> grids;
+};
+
+std::vector<Section> sceneToSections(const SsvdagScene& scene);
+SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName);
+
+std::vector<uint8_t> writeScene(const SsvdagScene& scene, const ContainerOptions& options = {});
+SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName);
+SsvdagScene readSceneFile(const std::string& path);
+
+} // namespace vdbdag::format

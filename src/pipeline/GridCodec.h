@@ -1,0 +1,27 @@
+// One grid's trip through the core: topology -> reduced DAG -> compact
+// encoding (encodeGrid), and back (decodeGrid). No file I/O here.
+#pragma once
+#include <functional>
+
+#include "src/format/SsvdagFile.h"
+#include "src/volume/GridRecord.h"
+
+namespace vdbdag::pipeline {
+
+struct EncodeOptions {
+    bool symmetry = true;            // SSVDAG; false = plain SVDAG (same compact encoding)
+    bool computeSvdagStats = false;  // also reduce without symmetry, for `info`
+    // Try this many root placements (DESIGN.md invariant 1) and keep the
+    // smallest encoding; 1 = the bounding box's aligned minimum only.
+    int placementTrials = 1;
+};
+
+format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options = {});
+GridRecord decodeGrid(const format::EncodedGrid& grid);
+
+// Whole volumes; `onGrid(index, count)` is called before each grid (progress).
+using GridProgress = std::function<void(size_t index, size_t count)>;
+format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
+Volume decodeScene(const format::SsvdagScene& scene, const GridProgress& onGrid = {});
+
+} // namespace vdbdag::pipeline
