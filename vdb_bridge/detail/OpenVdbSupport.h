@@ -1,0 +1,71 @@
+// Private helpers of vdb_bridge that need OpenVDB types: one-time library
+// initialisation, dispatch over the supported grid types, descriptor
+// (de)serialisation. Not to be included outside vdb_bridge/ and tests/.
+#pragma once
+#include <cstdint>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/io/Stream.h>
+#include <openvdb/points/PointDataGrid.h>
+
+#include "src/util/Error.h"
+#include "src/volume/GridRecord.h"
+
+namespace vdbdag::bridge::detail {
+
+inline void initializeOpenVdb() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+        openvdb::initialize();
+    });
+}
+
+inline std::string oneLine(std::string s) {
+    for (char& c : s)
+        if (c == '\n' || c == '\r') c = ' ';
+    return s;
+}
+
+// Calls fn(grid, ValueType) with the grid cast to its concrete type; returns
+// false for types vdbdag does not convert.
+template <typename Fn>
+bool dispatchGridType(const openvdb::GridBase& base, Fn&& fn) {
+    if (base.isType<openvdb::FloatGrid>()) { fn(static_cast<const openvdb::FloatGrid&>(base), ValueType::Float); return true; }
+    if (base.isType<openvdb::DoubleGrid>()) { fn(static_cast<const openvdb::DoubleGrid&>(base), ValueType::Double); return true; }
+    if (base.isType<openvdb::Int32Grid>()) { fn(static_cast<const openvdb::Int32Grid&>(base), ValueType::Int32); return true; }
+    if (base.isType<openvdb::Int64Grid>()) { fn(static_cast<const openvdb::Int64Grid&>(base), ValueType::Int64); return true; }
+    if (base.isType<openvdb::BoolGrid>()) { fn(static_cast<const openvdb::BoolGrid&>(base), ValueType::Bool); return true; }
+    if (base.isType<openvdb::MaskGrid>()) { fn(static_cast<const openvdb::MaskGrid&>(base), ValueType::Mask); return true; }
+    if (base.isType<openvdb::Vec3SGrid>()) { fn(static_cast<const openvdb::Vec3SGrid&>(base), ValueType::Vec3S); return true; }
+    if (base.isType<openvdb::Vec3DGrid>()) { fn(static_cast<const openvdb::Vec3DGrid&>(base), ValueType::Vec3D); return true; }
+    if (base.isType<openvdb::Vec3IGrid>()) { fn(static_cast<const openvdb::Vec3IGrid&>(base), ValueType::Vec3I); return true; }
+    return false;
+}
+
+inline std::string typeHint(const openvdb::GridBase& base) {
+    if (base.isType<openvdb::points::PointDataGrid>()) return " (a PointDataGrid)";
+    return "";
+}
+
+// The grid stored in a GridRecord's descriptor: an empty grid of the original
+// type with its name, class, transform, background and metadata.
+inline openvdb::GridBase::Ptr readDescriptor(const std::vector<uint8_t>& bytes, const std::string& what) {
+    initializeOpenVdb();
+    try {
+        std::istringstream in(std::string(bytes.begin(), bytes.end()), std::ios::binary);
+        openvdb::io::Stream stream(in);
+        openvdb::GridPtrVecPtr grids = stream.getGrids();
+        if (!grids || grids->size() != 1) throw Error(what + ": grid descriptor holds no grid");
+        return grids->front();
+    } catch (const openvdb::Exception& e) {
+        throw Error(what + ": grid descriptor is corrupted (" + oneLine(e.what()) + ")");
+    } catch (const std::ios_base::failure& e) {
+        throw Error(what + ": grid descriptor is corrupted (" + oneLine(e.what()) + ")");
+    }
+}
+
+} // namespace vdbdag::bridge::detail
