@@ -40,6 +40,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         pipeline::EncodeOptions encodeOptions;
         encodeOptions.symmetry = !opt->noSymmetry;
         encodeOptions.placementTrials = opt->placementTrials;
+        encodeOptions.computeSvdagStats = true;  // cheap next to I/O; lets `info` show all three node counts
         Progress progress("encode", imported.volume.grids.size());
         const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) { progress.set(i); });
         progress.finish();

@@ -1,0 +1,180 @@
+// The `vdbdag` command as a user meets it: exit codes, one-line errors that
+// name the file, no partial output left behind, JSON reports that parse and
+// agree with OpenVDB's own counts.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetSphere.h>
+
+#include "vdb_bridge/VdbCompare.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CommandResult {
+    int exitCode;
+    std::string out, err;
+};
+
+CommandResult runCli(const std::string& args) {
+    const fs::path errFile = fs::temp_directory_path() / ("vdbdag_cli_err_" + std::to_string(getpid()));
+    const std::string command = std::string(VDBDAG_BINARY) + " " + args + " 2>" + errFile.string();
+    CommandResult r{};
+    FILE* pipe = popen(command.c_str(), "r");
+    std::array<char, 4096> buffer{};
+    size_t n;
+    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
+    const int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream in(errFile);
+    r.err.assign(std::istreambuf_iterator<char>(in), {});
+    fs::remove(errFile);
+    return r;
+}
+
+fs::path workDir() {
+    static const fs::path dir = [] {
+        fs::path d = fs::temp_directory_path() / ("vdbdag_cli_" + std::to_string(getpid()));
+        fs::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+fs::path sphereFile() {
+    const fs::path p = workDir() / "sphere.vdb";
+    if (!fs::exists(p)) {
+        openvdb::initialize();
+        auto g = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(20.0f, openvdb::Vec3f(0.0f), 1.0f, 3.0f);
+        g->setName("ball");
+        openvdb::io::File f(p.string());
+        f.write({g});
+        f.close();
+    }
+    return p;
+}
+
+size_t countFiles(const fs::path& dir) {
+    size_t n = 0;
+    for (const auto& e : fs::directory_iterator(dir)) { (void)e; ++n; }
+    return n;
+}
+
+} // namespace
+
+TEST(Cli, EncodeDecodeVerifyInfoOnASphere) {
+    const fs::path in = sphereFile(), encoded = workDir() / "sphere.ssvdag", decoded = workDir() / "sphere_back.vdb";
+    CommandResult r = runCli("encode " + in.string() + " -o " + encoded.string() + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto report = nlohmann::json::parse(r.out);
+    openvdb::io::File f(in.string());
+    f.open();
+    const uint64_t voxels = f.readGrid("ball")->activeVoxelCount();
+    f.close();
+    EXPECT_EQ(report["active_voxels"].get<uint64_t>(), voxels);
+    EXPECT_EQ(report["bytes"].get<uint64_t>(), fs::file_size(encoded));
+
+    r = runCli("decode " + encoded.string() + " -o " + decoded.string());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    openvdb::io::File back(decoded.string());
+    back.open();
+    EXPECT_EQ(back.readGrid("ball")->activeVoxelCount(), voxels);
+    back.close();
+
+    r = runCli("verify " + in.string());
+    EXPECT_EQ(r.exitCode, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("identical"), std::string::npos);
+
+    r = runCli("info " + encoded.string() + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto info = nlohmann::json::parse(r.out);
+    EXPECT_EQ(info["grids"][0]["name"], "ball");
+    EXPECT_EQ(info["grids"][0]["active_voxels"].get<uint64_t>(), voxels);
+    uint64_t sectionBytes = 0;
+    for (const auto& s : info["grids"][0]["sections"]) sectionBytes += s["stored_bytes"].get<uint64_t>();
+    EXPECT_LT(sectionBytes, fs::file_size(encoded));
+
+    r = runCli("info " + in.string() + " --json");  // .vdb input: all three node counts
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto vdbInfo = nlohmann::json::parse(r.out);
+    const auto& leafLevel = vdbInfo["grids"][0]["levels"][0];
+    EXPECT_GE(leafLevel["svo_nodes"].get<uint64_t>(), leafLevel["svdag_nodes"].get<uint64_t>());
+    EXPECT_GE(leafLevel["svdag_nodes"].get<uint64_t>(), leafLevel["stored_nodes"].get<uint64_t>());
+}
+
+TEST(Cli, ComparisonUsedByVerifyFindsARemovedVoxelAndAnAddedTile) {
+    openvdb::initialize();
+    const fs::path a = workDir() / "a.vdb", b = workDir() / "b.vdb", c = workDir() / "c.vdb";
+    auto g = openvdb::FloatGrid::create();
+    g->setName("g");
+    g->tree().setValueOn(openvdb::Coord(1, 2, 3), 1.0f);
+    g->tree().setValueOn(openvdb::Coord(100, 2, 3), 1.0f);
+    openvdb::io::File(a.string()).write({g});
+    auto withoutVoxel = g->deepCopy();
+    withoutVoxel->tree().setValueOff(openvdb::Coord(100, 2, 3));
+    openvdb::io::File(b.string()).write({withoutVoxel});
+    auto withTile = g->deepCopy();
+    withTile->tree().addTile(1, openvdb::Coord(800, 0, 0), 1.0f, true);
+    openvdb::io::File(c.string()).write({withTile});
+
+    const auto removed = vdbdag::bridge::compareTopologyFiles(a.string(), b.string());
+    EXPECT_FALSE(removed.identical);
+    ASSERT_EQ(removed.topology.size(), 1u);
+    EXPECT_EQ(removed.topology[0].onlyInA, 1u);
+    EXPECT_EQ(removed.topology[0].onlyInB, 0u);
+    ASSERT_FALSE(removed.topology[0].examples.empty());
+    EXPECT_NE(removed.topology[0].examples[0].find("(100,2,3)"), std::string::npos) << removed.topology[0].examples[0];
+
+    const auto added = vdbdag::bridge::compareTopologyFiles(a.string(), c.string());
+    ASSERT_EQ(added.topology.size(), 1u);
+    EXPECT_EQ(added.topology[0].onlyInB, 512u);
+    EXPECT_TRUE(vdbdag::bridge::compareTopologyFiles(a.string(), a.string()).identical);
+}
+
+TEST(Cli, BadInputsGiveOneLineErrorsAndLeaveNoOutput) {
+    const fs::path dir = workDir() / "bad";
+    fs::create_directories(dir);
+    const size_t before = countFiles(dir);
+    struct Case { std::string args, mustMention; };
+    // A truncated and a corrupted .ssvdag.
+    const fs::path good = workDir() / "good.ssvdag";
+    ASSERT_EQ(runCli("encode " + sphereFile().string() + " -o " + good.string()).exitCode, 0);
+    std::ifstream in(good, std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+    const fs::path truncated = workDir() / "truncated.ssvdag", corrupted = workDir() / "corrupted.ssvdag", text = workDir() / "text.vdb";
+    std::ofstream(truncated, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size() / 2));
+    bytes[bytes.size() - 10] ^= 0x55;
+    std::ofstream(corrupted, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    std::ofstream(text) << "this is not a vdb file\n";
+    const std::vector<Case> cases = {
+        {"encode /nonexistent/in.vdb -o " + (dir / "x.ssvdag").string(), "/nonexistent/in.vdb"},
+        {"encode " + text.string() + " -o " + (dir / "x.ssvdag").string(), text.string()},
+        {"decode " + truncated.string() + " -o " + (dir / "x.vdb").string(), "truncated"},
+        {"decode " + corrupted.string() + " -o " + (dir / "x.vdb").string(), "corrupted"},
+        {"decode " + sphereFile().string() + " -o " + (dir / "x.vdb").string(), "not an .ssvdag file"},
+        {"info " + truncated.string(), "truncated"},
+        {"encode " + sphereFile().string() + " -o /nonexistent/dir/x.ssvdag", "does not exist"},
+        {"encode " + sphereFile().string() + " --grid nope -o " + (dir / "x.ssvdag").string(), "no grid named 'nope'"},
+    };
+    for (const Case& c : cases) {
+        const CommandResult r = runCli(c.args);
+        EXPECT_NE(r.exitCode, 0) << c.args;
+        EXPECT_NE(r.err.find(c.mustMention), std::string::npos) << c.args << " -> " << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << " -> " << r.err;
+    }
+    EXPECT_EQ(countFiles(dir), before) << "a failed command left output behind";
+    const fs::path points = fs::path(VDBDAG_SHARED_DATA) / "vdb" / "points.vdb";
+    if (fs::exists(points)) {
+        const CommandResult r = runCli("encode " + points.string() + " -o " + (dir / "p.ssvdag").string());
+        EXPECT_NE(r.exitCode, 0);
+        EXPECT_NE(r.err.find("PointDataGrid"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "p.ssvdag"));
+    }
+}
