@@ -79,7 +79,14 @@ std::vector<uint8_t> descriptorOf(const openvdb::GridBase& grid) {
     openvdb::io::Stream stream(out);
     stream.setGridStatsMetadataEnabled(false);
     stream.write(openvdb::GridCPtrVec{empty});
-    const std::string s = out.str();
+    std::string s = out.str();
+    // The stream header carries a random UUID (36 ASCII characters after the
+    // 8-byte magic, u32 file version, 2 x u32 library version and a flag
+    // byte). Fix it so the same input always gives a byte-identical file.
+    constexpr size_t kUuidOffset = 21, kUuidLength = 36;
+    if (s.size() < kUuidOffset + kUuidLength || s[kUuidOffset + 8] != '-')
+        throw Error("internal error: unexpected OpenVDB stream header layout");
+    s.replace(kUuidOffset, kUuidLength, "00000000-0000-0000-0000-000000000000");
     return std::vector<uint8_t>(s.begin(), s.end());
 }
 
@@ -103,8 +110,11 @@ ImportResult importVdb(const std::string& path, const ImportOptions& options) {
     if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a .vdb file");
     openvdb::GridPtrVecPtr grids;
     try {
+        // Delayed loading: topology (node masks) is read now, leaf value
+        // buffers only when touched, so a geometry-only import never
+        // decompresses the values.
         openvdb::io::File file(path);
-        file.open(false);
+        file.open(true);
         grids = file.getGrids();
         file.close();
     } catch (const openvdb::Exception& e) {

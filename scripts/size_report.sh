@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Geometry-only size report for the issue's checks, all measured in one run:
+# for each input, the .ssvdag (symmetry), the --no-symmetry .ssvdag (same
+# compact encoding, plain SVDAG), and the same topology written by OpenVDB as
+# a blosc MaskGrid .vdb (what `vdbdag decode` writes). Also encode time.
+# Usage: scripts/size_report.sh [OUTDIR]   (needs a built tree: scripts/setup.sh)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+OUT=${1:-build/size_report}
+mkdir -p "$OUT"
+inputs=()
+[ -f "$OUT/sphere_d1024.vdb" ] || vdb_tool -sphere d=1024 r=1.0 w=3 -write "$OUT/sphere_d1024.vdb" >/dev/null
+inputs+=("$OUT/sphere_d1024.vdb")
+[ -f ../shared/data/levelsets/bunny_d512_ls.vdb ] && inputs+=(../shared/data/levelsets/bunny_d512_ls.vdb)
+[ -f ../shared/data/levelsets/armadillo_d512_ls.vdb ] && inputs+=(../shared/data/levelsets/armadillo_d512_ls.vdb)
+printf "| input | active voxels | SSVDAG bytes | SVDAG bytes | SSVDAG/SVDAG | MaskGrid blosc .vdb | SSVDAG/MaskGrid | bits/voxel | encode s |\n"
+printf "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n"
+for f in "${inputs[@]}"; do
+  name=$(basename "$f" .vdb)
+  start=$(date +%s.%N)
+  build/vdbdag encode "$f" -o "$OUT/$name.ssvdag" --json > "$OUT/$name.json"
+  end=$(date +%s.%N)
+  build/vdbdag encode "$f" -o "$OUT/$name.svdag.ssvdag" --no-symmetry >/dev/null
+  build/vdbdag decode "$OUT/$name.ssvdag" -o "$OUT/${name}_mask.vdb"
+  voxels=$(python3 -c "import json;print(json.load(open('$OUT/$name.json'))['active_voxels'])")
+  s=$(stat -c %s "$OUT/$name.ssvdag"); p=$(stat -c %s "$OUT/$name.svdag.ssvdag"); m=$(stat -c %s "$OUT/${name}_mask.vdb")
+  python3 -c "print(f'| $name | {$voxels:,} | {$s:,} | {$p:,} | {$s/$p:.3f} | {$m:,} | {$s/$m:.4f} (1/{$m/$s:.1f}) | {8*$s/$voxels:.3f} | {$end-$start:.2f} |')"
+done

@@ -1,0 +1,45 @@
+// Writes a few valid .ssvdag files (compressed and raw, empty grid, tiles,
+// mirrored bricks) into a folder, as the fuzzer's seed corpus.
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "src/format/SsvdagFile.h"
+#include "src/pipeline/GridCodec.h"
+
+int main(int argc, char** argv) {
+    if (argc < 2) return 2;  // usage: make_seed_corpus READER_DIR [SECTIONS_DIR]
+    using namespace vdbdag;
+    GridRecord record;
+    record.name = "seed";
+    record.vdbDescriptor = {1, 2, 3};
+    for (int i = 0; i < 30; ++i) record.topology.bricks.push_back({4 * (i % 4), 4 * (i / 4), 8 * (i % 3), uint64_t(0x1234567) * uint64_t(i + 3)});
+    record.topology.tiles.push_back({64, 0, 0, 3});
+    format::SsvdagScene scene;
+    scene.grids.push_back(pipeline::encodeGrid(record));
+    scene.grids.push_back(pipeline::encodeGrid(GridRecord{}));
+    int n = 0;
+    for (bool compress : {true, false}) {
+        format::ContainerOptions options;
+        options.compress = compress;
+        const auto bytes = format::writeScene(scene, options);
+        std::ofstream(std::string(argv[1]) + "/seed" + std::to_string(n++) + ".ssvdag", std::ios::binary)
+            .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
+    // The same scene in the checksum-free section framing of fuzz_ssvdag_sections.
+    if (argc > 2) {
+        const auto sections = format::sceneToSections(scene);
+        std::vector<uint8_t> framed{uint8_t(sections.size())};
+        for (const auto& section : sections) {
+            framed.push_back(uint8_t(section.kind));
+            framed.push_back(uint8_t(section.grid));
+            const uint16_t length = uint16_t(section.data.size());
+            framed.push_back(uint8_t(length & 0xFF));
+            framed.push_back(uint8_t(length >> 8));
+            framed.insert(framed.end(), section.data.begin(), section.data.begin() + length);
+        }
+        std::ofstream(std::string(argv[2]) + "/seed_sections", std::ios::binary)
+            .write(reinterpret_cast<const char*>(framed.data()), std::streamsize(framed.size()));
+    }
+    return 0;
+}
