@@ -6,6 +6,8 @@
 //   BM_EncodeFile        vdbdag: read the .vdb, build + reduce + encode, write
 //                        the .ssvdag (the ">= 10M active voxels/s");
 //   BM_ReduceOnly        the SSVDAG reduction alone (bricks -> reduced DAG);
+//   BM_ReduceOnlyOneCore the same on one core (the reference code reduces
+//                        17-20M voxels/s on one core of this machine);
 //   BM_ReduceOnlyPlain   the plain SVDAG reduction, for the symmetry cost.
 // Counters: voxels/s (items_per_second), peak RSS in MiB.
 // Run: build/vdbdag_bench --benchmark_filter=Sphere
@@ -13,6 +15,8 @@
 
 #include <filesystem>
 #include <sys/resource.h>
+
+#include <tbb/global_control.h>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
@@ -105,6 +109,11 @@ void reduce(benchmark::State& state, bool symmetry) {
     state.counters["peak_rss_MiB"] = peakRssMiB();
 }
 void BM_ReduceOnly_Sphere(benchmark::State& state) { reduce(state, true); }
+// One core, for comparison with the paper's single-threaded reference builder.
+void BM_ReduceOnlyOneCore_Sphere(benchmark::State& state) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    reduce(state, true);
+}
 void BM_ReduceOnlyPlain_Sphere(benchmark::State& state) { reduce(state, false); }
 
 } // namespace
@@ -112,6 +121,7 @@ void BM_ReduceOnlyPlain_Sphere(benchmark::State& state) { reduce(state, false); 
 BENCHMARK(BM_OpenVdbReadWrite_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_EncodeFile_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_ReduceOnly_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
+BENCHMARK(BM_ReduceOnlyOneCore_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_ReduceOnlyPlain_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 
 BENCHMARK_MAIN();
