@@ -48,10 +48,13 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
 std::string formatSceneReport(const nlohmann::json& r) {
     std::string out = fmt::format("{}: {} bytes, {} grid(s)\n", r["file"].get<std::string>(), r["bytes"].get<uint64_t>(), r["grids"].size());
     for (const auto& g : r["grids"]) {
-        out += fmt::format("grid {} '{}' ({}, {}): {} active voxels, {}, root 2^{} at ({}, {}, {})\n", g["index"].get<size_t>(),
-                           g["name"].get<std::string>(), g["value_type"].get<std::string>(), g["class"].get<std::string>(),
-                           g["active_voxels"].get<uint64_t>(), g["encoding"].get<std::string>(), g["root_log2_size"].get<int>(),
-                           g["root_origin"][0].get<int64_t>(), g["root_origin"][1].get<int64_t>(), g["root_origin"][2].get<int64_t>());
+        const std::string root = g["root_log2_size"].get<int>() == 0
+                                     ? std::string("empty")
+                                     : fmt::format("root 2^{} at ({}, {}, {})", g["root_log2_size"].get<int>(), g["root_origin"][0].get<int64_t>(),
+                                                   g["root_origin"][1].get<int64_t>(), g["root_origin"][2].get<int64_t>());
+        out += fmt::format("grid {} '{}' ({}, {}): {} active voxels, {}, {}\n", g["index"].get<size_t>(), g["name"].get<std::string>(),
+                           g["value_type"].get<std::string>(), g["class"].get<std::string>(), g["active_voxels"].get<uint64_t>(),
+                           g["encoding"].get<std::string>(), root);
         if (!g["levels"].empty()) {
             out += fmt::format("  {:>10} {:>12} {:>12} {:>12}\n", "node size", "SVO nodes", "SVDAG nodes", g["encoding"].get<std::string>() + " nodes");
             for (size_t i = g["levels"].size(); i-- > 0;) {

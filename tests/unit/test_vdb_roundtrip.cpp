@@ -178,6 +178,10 @@ TEST(VdbRoundTrip, RandomGridsWithTilesAtEveryLevelAndInt32Extremes) {
         grids.push_back(empty);
         const fs::path in = tempDir() / ("random" + std::to_string(trial) + ".vdb");
         openvdb::io::File file(in.string());
+        // Alternate zip, blosc and no compression; half floats in some files.
+        const uint32_t codecs[3] = {openvdb::io::COMPRESS_ZIP, openvdb::io::COMPRESS_BLOSC, openvdb::io::COMPRESS_NONE};
+        file.setCompression(codecs[trial % 3] | openvdb::io::COMPRESS_ACTIVE_MASK);
+        g->setSaveFloatAsHalf(trial % 2 == 1);
         file.write(grids);
         file.close();
         SCOPED_TRACE(in.string());
