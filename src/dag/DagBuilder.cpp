@@ -3,7 +3,8 @@
 // Level by level, from the 4^3 bricks up to the root:
 //  1. the node instances of the level, sorted in Morton order so that the 8
 //     children of every parent are contiguous, are grouped into parents;
-//     active tiles of the parent level are merged in as "full" nodes;
+//     active tiles of the parent level are merged in as "solid" nodes (no
+//     children, one attribute: a tile is never expanded);
 //  2. every parent is put in canonical form: over the 8 reflections m, the
 //     lexicographically smallest key, where the key of reflection m lists the
 //     children as (index+1, tag) with child slot j taken from slot j^m and its
@@ -92,7 +93,6 @@ public:
         dag.svoNodeCount.assign(dag.log2Size - 1, 0);
 
         std::vector<Instance> level = brickInstances();
-        mergeTiles(level, 2);
         dag.svoNodeCount[0] = level.size();
         for (unsigned s = 3; s <= dag.log2Size; ++s) {
             level = parentInstances(level, s);
@@ -111,7 +111,7 @@ private:
         for (const Brick& b : topo_.bricks)
             if ((b.x & 3) || (b.y & 3) || (b.z & 3)) throw Error("internal error: brick corner not a multiple of 4");
         for (const Tile& t : topo_.tiles) {
-            if (t.log2Size < 2 || t.log2Size > 31) throw Error("tile size 2^" + std::to_string(t.log2Size) + " out of range");
+            if (t.log2Size < 3 || t.log2Size > 31) throw Error("tile size 2^" + std::to_string(t.log2Size) + " out of range (8 to 2^31)");
             const int64_t size = int64_t(1) << t.log2Size;
             if ((t.x % size) || (t.y % size) || (t.z % size)) throw Error("internal error: tile not aligned to its size");
         }
@@ -199,17 +199,11 @@ private:
         return parents;
     }
 
-    // The (shared) node for a completely active cube of level s.
-    ChildRef fullNodeRef(unsigned s) {
-        if (fullRef_[s]) return fullRef_[s];
-        if (s == 2) {
-            fullRef_[s] = makeChildRef(insertBrick({~uint64_t(0), 0, 0xFF}), 0);
-        } else {
-            const ChildRef child = fullNodeRef(s - 1);
-            InnerNode node;
-            node.fill(child);
-            fullRef_[s] = makeChildRef(insertInner(s, {node, 0, uint8_t(opt_.symmetry ? 0xFF : 1)}), 0);
-        }
+    // The (shared) solid node of level s: an active tile, one uniform cube
+    // carrying a single attribute. It has no children (key all zero, which no
+    // other node has) and every reflection leaves it unchanged.
+    ChildRef solidNodeRef(unsigned s) {
+        if (!fullRef_[s]) fullRef_[s] = makeChildRef(insertInner(s, {InnerNode{}, 0, uint8_t(opt_.symmetry ? 0xFF : 1)}), 0);
         return fullRef_[s];
     }
 
@@ -220,7 +214,7 @@ private:
             if (t.log2Size == s) tiles.push_back({cellOf(t.x, t.y, t.z, s), 0});
         if (tiles.empty()) return;
         std::sort(tiles.begin(), tiles.end(), MortonInstanceLess{});
-        const ChildRef full = fullNodeRef(s);
+        const ChildRef full = solidNodeRef(s);
         for (auto& t : tiles) t.ref = full;
         std::vector<Instance> merged(level.size() + tiles.size());
         std::merge(level.begin(), level.end(), tiles.begin(), tiles.end(), merged.begin(), MortonInstanceLess{});

@@ -19,7 +19,7 @@ constexpr uint32_t childIndex(ChildRef ref) { return (ref >> 3) - 1; }
 constexpr unsigned childReflection(ChildRef ref) { return ref & 7u; }
 constexpr uint32_t kMaxNodesPerLevel = (1u << 29) - 2;
 
-using InnerNode = std::array<ChildRef, 8>;  // by stored child slot
+using InnerNode = std::array<ChildRef, 8>;  // by stored child slot; all 0 = solid node (an active tile)
 
 struct InnerLevel {
     std::vector<InnerNode> nodes;

@@ -8,8 +8,10 @@
 //            word 0. Within a level, nodes are sorted by reference count,
 //            most referenced first (ties: builder order), so the most shared
 //            nodes get the short pointers.
-//   node   : word 0 is the header: bits 2j..2j+1 hold the tag of stored child
-//            slot j (slot = x | y<<1 | z<<2 within the node):
+//   node   : word 0 is the header. A header of 0 is a solid node: the whole
+//            cube is active and carries ONE attribute entry (an OpenVDB
+//            active tile; never expanded). Otherwise bits 2j..2j+1 hold the
+//            tag of stored child slot j (slot = x | y<<1 | z<<2):
 //              00  no child (nothing stored)
 //              01  16-bit pointer: one word  [mmm ooooooooooooo]
 //                  m = 3 reflection bits (bit 13: x, 14: y, 15: z),
@@ -18,7 +20,11 @@
 //                  first word: reflection in bits 13..15, offset bits 16..28
 //                  in its low 13 bits; second word: offset bits 0..15;
 //                  offset bit 29 = b, the low bit of the tag.
-//            followed by the pointers of the present children in slot order.
+//            followed by the present children in slot order: each child's
+//            pointer, then, for every child but the first, its attribute
+//            offset in offsetWords[level] 16-bit words (low word first): the
+//            attribute entries of the preceding present siblings (Dado et
+//            al. §4.1). offsetWords is 0 for geometry-only grids.
 //            Offsets count words from the start of the next level: 16-bit
 //            words for an inner level, 64-bit words (= leaf index) for the
 //            leaf level. So offsets reach 2^30 words (2 GiB of inner level,
@@ -26,7 +32,9 @@
 //            error instead of writing a corrupt node.
 //   leaves : uint64 per 4^3 brick, bit x + 4y + 16z.
 //
-// A child instance is the stored node reflected by the pointer's reflection
+// Attribute entries of a node: popcount for a leaf, 1 for a solid node, the
+// sum over its children otherwise. A child instance is the stored node
+// reflected by the pointer's reflection
 // composed (XOR) with the reflections above it. A traversal that is at
 // spatial child slot p under accumulated reflection m reads stored slot p^m;
 // in a leaf it reads bit mirror(m, voxel) (DESIGN.md invariant 2).
@@ -63,27 +71,45 @@ unsigned tagWords(unsigned tag) { return tag == 0 ? 0 : tag == 1 ? 1 : 2; }
 
 uint64_t saturatingAdd(uint64_t a, uint64_t b) { return a > std::numeric_limits<uint64_t>::max() - b ? std::numeric_limits<uint64_t>::max() : a + b; }
 
-// Reads the pointer of stored slot j of the node whose header is at inner[pos].
-ChildPointer readPointer(const std::vector<uint16_t>& inner, uint64_t pos, unsigned j) {
-    const uint16_t header = inner[pos];
-    uint64_t at = pos + 1;
-    for (unsigned k = 0; k < j; ++k) at += tagWords((header >> (2 * k)) & 3u);
-    const unsigned tag = (header >> (2 * j)) & 3u;
-    const uint16_t w0 = inner[at];
-    if (tag == 1) return {uint64_t(w0 & 0x1FFFu), unsigned(w0 >> 13)};
-    const uint64_t offset = (uint64_t(tag & 1u) << 29) | (uint64_t(w0 & 0x1FFFu) << 16) | inner[at + 1];
-    return {offset, unsigned(w0 >> 13)};
-}
-
 } // namespace
 
-unsigned nodeWordCount(uint16_t header) {
-    unsigned words = 1;
-    for (unsigned j = 0; j < 8; ++j) words += tagWords((header >> (2 * j)) & 3u);
-    return words;
+unsigned nodeWordCount(uint16_t header, unsigned offsetWords) {
+    unsigned words = 1, children = 0;
+    for (unsigned j = 0; j < 8; ++j) {
+        const unsigned tag = (header >> (2 * j)) & 3u;
+        words += tagWords(tag);
+        children += tag != 0;
+    }
+    return words + (children > 1 ? (children - 1) * offsetWords : 0);
 }
 
-CompactDag encodeCompact(const dag::ReducedDag& dag) {
+ChildPointer readChild(const std::vector<uint16_t>& inner, uint64_t pos, unsigned j, unsigned offsetWords) {
+    const uint16_t header = inner[pos];
+    uint64_t at = pos + 1;
+    bool first = true;
+    for (unsigned k = 0; k < j; ++k) {
+        const unsigned tag = (header >> (2 * k)) & 3u;
+        if (!tag) continue;
+        at += tagWords(tag) + (first ? 0 : offsetWords);
+        first = false;
+    }
+    const unsigned tag = (header >> (2 * j)) & 3u;
+    const uint16_t w0 = inner[at];
+    ChildPointer child{};
+    child.reflection = unsigned(w0 >> 13);
+    if (tag == 1) {
+        child.offset = uint64_t(w0 & 0x1FFFu);
+        at += 1;
+    } else {
+        child.offset = (uint64_t(tag & 1u) << 29) | (uint64_t(w0 & 0x1FFFu) << 16) | inner[at + 1];
+        at += 2;
+    }
+    if (!first)
+        for (unsigned w = 0; w < offsetWords; ++w) child.attributeOffset |= uint64_t(inner[at + w]) << (16 * w);
+    return child;
+}
+
+CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets) {
     CompactDag out;
     if (dag.empty()) return out;
     out.origin = dag.origin;
@@ -92,21 +118,42 @@ CompactDag encodeCompact(const dag::ReducedDag& dag) {
 
     // Leaves: position = word offset.
     std::vector<uint64_t> position(dag.bricks.size(), std::numeric_limits<uint64_t>::max());
+    std::vector<uint64_t> entries(dag.bricks.size());
+    for (size_t i = 0; i < dag.bricks.size(); ++i) entries[i] = uint64_t(std::popcount(dag.bricks[i]));
     for (uint32_t index : frequencyOrder(dag.brickRefcount)) {
         position[index] = out.leaves.size();
         out.leaves.push_back(dag.bricks[index]);
     }
     // Inner levels bottom-up, so each knows where its children landed.
     std::vector<std::vector<uint16_t>> levels(dag.inner.size());
+    std::vector<uint8_t> offsetWords(dag.inner.size(), 0);
     for (size_t k = 0; k < dag.inner.size(); ++k) {
         const dag::InnerLevel& level = dag.inner[k];
-        std::vector<uint16_t>& words = levels[k];
+        // Attribute entries per node, and the widest offset this level stores.
         std::vector<uint64_t> here(level.nodes.size(), std::numeric_limits<uint64_t>::max());
+        std::vector<uint64_t> nodeEntries(level.nodes.size(), 0);
+        uint64_t widest = 0;
+        bool anySibling = false;
+        for (size_t n = 0; n < level.nodes.size(); ++n) {
+            uint64_t sum = 0;
+            unsigned children = 0;
+            for (dag::ChildRef c : level.nodes[n]) {
+                if (!c) continue;
+                if (children++ > 0) { widest = std::max(widest, sum); anySibling = true; }
+                sum = saturatingAdd(sum, entries[dag::childIndex(c)]);
+            }
+            nodeEntries[n] = children == 0 ? 1 : sum;  // a solid node is one entry
+        }
+        if (attributeOffsets && anySibling) offsetWords[k] = uint8_t(std::max<uint64_t>(1, (std::bit_width(widest) + 15) / 16));
+        const unsigned ow = offsetWords[k];
+        std::vector<uint16_t>& words = levels[k];
         for (uint32_t index : frequencyOrder(level.refcount)) {
             here[index] = words.size();
             const size_t headerAt = words.size();
             words.push_back(0);
             uint16_t header = 0;
+            uint64_t preceding = 0;
+            bool first = true;
             for (unsigned j = 0; j < 8; ++j) {
                 const dag::ChildRef child = level.nodes[index][j];
                 if (!child) continue;
@@ -123,32 +170,53 @@ CompactDag encodeCompact(const dag::ReducedDag& dag) {
                     throw Error("DAG level " + std::to_string(k + 3) + " needs a child offset of " + std::to_string(offset) +
                                 " words, beyond the 30-bit pointer format (2^30 words)");
                 }
+                if (!first)
+                    for (unsigned w = 0; w < ow; ++w) words.push_back(uint16_t(preceding >> (16 * w)));
+                first = false;
+                preceding += entries[dag::childIndex(child)];
             }
             words[headerAt] = header;
         }
         position = std::move(here);
+        entries = std::move(nodeEntries);
     }
     // Concatenate, root level first.
     for (size_t k = levels.size(); k-- > 0;) {
         out.levelStart.push_back(out.inner.size());
+        out.offsetWords.push_back(offsetWords[k]);
         out.inner.insert(out.inner.end(), levels[k].begin(), levels[k].end());
     }
     return out;
 }
 
+namespace {
+
+// Per-node facts computed bottom-up over the stored (unmirrored) nodes, by
+// word offset within the level (only node starts are meaningful);
+// reflections change none of them.
+struct NodeFacts {
+    std::vector<uint64_t> voxels, entries, bricks, tiles;
+};
+
+} // namespace
+
 void validateCompact(const CompactDag& dag, const std::string& what) {
     auto fail = [&](const std::string& why) { throw Error(what + ": " + why); };
     if (dag.log2Size == 0) {
-        if (!dag.levelStart.empty() || !dag.inner.empty() || !dag.leaves.empty()) fail("an empty grid must have no nodes");
+        if (!dag.levelStart.empty() || !dag.inner.empty() || !dag.leaves.empty() || !dag.offsetWords.empty()) fail("an empty grid must have no nodes");
         return;
     }
     if (dag.log2Size < 3 || dag.log2Size > kMaxLog2Size) fail("root size 2^" + std::to_string(dag.log2Size) + " out of range");
     if (dag.rootReflection > 7) fail("bad root reflection");
     const size_t levels = dag.innerLevelCount();
     if (levels != size_t(dag.log2Size) - 2) fail("level table has " + std::to_string(levels) + " levels, expected " + std::to_string(dag.log2Size - 2));
+    if (dag.offsetWords.size() != levels) fail("offset width table has " + std::to_string(dag.offsetWords.size()) + " entries");
+    for (uint8_t w : dag.offsetWords)
+        if (w > 4) fail("attribute offsets of " + std::to_string(w) + " words are not supported (at most 4)");
     if (dag.levelStart[0] != 0) fail("root level does not start at word 0");
+    // Levels below solid nodes may be empty (a grid of tiles only); the root's may not.
     for (size_t i = 0; i < levels; ++i)
-        if (dag.levelStart[i] >= dag.levelEnd(i)) fail("inner level " + std::to_string(i) + " is empty or out of order");
+        if (dag.levelStart[i] > dag.levelEnd(i) || (i == 0 && dag.levelEnd(0) == 0)) fail("inner level " + std::to_string(i) + " is out of order or the root is missing");
     for (size_t i = 0; i < dag.leaves.size(); ++i)
         if (dag.leaves[i] == 0) fail("leaf " + std::to_string(i) + " is empty");
 
@@ -159,83 +227,82 @@ void validateCompact(const CompactDag& dag, const std::string& what) {
         isNodeStart[i].assign(end - begin, 0);
         uint64_t nodes = 0;
         for (uint64_t pos = begin; pos < end; ++nodes) {
-            const uint16_t header = dag.inner[pos];
-            if (header == 0) fail("node at word " + std::to_string(pos) + " has no children");
-            const unsigned words = nodeWordCount(header);
+            const unsigned words = nodeWordCount(dag.inner[pos], dag.offsetWords[i]);
             if (words > end - pos) fail("node at word " + std::to_string(pos) + " runs past the end of its level");
             isNodeStart[i][pos - begin] = 1;
             pos += words;
         }
         if (i == 0 && nodes != 1) fail("root level holds " + std::to_string(nodes) + " nodes, expected 1");
     }
-    // Pass 2: every pointer lands on a node of the next level (or a leaf).
-    for (size_t i = 0; i < levels; ++i) {
+    // Pass 2, bottom-up: every pointer lands on a node of the next level (or
+    // a leaf), and every stored attribute offset is the entries of the
+    // preceding siblings.
+    std::vector<uint64_t> below(dag.leaves.size()), here;
+    for (size_t n = 0; n < dag.leaves.size(); ++n) below[n] = uint64_t(std::popcount(dag.leaves[n]));
+    for (size_t i = levels; i-- > 0;) {
         const uint64_t begin = dag.levelStart[i], end = dag.levelEnd(i);
         const bool toLeaves = i + 1 == levels;
-        for (uint64_t pos = begin; pos < end; pos += nodeWordCount(dag.inner[pos])) {
+        here.assign(end - begin, 0);
+        for (uint64_t pos = begin; pos < end; pos += nodeWordCount(dag.inner[pos], dag.offsetWords[i])) {
             const uint16_t header = dag.inner[pos];
+            if (header == 0) { here[pos - begin] = 1; continue; }
+            uint64_t preceding = 0;
+            bool first = true;
             for (unsigned j = 0; j < 8; ++j) {
                 if (((header >> (2 * j)) & 3u) == 0) continue;
-                const ChildPointer p = readPointer(dag.inner, pos, j);
+                const ChildPointer p = readChild(dag.inner, pos, j, dag.offsetWords[i]);
                 const bool ok = toLeaves ? p.offset < dag.leaves.size()
                                          : p.offset < isNodeStart[i + 1].size() && isNodeStart[i + 1][p.offset];
                 if (!ok) fail("pointer at level " + std::to_string(i) + " word " + std::to_string(pos) + " targets " +
                               std::to_string(p.offset) + ", which is not a node of the next level");
+                if (!first && dag.offsetWords[i] && p.attributeOffset != preceding)
+                    fail("attribute offset at level " + std::to_string(i) + " word " + std::to_string(pos) + " is " +
+                         std::to_string(p.attributeOffset) + ", expected " + std::to_string(preceding));
+                first = false;
+                preceding = saturatingAdd(preceding, below[p.offset]);
             }
+            here[pos - begin] = preceding;
         }
+        below.swap(here);
     }
 }
 
 namespace {
 
-// Per-node facts computed bottom-up over the stored (unmirrored) nodes;
-// reflections change neither voxel counts nor fullness.
-struct NodeFacts {
-    std::vector<uint8_t> full;           // per inner word offset of the level: node there is fully active
-    std::vector<uint64_t> voxels;        // per inner word offset (only node starts are meaningful)
-    std::vector<uint64_t> bricks, tiles; // emitted by a decode of this node
-};
-
 std::vector<NodeFacts> computeFacts(const CompactDag& dag) {
     const size_t levels = dag.innerLevelCount();
     std::vector<NodeFacts> facts(levels);
-    const unsigned leafLevel = 2;
     for (size_t i = levels; i-- > 0;) {
         const uint64_t begin = dag.levelStart[i], end = dag.levelEnd(i);
         NodeFacts& f = facts[i];
-        f.full.assign(end - begin, 0);
-        f.voxels.assign(end - begin, 0);
-        f.bricks.assign(end - begin, 0);
-        f.tiles.assign(end - begin, 0);
-        const unsigned childLog2 = dag.log2Size - unsigned(i) - 1;
-        for (uint64_t pos = begin; pos < end; pos += nodeWordCount(dag.inner[pos])) {
+        for (auto* v : {&f.voxels, &f.entries, &f.bricks, &f.tiles}) v->assign(end - begin, 0);
+        const unsigned log2Size = dag.log2Size - unsigned(i);
+        const bool toLeaves = i + 1 == levels;
+        for (uint64_t pos = begin; pos < end; pos += nodeWordCount(dag.inner[pos], dag.offsetWords[i])) {
             const uint16_t header = dag.inner[pos];
-            uint64_t voxels = 0, bricks = 0, tiles = 0;
-            bool full = true;
+            const uint64_t at = pos - begin;
+            if (header == 0) {  // solid node
+                f.voxels[at] = 3 * log2Size >= 64 ? std::numeric_limits<uint64_t>::max() : uint64_t(1) << (3 * log2Size);
+                f.entries[at] = 1;
+                f.tiles[at] = 1;
+                continue;
+            }
             for (unsigned j = 0; j < 8; ++j) {
-                if (((header >> (2 * j)) & 3u) == 0) { full = false; continue; }
-                const ChildPointer p = readPointer(dag.inner, pos, j);
-                if (childLog2 == leafLevel) {
-                    const uint64_t leaf = dag.leaves[p.offset];
-                    voxels += uint64_t(std::popcount(leaf));
-                    bricks += 1;
-                    full = full && leaf == ~uint64_t(0);
+                if (((header >> (2 * j)) & 3u) == 0) continue;
+                const ChildPointer p = readChild(dag.inner, pos, j, dag.offsetWords[i]);
+                if (toLeaves) {
+                    const uint64_t n = uint64_t(std::popcount(dag.leaves[p.offset]));
+                    f.voxels[at] += n;
+                    f.entries[at] += n;
+                    f.bricks[at] += 1;
                 } else {
                     const NodeFacts& c = facts[i + 1];
-                    voxels = saturatingAdd(voxels, c.voxels[p.offset]);
-                    if (c.full[p.offset]) {
-                        tiles += 1;
-                    } else {
-                        bricks = saturatingAdd(bricks, c.bricks[p.offset]);
-                        tiles = saturatingAdd(tiles, c.tiles[p.offset]);
-                        full = false;
-                    }
+                    f.voxels[at] = saturatingAdd(f.voxels[at], c.voxels[p.offset]);
+                    f.entries[at] = saturatingAdd(f.entries[at], c.entries[p.offset]);
+                    f.bricks[at] = saturatingAdd(f.bricks[at], c.bricks[p.offset]);
+                    f.tiles[at] = saturatingAdd(f.tiles[at], c.tiles[p.offset]);
                 }
             }
-            f.full[pos - begin] = full;
-            f.voxels[pos - begin] = voxels;
-            f.bricks[pos - begin] = bricks;
-            f.tiles[pos - begin] = tiles;
         }
     }
     return facts;
@@ -247,63 +314,59 @@ DecodedSize decodedSize(const CompactDag& dag) {
     if (dag.empty()) return {};
     const auto facts = computeFacts(dag);
     const NodeFacts& root = facts[0];
-    if (root.full[0]) return {root.voxels[0], 0, 1};
-    return {root.voxels[0], root.bricks[0], root.tiles[0]};
+    return {root.voxels[0], root.bricks[0], root.tiles[0], root.entries[0]};
 }
 
-void visitInstances(const CompactDag& dag, const BrickVisitor& brick, const TileVisitor& tile) {
+uint64_t BrickInstance::spatialMask() const { return dag::reflectBrick(storedMask, mirror); }
+
+void visitInAttributeOrder(const CompactDag& dag, const BrickInstanceVisitor& brick, const SolidVisitor& solid) {
     if (dag.empty()) return;
     const auto facts = computeFacts(dag);
+    if (saturatingAdd(facts[0].bricks[0], facts[0].tiles[0]) > kMaxEmittedPieces)
+        throw Error("decoding would create more than 2^31 bricks and tiles: the grid is implausibly large to decode here");
 
     struct Walker {
         const CompactDag& dag;
         const std::vector<NodeFacts>& facts;
-        const BrickVisitor& brick;
-        const TileVisitor& tile;
-        uint64_t emitted = 0;
+        const BrickInstanceVisitor& brick;
+        const SolidVisitor& solid;
+        uint64_t entry = 0;
 
-        void count() {
-            if (++emitted > kMaxEmittedPieces)
-                throw Error("decoding would create more than 2^31 bricks and tiles: the grid is implausibly large to decode here");
-        }
-        // A fully active cube: a tile where OpenVDB-style alignment allows
-        // (position a multiple of the size), else split into its children.
-        void full(int64_t x, int64_t y, int64_t z, unsigned log2Size) {
-            const int64_t size = int64_t(1) << log2Size;
-            if (log2Size == 2) { count(); brick(x, y, z, ~uint64_t(0)); return; }
-            if ((x & (size - 1)) == 0 && (y & (size - 1)) == 0 && (z & (size - 1)) == 0) { count(); tile(x, y, z, log2Size); return; }
-            const int64_t half = size / 2;
-            for (unsigned p = 0; p < 8; ++p) full(x + ((p & 1u) ? half : 0), y + ((p & 2u) ? half : 0), z + ((p & 4u) ? half : 0), log2Size - 1);
-        }
         void visit(size_t i, uint64_t offset, unsigned mirror, int64_t x, int64_t y, int64_t z) {
             const unsigned log2Size = dag.log2Size - unsigned(i);
-            if (facts[i].full[offset]) { full(x, y, z, log2Size); return; }
             const uint64_t pos = dag.levelStart[i] + offset;
             const uint16_t header = dag.inner[pos];
+            if (header == 0) { solid(x, y, z, log2Size, entry++); return; }
             const int64_t half = int64_t(1) << (log2Size - 1);
             const bool toLeaves = i + 1 == dag.innerLevelCount();
-            for (unsigned p = 0; p < 8; ++p) {  // spatial slot
-                const unsigned j = p ^ mirror;  // stored slot
+            for (unsigned j = 0; j < 8; ++j) {  // stored slot order = attribute order
                 if (((header >> (2 * j)) & 3u) == 0) continue;
-                const ChildPointer ptr = readPointer(dag.inner, pos, j);
+                const unsigned p = j ^ mirror;   // spatial slot
+                const ChildPointer ptr = readChild(dag.inner, pos, j, dag.offsetWords[i]);
                 const unsigned childMirror = mirror ^ ptr.reflection;
                 const int64_t cx = x + ((p & 1u) ? half : 0), cy = y + ((p & 2u) ? half : 0), cz = z + ((p & 4u) ? half : 0);
                 if (toLeaves) {
-                    count();
-                    brick(cx, cy, cz, dag::reflectBrick(dag.leaves[ptr.offset], childMirror));
+                    const uint64_t stored = dag.leaves[ptr.offset];
+                    brick(BrickInstance{cx, cy, cz, childMirror, stored, entry});
+                    entry += uint64_t(std::popcount(stored));
                 } else {
                     visit(i + 1, ptr.offset, childMirror, cx, cy, cz);
                 }
             }
         }
     };
-    Walker{dag, facts, brick, tile}.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
+    Walker{dag, facts, brick, solid}.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
+}
+
+void visitInstances(const CompactDag& dag, const BrickVisitor& brick, const TileVisitor& tile) {
+    visitInAttributeOrder(
+        dag, [&](const BrickInstance& b) { brick(b.x, b.y, b.z, b.spatialMask()); },
+        [&](int64_t x, int64_t y, int64_t z, unsigned log2Size, uint64_t) { tile(x, y, z, log2Size); });
 }
 
 GridTopology decodeTopology(const CompactDag& dag) {
     GridTopology topology;
-    const DecodedSize size = decodedSize(dag);
-    topology.bricks.reserve(size.emittedBricks);
+    topology.bricks.reserve(decodedSize(dag).emittedBricks);
     auto toInt32 = [](int64_t v) {
         if (v < std::numeric_limits<int32_t>::min() || v > std::numeric_limits<int32_t>::max())
             throw Error("decoded coordinate " + std::to_string(v) + " is outside OpenVDB's int32 index range");
@@ -312,6 +375,10 @@ GridTopology decodeTopology(const CompactDag& dag) {
     visitInstances(
         dag, [&](int64_t x, int64_t y, int64_t z, uint64_t mask) { topology.bricks.push_back({toInt32(x), toInt32(y), toInt32(z), mask}); },
         [&](int64_t x, int64_t y, int64_t z, unsigned log2Size) {
+            const int64_t size = int64_t(1) << log2Size;
+            if (log2Size > 31 || (x & (size - 1)) || (y & (size - 1)) || (z & (size - 1)))
+                throw Error("solid node of 2^" + std::to_string(log2Size) + " voxels at (" + std::to_string(x) + "," + std::to_string(y) + "," +
+                            std::to_string(z) + ") is not aligned to its size: the file is corrupted");
             topology.tiles.push_back({toInt32(x), toInt32(y), toInt32(z), uint8_t(log2Size)});
         });
     return topology;

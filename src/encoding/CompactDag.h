@@ -21,6 +21,9 @@ struct CompactDag {
     // Start of each inner level in `inner` (16-bit words), root level first:
     // levelStart[i] holds nodes of size 2^(log2Size - i); log2Size - 2 entries.
     std::vector<uint64_t> levelStart;
+    // Per inner level (root first): 16-bit words of each attribute offset
+    // stored after a child pointer (0 = geometry only, no offsets).
+    std::vector<uint8_t> offsetWords;
     std::vector<uint16_t> inner;   // all inner levels, root level first
     std::vector<uint64_t> leaves;  // 4^3 bricks, bit x + 4y + 16z
 
@@ -31,27 +34,47 @@ struct CompactDag {
 };
 
 // Lays out `dag` with the nodes of each level ordered by reference count
-// (descending; ties by node index, so the result is deterministic). Throws
-// vdbdag::Error if an offset does not fit the 30-bit pointer format.
-CompactDag encodeCompact(const dag::ReducedDag& dag);
+// (descending; ties by node index, so the result is deterministic). With
+// `attributeOffsets`, every child pointer but a node's first carries the
+// number of attribute entries of the preceding siblings (Dado et al. §4.1),
+// in the smallest number of 16-bit words that fits the level. Throws
+// vdbdag::Error if a pointer offset does not fit the 30-bit format.
+CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets = false);
 
 // Checks that every header, pointer and offset is in range, that pointers
 // land on node starts of the next level, that the root level holds one node
-// and that no node is empty. Throws vdbdag::Error("<what>: ...").
+// and that every stored attribute offset equals the entries of the preceding
+// siblings. Throws vdbdag::Error("<what>: ...").
 void validateCompact(const CompactDag& dag, const std::string& what);
 
 // Decoded size, computed bottom-up without decoding (saturating at 2^64-1).
 struct DecodedSize {
     uint64_t activeVoxels = 0;
-    uint64_t emittedBricks = 0;  // partial bricks a decode emits
-    uint64_t emittedTiles = 0;   // fully active nodes a decode emits as tiles
+    uint64_t emittedBricks = 0;     // bricks a decode emits
+    uint64_t emittedTiles = 0;      // solid nodes (tiles) a decode emits
+    uint64_t attributeEntries = 0;  // = voxels in bricks + tiles
 };
 DecodedSize decodedSize(const CompactDag& dag);
 
-// Walks every instance of a validated DAG with the mirror masks applied and
-// calls `brick` for each partially active 4^3 brick and `tile` for each
-// maximal fully active cube (never expanded into voxels). Coordinates are
-// index coordinates of the minimum corner.
+// Walks every instance of a validated DAG in attribute order: depth-first,
+// children in the stored node's own slot order, with the reflections
+// accumulated on the way down (DESIGN.md invariant 2). For a brick the
+// callback gets the stored mask and the accumulated reflection: its
+// attribute entries are the stored mask's set bits in increasing order,
+// stored bit b being the voxel at reflect(mirror, b). A solid node (tile) is
+// one entry. `firstEntry` is the index of the instance's first entry.
+struct BrickInstance {
+    int64_t x, y, z;       // minimum corner (index space)
+    unsigned mirror;       // accumulated reflection
+    uint64_t storedMask;   // the leaf as stored
+    uint64_t firstEntry;
+    uint64_t spatialMask() const;
+};
+using BrickInstanceVisitor = std::function<void(const BrickInstance&)>;
+using SolidVisitor = std::function<void(int64_t x, int64_t y, int64_t z, unsigned log2Size, uint64_t entry)>;
+void visitInAttributeOrder(const CompactDag& dag, const BrickInstanceVisitor& brick, const SolidVisitor& solid);
+
+// Geometry-only convenience over visitInAttributeOrder.
 using BrickVisitor = std::function<void(int64_t x, int64_t y, int64_t z, uint64_t mask)>;
 using TileVisitor = std::function<void(int64_t x, int64_t y, int64_t z, unsigned log2Size)>;
 void visitInstances(const CompactDag& dag, const BrickVisitor& brick, const TileVisitor& tile);
@@ -61,10 +84,14 @@ GridTopology decodeTopology(const CompactDag& dag);
 
 // Parsing helpers shared with the tracers.
 struct ChildPointer {
-    uint64_t offset;     // in words of the next level (16-bit inner / 64-bit leaf words)
+    uint64_t offset;           // in words of the next level (16-bit inner / 64-bit leaf words)
     unsigned reflection;
+    uint64_t attributeOffset;  // entries of the preceding stored siblings (0 without offsets)
 };
-// Number of 16-bit words a node occupies, from its header.
-unsigned nodeWordCount(uint16_t header);
+// Number of 16-bit words a node occupies, from its header; a header of 0 is
+// a solid node (one word).
+unsigned nodeWordCount(uint16_t header, unsigned offsetWords);
+// Reads the child of stored slot j of the node whose header is at inner[pos].
+ChildPointer readChild(const std::vector<uint16_t>& inner, uint64_t pos, unsigned j, unsigned offsetWords);
 
 } // namespace vdbdag::encoding

@@ -4,7 +4,8 @@
 //                 f64[16] index-to-world, u64 active voxels
 //   VdbDescriptor opaque bytes (vdb_bridge)
 //   DagLevels     i64[3] origin, u8 log2Size, u8 root reflection,
-//                 u32 n, u64[n] level starts, u64 inner words, u64 leaves
+//                 u32 n, u64[n] level starts, u8[n] attribute-offset words,
+//                 u64 inner words, u64 leaves
 //   DagInner      u16[inner words]     (absent for an empty grid)
 //   DagLeaves     u64[leaves]          (absent for an empty grid)
 //   DagStats      u32 n, u8 hasSvdag, then n x (u64 svo, u64 svdag, u64 stored)
@@ -65,6 +66,7 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
         levels.put<uint8_t>(dag.rootReflection);
         levels.put<uint32_t>(uint32_t(dag.levelStart.size()));
         for (uint64_t s : dag.levelStart) levels.put<uint64_t>(s);
+        for (uint8_t w : dag.offsetWords) levels.put<uint8_t>(w);
         levels.put<uint64_t>(dag.inner.size());
         levels.put<uint64_t>(dag.leaves.size());
         sections.push_back({SectionKind::DagLevels, g, levels.take()});
@@ -140,6 +142,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             dag.rootReflection = r.get<uint8_t>();
             const uint32_t n = r.get<uint32_t>();
             dag.levelStart = r.getArray<uint64_t>(n);
+            dag.offsetWords = r.getArray<uint8_t>(n);
             innerWords = r.get<uint64_t>();
             leafCount = r.get<uint64_t>();
             r.expectEnd();

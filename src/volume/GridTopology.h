@@ -20,7 +20,7 @@ struct Brick {
 // (OpenVDB tiles are 8, 128 or 4096 voxels wide).
 struct Tile {
     int32_t x, y, z;
-    uint8_t log2Size;  // >= 2
+    uint8_t log2Size;  // >= 3
 };
 
 struct GridTopology {
