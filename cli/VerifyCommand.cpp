@@ -1,6 +1,7 @@
 // `vdbdag verify IN.vdb [--json]`: encode, write the container in memory,
 // read it back, decode, and compare with the original file using OpenVDB
-// alone (vdb_bridge/VdbCompare). Exit 0 only if identical.
+// alone (vdb_bridge/VdbCompare): headers, topology, every active value and
+// every stored inactive value, bit for bit. Exit 0 only if identical.
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
@@ -24,13 +25,17 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
         options.symmetry = !opt->noSymmetry;
         const std::vector<uint8_t> bytes = format::writeScene(pipeline::encodeVolume(imported.volume, options));
         const Volume decoded = pipeline::decodeScene(format::readScene(bytes, opt->input + " (in memory)"));
-        const bridge::CompareResult result = bridge::compareTopology(opt->input, decoded);
+        const bridge::CompareResult result = bridge::compareWithFile(opt->input, decoded);
 
         nlohmann::json report{{"input", opt->input}, {"identical", result.identical}, {"ssvdag_bytes", bytes.size()},
                               {"header_differences", result.headerDifferences}, {"grids", nlohmann::json::array()}};
         for (const auto& d : result.topology)
             report["grids"].push_back({{"index", d.gridIndex}, {"name", d.gridName}, {"only_in_original", d.onlyInA},
                                        {"only_in_decoded", d.onlyInB}, {"examples", d.examples}});
+        report["values"] = nlohmann::json::array();
+        for (const auto& d : result.values)
+            report["values"].push_back({{"index", d.gridIndex}, {"name", d.gridName}, {"active_values_differing", d.activeValues},
+                                        {"inactive_values_differing", d.inactiveValues}, {"examples", d.examples}});
         if (opt->json) {
             fmt::print("{}\n", report.dump(2));
         } else if (result.identical) {
@@ -40,6 +45,10 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
             for (const auto& h : result.headerDifferences) fmt::print("  {}\n", h);
             for (const auto& d : result.topology) {
                 fmt::print("  grid {} '{}': {} voxels only in the original, {} only in the decoded grid\n", d.gridIndex, d.gridName, d.onlyInA, d.onlyInB);
+                for (const auto& e : d.examples) fmt::print("    {}\n", e);
+            }
+            for (const auto& d : result.values) {
+                fmt::print("  grid {} '{}': {} active and {} inactive values differ\n", d.gridIndex, d.gridName, d.activeValues, d.inactiveValues);
                 for (const auto& e : d.examples) fmt::print("    {}\n", e);
             }
         }

@@ -1,22 +1,89 @@
-// Topology and header comparison with OpenVDB alone (independent of the DAG
-// code): both grids' topologies are copied into MaskTrees and subtracted with
-// OpenVDB's topologyDifference, which counts tiles as their voxels.
+// Comparison with OpenVDB alone (independent of the DAG code): both grids'
+// topologies are copied into MaskTrees and subtracted with OpenVDB's
+// topologyDifference (tiles count as their voxels); values are compared bit
+// for bit leaf by leaf and tile by tile through OpenVDB's accessors.
 #include "vdb_bridge/VdbCompare.h"
 
+#include <cstring>
 #include <set>
+#include <sstream>
+#include <type_traits>
 
 #include "src/util/Error.h"
-#include "vdb_bridge/detail/MaskGridBuilder.h"
+#include "vdb_bridge/detail/GridBuilder.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 
 namespace vdbdag::bridge {
 namespace {
 
 // Metadata OpenVDB's writer recomputes on every write (grid statistics and the
-// compression it used) or that only concerns value encoding (the half-float
-// flag, irrelevant to topology): not part of what a round trip must keep.
+// compression it used): not part of what a round trip must keep.
 const std::set<std::string> kWriterMetadata = {"file_bbox_min", "file_bbox_max", "file_mem_bytes", "file_voxel_count",
-                                               "file_compression", "file_delayed_load", "is_saved_as_half_float"};
+                                               "file_compression", "file_delayed_load"};
+
+template <typename T>
+bool sameBits(const T& a, const T& b) {
+    if constexpr (std::is_same_v<T, bool>) return a == b;
+    else return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+template <typename T>
+std::string show(const T& v) {
+    std::ostringstream s;
+    s.precision(9);
+    s << v;
+    return s.str();
+}
+
+template <typename GridT>
+void compareValues(const GridT& a, const GridT& b, ValueDifference& d) {
+    using TreeT = typename GridT::TreeType;
+    const TreeT &ta = a.tree(), &tb = b.tree();
+    auto accA = a.getConstAccessor();
+    auto accB = b.getConstAccessor();
+    auto record = [&](const openvdb::Coord& c, const auto& va, const auto& vb, bool active) {
+        (active ? d.activeValues : d.inactiveValues)++;
+        if (d.examples.size() < 8)
+            d.examples.push_back(std::string(active ? "active" : "inactive") + " value at (" + std::to_string(c.x()) + "," + std::to_string(c.y()) + "," +
+                                 std::to_string(c.z()) + "): " + show(va) + " vs " + show(vb));
+    };
+    // Leaves of A against B (B's leaf, or the tile/background covering it).
+    for (auto leaf = ta.cbeginLeaf(); leaf; ++leaf) {
+        const auto* other = tb.probeConstLeaf(leaf->origin());
+        for (openvdb::Index n = 0; n < TreeT::LeafNodeType::SIZE; ++n) {
+            const openvdb::Coord c = leaf->offsetToGlobalCoord(n);
+            const auto va = leaf->getValue(n);
+            const auto vb = other ? other->getValue(n) : accB.getValue(c);
+            const bool active = leaf->isValueOn(n) || (other ? other->isValueOn(n) : accB.isValueOn(c));
+            if (!sameBits(va, vb)) record(c, va, vb, active);
+        }
+    }
+    // Leaves of B where A has none.
+    for (auto leaf = tb.cbeginLeaf(); leaf; ++leaf) {
+        if (ta.probeConstLeaf(leaf->origin())) continue;
+        for (openvdb::Index n = 0; n < TreeT::LeafNodeType::SIZE; ++n) {
+            const openvdb::Coord c = leaf->offsetToGlobalCoord(n);
+            const auto va = accA.getValue(c);
+            const auto vb = leaf->getValue(n);
+            if (!sameBits(va, vb)) record(c, va, vb, leaf->isValueOn(n) || accA.isValueOn(c));
+        }
+    }
+    // Tiles of each against the other, where the other has no leaf.
+    for (int pass = 0; pass < 2; ++pass) {
+        const TreeT& from = pass == 0 ? ta : tb;
+        auto& otherAcc = pass == 0 ? accB : accA;
+        typename TreeT::ValueAllCIter it = from.cbeginValueAll();
+        it.setMaxDepth(TreeT::ValueAllCIter::LEAF_DEPTH - 1);
+        for (; it; ++it) {
+            if (!it.isTileValue()) continue;
+            const openvdb::Coord c = it.getCoord();
+            if (otherAcc.probeConstLeaf(c)) continue;  // compared voxel by voxel above
+            const auto v = *it;
+            const auto w = otherAcc.getValue(c);
+            if (!sameBits(v, w)) record(c, pass == 0 ? v : w, pass == 0 ? w : v, it.isValueOn() || otherAcc.isValueOn(c));
+        }
+    }
+}
 
 openvdb::MaskTree::Ptr topologyTree(const openvdb::GridBase& grid) {
     openvdb::MaskTree::Ptr tree;
@@ -70,6 +137,26 @@ TopologyDifference compareTrees(size_t index, const std::string& name, const ope
     return d;
 }
 
+void compareGridValues(size_t index, const openvdb::GridBase& a, const openvdb::GridBase& b, CompareResult& result) {
+    if (a.type() != b.type()) {
+        result.headerDifferences.push_back("grid " + std::to_string(index) + " '" + a.getName() + "': type differs (" + a.type() + " vs " + b.type() + ")");
+        return;
+    }
+    ValueDifference d;
+    d.gridIndex = index;
+    d.gridName = a.getName();
+    detail::dispatchGridType(a, [&](const auto& typed, ValueType type) {
+        using GridT = std::decay_t<decltype(typed)>;
+        const auto& other = static_cast<const GridT&>(b);
+        if (type != ValueType::Mask) {
+            if (!sameBits(typed.background(), other.background()))
+                result.headerDifferences.push_back("grid " + std::to_string(index) + " '" + a.getName() + "': background differs");
+            compareValues(typed, other, d);
+        }
+    });
+    if (d.activeValues || d.inactiveValues) result.values.push_back(std::move(d));
+}
+
 CompareResult compareGridLists(const openvdb::GridPtrVec& a, const openvdb::GridPtrVec& b) {
     CompareResult result;
     if (a.size() != b.size())
@@ -84,8 +171,9 @@ CompareResult compareGridLists(const openvdb::GridPtrVec& a, const openvdb::Grid
         }
         TopologyDifference d = compareTrees(g, a[g]->getName(), *ta, *tb);
         if (d.onlyInA || d.onlyInB) result.topology.push_back(std::move(d));
+        compareGridValues(g, *a[g], *b[g], result);
     }
-    result.identical = result.headerDifferences.empty() && result.topology.empty();
+    result.identical = result.headerDifferences.empty() && result.topology.empty() && result.values.empty();
     return result;
 }
 
@@ -104,15 +192,15 @@ openvdb::GridPtrVec readAll(const std::string& path) {
 
 } // namespace
 
-CompareResult compareTopology(const std::string& originalPath, const Volume& decoded) {
+CompareResult compareWithFile(const std::string& originalPath, const Volume& decoded) {
     const openvdb::GridPtrVec original = readAll(originalPath);
     openvdb::GridPtrVec rebuilt;
     for (size_t g = 0; g < decoded.grids.size(); ++g)
-        rebuilt.push_back(detail::buildMaskGrid(decoded.grids[g], originalPath + " (decoded grid " + std::to_string(g) + ")"));
+        rebuilt.push_back(detail::buildGrid(decoded.grids[g], originalPath + " (decoded grid " + std::to_string(g) + ")"));
     return compareGridLists(original, rebuilt);
 }
 
-CompareResult compareTopologyFiles(const std::string& pathA, const std::string& pathB) {
+CompareResult compareFiles(const std::string& pathA, const std::string& pathB) {
     return compareGridLists(readAll(pathA), readAll(pathB));
 }
 

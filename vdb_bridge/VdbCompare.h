@@ -1,7 +1,8 @@
 // Independent comparison of two .vdb files (or a file and a Volume) with
-// OpenVDB's own tree operations: same grids in the same order, same name,
-// class, transform and metadata, same active voxels (tiles counted as their
-// voxels). Reports the first differences with coordinates.
+// OpenVDB's own tree operations and accessors: same grids in the same order,
+// same name, type, class, transform, background and metadata, same active
+// voxels (tiles counted as their voxels), every active value and every
+// stored inactive value bit-identical. Reports the first differences.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -19,17 +20,26 @@ struct TopologyDifference {
     std::vector<std::string> examples;  // e.g. "voxel (1,2,3) active only in A"
 };
 
+struct ValueDifference {
+    size_t gridIndex = 0;
+    std::string gridName;
+    uint64_t activeValues = 0;    // voxels active in either grid whose values differ bitwise
+    uint64_t inactiveValues = 0;  // inactive in both, stored value differs bitwise
+    std::vector<std::string> examples;
+};
+
 struct CompareResult {
     bool identical = true;
     std::vector<std::string> headerDifferences;  // name / class / transform / metadata / grid count
     std::vector<TopologyDifference> topology;    // one per grid that differs
+    std::vector<ValueDifference> values;         // one per grid whose values differ
 };
 
-// Compares the topology (and grid headers) of every grid of the original
-// .vdb file at `originalPath` with `decoded` (grids in the same order).
-CompareResult compareTopology(const std::string& originalPath, const Volume& decoded);
+// Compares every grid of the original .vdb file at `originalPath` with
+// `decoded` (grids in the same order).
+CompareResult compareWithFile(const std::string& originalPath, const Volume& decoded);
 
 // Same, between two .vdb files.
-CompareResult compareTopologyFiles(const std::string& pathA, const std::string& pathB);
+CompareResult compareFiles(const std::string& pathA, const std::string& pathB);
 
 } // namespace vdbdag::bridge

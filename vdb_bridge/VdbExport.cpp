@@ -1,9 +1,9 @@
-// Volume -> .vdb (one MaskGrid per grid until value channels exist),
-// written atomically.
+// Volume -> .vdb: every grid rebuilt with its original type, header, values
+// and stored inactive values; written atomically.
 #include "vdb_bridge/VdbExport.h"
 
 #include "src/util/AtomicFile.h"
-#include "vdb_bridge/detail/MaskGridBuilder.h"
+#include "vdb_bridge/detail/GridBuilder.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 
 namespace vdbdag::bridge {
@@ -12,7 +12,7 @@ void exportVdb(const Volume& volume, const std::string& path) {
     detail::initializeOpenVdb();
     openvdb::GridPtrVec grids;
     for (size_t g = 0; g < volume.grids.size(); ++g)
-        grids.push_back(detail::buildMaskGrid(volume.grids[g], path + ": grid " + std::to_string(g)));
+        grids.push_back(detail::buildGrid(volume.grids[g], path + ": grid " + std::to_string(g)));
     writeViaTemporary(path, [&](const std::string& temporary) {
         try {
             openvdb::io::File file(temporary);

@@ -1,7 +1,7 @@
-// Writing vdbdag's Volume back to a .vdb file. Until value channels exist,
-// each grid is written as a MaskGrid with the original name, class,
-// transform and metadata (restored from GridRecord::vdbDescriptor); active
-// tiles are written as tiles, never expanded.
+// Writing vdbdag's Volume back to a .vdb file: each grid with its original
+// type, name, class, transform, background and metadata (restored from
+// GridRecord::vdbDescriptor), its active values and its stored inactive
+// values; active tiles are written as tiles, never expanded.
 #pragma once
 #include <string>
 

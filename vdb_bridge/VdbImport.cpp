@@ -4,6 +4,8 @@
 #include "vdb_bridge/VdbImport.h"
 
 #include <algorithm>
+#include <cstring>
+#include <type_traits>
 #include <filesystem>
 #include <sstream>
 
@@ -18,59 +20,93 @@
 namespace vdbdag::bridge {
 namespace {
 
-// Splits every leaf's 8^3 value mask into its (non-empty) 4^3 bricks. Leaves
-// are visited in the tree's order, so the output order is deterministic.
-template <typename TreeT>
-void collectBricks(const TreeT& tree, std::vector<Brick>& bricks) {
+// Raw bytes of a value (bool as one byte), so values round-trip bit-exactly.
+template <typename T>
+void appendValue(std::vector<uint8_t>& out, const T& value) {
+    if constexpr (std::is_same_v<T, bool>) {
+        out.push_back(value ? 1 : 0);
+    } else {
+        const auto* p = reinterpret_cast<const uint8_t*>(&value);
+        out.insert(out.end(), p, p + sizeof(T));
+    }
+}
+
+template <typename T>
+bool sameBits(const T& a, const T& b) {
+    if constexpr (std::is_same_v<T, bool>) return a == b;
+    else return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+// Per leaf: its 4^3 bricks of active voxels and of inactive voxels whose
+// value is not (bitwise) the background, each with its values.
+struct LeafLayers {
+    std::vector<Brick> active, inactive;
+    std::vector<uint8_t> activeValues, inactiveValues;
+};
+
+template <typename GridT>
+void collectLayers(const GridT& grid, GridRecord& record) {
+    using TreeT = typename GridT::TreeType;
+    using ValueT = typename GridT::ValueType;
+    constexpr bool hasValues = !std::is_same_v<typename GridT::TreeType::LeafNodeType::BuildType, openvdb::ValueMask>;  // mask grids carry no values
+    const TreeT& tree = grid.tree();
+    const ValueT background = tree.background();
     std::vector<const typename TreeT::LeafNodeType*> leaves;
     leaves.reserve(tree.leafCount());
     for (auto it = tree.cbeginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
-    std::vector<std::array<Brick, 8>> perLeaf(leaves.size());
-    std::vector<uint8_t> count(leaves.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 256), [&](const auto& range) {
+    std::vector<LeafLayers> perLeaf(leaves.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 64), [&](const auto& range) {
         for (size_t i = range.begin(); i != range.end(); ++i) {
             const auto& leaf = *leaves[i];
             const openvdb::Coord origin = leaf.origin();
-            // OpenVDB leaf words: 8 x uint64, word w holds x = w, bits (y<<3 | z).
-            const auto& mask = leaf.getValueMask();
-            uint64_t words[8];
-            for (int w = 0; w < 8; ++w) words[w] = mask.template getWord<openvdb::Index64>(w);
-            uint64_t brick[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-            for (int x = 0; x < 8; ++x) {
-                const uint64_t word = words[x];
-                if (!word) continue;
-                for (int yz = 0; yz < 64; ++yz) {
-                    if (!((word >> yz) & 1u)) continue;
-                    const int y = yz >> 3, z = yz & 7;
-                    const int b = (x >> 2) | ((y >> 2) << 1) | ((z >> 2) << 2);
-                    brick[b] |= uint64_t(1) << brickBitIndex(x & 3, y & 3, z & 3);
+            LeafLayers& out = perLeaf[i];
+            for (int b = 0; b < 8; ++b) {
+                const int bx = (b & 1) * 4, by = ((b >> 1) & 1) * 4, bz = ((b >> 2) & 1) * 4;
+                uint64_t activeMask = 0, inactiveMask = 0;
+                for (int bit = 0; bit < 64; ++bit) {
+                    const int x = bx + (bit & 3), y = by + ((bit >> 2) & 3), z = bz + (bit >> 4);
+                    const openvdb::Index n = openvdb::Index((x << 6) | (y << 3) | z);
+                    if (leaf.isValueOn(n)) {
+                        activeMask |= uint64_t(1) << bit;
+                        if constexpr (hasValues) appendValue(out.activeValues, leaf.getValue(n));
+                    } else if constexpr (hasValues) {
+                        if (!sameBits(leaf.getValue(n), background)) {
+                            inactiveMask |= uint64_t(1) << bit;
+                            appendValue(out.inactiveValues, leaf.getValue(n));
+                        }
+                    }
                 }
+                const int32_t cx = origin.x() + bx, cy = origin.y() + by, cz = origin.z() + bz;
+                if (activeMask) out.active.push_back({cx, cy, cz, activeMask});
+                if (inactiveMask) out.inactive.push_back({cx, cy, cz, inactiveMask});
             }
-            uint8_t n = 0;
-            for (int b = 0; b < 8; ++b)
-                if (brick[b])
-                    perLeaf[i][n++] = Brick{origin.x() + ((b & 1) ? 4 : 0), origin.y() + ((b & 2) ? 4 : 0), origin.z() + ((b & 4) ? 4 : 0), brick[b]};
-            count[i] = n;
         }
     });
-    for (size_t i = 0; i < leaves.size(); ++i) bricks.insert(bricks.end(), perLeaf[i].begin(), perLeaf[i].begin() + count[i]);
-}
-
-template <typename GridT>
-GridTopology topologyOf(const GridT& grid) {
-    GridTopology topology;
-    const auto& tree = grid.tree();
-    collectBricks(tree, topology.bricks);
-    // Active tiles at every level above the leaves (voxels are not visited).
-    typename GridT::TreeType::ValueOnCIter it = tree.cbeginValueOn();
-    it.setMaxDepth(GridT::TreeType::ValueOnCIter::LEAF_DEPTH - 1);
+    for (const LeafLayers& l : perLeaf) {
+        record.topology.bricks.insert(record.topology.bricks.end(), l.active.begin(), l.active.end());
+        record.values.bricks.insert(record.values.bricks.end(), l.activeValues.begin(), l.activeValues.end());
+        record.inactiveTopology.bricks.insert(record.inactiveTopology.bricks.end(), l.inactive.begin(), l.inactive.end());
+        record.inactiveValues.bricks.insert(record.inactiveValues.bricks.end(), l.inactiveValues.begin(), l.inactiveValues.end());
+    }
+    // Tiles at every level above the leaves (voxels are not visited): active
+    // ones, and inactive ones whose value is not the background.
+    typename TreeT::ValueAllCIter it = tree.cbeginValueAll();
+    it.setMaxDepth(TreeT::ValueAllCIter::LEAF_DEPTH - 1);
     for (; it; ++it) {
         if (!it.isTileValue()) continue;
         const openvdb::CoordBBox box = it.getBoundingBox();
-        const int size = box.dim().x();
-        topology.tiles.push_back({box.min().x(), box.min().y(), box.min().z(), uint8_t(std::countr_zero(unsigned(size)))});
+        const Tile tile{box.min().x(), box.min().y(), box.min().z(), uint8_t(std::countr_zero(unsigned(box.dim().x())))};
+        if (it.isValueOn()) {
+            record.topology.tiles.push_back(tile);
+            if constexpr (hasValues) appendValue(record.values.tiles, *it);
+        } else if constexpr (hasValues) {
+            if (!sameBits(ValueT(*it), background)) {
+                record.inactiveTopology.tiles.push_back(tile);
+                appendValue(record.inactiveValues.tiles, *it);
+            }
+        }
     }
-    return topology;
+    if constexpr (hasValues) appendValue(record.background, background);
 }
 
 std::vector<uint8_t> descriptorOf(const openvdb::GridBase& grid) {
@@ -145,7 +181,7 @@ ImportResult importVdb(const std::string& path, const ImportOptions& options) {
         record.gridClass = openvdb::GridBase::gridClassToString(base->getGridClass());
         const bool supported = detail::dispatchGridType(*base, [&](const auto& grid, ValueType type) {
             record.valueType = type;
-            record.topology = topologyOf(grid);
+            collectLayers(grid, record);
         });
         if (!supported) {
             const std::string message = "grid " + std::to_string(index) + " '" + base->getName() + "' has type '" + base->type() + "'" +

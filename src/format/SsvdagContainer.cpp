@@ -106,6 +106,11 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::DagInner: return "DagInner";
         case SectionKind::DagLeaves: return "DagLeaves";
         case SectionKind::DagStats: return "DagStats";
+        case SectionKind::Values: return "Values";
+        case SectionKind::InactiveLevels: return "InactiveLevels";
+        case SectionKind::InactiveInner: return "InactiveInner";
+        case SectionKind::InactiveLeaves: return "InactiveLeaves";
+        case SectionKind::InactiveValues: return "InactiveValues";
     }
     return "unknown";
 }

@@ -23,6 +23,11 @@ enum class SectionKind : uint32_t {
     DagInner = 5,       // per grid: inner-node 16-bit words
     DagLeaves = 6,      // per grid: 64-bit 4^3 leaves
     DagStats = 7,       // per grid: per-level SVO / SVDAG / SSVDAG node counts
+    Values = 8,         // per grid: active values in attribute order (byte-shuffled at rest)
+    InactiveLevels = 9, // per grid: the DAG of inactive voxels/tiles whose value is not the background
+    InactiveInner = 10,
+    InactiveLeaves = 11,
+    InactiveValues = 12,
 };
 const char* sectionKindName(SectionKind kind);
 

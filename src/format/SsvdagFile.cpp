@@ -1,7 +1,8 @@
 // Mapping between SsvdagScene and container sections. Section payloads:
 //   FileInfo      u32 grid count, string writer
 //   GridInfo      string name, string class, u8 value type, u8 symmetry,
-//                 f64[16] index-to-world, u64 active voxels
+//                 f64[16] index-to-world, u64 active voxels,
+//                 string background (raw value bytes), u64 inactive voxels
 //   VdbDescriptor opaque bytes (vdb_bridge)
 //   DagLevels     i64[3] origin, u8 log2Size, u8 root reflection,
 //                 u32 n, u64[n] level starts, u8[n] attribute-offset words,
@@ -9,6 +10,10 @@
 //   DagInner      u16[inner words]     (absent for an empty grid)
 //   DagLeaves     u64[leaves]          (absent for an empty grid)
 //   DagStats      u32 n, u8 hasSvdag, then n x (u64 svo, u64 svdag, u64 stored)
+//   Values        the active values in attribute order, byte-shuffled: all
+//                 values' byte 0, then all byte 1, ... (restored on load;
+//                 zstd compresses the shuffled planes of floats far better)
+//   Inactive*     the same four for the inactive layer (absent if empty)
 // Strings are u32 length + bytes. Everything little-endian (ByteIO.h).
 #include "src/format/SsvdagFile.h"
 
@@ -37,6 +42,49 @@ std::vector<T> fromRawBytes(const std::vector<uint8_t>& bytes, uint64_t expected
     return values;
 }
 
+std::vector<uint8_t> shuffleBytes(const std::vector<uint8_t>& values, unsigned valueSize) {
+    if (valueSize <= 1) return values;
+    const size_t n = values.size() / valueSize;
+    std::vector<uint8_t> out(values.size());
+    for (size_t i = 0; i < n; ++i)
+        for (unsigned k = 0; k < valueSize; ++k) out[k * n + i] = values[i * valueSize + k];
+    return out;
+}
+
+std::vector<uint8_t> unshuffleBytes(const std::vector<uint8_t>& planes, unsigned valueSize) {
+    if (valueSize <= 1) return planes;
+    const size_t n = planes.size() / valueSize;
+    std::vector<uint8_t> out(planes.size());
+    for (size_t i = 0; i < n; ++i)
+        for (unsigned k = 0; k < valueSize; ++k) out[i * valueSize + k] = planes[k * n + i];
+    return out;
+}
+
+struct LayerKinds {
+    SectionKind levels, inner, leaves, values;
+};
+constexpr LayerKinds kActive{SectionKind::DagLevels, SectionKind::DagInner, SectionKind::DagLeaves, SectionKind::Values};
+constexpr LayerKinds kInactive{SectionKind::InactiveLevels, SectionKind::InactiveInner, SectionKind::InactiveLeaves, SectionKind::InactiveValues};
+
+void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, const encoding::CompactDag& dag,
+              const std::vector<uint8_t>& attributes, unsigned valueSize) {
+    ByteWriter levels;
+    for (int64_t o : dag.origin) levels.put<int64_t>(o);
+    levels.put<uint8_t>(dag.log2Size);
+    levels.put<uint8_t>(dag.rootReflection);
+    levels.put<uint32_t>(uint32_t(dag.levelStart.size()));
+    for (uint64_t s : dag.levelStart) levels.put<uint64_t>(s);
+    for (uint8_t w : dag.offsetWords) levels.put<uint8_t>(w);
+    levels.put<uint64_t>(dag.inner.size());
+    levels.put<uint64_t>(dag.leaves.size());
+    sections.push_back({kinds.levels, g, levels.take()});
+    if (!dag.empty()) {
+        sections.push_back({kinds.inner, g, rawBytes(dag.inner)});
+        if (!dag.leaves.empty()) sections.push_back({kinds.leaves, g, rawBytes(dag.leaves)});
+        if (valueSize) sections.push_back({kinds.values, g, shuffleBytes(attributes, valueSize)});
+    }
+}
+
 } // namespace
 
 std::vector<Section> sceneToSections(const SsvdagScene& scene) {
@@ -56,24 +104,14 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
         info.put<uint8_t>(grid.symmetry ? 1 : 0);
         for (double v : grid.record.indexToWorld) info.put<double>(v);
         info.put<uint64_t>(grid.activeVoxels);
+        info.putString(std::string(grid.record.background.begin(), grid.record.background.end()));
+        info.put<uint64_t>(grid.inactiveVoxels);
         sections.push_back({SectionKind::GridInfo, g, info.take()});
         sections.push_back({SectionKind::VdbDescriptor, g, grid.record.vdbDescriptor});
 
-        const encoding::CompactDag& dag = grid.dag;
-        ByteWriter levels;
-        for (int64_t o : dag.origin) levels.put<int64_t>(o);
-        levels.put<uint8_t>(dag.log2Size);
-        levels.put<uint8_t>(dag.rootReflection);
-        levels.put<uint32_t>(uint32_t(dag.levelStart.size()));
-        for (uint64_t s : dag.levelStart) levels.put<uint64_t>(s);
-        for (uint8_t w : dag.offsetWords) levels.put<uint8_t>(w);
-        levels.put<uint64_t>(dag.inner.size());
-        levels.put<uint64_t>(dag.leaves.size());
-        sections.push_back({SectionKind::DagLevels, g, levels.take()});
-        if (!dag.empty()) {
-            sections.push_back({SectionKind::DagInner, g, rawBytes(dag.inner)});
-            sections.push_back({SectionKind::DagLeaves, g, rawBytes(dag.leaves)});
-        }
+        const unsigned vs = valueSize(grid.record.valueType);
+        putLayer(sections, g, kActive, grid.dag, grid.attributes, vs);
+        if (!grid.inactiveDag.empty()) putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveAttributes, vs);
         ByteWriter stats;
         const DagStats& st = grid.stats;
         stats.put<uint32_t>(uint32_t(st.svoNodes.size()));
@@ -130,36 +168,52 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             grid.symmetry = r.get<uint8_t>() != 0;
             for (double& v : grid.record.indexToWorld) v = r.get<double>();
             grid.activeVoxels = r.get<uint64_t>();
+            const std::string background = r.getString(64);
+            grid.record.background.assign(background.begin(), background.end());
+            grid.inactiveVoxels = r.get<uint64_t>();
             r.expectEnd();
+            if (grid.record.background.size() != valueSize(grid.record.valueType)) r.fail("background value has the wrong size");
         }
         grid.record.vdbDescriptor = std::move(find(g, SectionKind::VdbDescriptor, true)->data);
-        encoding::CompactDag& dag = grid.dag;
-        uint64_t innerWords = 0, leafCount = 0;
-        {
-            ByteReader r(find(g, SectionKind::DagLevels, true)->data, what + " DagLevels");
-            for (int64_t& o : dag.origin) o = r.get<int64_t>();
-            dag.log2Size = r.get<uint8_t>();
-            dag.rootReflection = r.get<uint8_t>();
-            const uint32_t n = r.get<uint32_t>();
-            dag.levelStart = r.getArray<uint64_t>(n);
-            dag.offsetWords = r.getArray<uint8_t>(n);
-            innerWords = r.get<uint64_t>();
-            leafCount = r.get<uint64_t>();
-            r.expectEnd();
-        }
-        Section* inner = find(g, SectionKind::DagInner, dag.log2Size != 0);
-        Section* leaves = find(g, SectionKind::DagLeaves, dag.log2Size != 0);
-        if (inner) dag.inner = fromRawBytes<uint16_t>(inner->data, innerWords, what + " DagInner");
-        else if (innerWords) throw Error(what + ": DagLevels claims inner words but there is no DagInner section");
-        if (leaves) dag.leaves = fromRawBytes<uint64_t>(leaves->data, leafCount, what + " DagLeaves");
-        else if (leafCount) throw Error(what + ": DagLevels claims leaves but there is no DagLeaves section");
-        for (uint64_t s : dag.levelStart)
-            if (s > dag.inner.size()) throw Error(what + ": level start " + std::to_string(s) + " beyond the inner array");
-        encoding::validateCompact(dag, what);
-        const encoding::DecodedSize size = encoding::decodedSize(dag);
-        if (size.activeVoxels != grid.activeVoxels)
-            throw Error(what + ": the DAG holds " + std::to_string(size.activeVoxels) + " active voxels but the header says " +
-                        std::to_string(grid.activeVoxels) + "; the file is corrupted");
+        const unsigned vs = valueSize(grid.record.valueType);
+        auto readLayer = [&](const LayerKinds& kinds, encoding::CompactDag& dag, std::vector<uint8_t>& attributes, uint64_t expectedVoxels,
+                             const std::string& layer) {
+            uint64_t innerWords = 0, leafCount = 0;
+            {
+                ByteReader r(find(g, kinds.levels, true)->data, what + " " + layer + " levels");
+                for (int64_t& o : dag.origin) o = r.get<int64_t>();
+                dag.log2Size = r.get<uint8_t>();
+                dag.rootReflection = r.get<uint8_t>();
+                const uint32_t n = r.get<uint32_t>();
+                dag.levelStart = r.getArray<uint64_t>(n);
+                dag.offsetWords = r.getArray<uint8_t>(n);
+                innerWords = r.get<uint64_t>();
+                leafCount = r.get<uint64_t>();
+                r.expectEnd();
+            }
+            Section* inner = find(g, kinds.inner, dag.log2Size != 0);
+            Section* leaves = find(g, kinds.leaves, false);
+            if (inner) dag.inner = fromRawBytes<uint16_t>(inner->data, innerWords, what + " " + layer + " inner nodes");
+            else if (innerWords) throw Error(what + ": " + layer + " levels claim inner words but there is no inner section");
+            if (leaves) dag.leaves = fromRawBytes<uint64_t>(leaves->data, leafCount, what + " " + layer + " leaves");
+            else if (leafCount) throw Error(what + ": " + layer + " levels claim leaves but there is no leaf section");
+            for (uint64_t s : dag.levelStart)
+                if (s > dag.inner.size()) throw Error(what + ": " + layer + " level start " + std::to_string(s) + " beyond the inner array");
+            encoding::validateCompact(dag, what + " " + layer);
+            const encoding::DecodedSize size = encoding::decodedSize(dag);
+            if (size.activeVoxels != expectedVoxels)
+                throw Error(what + ": the " + layer + " DAG holds " + std::to_string(size.activeVoxels) + " voxels but the header says " +
+                            std::to_string(expectedVoxels) + "; the file is corrupted");
+            if (vs && !dag.empty()) {
+                const std::vector<uint8_t>& planes = find(g, kinds.values, true)->data;
+                if (planes.size() / vs != size.attributeEntries || planes.size() % vs != 0)
+                    throw Error(what + ": " + layer + " values hold " + std::to_string(planes.size()) + " bytes, expected " +
+                                std::to_string(size.attributeEntries * vs));
+                attributes = unshuffleBytes(planes, vs);
+            }
+        };
+        readLayer(kActive, grid.dag, grid.attributes, grid.activeVoxels, "active");
+        if (grid.inactiveVoxels || find(g, kInactive.levels, false)) readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveVoxels, "inactive");
         if (Section* st = find(g, SectionKind::DagStats, false)) {
             ByteReader r(st->data, what + " DagStats");
             const uint32_t n = r.get<uint32_t>();

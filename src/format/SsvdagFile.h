@@ -21,11 +21,16 @@ struct DagStats {
 };
 
 struct EncodedGrid {
-    GridRecord record;          // name, class, type, transform, descriptor; topology left empty
+    GridRecord record;          // name, class, type, transform, descriptor, background; no voxels
     uint64_t activeVoxels = 0;  // tiles counted as their voxels
     bool symmetry = true;       // SSVDAG (true) or plain SVDAG
     encoding::CompactDag dag;
+    std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
     DagStats stats;
+    // Inactive voxels/tiles whose value differs from the background.
+    uint64_t inactiveVoxels = 0;
+    encoding::CompactDag inactiveDag;
+    std::vector<uint8_t> inactiveAttributes;
 };
 
 struct SsvdagScene {

@@ -3,6 +3,7 @@
 #include "src/pipeline/GridCodec.h"
 
 #include "src/dag/DagBuilder.h"
+#include "src/pipeline/AttributeOrder.h"
 
 namespace vdbdag::pipeline {
 namespace {
@@ -51,46 +52,69 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const GridTopology& topo
 
 } // namespace
 
-format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) {
-    format::EncodedGrid out;
-    out.record = grid;
-    out.record.topology = {};
-    out.activeVoxels = grid.topology.activeVoxelCount();
-    out.symmetry = options.symmetry;
+namespace {
 
+// Builds and lays out one layer (active or inactive), trying the placements.
+encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptions& options, bool withOffsets, format::DagStats* stats) {
     dag::BuildOptions build;
     build.symmetry = options.symmetry;
-    if (grid.topology.empty()) return out;
     bool first = true;
     std::array<int64_t, 3> keptOrigin{0, 0, 0};
-    for (const auto& origin : placementCandidates(grid.topology, std::max(1, options.placementTrials))) {
+    encoding::CompactDag kept;
+    for (const auto& origin : placementCandidates(topology, std::max(1, options.placementTrials))) {
         build.origin = origin;
-        const dag::ReducedDag reduced = dag::buildDag(grid.topology, build);
-        encoding::CompactDag compact = encoding::encodeCompact(reduced);
-        if (first || compact.byteSize() < out.dag.byteSize()) {
-            out.dag = std::move(compact);
-            out.stats = statsOf(reduced);
+        const dag::ReducedDag reduced = dag::buildDag(topology, build);
+        encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets);
+        if (first || compact.byteSize() < kept.byteSize()) {
+            kept = std::move(compact);
+            if (stats) *stats = statsOf(reduced);
             keptOrigin = origin;
         }
         first = false;
     }
-    if (options.computeSvdagStats) {
+    if (stats && options.computeSvdagStats) {
         if (!options.symmetry) {
-            out.stats.svdagNodes = out.stats.storedNodes;
+            stats->svdagNodes = stats->storedNodes;
         } else {
             build.symmetry = false;
             build.origin = keptOrigin;  // same placement, so the per-level counts compare
-            const dag::ReducedDag plain = dag::buildDag(grid.topology, build);
-            for (unsigned s = 2; s <= plain.log2Size; ++s) out.stats.svdagNodes.push_back(plain.uniqueNodeCount(s));
+            const dag::ReducedDag plain = dag::buildDag(topology, build);
+            for (unsigned s = 2; s <= plain.log2Size; ++s) stats->svdagNodes.push_back(plain.uniqueNodeCount(s));
         }
-        out.stats.hasSvdag = true;
+        stats->hasSvdag = true;
+    }
+    return kept;
+}
+
+} // namespace
+
+format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) {
+    format::EncodedGrid out;
+    out.record = grid;
+    out.record.topology = {};
+    out.record.values = {};
+    out.record.inactiveTopology = {};
+    out.record.inactiveValues = {};
+    out.symmetry = options.symmetry;
+    const unsigned vs = valueSize(grid.valueType);
+    out.activeVoxels = grid.topology.activeVoxelCount();
+    if (!grid.topology.empty()) {
+        out.dag = encodeLayer(grid.topology, options, vs > 0, &out.stats);
+        out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
+    }
+    out.inactiveVoxels = grid.inactiveTopology.activeVoxelCount();
+    if (!grid.inactiveTopology.empty()) {
+        out.inactiveDag = encodeLayer(grid.inactiveTopology, options, vs > 0, nullptr);
+        out.inactiveAttributes = gatherAttributes(out.inactiveDag, grid.inactiveTopology, grid.inactiveValues, vs);
     }
     return out;
 }
 
 GridRecord decodeGrid(const format::EncodedGrid& grid) {
     GridRecord record = grid.record;
-    record.topology = encoding::decodeTopology(grid.dag);
+    const unsigned vs = valueSize(grid.record.valueType);
+    scatterAttributes(grid.dag, grid.attributes, vs, record.topology, record.values);
+    scatterAttributes(grid.inactiveDag, grid.inactiveAttributes, vs, record.inactiveTopology, record.inactiveValues);
     return record;
 }
 

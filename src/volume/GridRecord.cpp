@@ -18,4 +18,19 @@ const char* valueTypeName(ValueType type) {
     return "unknown";
 }
 
+unsigned valueSize(ValueType type) {
+    switch (type) {
+        case ValueType::Float: return 4;
+        case ValueType::Double: return 8;
+        case ValueType::Int32: return 4;
+        case ValueType::Int64: return 8;
+        case ValueType::Bool: return 1;
+        case ValueType::Mask: return 0;
+        case ValueType::Vec3S: return 12;
+        case ValueType::Vec3D: return 24;
+        case ValueType::Vec3I: return 12;
+    }
+    return 0;
+}
+
 } // namespace vdbdag

@@ -26,6 +26,17 @@ enum class ValueType : uint8_t {
     Vec3I = 8,   // "vec3i"
 };
 const char* valueTypeName(ValueType type);
+// Bytes per value (bool: 1 byte; mask: 0, no values).
+unsigned valueSize(ValueType type);
+
+// Values of one topology, in input order: for brick i (topology order) the
+// values of its set bits in increasing bit order, then one value per tile.
+// Values are kept as raw bytes so the round trip is bit-exact (NaN payloads,
+// -0.0, denormals).
+struct LayerValues {
+    std::vector<uint8_t> bricks;
+    std::vector<uint8_t> tiles;
+};
 
 struct GridRecord {
     std::string name;        // may be empty; names may repeat within a file
@@ -36,7 +47,13 @@ struct GridRecord {
     // linear or not, lives in vdbDescriptor.
     std::array<double, 16> indexToWorld{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     std::vector<uint8_t> vdbDescriptor;  // opaque, see above
-    GridTopology topology;
+    std::vector<uint8_t> background;     // raw background value (valueSize bytes)
+    GridTopology topology;               // active voxels and tiles
+    LayerValues values;                  // their values (empty for mask grids)
+    // Inactive voxels and tiles whose stored value differs (bitwise) from the
+    // background, e.g. a level set's inside; cost grows with what differs.
+    GridTopology inactiveTopology;
+    LayerValues inactiveValues;
 };
 
 // A whole .vdb file, in file order.

@@ -124,7 +124,7 @@ TEST(Cli, ComparisonUsedByVerifyFindsARemovedVoxelAndAnAddedTile) {
     withTile->tree().addTile(1, openvdb::Coord(800, 0, 0), 1.0f, true);
     openvdb::io::File(c.string()).write({withTile});
 
-    const auto removed = vdbdag::bridge::compareTopologyFiles(a.string(), b.string());
+    const auto removed = vdbdag::bridge::compareFiles(a.string(), b.string());
     EXPECT_FALSE(removed.identical);
     ASSERT_EQ(removed.topology.size(), 1u);
     EXPECT_EQ(removed.topology[0].onlyInA, 1u);
@@ -132,10 +132,10 @@ TEST(Cli, ComparisonUsedByVerifyFindsARemovedVoxelAndAnAddedTile) {
     ASSERT_FALSE(removed.topology[0].examples.empty());
     EXPECT_NE(removed.topology[0].examples[0].find("(100,2,3)"), std::string::npos) << removed.topology[0].examples[0];
 
-    const auto added = vdbdag::bridge::compareTopologyFiles(a.string(), c.string());
+    const auto added = vdbdag::bridge::compareFiles(a.string(), c.string());
     ASSERT_EQ(added.topology.size(), 1u);
     EXPECT_EQ(added.topology[0].onlyInB, 512u);
-    EXPECT_TRUE(vdbdag::bridge::compareTopologyFiles(a.string(), a.string()).identical);
+    EXPECT_TRUE(vdbdag::bridge::compareFiles(a.string(), a.string()).identical);
 }
 
 TEST(Cli, BadInputsGiveOneLineErrorsAndLeaveNoOutput) {

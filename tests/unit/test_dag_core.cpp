@@ -288,7 +288,13 @@ TEST(SsvdagFile, SceneRoundTripsThroughSections) {
     record.gridClass = "fog volume";
     record.valueType = ValueType::Float;
     record.vdbDescriptor = {1, 2, 3};
+    record.background = {0, 0, 0, 0};
     record.topology = topologyFromVoxels(voxels);
+    for (size_t i = 0; i < voxels.size(); ++i) {
+        const float v = float(i) * 0.5f - 7.0f;
+        const auto* p = reinterpret_cast<const uint8_t*>(&v);
+        record.values.bricks.insert(record.values.bricks.end(), p, p + 4);
+    }
     pipeline::EncodeOptions options;
     options.computeSvdagStats = true;
     format::SsvdagScene scene;
@@ -302,7 +308,9 @@ TEST(SsvdagFile, SceneRoundTripsThroughSections) {
     EXPECT_EQ(back.grids[0].record.vdbDescriptor, record.vdbDescriptor);
     EXPECT_EQ(back.grids[0].activeVoxels, voxels.size());
     EXPECT_TRUE(back.grids[0].stats.hasSvdag);
-    EXPECT_EQ(voxelsOf(pipeline::decodeGrid(back.grids[0]).topology), voxels);
+    const GridRecord decoded = pipeline::decodeGrid(back.grids[0]);
+    EXPECT_EQ(voxelsOf(decoded.topology), voxels);
+    EXPECT_EQ(decoded.values.bricks.size(), record.values.bricks.size());
     EXPECT_TRUE(back.grids[1].dag.empty());
     EXPECT_EQ(back.grids[1].record.name, "");
 }

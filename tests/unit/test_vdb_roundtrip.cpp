@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <cstring>
 #include <random>
 
 #include <openvdb/openvdb.h>
@@ -15,6 +16,7 @@
 #include "src/pipeline/GridCodec.h"
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
+#include "vdb_bridge/VdbCompare.h"
 #include "vdb_bridge/VdbExport.h"
 #include "vdb_bridge/VdbImport.h"
 
@@ -58,7 +60,38 @@ openvdb::MaskTree maskOfAny(const openvdb::GridBase& g) {
     return {};
 }
 
-// The independent check: same grids, same headers, same active voxels.
+template <typename T>
+bool sameBits(const T& a, const T& b) {
+    if constexpr (std::is_same_v<T, bool>) return a == b;
+    else return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+// Every active value (voxels and tiles) and every value stored in A's leaves
+// and tiles, compared bit for bit with B through B's accessor.
+template <typename GridT>
+uint64_t valueMismatches(const GridT& a, const GridT& b) {
+    uint64_t mismatches = 0;
+    auto accB = b.getConstAccessor();
+    for (auto it = a.cbeginValueAll(); it; ++it) {
+        const bool isBackgroundTile = it.isTileValue() && !it.isValueOn() && sameBits(typename GridT::ValueType(*it), a.background());
+        if (isBackgroundTile) continue;
+        if (!sameBits(typename GridT::ValueType(*it), typename GridT::ValueType(accB.getValue(it.getCoord())))) ++mismatches;
+    }
+    return mismatches;
+}
+
+uint64_t valueMismatchesAny(const openvdb::GridBase& a, const openvdb::GridBase& b) {
+    if (a.type() != b.type()) return ~uint64_t(0);
+#define VDBDAG_CASE(G) \
+    if (auto p = dynamic_cast<const G*>(&a)) return valueMismatches(*p, static_cast<const G&>(b)) + valueMismatches(static_cast<const G&>(b), *p);
+    VDBDAG_CASE(openvdb::FloatGrid) VDBDAG_CASE(openvdb::DoubleGrid) VDBDAG_CASE(openvdb::Int32Grid) VDBDAG_CASE(openvdb::Int64Grid)
+    VDBDAG_CASE(openvdb::BoolGrid) VDBDAG_CASE(openvdb::Vec3SGrid) VDBDAG_CASE(openvdb::Vec3DGrid) VDBDAG_CASE(openvdb::Vec3IGrid)
+#undef VDBDAG_CASE
+    return 0;  // mask grids: no values
+}
+
+// The independent check: same grids, same headers, same active voxels,
+// bit-identical active and stored inactive values.
 void expectSameTopology(const fs::path& original, const fs::path& decoded) {
     const auto a = readGrids(original), b = readGrids(decoded);
     ASSERT_EQ(a.size(), b.size()) << original;
@@ -76,6 +109,9 @@ void expectSameTopology(const fs::path& original, const fs::path& decoded) {
         EXPECT_EQ(onlyB.activeVoxelCount(), 0u);
         EXPECT_EQ(ma.activeVoxelCount(), mb.activeVoxelCount());
         EXPECT_EQ(a[g]->activeVoxelCount(), b[g]->activeVoxelCount());
+        EXPECT_EQ(a[g]->type(), b[g]->type());
+        EXPECT_EQ(a[g]->saveFloatAsHalf(), b[g]->saveFloatAsHalf());
+        EXPECT_EQ(valueMismatchesAny(*a[g], *b[g]), 0u) << "values differ";
     }
 }
 
@@ -190,7 +226,8 @@ TEST(VdbRoundTrip, RandomGridsWithTilesAtEveryLevelAndInt32Extremes) {
         // Tiles stayed tiles: the decoded grid has no more leaves than the input.
         openvdb::io::File back(out.string());
         back.open();
-        const auto decoded = openvdb::gridPtrCast<openvdb::MaskGrid>(back.readGrid(g->getName()));
+        const auto decoded = openvdb::gridPtrCast<openvdb::FloatGrid>(back.readGrid(g->getName()));
+        ASSERT_TRUE(decoded) << "the decoded grid must keep its type";
         back.close();
         EXPECT_LE(decoded->tree().leafCount(), g->tree().leafCount());
         EXPECT_GE(decoded->tree().activeTileCount(), g->tree().activeTileCount());
@@ -232,4 +269,60 @@ TEST(VdbRoundTrip, OutputIsByteIdenticalWhateverTheThreadCount) {
     }
     many = format::writeScene(pipeline::encodeVolume(bridge::importVdb(f.string()).volume));
     EXPECT_EQ(one, many);
+}
+
+TEST(VdbRoundTrip, SpecialFloatValuesSurviveBitForBit) {
+    openvdb::initialize();
+    auto g = openvdb::FloatGrid::create(0.0f);
+    g->setName("special");
+    g->setGridClass(openvdb::GRID_FOG_VOLUME);
+    auto acc = g->getAccessor();
+    auto fromBits = [](uint32_t bits) { float f; std::memcpy(&f, &bits, 4); return f; };
+    const float specials[] = {fromBits(0x7FC00001u),  // quiet NaN with payload
+                              fromBits(0x7F800123u),  // signalling NaN with payload
+                              fromBits(0xFFC00000u),  // negative NaN
+                              -0.0f, fromBits(0x00000001u), fromBits(0x807FFFFFu),  // -0, smallest and largest denormals
+                              std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                              std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest(), 1.0f, std::nextafter(1.0f, 2.0f)};
+    int i = 0;
+    for (float v : specials) acc.setValueOn(openvdb::Coord(i++ * 3, -7, 100), v);
+    acc.setValueOff(openvdb::Coord(1, -7, 100), -0.0f);                   // inactive -0.0 next to background +0.0
+    acc.setValueOff(openvdb::Coord(2, -7, 100), fromBits(0x7FC0BEEFu));  // inactive NaN payload
+    g->tree().addTile(1, openvdb::Coord(64, 64, 64), fromBits(0x7FC00042u), true);   // active NaN tile
+    g->tree().addTile(1, openvdb::Coord(128, 64, 64), -0.0f, false);                 // inactive -0.0 tile
+    auto d = openvdb::DoubleGrid::create(-0.0);
+    d->setName("double");
+    d->tree().setValueOn(openvdb::Coord(0), std::numeric_limits<double>::denorm_min());
+    d->tree().setValueOn(openvdb::Coord(5), -std::numeric_limits<double>::infinity());
+    auto v = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f, -0.0f, 1.0f));
+    v->setName("vec");
+    v->tree().setValueOn(openvdb::Coord(-3), openvdb::Vec3s(fromBits(0x7FC00007u), -0.0f, 1e-45f));
+    const fs::path in = tempDir() / "special.vdb";
+    openvdb::io::File(in.string()).write({g, d, v});
+    expectSameTopology(in, roundTrip(in));
+}
+
+TEST(VdbRoundTrip, ComparisonDetectsAChangedActiveAndInactiveValue) {
+    openvdb::initialize();
+    auto g = openvdb::FloatGrid::create(3.0f);
+    g->setName("g");
+    g->tree().setValueOn(openvdb::Coord(1, 2, 3), 1.0f);
+    g->tree().setValueOff(openvdb::Coord(2, 2, 3), -3.0f);
+    const fs::path a = tempDir() / "cmp_a.vdb", b = tempDir() / "cmp_b.vdb", c = tempDir() / "cmp_c.vdb";
+    openvdb::io::File(a.string()).write({g});
+    auto changed = g->deepCopy();
+    changed->tree().setValueOn(openvdb::Coord(1, 2, 3), std::nextafter(1.0f, 2.0f));
+    openvdb::io::File(b.string()).write({changed});
+    auto inactive = g->deepCopy();
+    inactive->tree().setValueOff(openvdb::Coord(2, 2, 3), 3.0f);  // now the background: a level set's sign lost
+    openvdb::io::File(c.string()).write({inactive});
+    const auto r1 = bridge::compareFiles(a.string(), b.string());
+    EXPECT_FALSE(r1.identical);
+    ASSERT_EQ(r1.values.size(), 1u);
+    EXPECT_EQ(r1.values[0].activeValues, 1u);
+    const auto r2 = bridge::compareFiles(a.string(), c.string());
+    ASSERT_EQ(r2.values.size(), 1u);
+    EXPECT_EQ(r2.values[0].inactiveValues, 1u);
+    EXPECT_TRUE(bridge::compareFiles(a.string(), a.string()).identical);
+    EXPECT_GT(valueMismatchesAny(*readGrids(a)[0], *readGrids(b)[0]), 0u);
 }

@@ -46,6 +46,21 @@ bool dispatchGridType(const openvdb::GridBase& base, Fn&& fn) {
     return false;
 }
 
+// The same dispatch over mutable grids: fn(grid).
+template <typename Fn>
+bool dispatchMutableGridType(openvdb::GridBase& base, Fn&& fn) {
+    if (auto* g = dynamic_cast<openvdb::FloatGrid*>(&base)) { fn(*g); return true; }
+    if (auto* g = dynamic_cast<openvdb::DoubleGrid*>(&base)) { fn(*g); return true; }
+    if (auto* g = dynamic_cast<openvdb::Int32Grid*>(&base)) { fn(*g); return true; }
+    if (auto* g = dynamic_cast<openvdb::Int64Grid*>(&base)) { fn(*g); return true; }
+    if (auto* g = dynamic_cast<openvdb::BoolGrid*>(&base)) { fn(*g); return true; }
+    if (auto* g = dynamic_cast<openvdb::MaskGrid*>(&base)) { fn(*g); return true; }
+    if (auto* g = dynamic_cast<openvdb::Vec3SGrid*>(&base)) { fn(*g); return true; }
+    if (auto* g = dynamic_cast<openvdb::Vec3DGrid*>(&base)) { fn(*g); return true; }
+    if (auto* g = dynamic_cast<openvdb::Vec3IGrid*>(&base)) { fn(*g); return true; }
+    return false;
+}
+
 inline std::string typeHint(const openvdb::GridBase& base) {
     if (base.isType<openvdb::points::PointDataGrid>()) return " (a PointDataGrid)";
     return "";

@@ -1,0 +1,24 @@
+// Moving values between input order (per brick, increasing spatial bit) and
+// attribute order (the DAG's depth-first order as stored, DESIGN.md
+// invariant 2): gather when encoding, scatter when decoding. Both walk the
+// compact DAG with visitInAttributeOrder, so the order the tracers use and
+// the order the file stores are the same by construction.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "src/encoding/CompactDag.h"
+#include "src/volume/GridRecord.h"
+
+namespace vdbdag::pipeline {
+
+// Values of `topology` (input order) -> attribute order of `dag`, which must
+// encode exactly that topology.
+std::vector<uint8_t> gatherAttributes(const encoding::CompactDag& dag, const GridTopology& topology, const LayerValues& values,
+                                      unsigned valueSize);
+
+// Attribute-order values -> the decoded topology and its values in input order.
+void scatterAttributes(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, unsigned valueSize,
+                       GridTopology& topology, LayerValues& values);
+
+} // namespace vdbdag::pipeline
