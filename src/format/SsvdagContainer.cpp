@@ -121,8 +121,16 @@ std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const 
     for (size_t i = 0; i < sections.size(); ++i) {
         const auto& data = sections[i].data;
         if (options.compress && data.size() > 64) {
+            // Large sections (value channels) use a faster level on two
+            // threads: level 9 on 100 MB would dominate the encode time.
             std::vector<uint8_t> packed(ZSTD_compressBound(data.size()));
-            const size_t n = ZSTD_compress(packed.data(), packed.size(), data.data(), data.size(), options.zstdLevel);
+            ZSTD_CCtx* cctx = ZSTD_createCCtx();
+            const bool large = data.size() > (size_t(4) << 20);
+            ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, large ? std::min(options.zstdLevel, 3) : options.zstdLevel);
+            ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
+            if (large) ZSTD_CCtx_setParameter(cctx, ZSTD_c_nbWorkers, 2);  // ignored if libzstd lacks threads
+            const size_t n = ZSTD_compress2(cctx, packed.data(), packed.size(), data.data(), data.size());
+            ZSTD_freeCCtx(cctx);
             if (ZSTD_isError(n)) throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(n));
             if (n < data.size()) {
                 packed.resize(n);

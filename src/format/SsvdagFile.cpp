@@ -10,9 +10,8 @@
 //   DagInner      u16[inner words]     (absent for an empty grid)
 //   DagLeaves     u64[leaves]          (absent for an empty grid)
 //   DagStats      u32 n, u8 hasSvdag, then n x (u64 svo, u64 svdag, u64 stored)
-//   Values        the active values in attribute order, byte-shuffled: all
-//                 values' byte 0, then all byte 1, ... (restored on load;
-//                 zstd compresses the shuffled planes of floats far better)
+//   Values        the active values in attribute order as a palette channel
+//                 (serializePalette in src/attributes/PaletteChannel.cpp)
 //   Inactive*     the same four for the inactive layer (absent if empty)
 // Strings are u32 length + bytes. Everything little-endian (ByteIO.h).
 #include "src/format/SsvdagFile.h"
@@ -42,24 +41,6 @@ std::vector<T> fromRawBytes(const std::vector<uint8_t>& bytes, uint64_t expected
     return values;
 }
 
-std::vector<uint8_t> shuffleBytes(const std::vector<uint8_t>& values, unsigned valueSize) {
-    if (valueSize <= 1) return values;
-    const size_t n = values.size() / valueSize;
-    std::vector<uint8_t> out(values.size());
-    for (size_t i = 0; i < n; ++i)
-        for (unsigned k = 0; k < valueSize; ++k) out[k * n + i] = values[i * valueSize + k];
-    return out;
-}
-
-std::vector<uint8_t> unshuffleBytes(const std::vector<uint8_t>& planes, unsigned valueSize) {
-    if (valueSize <= 1) return planes;
-    const size_t n = planes.size() / valueSize;
-    std::vector<uint8_t> out(planes.size());
-    for (size_t i = 0; i < n; ++i)
-        for (unsigned k = 0; k < valueSize; ++k) out[i * valueSize + k] = planes[k * n + i];
-    return out;
-}
-
 struct LayerKinds {
     SectionKind levels, inner, leaves, values;
 };
@@ -67,7 +48,7 @@ constexpr LayerKinds kActive{SectionKind::DagLevels, SectionKind::DagInner, Sect
 constexpr LayerKinds kInactive{SectionKind::InactiveLevels, SectionKind::InactiveInner, SectionKind::InactiveLeaves, SectionKind::InactiveValues};
 
 void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, const encoding::CompactDag& dag,
-              const std::vector<uint8_t>& attributes, unsigned valueSize) {
+              const attributes::PaletteChannel& channel, unsigned valueSize) {
     ByteWriter levels;
     for (int64_t o : dag.origin) levels.put<int64_t>(o);
     levels.put<uint8_t>(dag.log2Size);
@@ -81,7 +62,7 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
     if (!dag.empty()) {
         sections.push_back({kinds.inner, g, rawBytes(dag.inner)});
         if (!dag.leaves.empty()) sections.push_back({kinds.leaves, g, rawBytes(dag.leaves)});
-        if (valueSize) sections.push_back({kinds.values, g, shuffleBytes(attributes, valueSize)});
+        if (valueSize) sections.push_back({kinds.values, g, attributes::serializePalette(channel)});
     }
 }
 
@@ -110,8 +91,8 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
         sections.push_back({SectionKind::VdbDescriptor, g, grid.record.vdbDescriptor});
 
         const unsigned vs = valueSize(grid.record.valueType);
-        putLayer(sections, g, kActive, grid.dag, grid.attributes, vs);
-        if (!grid.inactiveDag.empty()) putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveAttributes, vs);
+        putLayer(sections, g, kActive, grid.dag, grid.values, vs);
+        if (!grid.inactiveDag.empty()) putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveValues, vs);
         ByteWriter stats;
         const DagStats& st = grid.stats;
         stats.put<uint32_t>(uint32_t(st.svoNodes.size()));
@@ -176,8 +157,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         }
         grid.record.vdbDescriptor = std::move(find(g, SectionKind::VdbDescriptor, true)->data);
         const unsigned vs = valueSize(grid.record.valueType);
-        auto readLayer = [&](const LayerKinds& kinds, encoding::CompactDag& dag, std::vector<uint8_t>& attributes, uint64_t expectedVoxels,
-                             const std::string& layer) {
+        auto readLayer = [&](const LayerKinds& kinds, encoding::CompactDag& dag, std::vector<uint8_t>& attributes,
+                             attributes::PaletteChannel& channel, uint64_t expectedVoxels, const std::string& layer) {
             uint64_t innerWords = 0, leafCount = 0;
             {
                 ByteReader r(find(g, kinds.levels, true)->data, what + " " + layer + " levels");
@@ -205,15 +186,16 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 throw Error(what + ": the " + layer + " DAG holds " + std::to_string(size.activeVoxels) + " voxels but the header says " +
                             std::to_string(expectedVoxels) + "; the file is corrupted");
             if (vs && !dag.empty()) {
-                const std::vector<uint8_t>& planes = find(g, kinds.values, true)->data;
-                if (planes.size() / vs != size.attributeEntries || planes.size() % vs != 0)
-                    throw Error(what + ": " + layer + " values hold " + std::to_string(planes.size()) + " bytes, expected " +
-                                std::to_string(size.attributeEntries * vs));
-                attributes = unshuffleBytes(planes, vs);
+                channel = attributes::deserializePalette(find(g, kinds.values, true)->data, what + " " + layer + " values");
+                if (channel.valueSize != vs || channel.entryCount != size.attributeEntries)
+                    throw Error(what + ": " + layer + " values hold " + std::to_string(channel.entryCount) + " entries of " +
+                                std::to_string(channel.valueSize) + " bytes, expected " + std::to_string(size.attributeEntries) + " of " + std::to_string(vs));
+                attributes = channel.decodeAll();
             }
         };
-        readLayer(kActive, grid.dag, grid.attributes, grid.activeVoxels, "active");
-        if (grid.inactiveVoxels || find(g, kInactive.levels, false)) readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveVoxels, "inactive");
+        readLayer(kActive, grid.dag, grid.attributes, grid.values, grid.activeVoxels, "active");
+        if (grid.inactiveVoxels || find(g, kInactive.levels, false))
+            readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveValues, grid.inactiveVoxels, "inactive");
         if (Section* st = find(g, SectionKind::DagStats, false)) {
             ByteReader r(st->data, what + " DagStats");
             const uint32_t n = r.get<uint32_t>();

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "src/attributes/PaletteChannel.h"
 #include "src/encoding/CompactDag.h"
 #include "src/format/SsvdagContainer.h"
 #include "src/volume/GridRecord.h"
@@ -26,11 +27,13 @@ struct EncodedGrid {
     bool symmetry = true;       // SSVDAG (true) or plain SVDAG
     encoding::CompactDag dag;
     std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
+    attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout
     DagStats stats;
     // Inactive voxels/tiles whose value differs from the background.
     uint64_t inactiveVoxels = 0;
     encoding::CompactDag inactiveDag;
     std::vector<uint8_t> inactiveAttributes;
+    attributes::PaletteChannel inactiveValues;
 };
 
 struct SsvdagScene {

@@ -101,11 +101,13 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
     if (!grid.topology.empty()) {
         out.dag = encodeLayer(grid.topology, options, vs > 0, &out.stats);
         out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
+        out.values = attributes::compressPalette(out.attributes, vs);
     }
     out.inactiveVoxels = grid.inactiveTopology.activeVoxelCount();
     if (!grid.inactiveTopology.empty()) {
         out.inactiveDag = encodeLayer(grid.inactiveTopology, options, vs > 0, nullptr);
         out.inactiveAttributes = gatherAttributes(out.inactiveDag, grid.inactiveTopology, grid.inactiveValues, vs);
+        out.inactiveValues = attributes::compressPalette(out.inactiveAttributes, vs);
     }
     return out;
 }

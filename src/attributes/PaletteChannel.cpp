@@ -1,0 +1,522 @@
+// Palette compression of an attribute array (Dado et al. §4.2, Alg. 1),
+// in O(n log n):
+//  0. every entry gets the dense id of its distinct value (hash map, with a
+//     shortcut for runs of equal values);
+//  1. phase one, for ω = 0..3: the largest blocks with at most 2^ω distinct
+//     values. Instead of the paper's literal "largest block" scan, which is
+//     quadratic, a sliding window gives every maximal window in O(n); the
+//     windows go into a max-heap by length and are accepted largest first,
+//     clipped lazily to the still-free gap they start in (a clipped window is
+//     pushed back with its new length). A block is accepted when it pays:
+//     len * ω + palette + directory < len * (ω + 1) (the paper's line 6), and
+//     it beats direct storage;
+//  2. phase two: the rest is cut left to right; from each start, the longest
+//     block for each ω = 0..8 and a direct block are costed per entry and the
+//     cheapest is taken.
+// Costs include each value's share of the material array (its bits divided
+// by its number of occurrences), so unique floats fall back to direct
+// storage and a channel never grows by more than its directory.
+#include "src/attributes/PaletteChannel.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <map>
+#include <queue>
+#include <set>
+#include <cstdlib>
+#include <sys/mman.h>
+
+#include <xxhash.h>
+
+#include "src/format/ByteIO.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::attributes {
+namespace {
+
+constexpr double kDirectoryBits = 8 * 21;  // firstEntry, dataOffset, paletteOffset, ω
+constexpr uint64_t kMaxBlockEntries = 1u << 14;
+
+struct Segment {
+    uint64_t start, length;
+    uint8_t omega;  // PaletteBlock::kDirect for direct storage
+};
+
+// Bitwise equality and hash of one value, specialised for the common sizes
+// (a libc memcmp call per 4-byte value costs more than the comparison).
+inline bool sameValue(const uint8_t* a, const uint8_t* b, uint32_t vs) {
+    switch (vs) {
+        case 4: { uint32_t x, y; std::memcpy(&x, a, 4); std::memcpy(&y, b, 4); return x == y; }
+        case 8: { uint64_t x, y; std::memcpy(&x, a, 8); std::memcpy(&y, b, 8); return x == y; }
+        case 12: { uint64_t x, y; uint32_t z, w; std::memcpy(&x, a, 8); std::memcpy(&y, b, 8); std::memcpy(&z, a + 8, 4); std::memcpy(&w, b + 8, 4); return x == y && z == w; }
+        default: return std::memcmp(a, b, vs) == 0;
+    }
+}
+inline uint64_t hashValue(const uint8_t* v, uint32_t vs) {
+    if (vs == 4 || vs == 8) {
+        uint64_t x = 0;
+        std::memcpy(&x, v, vs);
+        x ^= x >> 31; x *= 0x7fb5d329728ea185ull; x ^= x >> 27; x *= 0x81dadef4bc2dd44dull; x ^= x >> 33;
+        return x;
+    }
+    return XXH3_64bits(v, vs);
+}
+
+// A zero-initialised array for random access over hundreds of MB: backed by
+// transparent huge pages where the kernel allows (madvise mode), which
+// removes most TLB misses of the hash table below.
+template <typename T>
+class RandomAccessArray {
+public:
+    explicit RandomAccessArray(size_t count) : count_(count) {
+        bytes_ = (count * sizeof(T) + kHuge - 1) / kHuge * kHuge;
+        data_ = static_cast<T*>(std::aligned_alloc(kHuge, bytes_));
+        if (!data_) throw std::bad_alloc();
+        madvise(data_, bytes_, MADV_HUGEPAGE);
+        std::memset(static_cast<void*>(data_), 0, bytes_);
+    }
+    ~RandomAccessArray() { std::free(data_); }
+    RandomAccessArray(const RandomAccessArray&) = delete;
+    RandomAccessArray& operator=(const RandomAccessArray&) = delete;
+    RandomAccessArray(RandomAccessArray&& o) noexcept : data_(o.data_), count_(o.count_), bytes_(o.bytes_) { o.data_ = nullptr; }
+    RandomAccessArray& operator=(RandomAccessArray&& o) noexcept {
+        std::swap(data_, o.data_);
+        std::swap(count_, o.count_);
+        std::swap(bytes_, o.bytes_);
+        return *this;
+    }
+    T& operator[](size_t i) { return data_[i]; }
+    const T& operator[](size_t i) const { return data_[i]; }
+    size_t size() const { return count_; }
+
+private:
+    static constexpr size_t kHuge = size_t(2) << 20;
+    T* data_ = nullptr;
+    size_t count_ = 0, bytes_ = 0;
+};
+
+// Dense ids of the distinct values, in order of first occurrence. The
+// table keeps each slot's 32-bit hash next to its id, so a probe touches
+// the value array only on a hash match, and growth never rereads values.
+std::vector<uint32_t> distinctIds(std::span<const uint8_t> values, uint32_t vs, uint64_t n, std::vector<uint64_t>& firstOccurrence) {
+    struct Slot {
+        uint32_t id1;   // id + 1, 0 = empty
+        uint32_t hash;  // low 32 bits of the value's hash (also its bucket)
+    };
+    std::vector<uint32_t> ids(n);
+    RandomAccessArray<Slot> slots(size_t(1) << 16);
+    size_t mask = slots.size() - 1;
+    auto grow = [&]() {
+        RandomAccessArray<Slot> bigger(slots.size() * 2);
+        const size_t m = bigger.size() - 1;
+        for (size_t k = 0; k < slots.size(); ++k) {
+            const Slot s = slots[k];
+            if (!s.id1) continue;
+            size_t h = s.hash & m;
+            while (bigger[h].id1) h = (h + 1) & m;
+            bigger[h] = s;
+        }
+        slots = std::move(bigger);
+        mask = m;
+    };
+    for (uint64_t i = 0; i < n; ++i) {
+        const uint8_t* v = values.data() + i * vs;
+        if (i > 0 && sameValue(v, v - vs, vs)) { ids[i] = ids[i - 1]; continue; }
+        const uint32_t hash = uint32_t(hashValue(v, vs));
+        for (size_t h = hash & mask;; h = (h + 1) & mask) {
+            const Slot slot = slots[h];
+            if (slot.id1 == 0) {
+                if (firstOccurrence.size() >= 0xFFFFFFF0u) throw Error("more than 2^32 distinct values in one channel");
+                firstOccurrence.push_back(i);
+                slots[h] = Slot{uint32_t(firstOccurrence.size()), hash};
+                ids[i] = uint32_t(firstOccurrence.size() - 1);
+                if (firstOccurrence.size() * 2 > slots.size()) {
+                    if (slots.size() >= (size_t(1) << 32)) throw Error("too many distinct values in one channel");
+                    grow();
+                }
+                break;
+            }
+            if (slot.hash == hash && sameValue(values.data() + firstOccurrence[slot.id1 - 1] * vs, v, vs)) { ids[i] = slot.id1 - 1; break; }
+        }
+    }
+    return ids;
+}
+
+class Partitioner {
+public:
+    Partitioner(const std::vector<uint32_t>& ids, uint64_t distinct, uint32_t vs)
+        : ids_(ids), n_(ids.size()), vs_(vs), materialBits_(std::max(1, int(std::bit_width(distinct > 1 ? distinct - 1 : 1)))),
+          stamp_(distinct, 0), count_(distinct, 0), share_(distinct, 0.0) {
+        std::vector<uint64_t> freq(distinct, 0);
+        for (uint32_t id : ids) ++freq[id];
+        for (size_t d = 0; d < distinct; ++d) share_[d] = 8.0 * vs / double(freq[d]);
+    }
+
+    std::vector<Segment> run() {
+        for (uint8_t omega = 0; omega < 4; ++omega) phaseOne(omega);
+        // Phase two on every gap left, left to right.
+        std::vector<Segment> segments(accepted_.begin(), accepted_.end());
+        std::sort(segments.begin(), segments.end(), [](const Segment& a, const Segment& b) { return a.start < b.start; });
+        std::vector<Segment> all;
+        uint64_t at = 0;
+        for (const Segment& s : segments) {
+            phaseTwo(at, s.start, all);
+            all.push_back(s);
+            at = s.start + s.length;
+        }
+        phaseTwo(at, n_, all);
+        // Merge neighbouring direct blocks (one directory entry instead of many).
+        std::vector<Segment> merged;
+        for (const Segment& s : all) {
+            if (!merged.empty() && s.omega == PaletteBlock::kDirect && merged.back().omega == PaletteBlock::kDirect &&
+                merged.back().length + s.length <= (uint64_t(1) << 30))
+                merged.back().length += s.length;
+            else
+                merged.push_back(s);
+        }
+        return merged;
+    }
+
+private:
+    struct SegmentLess {
+        bool operator()(const Segment& a, const Segment& b) const { return a.start < b.start; }
+    };
+
+    // End of the free gap containing `start` (or start itself if covered).
+    std::pair<bool, uint64_t> freeGapEnd(uint64_t start) const {
+        auto next = accepted_.lower_bound(Segment{start + 1, 0, 0});
+        if (next != accepted_.begin()) {
+            auto prev = std::prev(next);
+            if (prev->start + prev->length > start) return {false, start};
+        }
+        return {true, next == accepted_.end() ? n_ : next->start};
+    }
+
+    double materialShare(uint64_t begin, uint64_t end) const {
+        double s = 0;
+        for (uint64_t i = begin; i < end; ++i) s += share_[ids_[i]];
+        return s;
+    }
+
+    bool paletteWins(uint64_t begin, uint64_t length, uint8_t omega) const {
+        const double paletteBits = double(length) * omega + double(uint64_t(1) << omega) * materialBits_ + kDirectoryBits;
+        if (!(paletteBits < double(length) * (omega + 1))) return false;                  // Alg. 1, line 6
+        return paletteBits + materialShare(begin, begin + length) < double(length) * 8.0 * vs_ + kDirectoryBits;  // beats direct
+    }
+
+    void phaseOne(uint8_t omega) {
+        const uint64_t limit = uint64_t(1) << omega;
+        const double minLength = double(limit) * materialBits_ + kDirectoryBits;
+        std::priority_queue<std::pair<uint64_t, uint64_t>> heap;  // (length, start)
+        // Maximal windows with <= 2^omega distinct ids, inside each free gap.
+        uint64_t gapStart = 0;
+        auto scanGap = [&](uint64_t begin, uint64_t end) {
+            ++epoch_;
+            uint64_t distinct = 0, right = begin, lastRight = begin;
+            for (uint64_t left = begin; left < end; ++left) {
+                while (right < end) {
+                    const uint32_t id = ids_[right];
+                    const bool fresh = stamp_[id] != epoch_ || count_[id] == 0;
+                    if (fresh && distinct == limit) break;
+                    if (stamp_[id] != epoch_) { stamp_[id] = epoch_; count_[id] = 0; }
+                    if (count_[id]++ == 0) ++distinct;
+                    ++right;
+                }
+                if (right > lastRight && double(right - left) > minLength) heap.push({right - left, left});
+                lastRight = std::max(lastRight, right);
+                const uint32_t id = ids_[left];
+                if (--count_[id] == 0) --distinct;
+            }
+        };
+        for (const Segment& s : accepted_) {
+            if (s.start > gapStart) scanGap(gapStart, s.start);
+            gapStart = s.start + s.length;
+        }
+        if (gapStart < n_) scanGap(gapStart, n_);
+        while (!heap.empty()) {
+            auto [length, start] = heap.top();
+            heap.pop();
+            if (double(length) <= minLength) break;  // the heap is ordered: nothing longer remains
+            const auto [free, gapEnd] = freeGapEnd(start);
+            if (!free) continue;
+            if (start + length > gapEnd) {
+                heap.push({gapEnd - start, start});
+                continue;
+            }
+            if (paletteWins(start, length, omega)) accepted_.insert(Segment{start, length, omega});
+        }
+    }
+
+    void phaseTwo(uint64_t begin, uint64_t end, std::vector<Segment>& out) {
+        for (uint64_t start = begin; start < end;) {
+            const uint64_t stop = std::min(end, start + kMaxBlockEntries);
+            // lengthFor[ω]: longest block from `start` with <= 2^ω distinct ids.
+            uint64_t lengthFor[9];
+            double shareUpTo[9];
+            ++epoch_;
+            uint64_t distinct = 0, i = start;
+            double share = 0;
+            for (unsigned omega = 0; omega <= 8; ++omega) {
+                const uint64_t limit = uint64_t(1) << omega;
+                for (; i < stop; ++i) {
+                    const uint32_t id = ids_[i];
+                    if (stamp_[id] != epoch_) {
+                        if (distinct == limit) break;
+                        stamp_[id] = epoch_;
+                        ++distinct;
+                    }
+                    share += share_[id];
+                }
+                lengthFor[omega] = i - start;
+                shareUpTo[omega] = share;
+            }
+            double bestCost = (8.0 * vs_ * double(lengthFor[8]) + kDirectoryBits) / double(lengthFor[8]);
+            Segment best{start, lengthFor[8], PaletteBlock::kDirect};
+            for (unsigned omega = 0; omega <= 8; ++omega) {
+                const double len = double(lengthFor[omega]);
+                const double bits = len * omega + double(uint64_t(1) << omega) * materialBits_ + kDirectoryBits + shareUpTo[omega];
+                if (bits / len < bestCost) { bestCost = bits / len; best = {start, lengthFor[omega], uint8_t(omega)}; }
+            }
+            out.push_back(best);
+            start += best.length;
+        }
+    }
+
+    const std::vector<uint32_t>& ids_;
+    uint64_t n_;
+    uint32_t vs_;
+    int materialBits_;
+    std::vector<uint32_t> stamp_;
+    std::vector<uint32_t> count_;
+    std::vector<double> share_;
+    uint32_t epoch_ = 0;
+    std::set<Segment, SegmentLess> accepted_;
+};
+
+void putBits(std::vector<uint64_t>& words, uint64_t bitOffset, uint64_t value, unsigned bits) {
+    if (bits == 0) return;
+    const uint64_t word = bitOffset >> 6;
+    const unsigned shift = unsigned(bitOffset & 63);
+    if (words.size() < word + 2) words.resize(word + 2, 0);
+    words[word] |= value << shift;
+    if (shift + bits > 64) words[word + 1] |= value >> (64 - shift);
+}
+
+uint64_t getBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigned bits) {
+    if (bits == 0) return 0;
+    const uint64_t word = bitOffset >> 6;
+    const unsigned shift = unsigned(bitOffset & 63);
+    uint64_t v = words[word] >> shift;
+    if (shift + bits > 64) v |= words[word + 1] << (64 - shift);
+    return v & ((uint64_t(1) << bits) - 1);
+}
+
+} // namespace
+
+PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSize) {
+    PaletteChannel out;
+    out.valueSize = valueSize;
+    if (valueSize == 0) return out;
+    const uint64_t n = values.size() / valueSize;
+    out.entryCount = n;
+    if (n == 0) return out;
+    std::vector<uint64_t> first;
+    const std::vector<uint32_t> ids = distinctIds(values, valueSize, n, first);
+    const std::vector<Segment> segments = Partitioner(ids, first.size(), valueSize).run();
+
+    std::vector<uint32_t> material(first.size(), UINT32_MAX);  // id -> material index
+    std::map<std::vector<uint32_t>, uint32_t> paletteAt;          // shared palettes
+    std::vector<uint32_t> local(first.size(), 0);
+    std::vector<uint32_t> seen(first.size(), UINT32_MAX);  // block index that last listed this id
+    uint64_t bitCursor = 0;
+    for (const Segment& s : segments) {
+        PaletteBlock block{s.start, 0, 0, PaletteBlock::kDirect};
+        if (s.omega == PaletteBlock::kDirect) {
+            block.dataOffset = out.direct.size();
+            out.direct.insert(out.direct.end(), values.begin() + long(s.start * valueSize), values.begin() + long((s.start + s.length) * valueSize));
+        } else {
+            std::vector<uint32_t> palette;
+            const uint32_t blockIndex = uint32_t(out.blocks.size());
+            for (uint64_t i = s.start; i < s.start + s.length; ++i) {
+                if (seen[ids[i]] == blockIndex) continue;
+                seen[ids[i]] = blockIndex;
+                uint32_t& m = material[ids[i]];
+                if (m == UINT32_MAX) {
+                    m = uint32_t(out.materials.size() / valueSize);
+                    out.materials.insert(out.materials.end(), values.begin() + long(first[ids[i]] * valueSize),
+                                         values.begin() + long((first[ids[i]] + 1) * valueSize));
+                }
+                palette.push_back(m);
+            }
+            std::sort(palette.begin(), palette.end());  // at most 256 distinct entries
+            const unsigned bits = palette.size() <= 1 ? 0 : unsigned(std::bit_width(palette.size() - 1));
+            auto [it, inserted] = paletteAt.emplace(palette, uint32_t(out.palettes.size()));
+            if (inserted) out.palettes.insert(out.palettes.end(), palette.begin(), palette.end());
+            block.paletteOffset = it->second;
+            block.indexBits = uint8_t(bits);
+            block.dataOffset = bitCursor;
+            for (size_t k = 0; k < palette.size(); ++k) local[palette[k]] = uint32_t(k);
+            for (uint64_t i = s.start; i < s.start + s.length; ++i, bitCursor += bits)
+                putBits(out.indexBits, bitCursor, local[material[ids[i]]], bits);
+        }
+        out.blocks.push_back(block);
+    }
+    out.indexBits.resize((bitCursor + 63) / 64 + 1, 0);
+    return out;
+}
+
+uint64_t PaletteChannel::byteSize() const {
+    return materials.size() + palettes.size() * 4 + blocks.size() * sizeof(PaletteBlock) + indexBits.size() * 8 + direct.size();
+}
+
+void PaletteChannel::lookup(uint64_t index, uint8_t* out) const {
+    auto it = std::upper_bound(blocks.begin(), blocks.end(), index, [](uint64_t i, const PaletteBlock& b) { return i < b.firstEntry; });
+    const PaletteBlock& b = *std::prev(it);
+    const uint64_t k = index - b.firstEntry;
+    if (b.indexBits == PaletteBlock::kDirect) {
+        std::memcpy(out, &direct[b.dataOffset + k * valueSize], valueSize);
+    } else {
+        const uint64_t local = getBits(indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
+        std::memcpy(out, &materials[uint64_t(palettes[b.paletteOffset + local]) * valueSize], valueSize);
+    }
+}
+
+std::vector<uint8_t> PaletteChannel::decodeAll() const {
+    std::vector<uint8_t> out(entryCount * valueSize);
+    for (size_t bi = 0; bi < blocks.size(); ++bi) {
+        const PaletteBlock& b = blocks[bi];
+        const uint64_t end = bi + 1 < blocks.size() ? blocks[bi + 1].firstEntry : entryCount;
+        if (b.indexBits == PaletteBlock::kDirect) {
+            std::memcpy(&out[b.firstEntry * valueSize], &direct[b.dataOffset], (end - b.firstEntry) * valueSize);
+            continue;
+        }
+        for (uint64_t e = b.firstEntry; e < end; ++e) {
+            const uint64_t local = getBits(indexBits, b.dataOffset + (e - b.firstEntry) * b.indexBits, b.indexBits);
+            std::memcpy(&out[e * valueSize], &materials[uint64_t(palettes[b.paletteOffset + local]) * valueSize], valueSize);
+        }
+    }
+    return out;
+}
+
+namespace {
+
+// Byte planes (all values' byte 0, then byte 1, ...): zstd compresses the
+// planes of floats much better than interleaved bytes.
+std::vector<uint8_t> shuffle(const std::vector<uint8_t>& v, uint32_t vs) {
+    const size_t n = vs ? v.size() / vs : 0;
+    std::vector<uint8_t> out(v.size());
+    for (size_t i = 0; i < n; ++i)
+        for (uint32_t k = 0; k < vs; ++k) out[k * n + i] = v[i * vs + k];
+    return out;
+}
+std::vector<uint8_t> unshuffle(const std::vector<uint8_t>& p, uint32_t vs) {
+    const size_t n = vs ? p.size() / vs : 0;
+    std::vector<uint8_t> out(p.size());
+    for (size_t i = 0; i < n; ++i)
+        for (uint32_t k = 0; k < vs; ++k) out[i * vs + k] = p[k * n + i];
+    return out;
+}
+
+} // namespace
+
+// Layout: u32 valueSize, u64 entries, u64 materials bytes + bytes (shuffled),
+// u64 palette count + u32[], u64 blocks + (u64 first, u64 data, u32 palette, u8 ω)[],
+// u64 index words + u64[], u64 direct bytes + bytes (shuffled).
+std::vector<uint8_t> serializePalette(const PaletteChannel& c) {
+    format::ByteWriter w;
+    w.put<uint32_t>(c.valueSize);
+    w.put<uint64_t>(c.entryCount);
+    w.put<uint64_t>(c.materials.size());
+    w.putBytes(shuffle(c.materials, c.valueSize));
+    w.put<uint64_t>(c.palettes.size());
+    w.putArray<uint32_t>(c.palettes);
+    w.put<uint64_t>(c.blocks.size());
+    for (const PaletteBlock& b : c.blocks) {
+        w.put<uint64_t>(b.firstEntry);
+        w.put<uint64_t>(b.dataOffset);
+        w.put<uint32_t>(b.paletteOffset);
+        w.put<uint8_t>(b.indexBits);
+    }
+    w.put<uint64_t>(c.indexBits.size());
+    w.putArray<uint64_t>(c.indexBits);
+    w.put<uint64_t>(c.direct.size());
+    w.putBytes(shuffle(c.direct, c.valueSize));
+    return w.take();
+}
+
+PaletteChannel deserializePalette(std::span<const uint8_t> bytes, const std::string& what) {
+    format::ByteReader r(bytes, what);
+    PaletteChannel c;
+    c.valueSize = r.get<uint32_t>();
+    if (c.valueSize == 0 || c.valueSize > 64) r.fail("bad value size");
+    c.entryCount = r.get<uint64_t>();
+    const uint64_t materialBytes = r.get<uint64_t>();
+    if (materialBytes % c.valueSize) r.fail("material array is not a whole number of values");
+    c.materials = unshuffle(r.getArray<uint8_t>(materialBytes), c.valueSize);
+    c.palettes = r.getArray<uint32_t>(r.get<uint64_t>());
+    const uint64_t blockCount = r.get<uint64_t>();
+    if (blockCount > r.remaining() / 21) r.fail("block directory runs past the end");
+    c.blocks.resize(blockCount);
+    for (PaletteBlock& b : c.blocks) {
+        b.firstEntry = r.get<uint64_t>();
+        b.dataOffset = r.get<uint64_t>();
+        b.paletteOffset = r.get<uint32_t>();
+        b.indexBits = r.get<uint8_t>();
+    }
+    c.indexBits = r.getArray<uint64_t>(r.get<uint64_t>());
+    const uint64_t directBytes = r.get<uint64_t>();
+    if (directBytes % c.valueSize) r.fail("direct values are not a whole number of values");
+    c.direct = unshuffle(r.getArray<uint8_t>(directBytes), c.valueSize);
+    r.expectEnd();
+    // Every block must be addressable: entries in order, data in range.
+    const uint64_t materialsCount = c.materialCount();
+    for (size_t i = 0; i < c.blocks.size(); ++i) {
+        const PaletteBlock& b = c.blocks[i];
+        const uint64_t end = i + 1 < c.blocks.size() ? c.blocks[i + 1].firstEntry : c.entryCount;
+        if ((i == 0 && b.firstEntry != 0) || b.firstEntry >= end) r.fail("block " + std::to_string(i) + " is out of order");
+        const uint64_t len = end - b.firstEntry;
+        if (b.indexBits == PaletteBlock::kDirect) {
+            if (b.dataOffset > c.direct.size() || len > (c.direct.size() - b.dataOffset) / c.valueSize) r.fail("direct block " + std::to_string(i) + " out of range");
+            continue;
+        }
+        if (b.indexBits > 8) r.fail("block " + std::to_string(i) + " has " + std::to_string(b.indexBits) + "-bit indices");
+        const uint64_t paletteSize = uint64_t(1) << b.indexBits;
+        if (b.paletteOffset > c.palettes.size()) r.fail("palette of block " + std::to_string(i) + " out of range");
+        const uint64_t available = std::min<uint64_t>(paletteSize, c.palettes.size() - b.paletteOffset);
+        // getBits may read one word past a block's last bit: the writer keeps a spare word.
+        if (c.indexBits.empty() || len > (uint64_t(1) << 40) || b.dataOffset > (uint64_t(1) << 62) ||
+            b.dataOffset + len * b.indexBits > (c.indexBits.size() - 1) * 64)
+            r.fail("indices of block " + std::to_string(i) + " out of range");
+        // Every index must land in the palette and every palette entry in M.
+        for (uint64_t k = 0; k < len; ++k) {
+            const uint64_t local = getBits(c.indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
+            if (local >= available) r.fail("index out of its palette in block " + std::to_string(i));
+        }
+    }
+    for (size_t i = 0; i < c.palettes.size(); ++i)
+        if (c.palettes[i] >= materialsCount) r.fail("palette entry " + std::to_string(i) + " is not a material");
+    if (c.blocks.empty() && c.entryCount) r.fail("no blocks for " + std::to_string(c.entryCount) + " entries");
+    return c;
+}
+
+ChannelStats channelStats(std::span<const uint8_t> values, uint32_t valueSize, const PaletteChannel& channel) {
+    ChannelStats s;
+    if (!valueSize) return s;
+    s.entries = values.size() / valueSize;
+    std::vector<uint64_t> first;
+    distinctIds(values, valueSize, s.entries, first);
+    s.unique = first.size();
+    s.rawBytes = values.size();
+    const uint64_t bits = s.unique > 1 ? std::bit_width(s.unique - 1) : 0;
+    s.materialIndexBytes = s.unique * valueSize + (s.entries * bits + 7) / 8;
+    s.paletteBytes = channel.byteSize();
+    for (const PaletteBlock& b : channel.blocks) (b.indexBits == PaletteBlock::kDirect ? s.directBlocks : s.paletteBlocks)++;
+    std::set<uint32_t> stored;
+    for (const PaletteBlock& b : channel.blocks)
+        if (b.indexBits != PaletteBlock::kDirect) stored.insert(b.paletteOffset);
+    s.palettesStored = stored.size();
+    return s;
+}
+
+} // namespace vdbdag::attributes

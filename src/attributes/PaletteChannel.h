@@ -1,0 +1,61 @@
+// A palette-compressed attribute channel (Dado et al. §4.2): a global
+// material array M of the distinct values used through palettes, a block
+// directory (sorted by first entry, found by binary search), per block
+// either an ω-bit index (ω = 0..8) into a shared palette of material
+// indices, or - when palettes do not pay, e.g. unique floats - the values
+// stored directly. Random access in O(log blocks); this is the traceable
+// in-memory layout.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace vdbdag::attributes {
+
+struct PaletteBlock {
+    uint64_t firstEntry;     // attribute index of the block's first entry
+    uint64_t dataOffset;     // direct: byte offset into `direct`; palette: bit offset into `indexBits`
+    uint32_t paletteOffset;  // first material index of the block's palette in `palettes`
+    uint8_t indexBits;       // ω; kDirect for direct storage
+    static constexpr uint8_t kDirect = 0xFF;
+};
+
+struct PaletteChannel {
+    uint32_t valueSize = 0;
+    uint64_t entryCount = 0;                  // Λ
+    std::vector<uint8_t> materials;           // M: distinct values (valueSize bytes each)
+    std::vector<uint32_t> palettes;           // all palettes, concatenated (material indices)
+    std::vector<PaletteBlock> blocks;         // directory, by firstEntry
+    std::vector<uint64_t> indexBits;          // bit-packed palette indices of all palette blocks
+    std::vector<uint8_t> direct;              // values of direct blocks
+
+    uint64_t materialCount() const { return valueSize ? materials.size() / valueSize : 0; }
+    // Bytes of the traceable layout (what a tracer binds).
+    uint64_t byteSize() const;
+    // Copies entry `index`'s value (valueSize bytes) to `out`.
+    void lookup(uint64_t index, uint8_t* out) const;
+    // All entries, in order (for decoding).
+    std::vector<uint8_t> decodeAll() const;
+};
+
+// Compresses `values` (entries of `valueSize` bytes) with the two-phase
+// greedy partition of Dado et al. Alg. 1, in O(n log n).
+PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSize);
+
+// Serialisation for the .ssvdag Values sections (validated on read).
+std::vector<uint8_t> serializePalette(const PaletteChannel& channel);
+PaletteChannel deserializePalette(std::span<const uint8_t> bytes, const std::string& what);
+
+// The paper's Table 1 columns for a channel.
+struct ChannelStats {
+    uint64_t entries = 0;        // Λ
+    uint64_t unique = 0;         // λ (distinct values in the whole channel)
+    uint64_t rawBytes = 0;       // Λ * valueSize
+    uint64_t materialIndexBytes = 0;  // M + Λ * ceil(log2 λ) bits
+    uint64_t paletteBytes = 0;   // the traceable palette layout
+    uint64_t directBlocks = 0, paletteBlocks = 0, palettesStored = 0;
+};
+ChannelStats channelStats(std::span<const uint8_t> values, uint32_t valueSize, const PaletteChannel& channel);
+
+} // namespace vdbdag::attributes
