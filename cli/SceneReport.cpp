@@ -1,6 +1,8 @@
 // See SceneReport.h.
 #include "cli/SceneReport.h"
 
+#include <tuple>
+
 #include <fmt/core.h>
 
 namespace vdbdag::cli {
@@ -37,7 +39,20 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
         }
         fileLevelBytes -= std::min(fileLevelBytes, gridBytes);
         j["stored_bytes"] = gridBytes;
-        j["traceable_bytes"] = grid.dag.byteSize();
+        // Value channels: the columns of Dado et al.'s Table 1.
+        j["channels"] = json::array();
+        const unsigned vs = valueSize(grid.record.valueType);
+        uint64_t traceable = grid.dag.byteSize() + grid.inactiveDag.byteSize();
+        for (const auto& [layer, raw, channel] : {std::tuple{"active", &grid.attributes, &grid.values},
+                                                  std::tuple{"inactive", &grid.inactiveAttributes, &grid.inactiveValues}}) {
+            if (!vs || raw->empty()) continue;
+            const attributes::ChannelStats cs = attributes::channelStats(*raw, vs, *channel);
+            traceable += channel->byteSize();
+            j["channels"].push_back({{"layer", layer}, {"entries", cs.entries}, {"unique", cs.unique}, {"raw_bytes", cs.rawBytes},
+                                     {"material_index_bytes", cs.materialIndexBytes}, {"palette_bytes", cs.paletteBytes},
+                                     {"palette_blocks", cs.paletteBlocks}, {"direct_blocks", cs.directBlocks}, {"palettes", cs.palettesStored}});
+        }
+        j["traceable_bytes"] = traceable;
         j["bits_per_active_voxel"] = grid.activeVoxels ? 8.0 * double(gridBytes) / double(grid.activeVoxels) : 0.0;
         report["grids"].push_back(j);
     }
@@ -67,6 +82,11 @@ std::string formatSceneReport(const nlohmann::json& r) {
         for (const auto& s : g["sections"])
             out += fmt::format("  section {:<14} {:>12} bytes{}\n", s["kind"].get<std::string>(), s["stored_bytes"].get<uint64_t>(),
                                s["compressed"].get<bool>() ? fmt::format(" (zstd, {} raw)", s["raw_bytes"].get<uint64_t>()) : std::string());
+        for (const auto& c : g["channels"])
+            out += fmt::format("  {} values: {} entries, {} unique; raw {} B, material+index {} B, palette-compressed {} B ({} palette / {} direct blocks, {} palettes)\n",
+                               c["layer"].get<std::string>(), c["entries"].get<uint64_t>(), c["unique"].get<uint64_t>(), c["raw_bytes"].get<uint64_t>(),
+                               c["material_index_bytes"].get<uint64_t>(), c["palette_bytes"].get<uint64_t>(), c["palette_blocks"].get<uint64_t>(),
+                               c["direct_blocks"].get<uint64_t>(), c["palettes"].get<uint64_t>());
         out += fmt::format("  total {} bytes in file ({:.4f} bits/active voxel), {} bytes traceable in memory\n", g["stored_bytes"].get<uint64_t>(),
                            g["bits_per_active_voxel"].get<double>(), g["traceable_bytes"].get<uint64_t>());
     }
