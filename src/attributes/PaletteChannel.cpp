@@ -36,12 +36,14 @@ namespace vdbdag::attributes {
 namespace {
 
 constexpr double kDirectoryBits = 8 * 21;  // firstEntry, dataOffset, paletteOffset, ω
+constexpr double kPaletteEntryBits = 32;   // palettes store u32 material indices
 constexpr uint64_t kMaxBlockEntries = 1u << 14;
 
 struct Segment {
     uint64_t start, length;
-    uint8_t omega;  // PaletteBlock::kDirect for direct storage
+    uint8_t omega;  // PaletteBlock::kDirect for direct storage, kWhole for material-array indices
 };
+constexpr uint8_t kWhole = 0xFE;
 
 // Bitwise equality and hash of one value, specialised for the common sizes
 // (a libc memcmp call per 4-byte value costs more than the comparison).
@@ -200,14 +202,14 @@ private:
     }
 
     bool paletteWins(uint64_t begin, uint64_t length, uint8_t omega) const {
-        const double paletteBits = double(length) * omega + double(uint64_t(1) << omega) * materialBits_ + kDirectoryBits;
+        const double paletteBits = double(length) * omega + double(uint64_t(1) << omega) * kPaletteEntryBits + kDirectoryBits;
         if (!(paletteBits < double(length) * (omega + 1))) return false;                  // Alg. 1, line 6
         return paletteBits + materialShare(begin, begin + length) < double(length) * 8.0 * vs_ + kDirectoryBits;  // beats direct
     }
 
     void phaseOne(uint8_t omega) {
         const uint64_t limit = uint64_t(1) << omega;
-        const double minLength = double(limit) * materialBits_ + kDirectoryBits;
+        const double minLength = double(limit) * kPaletteEntryBits + kDirectoryBits;
         std::priority_queue<std::pair<uint64_t, uint64_t>> heap;  // (length, start)
         // Maximal windows with <= 2^omega distinct ids, inside each free gap.
         uint64_t gapStart = 0;
@@ -273,9 +275,14 @@ private:
             }
             double bestCost = (8.0 * vs_ * double(lengthFor[8]) + kDirectoryBits) / double(lengthFor[8]);
             Segment best{start, lengthFor[8], PaletteBlock::kDirect};
+            {   // indices straight into the material array, over the longest block considered
+                const uint64_t len = stop - start;
+                const double bits = double(len) * materialBits_ + kDirectoryBits + materialShare(start, stop);
+                if (bits / double(len) < bestCost) { bestCost = bits / double(len); best = {start, len, kWhole}; }
+            }
             for (unsigned omega = 0; omega <= 8; ++omega) {
                 const double len = double(lengthFor[omega]);
-                const double bits = len * omega + double(uint64_t(1) << omega) * materialBits_ + kDirectoryBits + shareUpTo[omega];
+                const double bits = len * omega + double(uint64_t(1) << omega) * kPaletteEntryBits + kDirectoryBits + shareUpTo[omega];
                 if (bits / len < bestCost) { bestCost = bits / len; best = {start, lengthFor[omega], uint8_t(omega)}; }
             }
             out.push_back(best);
@@ -332,7 +339,21 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
     uint64_t bitCursor = 0;
     for (const Segment& s : segments) {
         PaletteBlock block{s.start, 0, 0, PaletteBlock::kDirect};
-        if (s.omega == PaletteBlock::kDirect) {
+        if (s.omega == kWhole) {
+            const unsigned bits = unsigned(std::max(1, int(std::bit_width(first.size() > 1 ? first.size() - 1 : 1))));
+            block.paletteOffset = PaletteBlock::kWholeMaterialArray;
+            block.indexBits = uint8_t(bits);
+            block.dataOffset = bitCursor;
+            for (uint64_t i = s.start; i < s.start + s.length; ++i, bitCursor += bits) {
+                uint32_t& m = material[ids[i]];
+                if (m == UINT32_MAX) {
+                    m = uint32_t(out.materials.size() / valueSize);
+                    out.materials.insert(out.materials.end(), values.begin() + long(first[ids[i]] * valueSize),
+                                         values.begin() + long((first[ids[i]] + 1) * valueSize));
+                }
+                putBits(out.indexBits, bitCursor, m, bits);
+            }
+        } else if (s.omega == PaletteBlock::kDirect) {
             block.dataOffset = out.direct.size();
             out.direct.insert(out.direct.end(), values.begin() + long(s.start * valueSize), values.begin() + long((s.start + s.length) * valueSize));
         } else {
@@ -378,7 +399,8 @@ void PaletteChannel::lookup(uint64_t index, uint8_t* out) const {
         std::memcpy(out, &direct[b.dataOffset + k * valueSize], valueSize);
     } else {
         const uint64_t local = getBits(indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
-        std::memcpy(out, &materials[uint64_t(palettes[b.paletteOffset + local]) * valueSize], valueSize);
+        const uint64_t m = b.paletteOffset == PaletteBlock::kWholeMaterialArray ? local : palettes[b.paletteOffset + local];
+        std::memcpy(out, &materials[m * valueSize], valueSize);
     }
 }
 
@@ -393,7 +415,8 @@ std::vector<uint8_t> PaletteChannel::decodeAll() const {
         }
         for (uint64_t e = b.firstEntry; e < end; ++e) {
             const uint64_t local = getBits(indexBits, b.dataOffset + (e - b.firstEntry) * b.indexBits, b.indexBits);
-            std::memcpy(&out[e * valueSize], &materials[uint64_t(palettes[b.paletteOffset + local]) * valueSize], valueSize);
+            const uint64_t m = b.paletteOffset == PaletteBlock::kWholeMaterialArray ? local : palettes[b.paletteOffset + local];
+            std::memcpy(&out[e * valueSize], &materials[m * valueSize], valueSize);
         }
     }
     return out;
@@ -480,10 +503,10 @@ PaletteChannel deserializePalette(std::span<const uint8_t> bytes, const std::str
             if (b.dataOffset > c.direct.size() || len > (c.direct.size() - b.dataOffset) / c.valueSize) r.fail("direct block " + std::to_string(i) + " out of range");
             continue;
         }
-        if (b.indexBits > 8) r.fail("block " + std::to_string(i) + " has " + std::to_string(b.indexBits) + "-bit indices");
-        const uint64_t paletteSize = uint64_t(1) << b.indexBits;
-        if (b.paletteOffset > c.palettes.size()) r.fail("palette of block " + std::to_string(i) + " out of range");
-        const uint64_t available = std::min<uint64_t>(paletteSize, c.palettes.size() - b.paletteOffset);
+        const bool whole = b.paletteOffset == PaletteBlock::kWholeMaterialArray;
+        if (b.indexBits > (whole ? 32 : 8)) r.fail("block " + std::to_string(i) + " has " + std::to_string(b.indexBits) + "-bit indices");
+        if (!whole && b.paletteOffset > c.palettes.size()) r.fail("palette of block " + std::to_string(i) + " out of range");
+        const uint64_t available = whole ? materialsCount : std::min<uint64_t>(uint64_t(1) << b.indexBits, c.palettes.size() - b.paletteOffset);
         // getBits may read one word past a block's last bit: the writer keeps a spare word.
         if (c.indexBits.empty() || len > (uint64_t(1) << 40) || b.dataOffset > (uint64_t(1) << 62) ||
             b.dataOffset + len * b.indexBits > (c.indexBits.size() - 1) * 64)
@@ -514,7 +537,7 @@ ChannelStats channelStats(std::span<const uint8_t> values, uint32_t valueSize, c
     for (const PaletteBlock& b : channel.blocks) (b.indexBits == PaletteBlock::kDirect ? s.directBlocks : s.paletteBlocks)++;
     std::set<uint32_t> stored;
     for (const PaletteBlock& b : channel.blocks)
-        if (b.indexBits != PaletteBlock::kDirect) stored.insert(b.paletteOffset);
+        if (b.indexBits != PaletteBlock::kDirect && b.paletteOffset != PaletteBlock::kWholeMaterialArray) stored.insert(b.paletteOffset);
     s.palettesStored = stored.size();
     return s;
 }

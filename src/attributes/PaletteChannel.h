@@ -19,6 +19,10 @@ struct PaletteBlock {
     uint32_t paletteOffset;  // first material index of the block's palette in `palettes`
     uint8_t indexBits;       // ω; kDirect for direct storage
     static constexpr uint8_t kDirect = 0xFF;
+    // paletteOffset of a block whose indices address the material array
+    // directly (the "material + index" scheme, for blocks too varied for a
+    // 2^8-entry palette); its indexBits is ceil(log2 λ).
+    static constexpr uint32_t kWholeMaterialArray = 0xFFFFFFFFu;
 };
 
 struct PaletteChannel {
@@ -40,7 +44,9 @@ struct PaletteChannel {
 };
 
 // Compresses `values` (entries of `valueSize` bytes) with the two-phase
-// greedy partition of Dado et al. Alg. 1, in O(n log n).
+// greedy partition of Dado et al. Alg. 1, in O(n log n). Besides ω = 0..8
+// palettes and direct storage, a block may index the material array
+// directly (kWholeMaterialArray) when that is cheaper.
 PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSize);
 
 // Serialisation for the .ssvdag Values sections (validated on read).
