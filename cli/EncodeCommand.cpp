@@ -1,4 +1,4 @@
-// `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry]`
+// `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]`
 #include <chrono>
 
 #include <fmt/core.h>
@@ -16,7 +16,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string input, output;
         std::vector<std::string> grids;
-        bool noSymmetry = false, noCompress = false, skipUnsupported = false, json = false;
+        bool noSymmetry = false, noCompress = false, skipUnsupported = false, json = false, topologyOnly = false;
         int placementTrials = 1;
     };
     auto opt = std::make_shared<Options>();
@@ -28,12 +28,14 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--no-compress", opt->noCompress, "store sections without zstd");
     cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the smallest (1-64)")->check(CLI::Range(1, 64));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
+    cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     cmd->callback([opt, &exitCode] {
         const auto start = std::chrono::steady_clock::now();
         bridge::ImportOptions importOptions;
         importOptions.onlyGrids = opt->grids;
         importOptions.skipUnsupported = opt->skipUnsupported;
+        importOptions.topologyOnly = opt->topologyOnly;
         const bridge::ImportResult imported = bridge::importVdb(opt->input, importOptions);
         for (const auto& w : imported.warnings) fmt::print(stderr, "vdbdag: warning: {}\n", w);
 

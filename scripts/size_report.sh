@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Geometry-only size report for the issue's checks, all measured in one run:
-# for each input, the .ssvdag (symmetry), the --no-symmetry .ssvdag (same
-# compact encoding, plain SVDAG), and the same topology written by OpenVDB as
-# a blosc MaskGrid .vdb (what `vdbdag decode` writes). Also encode time.
+# Size report, all measured in one run. Geometry (`--topology-only`): the
+# .ssvdag (symmetry), the --no-symmetry .ssvdag (same compact encoding, plain
+# SVDAG), and the same topology written by OpenVDB as a blosc MaskGrid .vdb
+# (what `vdbdag decode` of a topology-only file writes). Then the lossless
+# encoding with values against the input .vdb (blosc) and NanoVDB's float
+# grid (nanovdb_convert), file and traceable in-memory sizes.
 # Usage: scripts/size_report.sh [OUTDIR]   (needs a built tree: scripts/setup.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,11 +20,25 @@ printf "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n"
 for f in "${inputs[@]}"; do
   name=$(basename "$f" .vdb)
   start=$(date +%s.%N)
-  build/vdbdag encode "$f" -o "$OUT/$name.ssvdag" --json > "$OUT/$name.json"
+  build/vdbdag encode "$f" -o "$OUT/$name.ssvdag" --topology-only --json > "$OUT/$name.json"
   end=$(date +%s.%N)
-  build/vdbdag encode "$f" -o "$OUT/$name.svdag.ssvdag" --no-symmetry >/dev/null
+  build/vdbdag encode "$f" -o "$OUT/$name.svdag.ssvdag" --no-symmetry --topology-only >/dev/null
   build/vdbdag decode "$OUT/$name.ssvdag" -o "$OUT/${name}_mask.vdb"
   voxels=$(python3 -c "import json;print(json.load(open('$OUT/$name.json'))['active_voxels'])")
   s=$(stat -c %s "$OUT/$name.ssvdag"); p=$(stat -c %s "$OUT/$name.svdag.ssvdag"); m=$(stat -c %s "$OUT/${name}_mask.vdb")
   python3 -c "print(f'| $name | {$voxels:,} | {$s:,} | {$p:,} | {$s/$p:.3f} | {$m:,} | {$s/$m:.4f} (1/{$m/$s:.1f}) | {8*$s/$voxels:.3f} | {$end-$start:.2f} |')"
+done
+
+printf "\n| input | blosc .vdb bytes | NanoVDB float bytes | lossless .ssvdag bytes | .ssvdag / .vdb | traceable bytes | traceable / NanoVDB | encode s |\n"
+printf "|---|---:|---:|---:|---:|---:|---:|---:|\n"
+for f in "${inputs[@]}"; do
+  name=$(basename "$f" .vdb)
+  nanovdb_convert -f "$f" "$OUT/$name.nvdb" >/dev/null
+  start=$(date +%s.%N)
+  build/vdbdag encode "$f" -o "$OUT/$name.values.ssvdag" >/dev/null
+  end=$(date +%s.%N)
+  build/vdbdag info "$OUT/$name.values.ssvdag" --json > "$OUT/$name.values.json"
+  v=$(stat -c %s "$f"); n=$(stat -c %s "$OUT/$name.nvdb"); s=$(stat -c %s "$OUT/$name.values.ssvdag")
+  t=$(python3 -c "import json;print(sum(g['traceable_bytes'] for g in json.load(open('$OUT/$name.values.json'))['grids']))")
+  python3 -c "print(f'| $name | {$v:,} | {$n:,} | {$s:,} | {$s/$v:.3f} | {$t:,} | {$t/$n:.3f} | {$end-$start:.2f} |')"
 done

@@ -157,7 +157,7 @@ void compareGridValues(size_t index, const openvdb::GridBase& a, const openvdb::
     if (d.activeValues || d.inactiveValues) result.values.push_back(std::move(d));
 }
 
-CompareResult compareGridLists(const openvdb::GridPtrVec& a, const openvdb::GridPtrVec& b) {
+CompareResult compareGridLists(const openvdb::GridPtrVec& a, const openvdb::GridPtrVec& b, bool values) {
     CompareResult result;
     if (a.size() != b.size())
         result.headerDifferences.push_back("grid count differs (" + std::to_string(a.size()) + " vs " + std::to_string(b.size()) + ")");
@@ -171,7 +171,7 @@ CompareResult compareGridLists(const openvdb::GridPtrVec& a, const openvdb::Grid
         }
         TopologyDifference d = compareTrees(g, a[g]->getName(), *ta, *tb);
         if (d.onlyInA || d.onlyInB) result.topology.push_back(std::move(d));
-        compareGridValues(g, *a[g], *b[g], result);
+        if (values) compareGridValues(g, *a[g], *b[g], result);
     }
     result.identical = result.headerDifferences.empty() && result.topology.empty() && result.values.empty();
     return result;
@@ -192,16 +192,16 @@ openvdb::GridPtrVec readAll(const std::string& path) {
 
 } // namespace
 
-CompareResult compareWithFile(const std::string& originalPath, const Volume& decoded) {
+CompareResult compareWithFile(const std::string& originalPath, const Volume& decoded, bool values) {
     const openvdb::GridPtrVec original = readAll(originalPath);
     openvdb::GridPtrVec rebuilt;
     for (size_t g = 0; g < decoded.grids.size(); ++g)
         rebuilt.push_back(detail::buildGrid(decoded.grids[g], originalPath + " (decoded grid " + std::to_string(g) + ")"));
-    return compareGridLists(original, rebuilt);
+    return compareGridLists(original, rebuilt, values);
 }
 
-CompareResult compareFiles(const std::string& pathA, const std::string& pathB) {
-    return compareGridLists(readAll(pathA), readAll(pathB));
+CompareResult compareFiles(const std::string& pathA, const std::string& pathB, bool values) {
+    return compareGridLists(readAll(pathA), readAll(pathB), values);
 }
 
 } // namespace vdbdag::bridge

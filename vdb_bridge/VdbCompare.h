@@ -37,9 +37,11 @@ struct CompareResult {
 
 // Compares every grid of the original .vdb file at `originalPath` with
 // `decoded` (grids in the same order).
-CompareResult compareWithFile(const std::string& originalPath, const Volume& decoded);
+// With `values` false only headers and topology are compared (for
+// --topology-only encodings, which decode to MaskGrids).
+CompareResult compareWithFile(const std::string& originalPath, const Volume& decoded, bool values = true);
 
 // Same, between two .vdb files.
-CompareResult compareFiles(const std::string& pathA, const std::string& pathB);
+CompareResult compareFiles(const std::string& pathA, const std::string& pathB, bool values = true);
 
 } // namespace vdbdag::bridge

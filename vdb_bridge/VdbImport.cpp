@@ -44,11 +44,10 @@ struct LeafLayers {
     std::vector<uint8_t> activeValues, inactiveValues;
 };
 
-template <typename GridT>
+template <typename GridT, bool hasValues = !std::is_same_v<typename GridT::TreeType::LeafNodeType::BuildType, openvdb::ValueMask>>
 void collectLayers(const GridT& grid, GridRecord& record) {
     using TreeT = typename GridT::TreeType;
     using ValueT = typename GridT::ValueType;
-    constexpr bool hasValues = !std::is_same_v<typename GridT::TreeType::LeafNodeType::BuildType, openvdb::ValueMask>;  // mask grids carry no values
     const TreeT& tree = grid.tree();
     const ValueT background = tree.background();
     std::vector<const typename TreeT::LeafNodeType*> leaves;
@@ -180,8 +179,13 @@ ImportResult importVdb(const std::string& path, const ImportOptions& options) {
         record.name = base->getName();
         record.gridClass = openvdb::GridBase::gridClassToString(base->getGridClass());
         const bool supported = detail::dispatchGridType(*base, [&](const auto& grid, ValueType type) {
-            record.valueType = type;
-            collectLayers(grid, record);
+            if (options.topologyOnly) {
+                record.valueType = ValueType::Mask;
+                collectLayers<std::decay_t<decltype(grid)>, false>(grid, record);
+            } else {
+                record.valueType = type;
+                collectLayers(grid, record);
+            }
         });
         if (!supported) {
             const std::string message = "grid " + std::to_string(index) + " '" + base->getName() + "' has type '" + base->type() + "'" +

@@ -15,6 +15,9 @@ struct ImportOptions {
     // the import with an error naming the grid and its type, unless this is
     // set; then the grid is skipped and a warning is added to `warnings`.
     bool skipUnsupported = false;
+    // Geometry only: keep each grid's header but import it as a mask (active
+    // topology, no values, no inactive layer); it decodes as a MaskGrid.
+    bool topologyOnly = false;
 };
 
 struct ImportResult {

@@ -3,8 +3,9 @@
 // run in the same process:
 //   BM_OpenVdbReadWrite  OpenVDB alone: read the .vdb, write its topology as
 //                        a blosc MaskGrid (what a user would otherwise do);
-//   BM_EncodeFile        vdbdag: read the .vdb, build + reduce + encode, write
-//                        the .ssvdag (the ">= 10M active voxels/s");
+//   BM_EncodeFile        vdbdag, geometry only (`encode --topology-only`): read
+//                        the .vdb, build + reduce + encode, write the .ssvdag;
+//   BM_EncodeFileWithValues  the same with every value, lossless;
 //   BM_ReduceOnly        the SSVDAG reduction alone (bricks -> reduced DAG);
 //   BM_ReduceOnlyOneCore the same on one core (the reference code reduces
 //                        17-20M voxels/s on one core of this machine);
@@ -80,12 +81,16 @@ void BM_OpenVdbReadWrite_Sphere(benchmark::State& state) {
     state.counters["bytes"] = double(std::filesystem::file_size(out));
 }
 
-void BM_EncodeFile_Sphere(benchmark::State& state) {
+void encodeFile(benchmark::State& state, bool topologyOnly) {
     const std::string out = (std::filesystem::temp_directory_path() / "vdbdag_bench_sphere.ssvdag").string();
     size_t bytes = 0;
+    vdbdag::bridge::ImportOptions options;
+    options.topologyOnly = topologyOnly;
     for (auto _ : state) {
-        const auto imported = vdbdag::bridge::importVdb(sphereFile());
-        const auto scene = vdbdag::pipeline::encodeVolume(imported.volume);
+        const auto imported = vdbdag::bridge::importVdb(sphereFile(), options);
+        vdbdag::pipeline::EncodeOptions encodeOptions;
+        encodeOptions.computeSvdagStats = true;  // as the CLI does
+        const auto scene = vdbdag::pipeline::encodeVolume(imported.volume, encodeOptions);
         const auto data = vdbdag::format::writeScene(scene);
         vdbdag::writeFileAtomically(out, data);
         bytes = data.size();
@@ -94,6 +99,9 @@ void BM_EncodeFile_Sphere(benchmark::State& state) {
     state.counters["peak_rss_MiB"] = peakRssMiB();
     state.counters["bytes"] = double(bytes);
 }
+// Geometry only (`encode --topology-only`), and the full lossless encode with values.
+void BM_EncodeFile_Sphere(benchmark::State& state) { encodeFile(state, true); }
+void BM_EncodeFileWithValues_Sphere(benchmark::State& state) { encodeFile(state, false); }
 
 void reduce(benchmark::State& state, bool symmetry) {
     const vdbdag::GridTopology& topo = sphereVolume().grids.at(0).topology;
@@ -120,6 +128,7 @@ void BM_ReduceOnlyPlain_Sphere(benchmark::State& state) { reduce(state, false); 
 
 BENCHMARK(BM_OpenVdbReadWrite_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_EncodeFile_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
+BENCHMARK(BM_EncodeFileWithValues_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_ReduceOnly_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_ReduceOnlyOneCore_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_ReduceOnlyPlain_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();

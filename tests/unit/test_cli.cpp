@@ -109,6 +109,21 @@ TEST(Cli, EncodeDecodeVerifyInfoOnASphere) {
     EXPECT_GE(leafLevel["svdag_nodes"].get<uint64_t>(), leafLevel["stored_nodes"].get<uint64_t>());
 }
 
+TEST(Cli, TopologyOnlyEncodingDecodesToAMaskGridWithTheSameVoxels) {
+    const fs::path in = sphereFile(), encoded = workDir() / "topo.ssvdag", decoded = workDir() / "topo.vdb";
+    ASSERT_EQ(runCli("encode --topology-only " + in.string() + " -o " + encoded.string()).exitCode, 0);
+    ASSERT_EQ(runCli("decode " + encoded.string() + " -o " + decoded.string()).exitCode, 0);
+    openvdb::io::File original(in.string()), back(decoded.string());
+    original.open();
+    back.open();
+    const auto a = original.readGrid("ball"), b = back.readGrid("ball");
+    EXPECT_TRUE(b->isType<openvdb::MaskGrid>());
+    EXPECT_EQ(a->activeVoxelCount(), b->activeVoxelCount());
+    EXPECT_TRUE(a->transform() == b->transform());
+    const CommandResult r = runCli("verify --topology-only " + in.string());
+    EXPECT_EQ(r.exitCode, 0) << r.out << r.err;
+}
+
 TEST(Cli, ComparisonUsedByVerifyFindsARemovedVoxelAndAnAddedTile) {
     openvdb::initialize();
     const fs::path a = workDir() / "a.vdb", b = workDir() / "b.vdb", c = workDir() / "c.vdb";

@@ -60,6 +60,14 @@ openvdb::GridBase::Ptr buildGrid(const GridRecord& record, const std::string& wh
     // The descriptor is an empty grid of the original type carrying the
     // name, class, transform, background, half-float flag and metadata.
     openvdb::GridBase::Ptr grid = readDescriptor(record.vdbDescriptor, what);
+    if (record.valueType == ValueType::Mask && !grid->isType<openvdb::MaskGrid>()) {
+        // Encoded with --topology-only: a MaskGrid with the original header.
+        openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create();
+        for (auto it = grid->beginMeta(); it != grid->endMeta(); ++it) mask->insertMeta(it->first, *it->second);
+        mask->setTransform(grid->transform().copy());
+        fill(*mask, record);
+        return mask;
+    }
     const bool supported = dispatchMutableGridType(*grid, [&](auto& typed) { fill(typed, record); });
     if (!supported) throw Error(what + ": grid descriptor has unsupported type '" + grid->type() + "'");
     return grid;
