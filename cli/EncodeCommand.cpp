@@ -18,6 +18,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         std::vector<std::string> grids;
         bool noSymmetry = false, noCompress = false, skipUnsupported = false, json = false, topologyOnly = false;
         int placementTrials = 1;
+        double absError = 0, relError = 0;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file into an .ssvdag file");
@@ -29,6 +30,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the smallest (1-64)")->check(CLI::Range(1, 64));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
+    auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error")->check(CLI::PositiveNumber);
+    cmd->add_option("--rel-error", opt->relError, "lossy: every float/double active value within this relative error")->check(CLI::Range(1e-12, 0.5))->excludes(abs);
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     cmd->callback([opt, &exitCode] {
         const auto start = std::chrono::steady_clock::now();
@@ -43,6 +46,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         encodeOptions.symmetry = !opt->noSymmetry;
         encodeOptions.placementTrials = opt->placementTrials;
         encodeOptions.computeSvdagStats = true;  // cheap next to I/O; lets `info` show all three node counts
+        if (opt->absError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Absolute, opt->absError};
+        if (opt->relError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Relative, opt->relError};
         Progress progress("encode", imported.volume.grids.size());
         const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) { progress.set(i); });
         progress.finish();
@@ -57,11 +62,23 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"bytes", bytes.size()}, {"grids", scene.grids.size()},
                               {"active_voxels", voxels}, {"seconds", seconds},
                               {"bits_per_active_voxel", voxels ? 8.0 * double(bytes.size()) / double(voxels) : 0.0}};
+        report["grids_lossy"] = nlohmann::json::array();
+        for (const auto& g : scene.grids) {
+            if (g.lossy.tolerance.mode == attributes::ScalarTolerance::Mode::Exact) continue;
+            report["grids_lossy"].push_back({{"name", g.record.name}, {"tolerance", attributes::describe(g.lossy.tolerance)},
+                                             {"entries", g.lossy.entries}, {"changed", g.lossy.changed}, {"kept_exact", g.lossy.keptExact},
+                                             {"max_abs_error", g.lossy.maxAbsError}, {"mean_abs_error", g.lossy.meanAbsError},
+                                             {"rms_error", g.lossy.rmsError}, {"max_rel_error", g.lossy.maxRelError}});
+        }
         if (opt->json) {
             fmt::print("{}\n", report.dump(2));
         } else {
             fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output,
                        scene.grids.size(), voxels, bytes.size(), report["bits_per_active_voxel"].get<double>(), seconds);
+            for (const auto& l : report["grids_lossy"])
+                fmt::print("  grid '{}' {}: {} of {} values changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
+                           l["name"].get<std::string>(), l["tolerance"].get<std::string>(), l["changed"].get<uint64_t>(), l["entries"].get<uint64_t>(),
+                           l["max_abs_error"].get<double>(), l["mean_abs_error"].get<double>(), l["rms_error"].get<double>(), l["max_rel_error"].get<double>());
         }
         exitCode = 0;
     });

@@ -53,6 +53,10 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
                                      {"palette_blocks", cs.paletteBlocks}, {"direct_blocks", cs.directBlocks}, {"palettes", cs.palettesStored}});
         }
         j["traceable_bytes"] = traceable;
+        if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
+            j["lossy"] = {{"tolerance", attributes::describe(grid.lossy.tolerance)}, {"changed", grid.lossy.changed},
+                          {"max_abs_error", grid.lossy.maxAbsError}, {"mean_abs_error", grid.lossy.meanAbsError},
+                          {"rms_error", grid.lossy.rmsError}, {"max_rel_error", grid.lossy.maxRelError}};
         j["bits_per_active_voxel"] = grid.activeVoxels ? 8.0 * double(gridBytes) / double(grid.activeVoxels) : 0.0;
         report["grids"].push_back(j);
     }
@@ -87,6 +91,10 @@ std::string formatSceneReport(const nlohmann::json& r) {
                                c["layer"].get<std::string>(), c["entries"].get<uint64_t>(), c["unique"].get<uint64_t>(), c["raw_bytes"].get<uint64_t>(),
                                c["material_index_bytes"].get<uint64_t>(), c["palette_bytes"].get<uint64_t>(), c["palette_blocks"].get<uint64_t>(),
                                c["direct_blocks"].get<uint64_t>(), c["palettes"].get<uint64_t>());
+        if (g.contains("lossy"))
+            out += fmt::format("  lossy values ({}): {} changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
+                               g["lossy"]["tolerance"].get<std::string>(), g["lossy"]["changed"].get<uint64_t>(), g["lossy"]["max_abs_error"].get<double>(),
+                               g["lossy"]["mean_abs_error"].get<double>(), g["lossy"]["rms_error"].get<double>(), g["lossy"]["max_rel_error"].get<double>());
         out += fmt::format("  total {} bytes in file ({:.4f} bits/active voxel), {} bytes traceable in memory\n", g["stored_bytes"].get<uint64_t>(),
                            g["bits_per_active_voxel"].get<double>(), g["traceable_bytes"].get<uint64_t>());
     }

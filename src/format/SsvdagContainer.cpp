@@ -111,6 +111,7 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::InactiveInner: return "InactiveInner";
         case SectionKind::InactiveLeaves: return "InactiveLeaves";
         case SectionKind::InactiveValues: return "InactiveValues";
+        case SectionKind::ValueErrors: return "ValueErrors";
     }
     return "unknown";
 }

@@ -28,6 +28,7 @@ enum class SectionKind : uint32_t {
     InactiveInner = 10,
     InactiveLeaves = 11,
     InactiveValues = 12,
+    ValueErrors = 13,   // per grid, lossy encodings only: the tolerance and the measured errors
 };
 const char* sectionKindName(SectionKind kind);
 

@@ -13,6 +13,8 @@
 //   Values        the active values in attribute order as a palette channel
 //                 (serializePalette in src/attributes/PaletteChannel.cpp)
 //   Inactive*     the same four for the inactive layer (absent if empty)
+//   ValueErrors   lossy only: u8 mode, f64 bound, u64 entries, changed, kept
+//                 exact, f64 max abs, mean abs, RMS, max relative error
 // Strings are u32 length + bytes. Everything little-endian (ByteIO.h).
 #include "src/format/SsvdagFile.h"
 
@@ -93,6 +95,15 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
         const unsigned vs = valueSize(grid.record.valueType);
         putLayer(sections, g, kActive, grid.dag, grid.values, vs);
         if (!grid.inactiveDag.empty()) putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveValues, vs);
+        if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact) {
+            ByteWriter e;
+            const auto& l = grid.lossy;
+            e.put<uint8_t>(uint8_t(l.tolerance.mode));
+            e.put<double>(l.tolerance.bound);
+            for (uint64_t v : {l.entries, l.changed, l.keptExact}) e.put<uint64_t>(v);
+            for (double v : {l.maxAbsError, l.meanAbsError, l.rmsError, l.maxRelError}) e.put<double>(v);
+            sections.push_back({SectionKind::ValueErrors, g, e.take()});
+        }
         ByteWriter stats;
         const DagStats& st = grid.stats;
         stats.put<uint32_t>(uint32_t(st.svoNodes.size()));
@@ -196,6 +207,22 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         readLayer(kActive, grid.dag, grid.attributes, grid.values, grid.activeVoxels, "active");
         if (grid.inactiveVoxels || find(g, kInactive.levels, false))
             readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveValues, grid.inactiveVoxels, "inactive");
+        if (Section* e = find(g, SectionKind::ValueErrors, false)) {
+            ByteReader r(e->data, what + " ValueErrors");
+            auto& l = grid.lossy;
+            const uint8_t mode = r.get<uint8_t>();
+            if (mode > 2) r.fail("unknown tolerance mode");
+            l.tolerance.mode = attributes::ScalarTolerance::Mode(mode);
+            l.tolerance.bound = r.get<double>();
+            l.entries = r.get<uint64_t>();
+            l.changed = r.get<uint64_t>();
+            l.keptExact = r.get<uint64_t>();
+            l.maxAbsError = r.get<double>();
+            l.meanAbsError = r.get<double>();
+            l.rmsError = r.get<double>();
+            l.maxRelError = r.get<double>();
+            r.expectEnd();
+        }
         if (Section* st = find(g, SectionKind::DagStats, false)) {
             ByteReader r(st->data, what + " DagStats");
             const uint32_t n = r.get<uint32_t>();

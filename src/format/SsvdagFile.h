@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "src/attributes/PaletteChannel.h"
+#include "src/attributes/ScalarTolerance.h"
 #include "src/encoding/CompactDag.h"
 #include "src/format/SsvdagContainer.h"
 #include "src/volume/GridRecord.h"
@@ -28,6 +29,7 @@ struct EncodedGrid {
     encoding::CompactDag dag;
     std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
     attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout
+    attributes::ToleranceReport lossy;  // what a lossy setting changed (mode Exact: nothing)
     DagStats stats;
     // Inactive voxels/tiles whose value differs from the background.
     uint64_t inactiveVoxels = 0;

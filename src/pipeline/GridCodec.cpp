@@ -101,6 +101,7 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
     if (!grid.topology.empty()) {
         out.dag = encodeLayer(grid.topology, options, vs > 0, &out.stats);
         out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
+        out.lossy = attributes::applyScalarTolerance(out.attributes, grid.valueType, options.tolerance);
         out.values = attributes::compressPalette(out.attributes, vs);
     }
     out.inactiveVoxels = grid.inactiveTopology.activeVoxelCount();

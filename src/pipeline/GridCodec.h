@@ -3,6 +3,7 @@
 #pragma once
 #include <functional>
 
+#include "src/attributes/ScalarTolerance.h"
 #include "src/format/SsvdagFile.h"
 #include "src/volume/GridRecord.h"
 
@@ -14,6 +15,9 @@ struct EncodeOptions {
     // Try this many root placements (DESIGN.md invariant 1) and keep the
     // smallest encoding; 1 = the bounding box's aligned minimum only.
     int placementTrials = 1;
+    // Lossy scalar values (float/double active values only; inactive values
+    // and other types stay exact). The report lands in EncodedGrid::lossy.
+    attributes::ScalarTolerance tolerance;
 };
 
 format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options = {});
