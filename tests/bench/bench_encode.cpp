@@ -135,4 +135,5 @@ BENCHMARK(BM_ReduceOnly_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->Us
 BENCHMARK(BM_ReduceOnlyOneCore_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_ReduceOnlyPlain_Sphere)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 
+// BENCHMARK_MAIN lives here; the other bench_*.cpp files only register.
 BENCHMARK_MAIN();
