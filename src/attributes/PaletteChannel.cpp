@@ -275,9 +275,11 @@ private:
             }
             double bestCost = (8.0 * vs_ * double(lengthFor[8]) + kDirectoryBits) / double(lengthFor[8]);
             Segment best{start, lengthFor[8], PaletteBlock::kDirect};
-            {   // indices straight into the material array, over the longest block considered
+            {   // indices straight into the material array, over the longest block considered; the
+                // material share is extrapolated from the scanned prefix (an exact sum would rescan)
                 const uint64_t len = stop - start;
-                const double bits = double(len) * materialBits_ + kDirectoryBits + materialShare(start, stop);
+                const double share = shareUpTo[8] / double(lengthFor[8]) * double(len);
+                const double bits = double(len) * materialBits_ + kDirectoryBits + share;
                 if (bits / double(len) < bestCost) { bestCost = bits / double(len); best = {start, len, kWhole}; }
             }
             for (unsigned omega = 0; omega <= 8; ++omega) {
