@@ -48,13 +48,21 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         encodeOptions.computeSvdagStats = true;  // cheap next to I/O; lets `info` show all three node counts
         if (opt->absError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Absolute, opt->absError};
         if (opt->relError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Relative, opt->relError};
-        Progress progress("encode", imported.volume.grids.size());
-        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) { progress.set(i); });
-        progress.finish();
+        Progress progress("encode", imported.volume.grids.size() * pipeline::kEncodeSteps + 1);
+        std::string gridName;
+        encodeOptions.onStep = [&](const char* step) {
+            progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
+            progress.advance();
+        };
+        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) {
+            gridName = imported.volume.grids[i].name;
+        });
+        progress.setLabel("encode: writing " + opt->output);
         format::ContainerOptions containerOptions;
         containerOptions.compress = !opt->noCompress;
         const std::vector<uint8_t> bytes = format::writeScene(scene, containerOptions);
         writeFileAtomically(opt->output, bytes);
+        progress.finish();
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
         uint64_t voxels = 0;

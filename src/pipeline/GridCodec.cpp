@@ -97,14 +97,19 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
     out.record.inactiveValues = {};
     out.symmetry = options.symmetry;
     const unsigned vs = valueSize(grid.valueType);
+    auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };
     out.activeVoxels = grid.topology.activeVoxelCount();
+    step("reducing the DAG");
+    if (!grid.topology.empty()) out.dag = encodeLayer(grid.topology, options, vs > 0, &out.stats);
+    step("ordering values");
     if (!grid.topology.empty()) {
-        out.dag = encodeLayer(grid.topology, options, vs > 0, &out.stats);
         out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
         out.lossy = attributes::applyScalarTolerance(out.attributes, grid.valueType, options.tolerance);
-        out.values = attributes::compressPalette(out.attributes, vs);
     }
+    step("palette compression");
+    if (!grid.topology.empty()) out.values = attributes::compressPalette(out.attributes, vs);
     out.inactiveVoxels = grid.inactiveTopology.activeVoxelCount();
+    step("inactive values");
     if (!grid.inactiveTopology.empty()) {
         out.inactiveDag = encodeLayer(grid.inactiveTopology, options, vs > 0, nullptr);
         out.inactiveAttributes = gatherAttributes(out.inactiveDag, grid.inactiveTopology, grid.inactiveValues, vs);

@@ -18,7 +18,10 @@ struct EncodeOptions {
     // Lossy scalar values (float/double active values only; inactive values
     // and other types stay exact). The report lands in EncodedGrid::lossy.
     attributes::ScalarTolerance tolerance;
+    // Called as each step of a grid starts (kEncodeSteps per grid), for progress.
+    std::function<void(const char* step)> onStep;
 };
+inline constexpr int kEncodeSteps = 4;
 
 format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options = {});
 GridRecord decodeGrid(const format::EncodedGrid& grid);

@@ -26,6 +26,15 @@ void Progress::set(uint64_t done) {
     draw(false);
 }
 
+void Progress::setLabel(std::string label) {
+    if (!enabled_) return;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        label_ = std::move(label);
+    }
+    draw(true);
+}
+
 void Progress::draw(bool force) {
     if (!enabled_) return;
     std::lock_guard<std::mutex> lock(mutex_);
@@ -38,7 +47,7 @@ void Progress::draw(bool force) {
     char bar[21];
     for (int i = 0; i < 20; ++i) bar[i] = i < percent / 5 ? '#' : '.';
     bar[20] = 0;
-    std::fprintf(stderr, "\r%s %3d%% [%s] %llu/%llu", label_.c_str(), percent, bar, (unsigned long long)done, (unsigned long long)total_);
+    std::fprintf(stderr, "\r\033[K%s %3d%% [%s]", label_.c_str(), percent, bar);
     std::fflush(stderr);
 }
 

@@ -17,6 +17,7 @@ public:
     void advance(uint64_t n = 1);
     void set(uint64_t done);
     void finish();
+    void setLabel(std::string label);  // e.g. the current step
 
     static void setQuiet(bool quiet);  // e.g. for --json output
 
