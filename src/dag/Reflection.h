@@ -30,11 +30,6 @@ constexpr uint64_t reflectBrick(uint64_t mask, unsigned m) {
     return mask;
 }
 
-// Mirrors a local cell coordinate c in [0, size) along the axes set in m.
-constexpr unsigned mirrorCell(unsigned m, unsigned axisBit, unsigned c, unsigned size) {
-    return (m & axisBit) ? size - 1 - c : c;
-}
-
 // A set of reflections that leaves a node unchanged is a subgroup G; a child
 // tag t is then only defined modulo G. canonicalTag(t, G) = min{t ^ g : g in G}
 // picks one representative of the coset so equal geometry compares equal.
