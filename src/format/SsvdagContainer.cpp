@@ -1,35 +1,61 @@
-// The .ssvdag container (see SsvdagContainer.h). Byte layout, little-endian:
+// The .ssvdag container (see SsvdagContainer.h). Byte layout, little-endian,
+// offsets from the start of the file:
 //
-//   offset  size  field
-//   0       8     magic "\x89SSVDAG\n" (a high byte and a newline, like PNG's,
-//                 so text-mode transfers and 7-bit channels are detected)
-//   8       4     u32 format version (kFormatVersion)
-//   12      4     u32 section count N
-//   16      48*N  section table, one entry per section:
-//                   u32 kind, u32 grid, u32 codec (0 raw, 1 zstd), u32 reserved (0),
-//                   u64 payload offset (from the start of the file),
-//                   u64 stored size (bytes in the file), u64 raw size (bytes restored),
-//                   u64 xxh3-64 of the stored bytes
-//   16+48N  8     u64 xxh3-64 of bytes [0, 16+48N): header and table
-//   ...           payloads, in table order, without gaps
+//   offset   size  field
+//   0        8     magic 89 53 53 56 44 41 47 0A  ("\x89SSVDAG\n"): the high
+//                  first byte catches 7-bit channels and text sniffing, the
+//                  final LF catches CRLF / LF translation, as in PNG
+//   8        4     u32 format version (1)
+//   12       4     u32 section count N
+//   16       48*N  section table; entry i starts at 16 + 48*i:
+//                    +0   u32 kind (SectionKind)
+//                    +4   u32 grid index (0 for file-level sections)
+//                    +8   u32 codec: 0 = raw, 1 = zstd (one frame with its
+//                                    content size in the frame header)
+//                    +12  u32 reserved, 0
+//                    +16  u64 payload offset (from the start of the file)
+//                    +24  u64 stored size (bytes in the file)
+//                    +32  u64 raw size (bytes once restored)
+//                    +40  u64 xxh3-64 (XXH3_64bits, seed 0) of the stored bytes
+//   16+48N   8     u64 xxh3-64 of bytes [0, 16+48N): header and table
+//   24+48N   ...   payloads, in table order, back to back: payload 0 starts
+//                  at 24+48N, payload i+1 where payload i ends, and the last
+//                  one ends at the end of the file
 //
-// The reader checks, in this order and before using any of it: the magic,
-// the version, that the table fits the file, the table checksum, every
-// payload's bounds (overflow-safe) and that payloads neither overlap nor
-// leave gaps, each payload's checksum, the raw size against what the codec
-// can produce from the stored size, and finally that zstd restores exactly
-// the raw size. So a truncated or corrupted file gets a one-line error, and
-// no allocation exceeds what the file's own size justifies.
+// Every byte of a file is therefore covered by the magic, the table checksum
+// or one payload checksum, so any corruption is detected.
+//
+// Writer: with ContainerOptions::compress a section of more than 64 bytes is
+// zstd-compressed at options.zstdLevel (sections over 4 MiB at
+// min(level, 3) on two worker threads, so value channels do not dominate the
+// encode time) and kept raw when zstd does not make it smaller.
+//
+// Reader, in this order and before using any of it: the magic; the version;
+// that the table for N sections fits the file; the table checksum; per entry
+// the codec, the reserved field, the payload bounds (overflow-safe), that the
+// payload starts exactly where the previous one ended (no overlap, no gap),
+// the raw size against what the codec can produce from the stored size (raw
+// == stored for raw; raw <= stored * 2^16 + 4096 for zstd); that nothing
+// follows the last payload. Then per section: the payload checksum, and for
+// zstd that the payload is exactly one frame declaring the raw size, before
+// allocating the raw size and decompressing into it, and that decompression
+// yields exactly that many bytes. Each failure is a vdbdag::Error with a
+// one-line message starting with the source name; no allocation exceeds what
+// the file's own size justifies through these bounds.
 #include "src/format/SsvdagContainer.h"
 
-#include <bit>
+#include <algorithm>
+#include <cerrno>
 #include <cstring>
-#include <fstream>
+#include <fcntl.h>
 #include <limits>
+#include <memory>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <xxhash.h>
 #include <zstd.h>
+#include <zstd_errors.h>
 
 #include "src/format/ByteIO.h"
 #include "src/util/Error.h"
@@ -37,62 +63,165 @@
 namespace vdbdag::format {
 namespace {
 
-static_assert(std::endian::native == std::endian::little, "the .ssvdag reader and writer assume a little-endian host");
-
 constexpr uint8_t kMagic[8] = {0x89, 'S', 'S', 'V', 'D', 'A', 'G', '\n'};
 constexpr uint32_t kFormatVersion = 1;
-constexpr size_t kHeaderBytes = 16;
-constexpr size_t kEntryBytes = 48;
+constexpr uint64_t kHeaderBytes = 16;
+constexpr uint64_t kEntryBytes = 48;
+constexpr uint64_t kChecksumBytes = 8;
 constexpr uint32_t kCodecRaw = 0, kCodecZstd = 1;
-// zstd cannot expand data by more than this factor (RLE blocks of 128 KiB
-// cost a few bytes each); a claim beyond it is a corrupt table.
+// zstd cannot expand data by more than this factor (a 128 KiB RLE block costs
+// 4 bytes, a 128 KiB single-match block about 8); a claim beyond it is a
+// corrupt or forged table.
 constexpr uint64_t kMaxZstdRatio = uint64_t(1) << 16;
+constexpr uint64_t kMaxZstdSlack = 4096;
+constexpr size_t kMinBytesToCompress = 64;
+constexpr size_t kLargeSection = size_t(4) << 20;
 
 struct Entry {
     uint32_t kind, grid, codec, reserved;
     uint64_t offset, stored, raw, checksum;
 };
 
-struct ParsedTable {
-    std::vector<Entry> entries;
-};
+std::string num(uint64_t v) { return std::to_string(v); }
 
-ParsedTable parseTable(std::span<const uint8_t> bytes, const std::string& name) {
-    auto fail = [&](const std::string& why) -> void { throw Error(name + ": " + why); };
-    if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
+// "section 3 ('DagInner' of grid 0)"; unknown kinds by number.
+std::string describe(size_t index, uint32_t kind, uint32_t grid) {
+    const char* name = sectionKindName(SectionKind(kind));
+    std::string text = "section " + num(index) + " (";
+    if (std::strcmp(name, "unknown") == 0) {
+        text += "kind ";
+        text += num(kind);
+    } else {
+        text += '\'';
+        text += name;
+        text += '\'';
+    }
+    text += " of grid ";
+    text += num(grid);
+    text += ')';
+    return text;
+}
+
+std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string& name) {
+    auto fail = [&](const std::string& why) { throw Error(name + ": " + why); };
+    const uint64_t size = bytes.size();
+    if (size < sizeof(kMagic)) {
+        // A prefix of the magic is a truncated file; anything else is not ours.
+        if (size == 0 || std::memcmp(bytes.data(), kMagic, size) == 0)  // (no memcmp on a null pointer)
+            fail("truncated: the file has " + num(size) + " bytes, the header alone needs " + num(kHeaderBytes + kChecksumBytes));
         fail("not an .ssvdag file (bad magic)");
-    if (bytes.size() < kHeaderBytes) fail("truncated: the header needs " + std::to_string(kHeaderBytes) + " bytes, the file has " + std::to_string(bytes.size()));
+    }
+    if (std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
+        if (std::memcmp(bytes.data() + 1, kMagic + 1, 6) == 0 && bytes[7] == '\r')
+            fail("not an .ssvdag file (bad magic: line endings were translated, copy it in binary mode)");
+        fail("not an .ssvdag file (bad magic)");
+    }
+    if (size < kHeaderBytes + kChecksumBytes)
+        fail("truncated: the file has " + num(size) + " bytes, the header alone needs " + num(kHeaderBytes + kChecksumBytes));
     ByteReader header(bytes.subspan(8, 8), name);
     const uint32_t version = header.get<uint32_t>();
     const uint32_t count = header.get<uint32_t>();
     if (version != kFormatVersion)
-        fail("unsupported format version " + std::to_string(version) + " (this vdbdag reads version " + std::to_string(kFormatVersion) + ")");
+        fail("unsupported format version " + num(version) + " (this vdbdag reads version " + num(kFormatVersion) + ")");
+    // count < 2^32, so this cannot overflow.
     const uint64_t tableEnd = kHeaderBytes + uint64_t(count) * kEntryBytes;
-    if (tableEnd + 8 > bytes.size())
-        fail("truncated: the section table of " + std::to_string(count) + " sections needs " + std::to_string(tableEnd + 8) + " bytes, the file has " + std::to_string(bytes.size()));
-    ByteReader tail(bytes.subspan(tableEnd, 8), name);
-    if (tail.get<uint64_t>() != XXH3_64bits(bytes.data(), tableEnd)) fail("checksum mismatch in the section table: the file is corrupted");
+    if (tableEnd + kChecksumBytes > size)
+        fail("truncated: the table of " + num(count) + " sections ends at byte " + num(tableEnd + kChecksumBytes) + " but the file has " +
+             num(size) + " bytes");
+    ByteReader tail(bytes.subspan(tableEnd, kChecksumBytes), name);
+    if (tail.get<uint64_t>() != XXH3_64bits(bytes.data(), tableEnd))
+        fail("checksum mismatch in the header or section table: the file is corrupted");
 
-    ParsedTable table;
+    std::vector<Entry> entries;
+    entries.reserve(count);  // bounded by size / 48 above
     ByteReader r(bytes.subspan(kHeaderBytes, tableEnd - kHeaderBytes), name);
-    uint64_t expectedOffset = tableEnd + 8;
+    uint64_t expectedOffset = tableEnd + kChecksumBytes;
     for (uint32_t i = 0; i < count; ++i) {
-        Entry e{r.get<uint32_t>(), r.get<uint32_t>(), r.get<uint32_t>(), r.get<uint32_t>(),
-                r.get<uint64_t>(), r.get<uint64_t>(), r.get<uint64_t>(), r.get<uint64_t>()};
-        const std::string what = "section " + std::to_string(i) + " ('" + sectionKindName(SectionKind(e.kind)) + "' of grid " + std::to_string(e.grid) + ")";
-        if (e.codec != kCodecRaw && e.codec != kCodecZstd) fail(what + " has unknown codec " + std::to_string(e.codec));
-        if (e.reserved != 0) fail(what + " has a non-zero reserved field");
-        if (e.offset != expectedOffset) fail(what + " starts at byte " + std::to_string(e.offset) + ", expected " + std::to_string(expectedOffset));
-        if (e.stored > bytes.size() || e.offset > bytes.size() - e.stored)
-            fail("truncated: " + what + " ends past byte " + std::to_string(bytes.size()) + ", the end of the file");
-        if (e.codec == kCodecRaw && e.raw != e.stored) fail(what + " claims " + std::to_string(e.raw) + " raw bytes for " + std::to_string(e.stored) + " stored raw bytes");
-        if (e.codec == kCodecZstd && e.raw > e.stored * kMaxZstdRatio + 4096)
-            fail(what + " claims " + std::to_string(e.raw) + " bytes from " + std::to_string(e.stored) + " compressed bytes, which zstd cannot produce");
-        expectedOffset = e.offset + e.stored;
-        table.entries.push_back(e);
+        Entry e{};
+        e.kind = r.get<uint32_t>();
+        e.grid = r.get<uint32_t>();
+        e.codec = r.get<uint32_t>();
+        e.reserved = r.get<uint32_t>();
+        e.offset = r.get<uint64_t>();
+        e.stored = r.get<uint64_t>();
+        e.raw = r.get<uint64_t>();
+        e.checksum = r.get<uint64_t>();
+        const std::string what = describe(i, e.kind, e.grid);
+        if (e.codec != kCodecRaw && e.codec != kCodecZstd) fail(what + " has unknown codec " + num(e.codec));
+        if (e.reserved != 0) fail(what + " has a non-zero reserved field " + num(e.reserved));
+        if (e.offset > size) fail("truncated: " + what + " starts at byte " + num(e.offset) + " but the file has " + num(size) + " bytes");
+        if (e.stored > std::numeric_limits<uint64_t>::max() - e.offset)
+            fail(what + " claims an impossible size of " + num(e.stored) + " bytes at byte " + num(e.offset));
+        const uint64_t end = e.offset + e.stored;
+        if (end > size) fail("truncated: " + what + " ends at byte " + num(end) + " but the file has " + num(size) + " bytes");
+        if (e.offset < expectedOffset) {
+            if (e.offset < tableEnd + kChecksumBytes)
+                fail(what + " starts at byte " + num(e.offset) + ", inside the header and table that end at byte " + num(tableEnd + kChecksumBytes));
+            fail(what + " starts at byte " + num(e.offset) + " and overlaps section " + num(i - 1) + " which ends at byte " + num(expectedOffset));
+        }
+        if (e.offset > expectedOffset)
+            fail(what + " starts at byte " + num(e.offset) + ", leaving " + num(e.offset - expectedOffset) + " unaccounted bytes after byte " +
+                 num(expectedOffset));
+        if (e.codec == kCodecRaw && e.raw != e.stored)
+            fail(what + " claims " + num(e.raw) + " raw bytes for " + num(e.stored) + " bytes stored uncompressed");
+        // e.stored <= size < 2^48 in practice, but stay overflow-safe anyway.
+        if (e.codec == kCodecZstd &&
+            (e.stored > (std::numeric_limits<uint64_t>::max() - kMaxZstdSlack) / kMaxZstdRatio || e.raw > e.stored * kMaxZstdRatio + kMaxZstdSlack))
+            fail(what + " claims " + num(e.raw) + " bytes from " + num(e.stored) + " compressed bytes, which zstd cannot produce");
+        expectedOffset = end;
+        entries.push_back(e);
     }
-    if (expectedOffset != bytes.size()) fail(std::to_string(bytes.size() - expectedOffset) + " unexpected bytes after the last section");
-    return table;
+    if (expectedOffset != size) fail(num(size - expectedOffset) + " unexpected bytes after the last section (at byte " + num(expectedOffset) + ")");
+    return entries;
+}
+
+std::vector<uint8_t> restore(const Entry& e, std::span<const uint8_t> stored, const std::string& what) {
+    if (XXH3_64bits(stored.data(), stored.size()) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
+    if (e.codec == kCodecRaw) return std::vector<uint8_t>(stored.begin(), stored.end());
+    const size_t frameBytes = ZSTD_findFrameCompressedSize(stored.data(), stored.size());
+    if (ZSTD_isError(frameBytes)) throw Error(what + ": corrupted zstd frame (" + ZSTD_getErrorName(frameBytes) + ")");
+    if (frameBytes != stored.size())
+        throw Error(what + ": the zstd frame takes " + num(frameBytes) + " of the section's " + num(stored.size()) + " bytes, the file is corrupted");
+    const unsigned long long declared = ZSTD_getFrameContentSize(stored.data(), stored.size());
+    if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN)
+        throw Error(what + ": the zstd frame does not declare its size, the file is corrupted");
+    if (declared != e.raw)
+        throw Error(what + ": the zstd frame declares " + num(declared) + " bytes but the table " + num(e.raw) + ", the file is corrupted");
+    std::vector<uint8_t> data(e.raw);  // raw <= stored * 2^16 + 4096 (parseTable)
+    const size_t n = ZSTD_decompress(data.data(), data.size(), stored.data(), stored.size());
+    if (ZSTD_isError(n)) throw Error(what + ": corrupted zstd data (" + ZSTD_getErrorName(n) + ")");
+    if (n != e.raw) throw Error(what + ": zstd restored " + num(n) + " bytes instead of " + num(e.raw) + ", the file is corrupted");
+    return data;
+}
+
+// Compresses `data` into `out`; returns false (leaving `out` empty) when zstd
+// does not make it smaller.
+bool compressSection(std::span<const uint8_t> data, const ContainerOptions& options, std::vector<uint8_t>& out) {
+    struct CCtxDeleter {
+        void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
+    };
+    std::unique_ptr<ZSTD_CCtx, CCtxDeleter> cctx(ZSTD_createCCtx());
+    if (!cctx) throw Error("zstd compression failed: out of memory");
+    const bool large = data.size() > kLargeSection;
+    const int level = large ? std::min(options.zstdLevel, 3) : options.zstdLevel;
+    auto check = [](size_t r) {
+        if (ZSTD_isError(r)) throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(r));
+    };
+    check(ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, level));
+    check(ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_contentSizeFlag, 1));  // the reader requires the frame content size
+    if (large) ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_nbWorkers, 2);  // fails harmlessly if libzstd lacks threads
+    // A destination one byte smaller than the input: if zstd cannot fit there
+    // it does not shrink the data, and we keep it raw without a full-size bound.
+    out.resize(data.size() - 1);
+    const size_t n = ZSTD_compress2(cctx.get(), out.data(), out.size(), data.data(), data.size());
+    if (ZSTD_isError(n)) {
+        out.clear();
+        out.shrink_to_fit();
+        if (ZSTD_getErrorCode(n) == ZSTD_error_dstSize_tooSmall) return false;
+        check(n);
+    }
+    out.resize(n);
+    return true;
 }
 
 } // namespace
@@ -117,36 +246,27 @@ const char* sectionKindName(SectionKind kind) {
 }
 
 std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const ContainerOptions& options) {
-    std::vector<std::vector<uint8_t>> stored(sections.size());
+    if (sections.size() > std::numeric_limits<uint32_t>::max()) throw Error("too many sections for one .ssvdag file: " + num(sections.size()));
+    std::vector<std::vector<uint8_t>> packed(sections.size());
+    std::vector<std::span<const uint8_t>> stored(sections.size());
     std::vector<uint32_t> codec(sections.size(), kCodecRaw);
     for (size_t i = 0; i < sections.size(); ++i) {
         const auto& data = sections[i].data;
-        if (options.compress && data.size() > 64) {
-            // Large sections (value channels) use a faster level on two
-            // threads: level 9 on 100 MB would dominate the encode time.
-            std::vector<uint8_t> packed(ZSTD_compressBound(data.size()));
-            ZSTD_CCtx* cctx = ZSTD_createCCtx();
-            const bool large = data.size() > (size_t(4) << 20);
-            ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, large ? std::min(options.zstdLevel, 3) : options.zstdLevel);
-            ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
-            if (large) ZSTD_CCtx_setParameter(cctx, ZSTD_c_nbWorkers, 2);  // ignored if libzstd lacks threads
-            const size_t n = ZSTD_compress2(cctx, packed.data(), packed.size(), data.data(), data.size());
-            ZSTD_freeCCtx(cctx);
-            if (ZSTD_isError(n)) throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(n));
-            if (n < data.size()) {
-                packed.resize(n);
-                stored[i] = std::move(packed);
-                codec[i] = kCodecZstd;
-                continue;
-            }
-        }
         stored[i] = data;
+        if (options.compress && data.size() > kMinBytesToCompress && compressSection(data, options, packed[i])) {
+            stored[i] = packed[i];
+            codec[i] = kCodecZstd;
+        }
     }
+    const uint64_t tableEnd = kHeaderBytes + sections.size() * kEntryBytes;
+    uint64_t total = tableEnd + kChecksumBytes;
+    for (const auto& s : stored) total += s.size();
     ByteWriter w;
+    w.bytes().reserve(total);
     w.putBytes(std::span<const uint8_t>(kMagic, sizeof(kMagic)));
     w.put<uint32_t>(kFormatVersion);
     w.put<uint32_t>(uint32_t(sections.size()));
-    uint64_t offset = kHeaderBytes + sections.size() * kEntryBytes + 8;
+    uint64_t offset = tableEnd + kChecksumBytes;
     for (size_t i = 0; i < sections.size(); ++i) {
         w.put<uint32_t>(uint32_t(sections[i].kind));
         w.put<uint32_t>(sections[i].grid);
@@ -165,45 +285,65 @@ std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const 
 
 std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, const std::string& sourceName) {
     std::vector<SectionSummary> out;
-    for (const Entry& e : parseTable(bytes, sourceName).entries)
-        out.push_back({SectionKind(e.kind), e.grid, e.codec == kCodecZstd, e.stored, e.raw});
+    const std::vector<Entry> entries = parseTable(bytes, sourceName);
+    out.reserve(entries.size());
+    for (const Entry& e : entries) out.push_back({SectionKind(e.kind), e.grid, e.codec == kCodecZstd, e.stored, e.raw});
     return out;
 }
 
 std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName) {
-    const ParsedTable table = parseTable(bytes, sourceName);
+    const std::vector<Entry> entries = parseTable(bytes, sourceName);
     std::vector<Section> sections;
-    sections.reserve(table.entries.size());
-    for (size_t i = 0; i < table.entries.size(); ++i) {
-        const Entry& e = table.entries[i];
-        const std::string what = sourceName + ": section " + std::to_string(i) + " ('" + sectionKindName(SectionKind(e.kind)) + "' of grid " + std::to_string(e.grid) + ")";
-        const uint8_t* payload = bytes.data() + e.offset;
-        if (XXH3_64bits(payload, e.stored) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
-        Section s{SectionKind(e.kind), e.grid, {}};
-        if (e.codec == kCodecRaw) {
-            s.data.assign(payload, payload + e.stored);
-        } else {
-            const unsigned long long frameSize = ZSTD_getFrameContentSize(payload, e.stored);
-            if (frameSize == ZSTD_CONTENTSIZE_ERROR || frameSize == ZSTD_CONTENTSIZE_UNKNOWN || frameSize != e.raw)
-                throw Error(what + ": the zstd frame does not declare the expected " + std::to_string(e.raw) + " bytes");
-            s.data.resize(e.raw);
-            const size_t n = ZSTD_decompress(s.data.data(), s.data.size(), payload, e.stored);
-            if (ZSTD_isError(n) || n != e.raw) throw Error(what + ": zstd data is corrupted");
-        }
-        sections.push_back(std::move(s));
+    sections.reserve(entries.size());
+    for (size_t i = 0; i < entries.size(); ++i) {
+        const Entry& e = entries[i];
+        const std::string what = sourceName + ": " + describe(i, e.kind, e.grid);
+        sections.push_back({SectionKind(e.kind), e.grid, restore(e, bytes.subspan(e.offset, e.stored), what)});
     }
     return sections;
 }
 
 std::vector<uint8_t> readFileBytes(const std::string& path) {
+    auto fail = [&](const std::string& why, int err) { throw Error(path + ": " + why + " (" + std::strerror(err) + ")"); };
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+        const int err = errno;
+        if (err == ENOENT || err == ENOTDIR) throw Error(path + ": no such file");
+        fail("cannot be opened for reading", err);
+    }
+    struct Closer {
+        int fd;
+        ~Closer() { ::close(fd); }
+    } closer{fd};
     struct stat st{};
-    if (stat(path.c_str(), &st) != 0) throw Error(path + ": no such file");
+    if (::fstat(fd, &st) != 0) fail("cannot be read", errno);
     if (S_ISDIR(st.st_mode)) throw Error(path + ": is a directory, not a file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path + ": cannot be opened for reading");
-    std::vector<uint8_t> bytes(size_t(st.st_size));
-    if (!bytes.empty() && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
-        throw Error(path + ": read error");
+    // Regular files: their size up front, then read on until the end in case
+    // the file grew; pipes and devices: chunks until the end.
+    std::vector<uint8_t> bytes(S_ISREG(st.st_mode) ? size_t(st.st_size) : 0);
+    size_t done = 0;
+    for (;;) {
+        if (done == bytes.size()) {
+            uint8_t probe[1 << 12];
+            const ssize_t n = ::read(fd, probe, sizeof(probe));
+            if (n < 0) {
+                if (errno == EINTR) continue;
+                fail("read error", errno);
+            }
+            if (n == 0) break;
+            bytes.insert(bytes.end(), probe, probe + n);
+            done += size_t(n);
+            continue;
+        }
+        const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            fail("read error", errno);
+        }
+        if (n == 0) break;  // shrank while reading
+        done += size_t(n);
+    }
+    bytes.resize(done);
     return bytes;
 }
 

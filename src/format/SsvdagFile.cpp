@@ -39,7 +39,7 @@ std::vector<T> fromRawBytes(const std::vector<uint8_t>& bytes, uint64_t expected
     if (bytes.size() % sizeof(T) != 0 || bytes.size() / sizeof(T) != expectedCount)
         throw Error(what + ": holds " + std::to_string(bytes.size()) + " bytes, expected " + std::to_string(expectedCount * sizeof(T)));
     std::vector<T> values(expectedCount);
-    std::memcpy(values.data(), bytes.data(), bytes.size());
+    if (!bytes.empty()) std::memcpy(values.data(), bytes.data(), bytes.size());
     return values;
 }
 

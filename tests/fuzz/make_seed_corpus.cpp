@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
@@ -25,6 +26,25 @@ int main(int argc, char** argv) {
         const auto bytes = format::writeScene(scene, options);
         std::ofstream(std::string(argv[1]) + "/seed" + std::to_string(n++) + ".ssvdag", std::ios::binary)
             .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
+    // Bare containers: no sections, and a few sections (empty, compressible,
+    // incompressible, an unknown kind), zstd and raw.
+    std::vector<format::Section> bare;
+    bare.push_back({format::SectionKind::FileInfo, 0, {}});
+    bare.push_back({format::SectionKind::DagInner, 1, std::vector<uint8_t>(1500, 0x5A)});
+    std::vector<uint8_t> noise(200);
+    uint32_t x = 12345;
+    for (auto& b : noise) b = uint8_t((x = x * 1664525u + 1013904223u) >> 24);
+    bare.push_back({format::SectionKind::DagLeaves, 1, noise});
+    bare.push_back({format::SectionKind(99), 2, {1, 2, 3}});
+    for (const auto& list : {std::vector<format::Section>{}, bare}) {
+        for (bool compress : {true, false}) {
+            format::ContainerOptions options;
+            options.compress = compress;
+            const auto bytes = format::writeContainer(list, options);
+            std::ofstream(std::string(argv[1]) + "/container" + std::to_string(n++) + ".ssvdag", std::ios::binary)
+                .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        }
     }
     // The same scene in the checksum-free section framing of fuzz_ssvdag_sections.
     if (argc > 2) {

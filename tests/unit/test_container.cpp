@@ -1,12 +1,25 @@
-// The .ssvdag reader against truncated, corrupted and forged files: every
-// prefix and every single-byte change of a real file must give vdbdag::Error
-// (never a crash, a hang or a huge allocation); atomic writes leave nothing
-// behind on failure.
+// The .ssvdag container and atomic output: round trips (raw and zstd), the
+// documented byte layout, and the reader against truncated, corrupted and
+// forged files: every prefix and every single-byte change must give
+// vdbdag::Error (never a crash, a hang or a huge allocation), forged tables
+// with valid checksums must be caught by the bounds and size checks before
+// anything is allocated; atomic writes leave nothing behind on failure.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
+#include <functional>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <new>
 #include <random>
+
+#include <csignal>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <xxhash.h>
 
@@ -16,10 +29,99 @@
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 
+// Records the largest single allocation made while tracking is on, so tests
+// can prove a forged size was rejected before it was allocated.
+namespace {
+std::atomic<bool> gTrackAllocations{false};
+std::atomic<size_t> gLargestAllocation{0};
+}  // namespace
+
+void* operator new(size_t n) {
+    if (gTrackAllocations.load(std::memory_order_relaxed)) {
+        size_t prev = gLargestAllocation.load(std::memory_order_relaxed);
+        while (n > prev && !gLargestAllocation.compare_exchange_weak(prev, n)) {
+        }
+    }
+    if (void* p = std::malloc(n ? n : 1)) return p;
+    throw std::bad_alloc();
+}
+void* operator new[](size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, size_t) noexcept { std::free(p); }
+void operator delete[](void* p, size_t) noexcept { std::free(p); }
+
 namespace fs = std::filesystem;
 using namespace vdbdag;
+using format::Section;
+using format::SectionKind;
 
 namespace {
+
+// Layout constants as documented in SsvdagContainer.cpp.
+constexpr size_t kHeader = 16, kEntry = 48;
+constexpr size_t kKindAt = 0, kCodecAt = 8, kReservedAt = 12, kOffsetAt = 16, kStoredAt = 24, kRawAt = 32, kSumAt = 40;
+
+struct AllocationProbe {
+    AllocationProbe() {
+        gLargestAllocation = 0;
+        gTrackAllocations = true;
+    }
+    ~AllocationProbe() { gTrackAllocations = false; }
+    size_t largest() const { return gLargestAllocation.load(); }
+};
+
+template <typename T>
+T load(const std::vector<uint8_t>& b, size_t at) {
+    T v;
+    std::memcpy(&v, b.data() + at, sizeof(T));
+    return v;
+}
+template <typename T>
+void store(std::vector<uint8_t>& b, size_t at, T v) {
+    std::memcpy(b.data() + at, &v, sizeof(T));
+}
+size_t entryAt(size_t i) { return kHeader + i * kEntry; }
+uint32_t sectionCount(const std::vector<uint8_t>& b) { return load<uint32_t>(b, 12); }
+
+// Recomputes every in-bounds payload checksum and the table checksum, so a
+// forged table passes the checksums and only the structural checks remain.
+void fixChecksums(std::vector<uint8_t>& b) {
+    const size_t tableEnd = kHeader + sectionCount(b) * kEntry;
+    for (size_t i = 0; i < sectionCount(b); ++i) {
+        const uint64_t offset = load<uint64_t>(b, entryAt(i) + kOffsetAt), stored = load<uint64_t>(b, entryAt(i) + kStoredAt);
+        if (offset <= b.size() && stored <= b.size() - offset) store<uint64_t>(b, entryAt(i) + kSumAt, XXH3_64bits(b.data() + offset, stored));
+    }
+    store<uint64_t>(b, tableEnd, XXH3_64bits(b.data(), tableEnd));
+}
+
+std::string errorOf(std::span<const uint8_t> bytes, const std::string& name = "forged.ssvdag") {
+    try {
+        format::readContainer(bytes, name);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+std::vector<uint8_t> noise(size_t n, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::vector<uint8_t> v(n);
+    for (auto& b : v) b = uint8_t(rng());
+    return v;
+}
+
+std::vector<Section> mixedSections() {
+    std::vector<uint8_t> text;
+    for (int i = 0; i < 300; ++i) text.push_back(uint8_t("symmetry-aware "[i % 15]));
+    return {
+        {SectionKind::FileInfo, 0, {}},
+        {SectionKind::DagInner, 0, text},
+        {SectionKind::DagLeaves, 0, noise(150, 1)},
+        {SectionKind::GridInfo, 1, {1, 2, 3, 4, 5}},
+        {SectionKind(77), 2, std::vector<uint8_t>(100, 0)},  // unknown kinds are kept
+    };
+}
 
 std::vector<uint8_t> smallSceneBytes(bool compress) {
     GridRecord record;
@@ -35,32 +137,197 @@ std::vector<uint8_t> smallSceneBytes(bool compress) {
     return format::writeScene(scene, options);
 }
 
-} // namespace
-
-TEST(Container, SectionsRoundTripRawAndCompressed) {
-    std::mt19937_64 rng(5);
-    std::vector<format::Section> sections;
-    sections.push_back({format::SectionKind::FileInfo, 0, {}});
-    sections.push_back({format::SectionKind::DagInner, 3, std::vector<uint8_t>(100000, 7)});
-    std::vector<uint8_t> noise(5000);
-    for (auto& b : noise) b = uint8_t(rng());
-    sections.push_back({format::SectionKind::DagLeaves, 1, noise});
-    for (bool compress : {true, false}) {
-        format::ContainerOptions options;
-        options.compress = compress;
-        const auto bytes = format::writeContainer(sections, options);
-        const auto back = format::readContainer(bytes, "mem");
-        ASSERT_EQ(back.size(), sections.size());
-        for (size_t i = 0; i < back.size(); ++i) {
-            EXPECT_EQ(back[i].kind, sections[i].kind);
-            EXPECT_EQ(back[i].grid, sections[i].grid);
-            EXPECT_EQ(back[i].data, sections[i].data);
-        }
-        if (compress) EXPECT_LT(bytes.size(), 20000u);
+void expectSame(const std::vector<Section>& a, const std::vector<Section>& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i].kind, b[i].kind) << i;
+        EXPECT_EQ(a[i].grid, b[i].grid) << i;
+        EXPECT_TRUE(a[i].data == b[i].data) << "section " << i << " payload differs";
     }
 }
 
-TEST(Container, EveryTruncationIsAnError) {
+fs::path freshDir(const std::string& tag) {
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_" + tag + "_" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::vector<std::string> listDir(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+std::vector<uint8_t> slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), {});
+}
+
+} // namespace
+
+// ---- round trips and layout -------------------------------------------------
+
+TEST(Container, RoundTripsRawAndCompressed) {
+    std::vector<uint8_t> big;  // 3 MB, compressible
+    for (size_t i = 0; i < (size_t(3) << 20); ++i) big.push_back(uint8_t((i * 7) % 251 < 128 ? i & 15 : 0));
+    const std::vector<uint8_t> random = noise(64 << 10, 2);
+    const std::vector<std::vector<Section>> cases = {
+        {},
+        {{SectionKind::FileInfo, 0, {}}},
+        {{SectionKind::DagInner, 3, big}, {SectionKind::DagLeaves, 1, random}, {SectionKind::Values, 7, {42}}},
+        mixedSections(),
+    };
+    for (const auto& sections : cases) {
+        for (bool compress : {true, false}) {
+            format::ContainerOptions options;
+            options.compress = compress;
+            const auto bytes = format::writeContainer(sections, options);
+            expectSame(format::readContainer(bytes, "mem"), sections);
+            const auto summary = format::summarizeContainer(bytes, "mem");
+            ASSERT_EQ(summary.size(), sections.size());
+            uint64_t stored = 0;
+            for (size_t i = 0; i < summary.size(); ++i) {
+                EXPECT_EQ(summary[i].kind, sections[i].kind);
+                EXPECT_EQ(summary[i].grid, sections[i].grid);
+                EXPECT_EQ(summary[i].rawBytes, sections[i].data.size());
+                if (!summary[i].compressed) EXPECT_EQ(summary[i].storedBytes, summary[i].rawBytes);
+                else EXPECT_LT(summary[i].storedBytes, summary[i].rawBytes) << "zstd kept although it does not shrink";
+                if (!compress) EXPECT_FALSE(summary[i].compressed);
+                if (compress && sections[i].data == big) EXPECT_LT(summary[i].storedBytes, big.size() / 20);
+                if (sections[i].data == random) EXPECT_FALSE(summary[i].compressed) << "random data should stay raw";
+                stored += summary[i].storedBytes;
+            }
+            EXPECT_EQ(bytes.size(), kHeader + kEntry * sections.size() + 8 + stored) << "payloads are back to back";
+        }
+    }
+}
+
+TEST(Container, LargeSectionsUseTheThreadedPathAndRoundTrip) {
+    std::vector<uint8_t> large(size_t(6) << 20);
+    for (size_t i = 0; i < large.size(); ++i) large[i] = uint8_t((i >> 10) * 31);
+    const std::vector<Section> sections{{SectionKind::Values, 0, large}};
+    const auto bytes = format::writeContainer(sections);
+    EXPECT_LT(bytes.size(), large.size() / 50);
+    expectSame(format::readContainer(bytes, "mem"), sections);
+}
+
+TEST(Container, ByteLayoutIsAsDocumented) {
+    const auto sections = mixedSections();
+    const auto bytes = format::writeContainer(sections);
+    const uint8_t magic[8] = {0x89, 'S', 'S', 'V', 'D', 'A', 'G', '\n'};
+    ASSERT_GE(bytes.size(), 24u);
+    EXPECT_EQ(std::memcmp(bytes.data(), magic, 8), 0);
+    EXPECT_EQ(load<uint32_t>(bytes, 8), 1u);
+    ASSERT_EQ(sectionCount(bytes), sections.size());
+    const size_t tableEnd = kHeader + kEntry * sections.size();
+    EXPECT_EQ(load<uint64_t>(bytes, tableEnd), XXH3_64bits(bytes.data(), tableEnd));
+    uint64_t next = tableEnd + 8;
+    for (size_t i = 0; i < sections.size(); ++i) {
+        const size_t e = entryAt(i);
+        EXPECT_EQ(load<uint32_t>(bytes, e + kKindAt), uint32_t(sections[i].kind));
+        EXPECT_EQ(load<uint32_t>(bytes, e + 4), sections[i].grid);
+        const uint32_t codec = load<uint32_t>(bytes, e + kCodecAt);
+        EXPECT_TRUE(codec == 0 || codec == 1);
+        EXPECT_EQ(load<uint32_t>(bytes, e + kReservedAt), 0u);
+        EXPECT_EQ(load<uint64_t>(bytes, e + kOffsetAt), next);
+        const uint64_t stored = load<uint64_t>(bytes, e + kStoredAt);
+        EXPECT_EQ(load<uint64_t>(bytes, e + kRawAt), sections[i].data.size());
+        EXPECT_EQ(load<uint64_t>(bytes, e + kSumAt), XXH3_64bits(bytes.data() + next, stored));
+        if (codec == 0) EXPECT_EQ(std::memcmp(bytes.data() + next, sections[i].data.data(), stored), 0);
+        next += stored;
+    }
+    EXPECT_EQ(next, bytes.size());
+    // The 300-byte repetitive section is zstd, the 150 random bytes raw.
+    EXPECT_EQ(load<uint32_t>(bytes, entryAt(1) + kCodecAt), 1u);
+    EXPECT_EQ(load<uint32_t>(bytes, entryAt(2) + kCodecAt), 0u);
+}
+
+TEST(Container, SectionKindNames) {
+    EXPECT_STREQ(format::sectionKindName(SectionKind::GridInfo), "GridInfo");
+    EXPECT_STREQ(format::sectionKindName(SectionKind::DagInner), "DagInner");
+    EXPECT_STREQ(format::sectionKindName(SectionKind::ValueErrors), "ValueErrors");
+    EXPECT_STREQ(format::sectionKindName(SectionKind(1000)), "unknown");
+}
+
+// ---- truncation and corruption ------------------------------------------------
+
+TEST(Container, EveryPrefixIsATruncationError) {
+    for (bool compress : {true, false}) {
+        format::ContainerOptions options;
+        options.compress = compress;
+        for (const auto& sections : {std::vector<Section>{}, mixedSections()}) {
+            const auto bytes = format::writeContainer(sections, options);
+            ASSERT_NO_THROW(format::readContainer(bytes, "full"));
+            for (size_t n = 0; n < bytes.size(); ++n) {
+                const std::span<const uint8_t> prefix(bytes.data(), n);
+                const std::string m = errorOf(prefix, "cut.ssvdag");
+                EXPECT_EQ(m.rfind("cut.ssvdag: truncated", 0), 0u) << "prefix of " << n << " bytes: " << m;
+                EXPECT_THROW(format::summarizeContainer(prefix, "cut"), Error) << n;
+            }
+        }
+    }
+}
+
+TEST(Container, TruncationMessageSaysWhere) {
+    const auto bytes = format::writeContainer(mixedSections(), {.compress = false});
+    const size_t cut = bytes.size() - 50;  // inside section 4 (100 raw bytes)
+    EXPECT_EQ(errorOf(std::span<const uint8_t>(bytes.data(), cut), "file.ssvdag"),
+              "file.ssvdag: truncated: section 4 (kind 77 of grid 2) ends at byte " + std::to_string(bytes.size()) + " but the file has " +
+                  std::to_string(cut) + " bytes");
+}
+
+TEST(Container, EverySingleByteCorruptionIsAnError) {
+    for (bool compress : {true, false}) {
+        format::ContainerOptions options;
+        options.compress = compress;
+        const auto bytes = format::writeContainer(mixedSections(), options);
+        for (size_t i = 0; i < bytes.size(); ++i) {
+            for (uint8_t flip : {uint8_t(0x01), uint8_t(0x80), uint8_t(0xFF)}) {
+                auto bad = bytes;
+                bad[i] ^= flip;
+                EXPECT_THROW(format::readContainer(bad, "corrupt"), Error) << "byte " << i << " xor " << int(flip);
+            }
+        }
+    }
+}
+
+TEST(Container, PayloadCorruptionNamesTheSection) {
+    auto bytes = format::writeContainer(mixedSections());
+    const uint64_t offset = load<uint64_t>(bytes, entryAt(1) + kOffsetAt);
+    bytes[offset + 3] ^= 0x10;
+    EXPECT_EQ(errorOf(bytes, "file.ssvdag"), "file.ssvdag: section 1 ('DagInner' of grid 0): checksum mismatch, the file is corrupted");
+    auto table = format::writeContainer(mixedSections());
+    table[entryAt(2) + 4] ^= 1;  // the grid index of section 2
+    EXPECT_EQ(errorOf(table, "file.ssvdag"), "file.ssvdag: checksum mismatch in the header or section table: the file is corrupted");
+}
+
+// Whatever a forger writes into a zstd payload (with the checksums fixed up),
+// the reader either refuses it with Error or returns exactly the raw size.
+TEST(Container, ForgedZstdPayloadsNeverBreakTheReader) {
+    const auto bytes = format::writeContainer(mixedSections());
+    ASSERT_EQ(load<uint32_t>(bytes, entryAt(1) + kCodecAt), 1u);
+    const uint64_t offset = load<uint64_t>(bytes, entryAt(1) + kOffsetAt), stored = load<uint64_t>(bytes, entryAt(1) + kStoredAt);
+    size_t refused = 0;
+    for (uint64_t i = offset; i < offset + stored; ++i) {
+        for (uint8_t flip : {uint8_t(0x01), uint8_t(0x80), uint8_t(0xFF)}) {
+            auto bad = bytes;
+            bad[i] ^= flip;
+            fixChecksums(bad);
+            try {
+                const auto sections = format::readContainer(bad, "forged");
+                ASSERT_EQ(sections.size(), 5u);
+                EXPECT_EQ(sections[1].data.size(), 300u);
+            } catch (const Error&) {
+                ++refused;
+            }
+        }
+    }
+    EXPECT_GT(refused, 0u);
+}
+
+TEST(Container, SceneEveryTruncationIsAnError) {
     for (bool compress : {true, false}) {
         const auto bytes = smallSceneBytes(compress);
         ASSERT_NO_THROW(format::readScene(bytes, "full"));
@@ -71,7 +338,7 @@ TEST(Container, EveryTruncationIsAnError) {
     }
 }
 
-TEST(Container, EverySingleByteCorruptionIsAnError) {
+TEST(Container, SceneEverySingleByteCorruptionIsAnError) {
     for (bool compress : {true, false}) {
         const auto bytes = smallSceneBytes(compress);
         for (size_t i = 0; i < bytes.size(); ++i) {
@@ -84,55 +351,236 @@ TEST(Container, EverySingleByteCorruptionIsAnError) {
     }
 }
 
+// ---- forged tables (valid checksums) ---------------------------------------------
+
 TEST(Container, ForgedHugeRawSizeIsRejectedBeforeAllocating) {
-    // Rebuild a valid table that claims 2^50 raw bytes for a tiny zstd payload,
-    // with correct checksums, so only the plausibility check can stop it.
-    std::vector<format::Section> sections{{format::SectionKind::DagInner, 0, std::vector<uint8_t>(1000, 1)}};
+    const std::vector<Section> sections{{SectionKind::DagInner, 0, std::vector<uint8_t>(1000, 1)}};
     auto bytes = format::writeContainer(sections);
-    const size_t rawSizeAt = 16 + 32;  // entry: kind, grid, codec, reserved, offset, stored, raw
-    uint64_t huge = uint64_t(1) << 50;
-    std::memcpy(bytes.data() + rawSizeAt, &huge, 8);
-    const uint64_t tableEnd = 16 + 48;
-    const uint64_t sum = XXH3_64bits(bytes.data(), tableEnd);
-    std::memcpy(bytes.data() + tableEnd, &sum, 8);
-    try {
-        format::readContainer(bytes, "forged");
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("cannot produce"), std::string::npos) << e.what();
+    ASSERT_EQ(load<uint32_t>(bytes, entryAt(0) + kCodecAt), 1u);
+    const uint64_t stored = load<uint64_t>(bytes, entryAt(0) + kStoredAt);
+    for (uint64_t raw : {uint64_t(1) << 50, stored * 65536 + 4097, ~uint64_t(0)}) {
+        auto bad = bytes;
+        store<uint64_t>(bad, entryAt(0) + kRawAt, raw);
+        fixChecksums(bad);
+        AllocationProbe probe;
+        const std::string m = errorOf(bad);
+        EXPECT_NE(m.find("which zstd cannot produce"), std::string::npos) << m;
+        EXPECT_LT(probe.largest(), size_t(1) << 20) << "allocated " << probe.largest() << " bytes for a forged size";
+        EXPECT_THROW(format::summarizeContainer(bad, "forged"), Error);
+    }
+    // Within the plausible bound but not what the frame declares: still
+    // rejected before the claimed size is allocated.
+    auto bad = bytes;
+    store<uint64_t>(bad, entryAt(0) + kRawAt, stored * 65536);
+    fixChecksums(bad);
+    AllocationProbe probe;
+    const std::string m = errorOf(bad);
+    EXPECT_NE(m.find("the zstd frame declares 1000 bytes"), std::string::npos) << m;
+    EXPECT_LT(probe.largest(), size_t(1) << 20) << "allocated " << probe.largest() << " bytes for a forged size";
+}
+
+TEST(Container, ForgedRawCodecSizesAreRejected) {
+    auto bytes = format::writeContainer({{SectionKind::DagLeaves, 0, noise(100, 3)}}, {.compress = false});
+    store<uint64_t>(bytes, entryAt(0) + kRawAt, 101);
+    fixChecksums(bytes);
+    EXPECT_NE(errorOf(bytes).find("claims 101 raw bytes for 100 bytes stored uncompressed"), std::string::npos) << errorOf(bytes);
+}
+
+TEST(Container, OverlapsGapsAndOutOfBoundsOffsetsAreRejected) {
+    const auto good = format::writeContainer(mixedSections(), {.compress = false});
+    const uint64_t off1 = load<uint64_t>(good, entryAt(1) + kOffsetAt);
+    const uint64_t off2 = load<uint64_t>(good, entryAt(2) + kOffsetAt);
+    struct Case {
+        std::function<void(std::vector<uint8_t>&)> forge;
+        std::string expect;
+    };
+    const std::vector<Case> cases = {
+        {[&](auto& b) { store<uint64_t>(b, entryAt(2) + kOffsetAt, off1); }, "overlaps section 1"},
+        {[&](auto& b) { store<uint64_t>(b, entryAt(2) + kOffsetAt, off2 - 1); }, "overlaps section 1"},
+        {[&](auto& b) { store<uint64_t>(b, entryAt(2) + kOffsetAt, off2 + 1); }, "unaccounted bytes"},
+        {[&](auto& b) { store<uint64_t>(b, entryAt(1) + kOffsetAt, 0); }, "inside the header and table"},
+        {[&](auto& b) { store<uint64_t>(b, entryAt(3) + kOffsetAt, ~uint64_t(0) - 2); }, "truncated: section 3"},
+        {[&](auto& b) { store<uint64_t>(b, entryAt(3) + kStoredAt, ~uint64_t(0) - 2); }, "impossible size"},
+        {[&](auto& b) { store<uint64_t>(b, entryAt(3) + kStoredAt, uint64_t(1) << 40); }, "truncated: section 3"},
+        {[&](auto& b) { store<uint32_t>(b, entryAt(0) + kCodecAt, 2); }, "unknown codec 2"},
+        {[&](auto& b) { store<uint32_t>(b, entryAt(0) + kReservedAt, 1); }, "non-zero reserved field"},
+        {[&](auto& b) { b.push_back(0); }, "1 unexpected bytes after the last section"},
+        {[&](auto& b) { store<uint32_t>(b, 12, 0xFFFFFFFFu); }, "truncated: the table of 4294967295 sections"},
+        {[&](auto& b) { store<uint32_t>(b, 8, 7); }, "unsupported format version 7 (this vdbdag reads version 1)"},
+    };
+    for (const Case& c : cases) {
+        auto bad = good;
+        c.forge(bad);
+        if (sectionCount(bad) == sectionCount(good)) fixChecksums(bad);
+        AllocationProbe probe;
+        const std::string m = errorOf(bad, "forged.ssvdag");
+        EXPECT_NE(m.find(c.expect), std::string::npos) << m;
+        EXPECT_EQ(m.rfind("forged.ssvdag: ", 0), 0u) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        EXPECT_LT(probe.largest(), size_t(1) << 20);
+        EXPECT_THROW(format::summarizeContainer(bad, "forged"), Error) << c.expect;
     }
 }
 
-TEST(Container, ErrorsAreOneLineAndNameTheSource) {
-    const auto bytes = smallSceneBytes(true);
-    std::vector<uint8_t> bad(bytes.begin(), bytes.begin() + long(bytes.size() / 2));
-    try {
-        format::readScene(bad, "half.ssvdag");
-        FAIL();
-    } catch (const Error& e) {
-        const std::string m = e.what();
-        EXPECT_EQ(m.rfind("half.ssvdag: ", 0), 0u) << m;
-        EXPECT_EQ(m.find('\n'), std::string::npos);
+TEST(Container, ZstdFramesMustMatchTheTableExactly) {
+    const auto good = format::writeContainer(mixedSections());
+    ASSERT_EQ(load<uint32_t>(good, entryAt(1) + kCodecAt), 1u);
+    // One byte more or less than the frame declares.
+    for (uint64_t raw : {299u, 301u}) {
+        auto bad = good;
+        store<uint64_t>(bad, entryAt(1) + kRawAt, raw);
+        fixChecksums(bad);
+        EXPECT_NE(errorOf(bad).find("the zstd frame declares 300 bytes but the table " + std::to_string(raw)), std::string::npos) << errorOf(bad);
     }
-    EXPECT_THROW(format::readFileBytes("/nonexistent/file.ssvdag"), Error);
+    // Extra bytes after the frame inside the section: rebuild a file whose
+    // section 1 is the frame plus a second (empty) frame's worth of junk.
+    const std::vector<Section> one{{SectionKind::DagInner, 0, std::vector<uint8_t>(500, 9)}};
+    auto bytes = format::writeContainer(one);
+    const std::vector<uint8_t> junk{0x28, 0xB5, 0x2F, 0xFD, 0x20, 0x00, 0x01, 0x00, 0x00};  // an empty zstd frame
+    bytes.insert(bytes.end(), junk.begin(), junk.end());
+    store<uint64_t>(bytes, entryAt(0) + kStoredAt, load<uint64_t>(bytes, entryAt(0) + kStoredAt) + junk.size());
+    fixChecksums(bytes);
+    EXPECT_NE(errorOf(bytes).find("the zstd frame takes"), std::string::npos) << errorOf(bytes);
 }
 
-TEST(AtomicFile, ReplacesAtomicallyAndLeavesNothingOnFailure) {
-    const fs::path dir = fs::temp_directory_path() / ("vdbdag_atomic_" + std::to_string(getpid()));
-    fs::create_directories(dir);
+TEST(Container, NotAnSsvdagFile) {
+    const std::string text = "this is a text file, not an ssvdag\n";
+    const std::vector<uint8_t> bytes(text.begin(), text.end());
+    EXPECT_EQ(errorOf(bytes, "a.txt"), "a.txt: not an .ssvdag file (bad magic)");
+    auto crlf = format::writeContainer({});
+    crlf.insert(crlf.begin() + 7, '\r');  // a text-mode copy turned the LF into CRLF
+    EXPECT_NE(errorOf(crlf, "c.ssvdag").find("line endings"), std::string::npos) << errorOf(crlf, "c.ssvdag");
+}
+
+// ---- files ----------------------------------------------------------------------
+
+TEST(ReadFileBytes, ReadsFilesAndNamesTheProblem) {
+    const fs::path dir = freshDir("read");
+    const auto data = noise(100000, 4);
+    std::ofstream(dir / "f.bin", std::ios::binary).write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size()));
+    EXPECT_EQ(format::readFileBytes((dir / "f.bin").string()), data);
+    std::ofstream(dir / "empty.bin").close();
+    EXPECT_TRUE(format::readFileBytes((dir / "empty.bin").string()).empty());
+    try {
+        format::readFileBytes((dir / "missing.ssvdag").string());
+        ADD_FAILURE() << "no error for a missing file";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), (dir / "missing.ssvdag").string() + ": no such file");
+    }
+    EXPECT_THROW(format::readFileBytes((dir / "f.bin" / "x").string()), Error);
+    try {
+        format::readFileBytes(dir.string());
+        ADD_FAILURE() << "no error for a directory";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+    }
+    if (geteuid() != 0) {  // root reads anything
+        fs::permissions(dir / "f.bin", fs::perms::none);
+        EXPECT_THROW(format::readFileBytes((dir / "f.bin").string()), Error);
+    }
+    EXPECT_TRUE(format::readFileBytes("/dev/null").empty());
+    fs::remove_all(dir);
+}
+
+TEST(AtomicFile, WritesAndReplacesWithoutLeavingTemporaries) {
+    const fs::path dir = freshDir("atomic");
     const fs::path target = dir / "out.bin";
-    const std::vector<uint8_t> a(10, 1), b(20, 2);
+    const auto a = noise(10, 5), b = noise(20000, 6);
     writeFileAtomically(target.string(), a);
+    EXPECT_EQ(slurp(target), a);
+    // An open reader of the old file keeps seeing the old bytes: the new file
+    // replaced it by rename, it was not rewritten in place.
+    std::ifstream old(target, std::ios::binary);
+    struct stat before{};
+    ASSERT_EQ(::stat(target.c_str(), &before), 0);
     writeFileAtomically(target.string(), b);
-    EXPECT_EQ(fs::file_size(target), 20u);
-    EXPECT_THROW(writeViaTemporary((dir / "never.vdb").string(), [](const std::string& tmp) {
-                     std::ofstream(tmp) << "partial";
-                     throw Error("writer failed");
-                 }),
+    struct stat after{};
+    ASSERT_EQ(::stat(target.c_str(), &after), 0);
+    EXPECT_NE(before.st_ino, after.st_ino);
+    EXPECT_EQ(std::vector<uint8_t>((std::istreambuf_iterator<char>(old)), {}), a);
+    EXPECT_EQ(slurp(target), b);
+    EXPECT_EQ(listDir(dir), std::vector<std::string>{"out.bin"});
+    // Relative paths work too (folder ".").
+    const fs::path cwd = fs::current_path();
+    fs::current_path(dir);
+    writeFileAtomically("rel.bin", a);
+    fs::current_path(cwd);
+    EXPECT_EQ(listDir(dir), (std::vector<std::string>{"out.bin", "rel.bin"}));
+    fs::remove_all(dir);
+}
+
+TEST(AtomicFile, FailuresLeaveNothingBehind) {
+    const fs::path dir = freshDir("atomic_fail");
+    const auto a = noise(10, 7);
+    try {
+        writeFileAtomically((dir / "missing" / "x.bin").string(), a);
+        ADD_FAILURE() << "no error for a missing folder";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), (dir / "missing" / "x.bin").string() + ": the folder " + (dir / "missing").string() + " does not exist");
+    }
+    fs::create_directories(dir / "sub");
+    EXPECT_THROW(writeFileAtomically((dir / "sub").string(), a), Error);
+    // A write that fails halfway (file size limit), after the temporary exists.
+    writeFileAtomically((dir / "keep.bin").string(), a);
+    {
+        struct rlimit saved{};
+        ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+        auto oldHandler = std::signal(SIGXFSZ, SIG_IGN);
+        struct rlimit small = saved;
+        small.rlim_cur = 4096;
+        ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+        std::string message;
+        try {
+            writeFileAtomically((dir / "keep.bin").string(), noise(100000, 8));
+        } catch (const Error& e) {
+            message = e.what();
+        }
+        ::setrlimit(RLIMIT_FSIZE, &saved);
+        std::signal(SIGXFSZ, oldHandler);
+        EXPECT_EQ(message.rfind((dir / "keep.bin").string() + ": write failed (", 0), 0u) << message;
+    }
+    EXPECT_EQ(slurp(dir / "keep.bin"), a) << "a failed write touched the existing file";
+    if (geteuid() != 0) {  // root writes anywhere
+        fs::permissions(dir / "sub", fs::perms::owner_read | fs::perms::owner_exec);
+        EXPECT_THROW(writeFileAtomically((dir / "sub" / "x.bin").string(), a), Error);
+        fs::permissions(dir / "sub", fs::perms::owner_all);
+        EXPECT_TRUE(listDir(dir / "sub").empty());
+    }
+    EXPECT_EQ(listDir(dir), (std::vector<std::string>{"keep.bin", "sub"}));
+    fs::remove_all(dir);
+}
+
+TEST(AtomicFile, WriteViaTemporary) {
+    const fs::path dir = freshDir("via_tmp");
+    const fs::path target = dir / "grid.vdb";
+    std::string seen;
+    writeViaTemporary(target.string(), [&](const std::string& tmp) {
+        seen = tmp;
+        std::ofstream(tmp) << "content";
+    });
+    EXPECT_EQ(fs::path(seen).parent_path(), dir) << "the temporary must be beside the destination";
+    EXPECT_EQ(fs::path(seen).filename().string().rfind(".grid.vdb.tmp." + std::to_string(getpid()) + ".", 0), 0u) << seen;
+    EXPECT_EQ(slurp(target), std::vector<uint8_t>({'c', 'o', 'n', 't', 'e', 'n', 't'}));
+    // The callback throws after writing part of its file: the exception (of
+    // any type) propagates and the temporary is gone; the old file survives.
+    struct WriterFailure {};
+    EXPECT_THROW(writeViaTemporary(target.string(),
+                                   [](const std::string& tmp) {
+                                       std::ofstream(tmp) << "partial";
+                                       throw WriterFailure{};
+                                   }),
+                 WriterFailure);
+    EXPECT_THROW(writeViaTemporary((dir / "never.vdb").string(),
+                                   [](const std::string& tmp) {
+                                       std::ofstream(tmp) << "partial";
+                                       throw Error("writer failed");
+                                   }),
                  Error);
-    EXPECT_THROW(writeFileAtomically((dir / "missing" / "x.bin").string(), a), Error);
-    size_t files = 0;
-    for (const auto& e : fs::directory_iterator(dir)) { (void)e; ++files; }
-    EXPECT_EQ(files, 1u) << "a temporary or partial file was left behind";
+    // A callback that creates nothing is an error, not a silent success.
+    EXPECT_THROW(writeViaTemporary((dir / "nothing.vdb").string(), [](const std::string&) {}), Error);
+    EXPECT_THROW(writeViaTemporary((dir / "no" / "x.vdb").string(), [](const std::string&) { ADD_FAILURE() << "called for a missing folder"; }),
+                 Error);
+    EXPECT_EQ(listDir(dir), std::vector<std::string>{"grid.vdb"});
+    EXPECT_EQ(slurp(target).size(), 7u);
     fs::remove_all(dir);
 }
