@@ -86,13 +86,12 @@ inline unsigned storedBit(unsigned x, unsigned y, unsigned z, unsigned m) {
     return x + 4 * y + 16 * z;
 }
 
-} // namespace
-
-DagTracer::DagTracer(const encoding::CompactDag& dag, TraceOptions options) : dag_(dag), options_(options) {}
-
-RayHit DagTracer::trace(const Ray& ray) const {
+// The traversal. With kFirstHitOnly it returns the first occupied box;
+// otherwise it calls visit(hit, tLeave) for every occupied box (voxel, tile
+// or LOD node) along the ray, in order, until visit returns true.
+template <bool kFirstHitOnly, class Visitor>
+RayHit walkRay(const encoding::CompactDag& dag, const TraceOptions& options, const Ray& ray, Visitor&& visit) {
     RayHit result;
-    const encoding::CompactDag& dag = dag_;
     if (dag.empty()) return result;
     LocalRay r;
     for (int a = 0; a < 3; ++a) {
@@ -137,7 +136,8 @@ RayHit DagTracer::trace(const Ray& ray) const {
     const unsigned innerLevels = unsigned(dag.innerLevelCount());
     uint32_t steps = 0;
 
-    auto finishHit = [&](uint64_t attribute, unsigned lodLevel) {
+    bool pending = false;  // result holds an occupied box not yet passed to visit
+    auto makeHit = [&](uint64_t attribute, unsigned lodLevel) {
         int faceAxis = -1;
         const int64_t within = (int64_t(1) << lodLevel) - 1;
         for (int a = 0; a < 3 && faceAxis < 0; ++a)
@@ -150,7 +150,6 @@ RayHit DagTracer::trace(const Ray& ray) const {
         result.faceSign = faceAxis < 0 ? 0 : (r.d[faceAxis] > 0 ? -1 : 1);
         result.lodLevel = uint8_t(lodLevel);
         result.steps = steps;
-        return result;
     };
 
     while (true) {
@@ -161,7 +160,13 @@ RayHit DagTracer::trace(const Ray& ray) const {
             const StackEntry& node = stack[depth];
             const unsigned s = L - depth;  // log2 size of this node
             const uint16_t header = inner[node.pos];
-            if (header == 0) return finishHit(node.base, s);  // solid node: an active tile
+            if (header == 0) {  // solid node: an active tile
+                makeHit(node.base, s);
+                if constexpr (kFirstHitOnly) return result;
+                pending = true;
+                skip = s;
+                break;
+            }
             const unsigned half = s - 1;
             const unsigned p = unsigned((v[0] >> half) & 1) | unsigned((v[1] >> half) & 1) << 1 | unsigned((v[2] >> half) & 1) << 2;
             const unsigned j = p ^ node.mirror;
@@ -174,17 +179,27 @@ RayHit DagTracer::trace(const Ray& ray) const {
             if (depth + 1 == innerLevels) {  // the child is a 4^3 leaf
                 const uint64_t mask = leaves[offset];
                 const unsigned bit = storedBit(unsigned(v[0] & 3), unsigned(v[1] & 3), unsigned(v[2] & 3), mirror);
-                if ((mask >> bit) & 1u) return finishHit(base + uint64_t(std::popcount(mask & ((uint64_t(1) << bit) - 1))), 0);
+                if ((mask >> bit) & 1u) {
+                    makeHit(base + uint64_t(std::popcount(mask & ((uint64_t(1) << bit) - 1))), 0);
+                    if constexpr (kFirstHitOnly) return result;
+                    pending = true;
+                }
                 skip = 0;
                 break;
             }
-            if (options_.lodScale > 0 && double(int64_t(1) << half) <= options_.lodScale * t) return finishHit(base, half);
+            if (options.lodScale > 0 && double(int64_t(1) << half) <= options.lodScale * t) {
+                makeHit(base, half);
+                if constexpr (kFirstHitOnly) return result;
+                pending = true;
+                skip = half;
+                break;
+            }
             stack[depth + 1] = {dag.levelStart[depth + 1] + offset, base, mirror};
             ++depth;
         }
 
-        // Leave the empty cube of size 2^skip containing v.
-        if (++steps > options_.maxSteps) return result;
+        // Leave the cube of size 2^skip containing v (empty, or just visited).
+        if (++steps > options.maxSteps) return kFirstHitOnly ? RayHit{} : result;
         const int64_t cube = int64_t(1) << skip;
         int64_t lo[3], hi[3];
         double tc[3];
@@ -195,7 +210,12 @@ RayHit DagTracer::trace(const Ray& ray) const {
             tc[a] = r.d[a] == 0 ? kInf : r.crossing(a, r.d[a] > 0 ? hi[a] + 1 : lo[a]);
             tNew = std::min(tNew, tc[a]);
         }
-        if (!(tNew < tExit)) return result;  // left the root cube or passed tMax
+        if constexpr (!kFirstHitOnly)
+            if (pending) {
+                pending = false;
+                if (visit(result, std::min(tNew, tExit))) return result;
+            }
+        if (!(tNew < tExit)) return kFirstHitOnly ? RayHit{} : result;  // left the root cube or passed tMax
         int64_t next[3];
         crossed = 0;
         for (int a = 0; a < 3; ++a) {
@@ -204,7 +224,7 @@ RayHit DagTracer::trace(const Ray& ray) const {
             } else {
                 next[a] = r.d[a] > 0 ? r.voxelAt(a, tNew, v[a], hi[a]) : r.d[a] < 0 ? r.voxelAt(a, tNew, lo[a], v[a]) : v[a];
             }
-            if (next[a] < 0 || next[a] >= size) return result;
+            if (next[a] < 0 || next[a] >= size) return kFirstHitOnly ? RayHit{} : result;
             if (next[a] != v[a] && (tc[a] == tNew || r.crossing(a, r.d[a] > 0 ? next[a] : next[a] + 1) == tNew)) crossed |= 1u << a;
         }
         // Pop to the deepest stored node that still contains the new voxel.
@@ -213,6 +233,52 @@ RayHit DagTracer::trace(const Ray& ray) const {
         if (L - depth < keepLog2) depth = L - keepLog2;
         for (int a = 0; a < 3; ++a) v[a] = next[a];
         t = tNew;
+    }
+}
+
+} // namespace
+
+DagTracer::DagTracer(const encoding::CompactDag& dag, TraceOptions options) : dag_(dag), options_(options) {}
+
+RayHit DagTracer::trace(const Ray& ray) const {
+    return walkRay<true>(dag_, options_, ray, [](const RayHit&, double) { return true; });
+}
+
+void DagTracer::forEachSegment(const Ray& ray, const SegmentVisitor& visit) const {
+    walkRay<false>(dag_, options_, ray, visit);
+}
+
+std::optional<uint64_t> DagTracer::find(const std::array<int64_t, 3>& voxel) const {
+    const encoding::CompactDag& dag = dag_;
+    if (dag.empty()) return std::nullopt;
+    int64_t v[3];
+    const int64_t size = int64_t(1) << dag.log2Size;
+    for (int a = 0; a < 3; ++a) {
+        v[a] = voxel[a] - dag.origin[a];
+        if (v[a] < 0 || v[a] >= size) return std::nullopt;
+    }
+    uint64_t pos = 0, base = 0;
+    unsigned mirror = dag.rootReflection;
+    const unsigned innerLevels = unsigned(dag.innerLevelCount());
+    for (unsigned depth = 0;; ++depth) {
+        const uint16_t header = dag.inner[pos];
+        if (header == 0) return base;
+        const unsigned half = dag.log2Size - depth - 1;
+        const unsigned p = unsigned((v[0] >> half) & 1) | unsigned((v[1] >> half) & 1) << 1 | unsigned((v[2] >> half) & 1) << 2;
+        const unsigned j = p ^ mirror;
+        if (((header >> (2 * j)) & 3u) == 0) return std::nullopt;
+        uint64_t offset, attributeOffset;
+        unsigned reflection;
+        readChildPointer(dag.inner.data(), pos, header, j, dag.offsetWords[depth], offset, reflection, attributeOffset);
+        mirror ^= reflection;
+        base += attributeOffset;
+        if (depth + 1 == innerLevels) {
+            const uint64_t mask = dag.leaves[offset];
+            const unsigned bit = storedBit(unsigned(v[0] & 3), unsigned(v[1] & 3), unsigned(v[2] & 3), mirror);
+            if (!((mask >> bit) & 1u)) return std::nullopt;
+            return base + uint64_t(std::popcount(mask & ((uint64_t(1) << bit) - 1)));
+        }
+        pos = dag.levelStart[depth + 1] + offset;
     }
 }
 

@@ -12,6 +12,8 @@
 // flat voxel-by-voxel walk (Amanatides-Woo) would, ties included.
 #pragma once
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -37,6 +39,13 @@ public:
     explicit DagTracer(const encoding::CompactDag& dag, TraceOptions options = {});
 
     RayHit trace(const Ray& ray) const;
+    // Every occupied box along the ray in order (voxels, tiles, LOD nodes):
+    // visit(box, tLeave) gets the box's entry as a RayHit and the parameter
+    // where the ray leaves it; returning true stops the walk. For volumes.
+    using SegmentVisitor = std::function<bool(const RayHit& box, double tLeave)>;
+    void forEachSegment(const Ray& ray, const SegmentVisitor& visit) const;
+    // Attribute entry of the active voxel at an index coordinate (point query).
+    std::optional<uint64_t> find(const std::array<int64_t, 3>& voxel) const;
     // All rays, in parallel (TBB).
     void traceBatch(std::span<const Ray> rays, std::span<RayHit> hits) const;
 

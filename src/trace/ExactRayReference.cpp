@@ -5,6 +5,7 @@
 
 #include <bit>
 #include <cmath>
+#include <algorithm>
 #include <optional>
 
 #include "src/util/Error.h"
@@ -63,7 +64,7 @@ bool ExactRayReference::representable(const Ray& ray) {
     return scaled(ray.tMin) && (std::isinf(ray.tMax) ? ray.tMax > 0 : bool(scaled(ray.tMax)));
 }
 
-RayHit ExactRayReference::trace(const Ray& ray) const {
+std::vector<RayHit> ExactRayReference::traceAll(const Ray& ray) const {
     if (!representable(ray)) throw Error("exact ray reference: ray components must be multiples of 2^-16 below 2^40");
     i128 O[3], D[3];
     for (int a = 0; a < 3; ++a) { O[a] = *scaled(ray.origin[a]); D[a] = *scaled(ray.direction[a]); }
@@ -71,10 +72,8 @@ RayHit ExactRayReference::trace(const Ray& ray) const {
     const bool bounded = !std::isinf(ray.tMax);
     const Fraction tMax{bounded ? i128(*scaled(ray.tMax)) : 0, kScale};
 
-    RayHit best;
-    Fraction bestT{0, 1};
-    const Box* bestBox = nullptr;
-    int bestAxis = -1;
+    struct Found { Fraction t; const Box* box; int axis; };
+    std::vector<Found> found;
     for (const Box& box : boxes_) {
         Fraction lo = tMin, hi{0, 0};  // hi.m == 0: unbounded
         int axis = -1;
@@ -95,27 +94,44 @@ RayHit ExactRayReference::trace(const Ray& ray) const {
         if (empty) continue;
         if (hi.m != 0 && !less(lo, hi)) continue;
         if (bounded && !less(lo, tMax)) continue;
-        if (bestBox && !less(lo, bestT)) continue;
-        bestT = lo;
-        bestBox = &box;
-        bestAxis = axis;
+        found.push_back({lo, &box, axis});
     }
-    if (!bestBox) return best;
-    best.hit = true;
-    best.t = double(bestT.n) / double(bestT.m);
-    best.attribute = bestBox->attribute;
-    best.faceAxis = int8_t(bestAxis);
-    best.faceSign = bestAxis < 0 ? 0 : (D[bestAxis] > 0 ? -1 : 1);
-    best.lodLevel = uint8_t(bestBox->log2Size);
-    for (int a = 0; a < 3; ++a) {
-        if (bestBox->size == 1) { best.voxel[a] = bestBox->min[a]; continue; }
-        // Position * 2^16 * m = O * m + n * D; voxel per the face convention.
-        const i128 num = O[a] * bestT.m + bestT.n * D[a], den = kScale * bestT.m;
-        i128 c = D[a] < 0 ? -floorDiv(-num, den) - 1 : floorDiv(num, den);  // ceil(x) - 1 = -floor(-x) - 1
-        c = std::max<i128>(bestBox->min[a], std::min<i128>(c, bestBox->min[a] + bestBox->size - 1));
-        best.voxel[a] = int64_t(c);
+    std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return less(a.t, b.t); });
+
+    std::vector<RayHit> hits;
+    for (const Found& f : found) {
+        RayHit hit;
+        hit.hit = true;
+        hit.t = double(f.t.n) / double(f.t.m);
+        hit.attribute = f.box->attribute;
+        hit.faceAxis = int8_t(f.axis);
+        hit.faceSign = f.axis < 0 ? 0 : (D[f.axis] > 0 ? -1 : 1);
+        hit.lodLevel = uint8_t(f.box->log2Size);
+        for (int a = 0; a < 3; ++a) {
+            if (f.box->size == 1) { hit.voxel[a] = f.box->min[a]; continue; }
+            // Position * 2^16 * m = O * m + n * D; voxel per the face convention.
+            const i128 num = O[a] * f.t.m + f.t.n * D[a], den = kScale * f.t.m;
+            i128 c = D[a] < 0 ? -floorDiv(-num, den) - 1 : floorDiv(num, den);  // ceil(x) - 1 = -floor(-x) - 1
+            c = std::max<i128>(f.box->min[a], std::min<i128>(c, f.box->min[a] + f.box->size - 1));
+            hit.voxel[a] = int64_t(c);
+        }
+        hits.push_back(hit);
     }
-    return best;
+    return hits;
+}
+
+RayHit ExactRayReference::trace(const Ray& ray) const {
+    std::vector<RayHit> hits = traceAll(ray);
+    return hits.empty() ? RayHit{} : hits.front();
+}
+
+std::optional<uint64_t> ExactRayReference::find(const std::array<int64_t, 3>& voxel) const {
+    for (const Box& box : boxes_) {
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) inside = inside && voxel[a] >= box.min[a] && voxel[a] < box.min[a] + box.size;
+        if (inside) return box.attribute;
+    }
+    return std::nullopt;
 }
 
 } // namespace vdbdag::trace

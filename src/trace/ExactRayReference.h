@@ -8,6 +8,7 @@
 // tells. Slow (O(boxes) per ray): for tests and `vdbdag selftest` on small
 // grids.
 #pragma once
+#include <optional>
 #include <vector>
 
 #include "src/encoding/CompactDag.h"
@@ -23,6 +24,11 @@ public:
     static bool representable(const Ray& ray);
     // Throws vdbdag::Error if !representable(ray).
     RayHit trace(const Ray& ray) const;
+    // Every occupied box the ray overlaps over a positive length (or starts
+    // in), by entry parameter.
+    std::vector<RayHit> traceAll(const Ray& ray) const;
+    // Attribute entry of the active voxel (or tile) at an index coordinate.
+    std::optional<uint64_t> find(const std::array<int64_t, 3>& voxel) const;
 
 private:
     struct Box {

@@ -221,3 +221,39 @@ TEST(CpuTracer, NonFiniteAndDegenerateRaysMissWithoutLooping) {
     bounded.tMax = 50;
     EXPECT_FALSE(tracer.trace(bounded).hit);
 }
+
+TEST(CpuTracer, SegmentWalkVisitsEveryOccupiedBoxInOrderAndPointQueriesAgree) {
+    std::mt19937_64 rng(21);
+    const encoding::CompactDag dag = compactOf(randomTopology(rng, 4, -8));
+    const trace::DagTracer tracer(dag);
+    const trace::ExactRayReference reference(dag);
+    size_t segments = 0;
+    for (int i = 0; i < 1500; ++i) {
+        Ray ray;
+        for (int a = 0; a < 3; ++a) {
+            ray.origin[a] = dyadic(rng, -20, 40, 6);
+            ray.direction[a] = dyadic(rng, -1, 1, 4);
+        }
+        if (i % 5 == 0) ray.direction[i % 3] = 0.0;
+        std::vector<RayHit> got;
+        std::vector<double> leave;
+        tracer.forEachSegment(ray, [&](const RayHit& box, double tLeave) {
+            got.push_back(box);
+            leave.push_back(tLeave);
+            return false;
+        });
+        const std::vector<RayHit> want = reference.traceAll(ray);
+        ASSERT_EQ(got.size(), want.size());
+        for (size_t k = 0; k < want.size(); ++k) {
+            expectSameHit(got[k], want[k], ray, "segment " + std::to_string(k));
+            EXPECT_GT(leave[k], got[k].t);
+            if (k + 1 < want.size()) EXPECT_LE(leave[k], want[k + 1].t);
+        }
+        segments += want.size();
+    }
+    EXPECT_GT(segments, 500u);
+    for (int i = 0; i < 20000; ++i) {
+        const std::array<int64_t, 3> voxel{int64_t(rng() % 40) - 12, int64_t(rng() % 40) - 12, int64_t(rng() % 40) - 12};
+        ASSERT_EQ(tracer.find(voxel), reference.find(voxel));
+    }
+}
