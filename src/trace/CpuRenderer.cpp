@@ -1,0 +1,144 @@
+// CPU renderer; see CpuRenderer.h.
+#include "src/trace/CpuRenderer.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "src/trace/DagTracer.h"
+
+namespace vdbdag::trace {
+namespace {
+
+// Index-space gradient of a level set at a voxel by central differences of
+// the stored values (one-sided where a neighbour is not active).
+std::optional<glm::dvec3> levelSetGradient(const RenderGrid& grid, const DagTracer& tracer, const RayHit& hit, uint64_t centreAttribute) {
+    const double centre = valueAsDoubles(grid, centreAttribute)[0];
+    glm::dvec3 g(0);
+    for (int a = 0; a < 3; ++a) {
+        std::array<int64_t, 3> plus = hit.voxel, minus = hit.voxel;
+        ++plus[a];
+        --minus[a];
+        const auto p = tracer.find(plus), m = tracer.find(minus);
+        if (p && m) g[a] = (valueAsDoubles(grid, *p)[0] - valueAsDoubles(grid, *m)[0]) * 0.5;
+        else if (p) g[a] = valueAsDoubles(grid, *p)[0] - centre;
+        else if (m) g[a] = centre - valueAsDoubles(grid, *m)[0];
+    }
+    const double len = glm::length(g);
+    if (!(len > 0) || !std::isfinite(len)) return std::nullopt;
+    return g / len;
+}
+
+// Level sets skip voxels within this many voxel lengths of a shadow ray's
+// start: the narrow band's staircase would otherwise shadow its own surface.
+constexpr double kShadowBias = 3.0;
+
+// The surface a ray sees: the first active voxel, or for a level set the
+// first active voxel whose value is <= 0 (the zero crossing, as NanoVDB's
+// ZeroCrossing), skipping the band's outside voxels.
+RayHit firstSurfaceHit(const RenderGrid& grid, const DagTracer& tracer, const Ray& ray, double ignoreBefore) {
+    if (!grid.levelSet) {
+        Ray clipped = ray;
+        clipped.tMin = std::max(ray.tMin, ignoreBefore);
+        return tracer.trace(clipped);
+    }
+    RayHit found;
+    tracer.forEachSegment(ray, [&](const RayHit& box, double) {
+        if (box.t < ignoreBefore || !(valueAsDoubles(grid, box.attribute)[0] <= 0)) return false;
+        found = box;
+        return true;
+    });
+    return found;
+}
+
+} // namespace
+
+Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {
+    const auto start = std::chrono::steady_clock::now();
+    const GridFrame frame(grid.indexToWorld);
+    TraceOptions traceOptions;
+    if (options.lodPixels > 0) traceOptions.lodScale = options.lodPixels * camera.pixelAngle() / frame.voxelSize();
+    const DagTracer tracer(*grid.dag, traceOptions);
+    const DagTracer shadowTracer(*grid.dag);
+    const glm::dvec3 light = defaultLight(camera.eye, camera.target, camera.up);
+    const Ray lightRay = frame.toCellRay(glm::dvec3(0), light);  // its direction is the light's, in cell space
+
+    Image image;
+    image.resize(camera.width, camera.height);
+    std::atomic<uint64_t> secondary{0};
+    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& rows) {
+        uint64_t localSecondary = 0;
+        for (int py = rows.begin(); py != rows.end(); ++py)
+            for (int px = 0; px < camera.width; ++px) {
+                const size_t pixel = size_t(py) * camera.width + px;
+                glm::dvec3 eye, dir;
+                camera.pixelRay(px, py, eye, dir);
+                const Ray ray = frame.toCellRay(eye, dir);
+                glm::dvec3 colour = options.background;
+                if (grid.fog) {
+                    double transmittance = 1, firstHit = -1;
+                    glm::dvec3 sum(0);
+                    const double scale = options.densityScale / (grid.valueMax * frame.voxelSize());
+                    tracer.forEachSegment(ray, [&](const RayHit& box, double tLeave) {
+                        if (firstHit < 0) firstHit = box.t;
+                        const double density = std::max(0.0, valueAsDoubles(grid, box.attribute)[0]);
+                        const double alpha = 1 - std::exp(-scale * density * (tLeave - box.t));
+                        sum += transmittance * alpha * kFogEmission;
+                        transmittance *= 1 - alpha;
+                        return transmittance < 1e-3;
+                    });
+                    colour = sum + transmittance * options.background;
+                    image.alpha[pixel] = float(1 - transmittance);
+                    if (firstHit >= 0) image.depth[pixel] = float(firstHit);
+                } else {
+                    const RayHit hit = firstSurfaceHit(grid, tracer, ray, 0);
+                    if (hit.hit) {
+                        glm::dvec3 normal;
+                        std::optional<glm::dvec3> gradient;
+                        if (grid.levelSet && hit.lodLevel == 0) gradient = levelSetGradient(grid, tracer, hit, hit.attribute);
+                        if (gradient) {
+                            normal = frame.normalToWorld(*gradient);
+                        } else if (hit.faceAxis >= 0) {
+                            glm::dvec3 n(0);
+                            n[hit.faceAxis] = hit.faceSign;
+                            normal = frame.normalToWorld(n);
+                        } else {
+                            normal = -dir;
+                        }
+                        if (glm::dot(normal, dir) > 0 && !gradient) normal = -normal;
+                        double lambert = std::max(0.0, glm::dot(normal, light));
+                        if (options.shadows && lambert > 0 && hit.faceAxis >= 0) {
+                            // From the hit point, exactly on the entry face, towards the light.
+                            Ray shadow;
+                            for (int a = 0; a < 3; ++a) {
+                                shadow.origin[a] = ray.origin[a] + hit.t * ray.direction[a];
+                                shadow.direction[a] = lightRay.direction[a];
+                            }
+                            const int f = hit.faceAxis;
+                            shadow.origin[f] = double(hit.faceSign < 0 ? hit.voxel[f] : hit.voxel[f] + 1);
+                            if ((shadow.direction[f] > 0) == (hit.faceSign > 0) && shadow.direction[f] != 0) {
+                                ++localSecondary;
+                                if (firstSurfaceHit(grid, shadowTracer, shadow, grid.levelSet ? kShadowBias * frame.voxelSize() : 0).hit) lambert = 0;
+                            }  // else the light leaves through another face: no shadow test (a gradient normal may still face it)
+                        }
+                        colour = baseColour(grid, hit.attribute) * (kAmbient + (1 - kAmbient) * lambert);
+                        image.alpha[pixel] = 1;
+                        image.depth[pixel] = float(hit.t);
+                        for (int a = 0; a < 3; ++a) image.normal[3 * pixel + a] = float(normal[a]);
+                    }
+                }
+                for (int a = 0; a < 3; ++a) image.rgb[3 * pixel + a] = float(colour[a]);
+            }
+        secondary += localSecondary;
+    });
+    if (stats) {
+        stats->primaryRays = uint64_t(camera.width) * uint64_t(camera.height);
+        stats->secondaryRays = secondary;
+        stats->milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    }
+    return image;
+}
+
+} // namespace vdbdag::trace

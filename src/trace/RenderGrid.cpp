@@ -1,0 +1,119 @@
+// Shading choices and value access for renderers; see RenderGrid.h.
+#include "src/trace/RenderGrid.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace vdbdag::trace {
+namespace {
+
+bool looksLikeColour(std::string name) {
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return name == "cd" || name.find("col") != std::string::npos || name.find("rgb") != std::string::npos;
+}
+
+std::array<double, 3> decodeValue(ValueType type, const uint8_t* bytes) {
+    std::array<double, 3> out{0, 0, 0};
+    switch (type) {
+    case ValueType::Float: { float f; std::memcpy(&f, bytes, 4); out[0] = f; break; }
+    case ValueType::Double: std::memcpy(&out[0], bytes, 8); break;
+    case ValueType::Int32: { int32_t i; std::memcpy(&i, bytes, 4); out[0] = i; break; }
+    case ValueType::Int64: { int64_t i; std::memcpy(&i, bytes, 8); out[0] = double(i); break; }
+    case ValueType::Bool: out[0] = bytes[0] ? 1 : 0; break;
+    case ValueType::Mask: break;
+    case ValueType::Vec3S: { float f[3]; std::memcpy(f, bytes, 12); out = {f[0], f[1], f[2]}; break; }
+    case ValueType::Vec3D: std::memcpy(out.data(), bytes, 24); break;
+    case ValueType::Vec3I: { int32_t i[3]; std::memcpy(i, bytes, 12); out = {double(i[0]), double(i[1]), double(i[2])}; break; }
+    }
+    return out;
+}
+
+// Bounds of the occupied cells, from the nodes down to `maxDepth` levels
+// below the root (a conservative box, cheap for any DAG size).
+void occupiedBounds(const encoding::CompactDag& dag, std::array<double, 3>& lo, std::array<double, 3>& hi) {
+    std::array<int64_t, 3> bmin{INT64_MAX, INT64_MAX, INT64_MAX}, bmax{INT64_MIN, INT64_MIN, INT64_MIN};
+    const unsigned maxDepth = std::min<unsigned>(unsigned(dag.innerLevelCount()) - 1, 5);
+    struct Walk {
+        const encoding::CompactDag& dag;
+        unsigned maxDepth;
+        std::array<int64_t, 3>& bmin;
+        std::array<int64_t, 3>& bmax;
+        void visit(unsigned depth, uint64_t pos, unsigned mirror, int64_t x, int64_t y, int64_t z) {
+            const unsigned log2 = dag.log2Size - depth;
+            const uint16_t header = dag.inner[pos];
+            if (header == 0 || depth == maxDepth) {
+                const int64_t c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a) { bmin[a] = std::min(bmin[a], c[a]); bmax[a] = std::max(bmax[a], c[a] + (int64_t(1) << log2)); }
+                return;
+            }
+            const int64_t half = int64_t(1) << (log2 - 1);
+            for (unsigned j = 0; j < 8; ++j) {
+                if (((header >> (2 * j)) & 3u) == 0) continue;
+                const encoding::ChildPointer child = encoding::readChild(dag.inner, pos, j, dag.offsetWords[depth]);
+                const unsigned p = j ^ mirror;
+                visit(depth + 1, dag.levelStart[depth + 1] + child.offset, mirror ^ child.reflection, x + ((p & 1) ? half : 0),
+                      y + ((p & 2) ? half : 0), z + ((p & 4) ? half : 0));
+            }
+        }
+    };
+    Walk{dag, maxDepth, bmin, bmax}.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
+    for (int a = 0; a < 3; ++a) { lo[a] = double(bmin[a]); hi[a] = double(bmax[a]); }
+}
+
+} // namespace
+
+RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
+    RenderGrid out;
+    out.dag = &grid.dag;
+    out.valueType = grid.record.valueType;
+    out.indexToWorld = grid.record.indexToWorld;
+    const bool scalarFloat = out.valueType == ValueType::Float || out.valueType == ValueType::Double;
+    out.levelSet = grid.record.gridClass == "level set" && scalarFloat;
+    out.fog = grid.record.gridClass == "fog volume" && scalarFloat;
+    if (valueSize(out.valueType) > 0 && grid.values.entryCount > 0) out.values = &grid.values;
+    switch (out.valueType) {
+    case ValueType::Vec3I: out.colouring = ValueColouring::Colour; break;
+    case ValueType::Vec3S:
+    case ValueType::Vec3D: out.colouring = looksLikeColour(grid.record.name) ? ValueColouring::Colour : ValueColouring::Vector; break;
+    case ValueType::Float:
+    case ValueType::Double:
+    case ValueType::Int32:
+    case ValueType::Int64: out.colouring = out.levelSet ? ValueColouring::None : ValueColouring::Scalar; break;
+    default: out.colouring = ValueColouring::None;
+    }
+    if (!out.values) out.colouring = ValueColouring::None;
+    if (out.values && out.colouring == ValueColouring::Scalar) {
+        // Range over the material array and the directly stored values.
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        const unsigned vs = grid.values.valueSize;
+        auto take = [&](const uint8_t* bytes) {
+            const double v = decodeValue(out.valueType, bytes)[0];
+            if (std::isfinite(v)) { lo = std::min(lo, v); hi = std::max(hi, v); }
+        };
+        for (size_t i = 0; i + vs <= grid.values.materials.size(); i += vs) take(&grid.values.materials[i]);
+        for (size_t i = 0; i + vs <= grid.values.direct.size(); i += vs) take(&grid.values.direct[i]);
+        if (lo <= hi) { out.valueMin = lo; out.valueMax = hi > lo ? hi : lo + 1; }
+    }
+    if (out.fog && out.values) {
+        double hi = 0;
+        const unsigned vs = grid.values.valueSize;
+        for (size_t i = 0; i + vs <= grid.values.materials.size(); i += vs) hi = std::max(hi, decodeValue(out.valueType, &grid.values.materials[i])[0]);
+        for (size_t i = 0; i + vs <= grid.values.direct.size(); i += vs) hi = std::max(hi, decodeValue(out.valueType, &grid.values.direct[i])[0]);
+        out.valueMax = std::isfinite(hi) && hi > 0 ? hi : 1;
+        out.valueMin = 0;
+    }
+    if (!grid.dag.empty()) occupiedBounds(grid.dag, out.cellLo, out.cellHi);
+    return out;
+}
+
+std::array<double, 3> valueAsDoubles(const RenderGrid& grid, uint64_t attribute) {
+    if (!grid.values || attribute >= grid.values->entryCount) return {0, 0, 0};
+    uint8_t bytes[24];
+    grid.values->lookup(attribute, bytes);
+    return decodeValue(grid.valueType, bytes);
+}
+
+} // namespace vdbdag::trace

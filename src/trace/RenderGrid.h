@@ -1,0 +1,42 @@
+// What a renderer needs to know about one encoded grid: its DAG, its value
+// channel, how to shade it (surface or fog, colour or scalar), its frame,
+// and the bounds of its occupied cells (for the default camera). Shared by
+// the CPU renderer and the Vulkan backend.
+#pragma once
+#include <array>
+#include <optional>
+
+#include "src/attributes/PaletteChannel.h"
+#include "src/encoding/CompactDag.h"
+#include "src/format/SsvdagFile.h"
+
+namespace vdbdag::trace {
+
+enum class ValueColouring {
+    None,        // mask/bool grids, or no values: a plain material
+    Scalar,      // float/double/int: a colour map over [valueMin, valueMax]
+    Colour,      // vec3 colours: [0,1] floats, or 0..255 integers (vec3i)
+    Vector,      // other vec3 grids: 0.5 + 0.5 * normalised vector
+};
+
+struct RenderGrid {
+    const encoding::CompactDag* dag = nullptr;
+    const attributes::PaletteChannel* values = nullptr;  // null when the grid stores none
+    ValueType valueType = ValueType::Mask;
+    bool levelSet = false;  // grid class "level set" with float/double values: smooth gradient normals
+    bool fog = false;       // grid class "fog volume": emission-absorption
+    ValueColouring colouring = ValueColouring::None;
+    double valueMin = 0, valueMax = 1;  // over the stored values (finite ones)
+    std::array<double, 16> indexToWorld{};
+    std::array<double, 3> cellLo{0, 0, 0}, cellHi{1, 1, 1};  // occupied cells, [lo, hi)
+};
+
+// Chooses the shading from the grid's class, type and name (colour grids
+// are vec3 grids named like Cd, color, colour, rgb, or any vec3i grid).
+// `grid` must outlive the result.
+RenderGrid makeRenderGrid(const format::EncodedGrid& grid);
+
+// A stored value as up to three doubles (scalars in [0]).
+std::array<double, 3> valueAsDoubles(const RenderGrid& grid, uint64_t attribute);
+
+} // namespace vdbdag::trace
