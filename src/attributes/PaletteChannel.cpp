@@ -394,8 +394,16 @@ uint64_t PaletteChannel::byteSize() const {
 }
 
 void PaletteChannel::lookup(uint64_t index, uint8_t* out) const {
-    auto it = std::upper_bound(blocks.begin(), blocks.end(), index, [](uint64_t i, const PaletteBlock& b) { return i < b.firstEntry; });
-    const PaletteBlock& b = *std::prev(it);
+    size_t hint = 0;
+    lookup(index, out, hint);
+}
+
+void PaletteChannel::lookup(uint64_t index, uint8_t* out, size_t& hint) const {
+    if (!(hint < blocks.size() && blocks[hint].firstEntry <= index && (hint + 1 == blocks.size() || index < blocks[hint + 1].firstEntry))) {
+        auto it = std::upper_bound(blocks.begin(), blocks.end(), index, [](uint64_t i, const PaletteBlock& b) { return i < b.firstEntry; });
+        hint = size_t(std::prev(it) - blocks.begin());
+    }
+    const PaletteBlock& b = blocks[hint];
     const uint64_t k = index - b.firstEntry;
     if (b.indexBits == PaletteBlock::kDirect) {
         std::memcpy(out, &direct[b.dataOffset + k * valueSize], valueSize);

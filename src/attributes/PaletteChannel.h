@@ -39,6 +39,9 @@ struct PaletteChannel {
     uint64_t byteSize() const;
     // Copies entry `index`'s value (valueSize bytes) to `out`.
     void lookup(uint64_t index, uint8_t* out) const;
+    // The same, trying block `hint` first and leaving the block used in it:
+    // a walk that reads nearby entries skips most binary searches.
+    void lookup(uint64_t index, uint8_t* out, size_t& hint) const;
     // All entries, in order (for decoding).
     std::vector<uint8_t> decodeAll() const;
 };

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "src/trace/DagTracer.h"
+#include "src/trace/SurfaceHit.h"
 
 namespace vdbdag::trace {
 namespace {
@@ -34,24 +35,6 @@ std::optional<glm::dvec3> levelSetGradient(const RenderGrid& grid, const DagTrac
 // Level sets skip voxels within this many voxel lengths of a shadow ray's
 // start: the narrow band's staircase would otherwise shadow its own surface.
 constexpr double kShadowBias = 3.0;
-
-// The surface a ray sees: the first active voxel, or for a level set the
-// first active voxel whose value is <= 0 (the zero crossing, as NanoVDB's
-// ZeroCrossing), skipping the band's outside voxels.
-RayHit firstSurfaceHit(const RenderGrid& grid, const DagTracer& tracer, const Ray& ray, double ignoreBefore) {
-    if (!grid.levelSet) {
-        Ray clipped = ray;
-        clipped.tMin = std::max(ray.tMin, ignoreBefore);
-        return tracer.trace(clipped);
-    }
-    RayHit found;
-    tracer.forEachSegment(ray, [&](const RayHit& box, double) {
-        if (box.t < ignoreBefore || !(valueAsDoubles(grid, box.attribute)[0] <= 0)) return false;
-        found = box;
-        return true;
-    });
-    return found;
-}
 
 } // namespace
 

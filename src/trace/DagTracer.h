@@ -33,6 +33,13 @@ struct TraceOptions {
     uint32_t maxSteps = 1u << 24;
 };
 
+// The cells any occupied voxel or tile lies in, [lo, hi) relative to the
+// root cube's corner: a conservative box from the top levels of the DAG.
+struct OccupiedBox {
+    int64_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+};
+OccupiedBox occupiedBox(const encoding::CompactDag& dag, unsigned levels = 6);
+
 class DagTracer {
 public:
     // `dag` must be validated (encoding::validateCompact) and outlive the tracer.
@@ -50,10 +57,13 @@ public:
     void traceBatch(std::span<const Ray> rays, std::span<RayHit> hits) const;
 
     const encoding::CompactDag& dag() const { return dag_; }
+    const TraceOptions& options() const { return options_; }
+    const OccupiedBox& box() const { return box_; }
 
 private:
     const encoding::CompactDag& dag_;
     TraceOptions options_;
+    OccupiedBox box_;
 };
 
 } // namespace vdbdag::trace

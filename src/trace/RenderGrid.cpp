@@ -110,9 +110,14 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
 }
 
 std::array<double, 3> valueAsDoubles(const RenderGrid& grid, uint64_t attribute) {
+    size_t hint = 0;
+    return valueAsDoubles(grid, attribute, hint);
+}
+
+std::array<double, 3> valueAsDoubles(const RenderGrid& grid, uint64_t attribute, size_t& blockHint) {
     if (!grid.values || attribute >= grid.values->entryCount) return {0, 0, 0};
     uint8_t bytes[24];
-    grid.values->lookup(attribute, bytes);
+    grid.values->lookup(attribute, bytes, blockHint);
     return decodeValue(grid.valueType, bytes);
 }
 

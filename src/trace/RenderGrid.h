@@ -38,5 +38,7 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid);
 
 // A stored value as up to three doubles (scalars in [0]).
 std::array<double, 3> valueAsDoubles(const RenderGrid& grid, uint64_t attribute);
+// The same with a palette block hint (PaletteChannel::lookup).
+std::array<double, 3> valueAsDoubles(const RenderGrid& grid, uint64_t attribute, size_t& blockHint);
 
 } // namespace vdbdag::trace
