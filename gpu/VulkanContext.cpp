@@ -27,14 +27,14 @@ Error noDeviceError(const char* detail) {
                              detail, env));
 }
 
-VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT type,
                                               const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
-    if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
-        if (user) static_cast<std::atomic<uint64_t>*>(user)->fetch_add(1);
-        std::fprintf(stderr, "vulkan validation error: %s\n", data->pMessage);
-    } else {
-        std::fprintf(stderr, "vulkan validation warning: %s\n", data->pMessage);
-    }
+    const bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    if (error && user) static_cast<std::atomic<uint64_t>*>(user)->fetch_add(1);
+    const char* source = (type & VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT)    ? "vulkan validation"
+                         : (type & VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT) ? "vulkan performance"
+                                                                                   : "vulkan";  // e.g. the loader
+    std::fprintf(stderr, "%s %s: %s\n", source, error ? "error" : "warning", data->pMessage);
     return VK_FALSE;
 }
 
