@@ -1,6 +1,8 @@
-// `vdbdag devices [--json]`: the Vulkan devices the loader sees, with the
-// limits and features the tracer depends on, and which one is chosen by
-// default (like `vulkaninfo --summary`). No devices -> one-line error, exit 1.
+// `vdbdag devices [--json] [--device N]`: the Vulkan devices the loader sees,
+// with the limits and features the tracer depends on, and which one is
+// chosen by default (like `vulkaninfo --summary`); --device N opens device N
+// (as `render --device N` would) and marks it selected. No devices, or no
+// device N -> one-line error, exit 1.
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
@@ -18,7 +20,7 @@ std::string mib(uint64_t bytes) {
     return fmt::format("{} bytes", bytes);
 }
 
-nlohmann::json toJson(const gpu::DeviceInfo& d, bool isDefault) {
+nlohmann::json toJson(const gpu::DeviceInfo& d, bool isChosen) {
     return {{"index", d.index},
             {"name", d.name},
             {"type", d.type},
@@ -45,7 +47,7 @@ nlohmann::json toJson(const gpu::DeviceInfo& d, bool isDefault) {
             {"timestamp_period_ns", d.timestampPeriodNs},
             {"usable", d.usable},
             {"unusable_reason", d.unusableReason},
-            {"default", isDefault}};
+            {"chosen", isChosen}};
 }
 
 std::string yesNo(bool b) { return b ? "yes" : "no"; }
@@ -53,20 +55,30 @@ std::string yesNo(bool b) { return b ? "yes" : "no"; }
 } // namespace
 
 void addDevicesCommand(CLI::App& app, int& exitCode) {
-    auto json = std::make_shared<bool>(false);
+    struct Options { bool json = false; std::optional<uint32_t> device; };
+    auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("devices", "List the Vulkan devices (index for --device N, limits, features, the default choice)");
-    cmd->add_flag("--json", *json, "print JSON");
-    cmd->callback([json, &exitCode] {
+    cmd->add_flag("--json", opt->json, "print JSON");
+    cmd->add_option("--device", opt->device, "open device N and mark it as the selected one");
+    cmd->callback([opt, &exitCode] {
         const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
-        const std::optional<uint32_t> chosen = gpu::defaultDeviceIndex(devices);
-        if (*json) {
+        std::optional<uint32_t> chosen = gpu::defaultDeviceIndex(devices);
+        if (opt->device) {
+            gpu::ContextOptions options;
+            options.deviceIndex = opt->device;
+            chosen = gpu::openDevice(options).index;
+        }
+        const char* mark = opt->device ? "  (selected)" : "  (default)";
+        const bool json = opt->json;
+        if (json) {
             nlohmann::json report = nlohmann::json::array();
             for (const gpu::DeviceInfo& d : devices) report.push_back(toJson(d, chosen && *chosen == d.index));
-            fmt::print("{}\n", nlohmann::json{{"devices", report}}.dump(2));
+            report = nlohmann::json{{"devices", report}};
+            if (chosen) report[opt->device ? "selected" : "default"] = *chosen;
+            fmt::print("{}\n", report.dump(2));
         } else {
             for (const gpu::DeviceInfo& d : devices) {
-                const bool isDefault = chosen && *chosen == d.index;
-                fmt::print("{}: {} [{}]{}\n", d.index, d.name, d.type, isDefault ? "  (default)" : "");
+                fmt::print("{}: {} [{}]{}\n", d.index, d.name, d.type, chosen && *chosen == d.index ? mark : "");
                 fmt::print("   Vulkan {}, driver {} {}\n", d.apiVersion, d.driverName, d.driverInfo);
                 fmt::print("   maxStorageBufferRange {}, maxMemoryAllocationSize {}, device-local heap {}\n", mib(d.maxStorageBufferRange),
                            mib(d.maxMemoryAllocationSize), mib(d.deviceLocalHeapBytes));

@@ -57,6 +57,11 @@ struct ContextOptions {
 // ("no Vulkan device found: ...") when there is no loader, no driver or no device.
 std::vector<DeviceInfo> listDevices(const ContextOptions& options = {});
 
+// Opens the device `options` choose (a full VulkanContext, then closes it)
+// and returns its description: checks that `--device N` exists and works.
+// Throws the same one-line vdbdag::Error as VulkanContext.
+DeviceInfo openDevice(const ContextOptions& options);
+
 // The index the default choice picks among `devices` (usable ones only), or
 // empty when none is usable.
 std::optional<uint32_t> defaultDeviceIndex(const std::vector<DeviceInfo>& devices);

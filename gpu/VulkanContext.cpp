@@ -254,6 +254,11 @@ std::vector<DeviceInfo> listDevices(const ContextOptions& options) {
     return infos;
 }
 
+DeviceInfo openDevice(const ContextOptions& options) {
+    const VulkanContext context(options);
+    return context.deviceInfo();
+}
+
 std::optional<uint32_t> defaultDeviceIndex(const std::vector<DeviceInfo>& devices) {
     std::optional<uint32_t> best;
     for (const DeviceInfo& d : devices)

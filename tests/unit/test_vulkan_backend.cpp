@@ -261,6 +261,20 @@ TEST(VulkanBackend, ImpossibleDeviceIndexGivesAOneLineError) {
     }
 }
 
+TEST(VulkanBackend, DevicesCommandOpensTheRequestedDeviceOrFailsInOneLine) {
+    VULKAN_CONTEXT_OR_SKIP(probe);
+    const uint32_t index = probe->deviceInfo().index;
+    const CommandResult ok = runShell(std::string(VDBDAG_BINARY) + " devices --json --device " + std::to_string(index));
+    ASSERT_EQ(ok.exitCode, 0) << ok.err;
+    EXPECT_EQ(nlohmann::json::parse(ok.out)["selected"], index);
+    const size_t missing = probe->allDevices().size() + 3;
+    const CommandResult bad = runShell(std::string(VDBDAG_BINARY) + " devices --device " + std::to_string(missing));
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_TRUE(bad.out.empty()) << bad.out;
+    EXPECT_TRUE(bad.err.starts_with("vdbdag: Vulkan device " + std::to_string(missing) + " does not exist")) << bad.err;
+    EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+}
+
 TEST(VulkanBackend, OversizedBufferAndUnknownShaderGiveClearErrors) {
     VULKAN_CONTEXT_OR_SKIP(ctx);
     const uint64_t tooBig = ctx->deviceInfo().maxMemoryAllocationSize + 1;
@@ -298,15 +312,16 @@ TEST(VulkanBackend, DevicesCommandListsWhatVulkaninfoSees) {
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const nlohmann::json report = nlohmann::json::parse(r.out);
     ASSERT_EQ(report["devices"].size(), ctx->allDevices().size());
-    int defaults = 0;
+    int chosen = 0;
     for (const auto& d : report["devices"]) {
-        if (d["default"].get<bool>()) {
-            ++defaults;
+        if (d["chosen"].get<bool>()) {
+            ++chosen;
+            EXPECT_EQ(d["index"], report["default"]);
             EXPECT_EQ(d["name"], ctx->deviceInfo().name);
             EXPECT_EQ(d["max_storage_buffer_range"], ctx->deviceInfo().maxStorageBufferRange);
         }
     }
-    EXPECT_EQ(defaults, 1);
+    EXPECT_EQ(chosen, 1);
     // Independent reference: the names vulkaninfo (vulkan-tools) reports.
     const CommandResult vi = runShell("vulkaninfo --summary");
     if (vi.exitCode != 0) GTEST_SKIP() << "vulkaninfo unavailable";
