@@ -9,7 +9,11 @@
 //    grid of workgroups; the shader returns early when the index >= its item
 //    count (which it receives in its own push constants);
 //  - no descriptor sets: data is reached through 64-bit buffer device
-//    addresses (DeviceBuffer::address(), DeviceArrayRef) in push constants.
+//    addresses (DeviceBuffer::address(), DeviceArrayRef) in push constants;
+//    parameters beyond the 128 push-constant bytes every device guarantees
+//    go into a small DeviceBuffer whose address is pushed;
+//  - 16-bit loads need storageBuffer16BitAccess, 64-bit ones shaderInt64
+//    (both enabled when present; lavapipe has them).
 // Specialisation constants (ids >= 1) compile in only what a scene has, e.g.
 // `layout(constant_id = 1) const bool HAS_COLOR = false;`.
 #pragma once
