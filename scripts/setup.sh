@@ -9,7 +9,7 @@ PACKAGES=(
   libopenvdb-dev libnanovdb-dev libboost-iostreams-dev libopenvdb-tools libnanovdb-tools
   libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
   libvtk9-dev python3-vtk9 libglm-dev
-  mesa-vulkan-drivers libvulkan-dev glslc glslang-tools spirv-tools vulkan-tools
+  mesa-vulkan-drivers libvulkan-dev glslc glslang-tools spirv-tools vulkan-tools vulkan-validationlayers
   libtbb-dev libblosc-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils
   libzfp-dev
