@@ -26,6 +26,12 @@ struct StackEntry {
     unsigned mirror;  // accumulated reflection
 };
 
+// floor() for |x| < 2^62 without a libm call (baseline x86-64 has no roundsd).
+inline int64_t floorToInt(double x) {
+    const int64_t i = int64_t(x);
+    return i - int64_t(double(i) > x);
+}
+
 // The ray in the root cube's frame, with the per-axis crossing times.
 struct LocalRay {
     double o[3], d[3];
@@ -39,7 +45,7 @@ struct LocalRay {
         int64_t c;
         if (!(p > double(lo) - 1)) c = lo;  // also NaN
         else if (!(p < double(hi) + 2)) c = hi;
-        else c = d[a] > 0 ? int64_t(std::floor(p)) : int64_t(std::ceil(p)) - 1;
+        else c = d[a] > 0 ? floorToInt(p) : -floorToInt(-p) - 1;  // ceil(p) - 1
         c = std::clamp(c, lo, hi);
         if (d[a] > 0) {  // voxel c spans [crossing(c), crossing(c + 1))
             tOut = crossing(a, c + 1);
@@ -55,7 +61,7 @@ struct LocalRay {
         return c;
     }
     int64_t voxelAt(int a, double t, int64_t lo, int64_t hi) const {
-        if (d[a] == 0) return std::clamp(int64_t(std::floor(o[a])), lo, hi);
+        if (d[a] == 0) return std::clamp(floorToInt(o[a]), lo, hi);
         double tIn, tOut;
         return voxelAt(a, t, lo, hi, tIn, tOut);
     }
@@ -127,20 +133,25 @@ RayHit walkRay(const encoding::CompactDag& dag, const TraceOptions& options, con
     }
     if (!(tEnter < tExit)) return result;
 
+    // The voxel at tEnter, the crossing time of the voxel boundary ahead on
+    // each axis (inf if none), and the axes whose voxel boundary the ray
+    // crosses exactly at tEnter (an edge or a corner crossing sets several;
+    // the hit face is the lowest of them that is also a face of the hit box:
+    // a voxel, a tile or an LOD node). Starting inside crosses nothing.
     int64_t v[3];
-    for (int a = 0; a < 3; ++a) v[a] = r.voxelAt(a, tEnter, box.lo[a], box.hi[a] - 1);
-    double t = tEnter;
-    // Axes whose voxel boundary the ray crosses exactly at t (an edge or a
-    // corner crossing sets several); the hit face is the lowest of them that
-    // is also a face of the hit box (a voxel, a tile or an LOD node).
-    unsigned crossed = 0;
-    if (enterAxis >= 0)
-        for (int a = 0; a < 3; ++a)
-            if (r.d[a] != 0 && r.crossing(a, r.d[a] > 0 ? v[a] : v[a] + 1) == t) crossed |= 1u << a;
-
-    // Crossing time of the voxel boundary ahead on each axis (inf if none).
     double tNext[3];
-    for (int a = 0; a < 3; ++a) tNext[a] = r.d[a] == 0 ? kInf : r.crossing(a, r.d[a] > 0 ? v[a] + 1 : v[a]);
+    unsigned crossed = 0;
+    for (int a = 0; a < 3; ++a) {
+        if (r.d[a] == 0) {
+            v[a] = std::clamp(floorToInt(r.o[a]), box.lo[a], box.hi[a] - 1);
+            tNext[a] = kInf;
+            continue;
+        }
+        double tIn;
+        v[a] = r.voxelAt(a, tEnter, box.lo[a], box.hi[a] - 1, tIn, tNext[a]);
+        if (enterAxis >= 0 && tIn == tEnter) crossed |= 1u << a;
+    }
+    double t = tEnter;
 
     StackEntry stack[kMaxLevels];
     unsigned depth = 0;
