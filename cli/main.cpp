@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
     vdbdag::cli::addDecodeCommand(app, exitCode);
     vdbdag::cli::addInfoCommand(app, exitCode);
     vdbdag::cli::addVerifyCommand(app, exitCode);
+    vdbdag::cli::addExportCommand(app, exitCode);
+    vdbdag::cli::addDiffCommand(app, exitCode);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
