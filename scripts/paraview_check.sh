@@ -82,11 +82,12 @@ SaveScreenshot("$OUTPUT", view, ImageResolution=[1024, 768])
 print("paraview_check: wrote $OUTPUT")
 PY
 shift 3
-# pvpython under xvfb now and then aborts at start-up (X connection races):
-# retry a crash (exit >= 128), never an ordinary failure.
+# pvpython under xvfb now and then aborts at start-up ("bad X server
+# connection": xvfb-run -a races other users of display :99). Start from a
+# random display number and retry a crash (exit >= 128), never an ordinary failure.
 for attempt in 1 2 3; do
   status=0
-  xvfb-run -a -s "-screen 0 1024x768x24" "$PV_DIR/usr/bin/pvpython" --force-offscreen-rendering "$script" "$@" || status=$?
+  xvfb-run -a -n $((100 + RANDOM % 800)) -s "-screen 0 1024x768x24" "$PV_DIR/usr/bin/pvpython" --force-offscreen-rendering "$script" "$@" || status=$?
   [ "$status" -lt 128 ] && exit "$status"
   echo "paraview_check: pvpython crashed (exit $status), attempt $attempt of 3" >&2
 done
