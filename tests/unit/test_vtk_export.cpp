@@ -302,6 +302,21 @@ TEST(VtkExport, LimitsStopWithOneLineErrorsAndWriteNothing) {
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
         EXPECT_FALSE(fs::exists(vtu)) << args;
     }
+    // A .vdb cut short anywhere inside its grids (OpenVDB alone reads it without complaint).
+    const auto size = fs::file_size(in);
+    for (const double fraction : {0.3, 0.6, 0.95}) {
+        const fs::path cut = workDir() / "cut.vdb";
+        std::vector<char> bytes(size);
+        std::ifstream(in, std::ios::binary).read(bytes.data(), std::streamsize(size));
+        std::ofstream(cut, std::ios::binary).write(bytes.data(), std::streamsize(double(size) * fraction));
+        for (const std::string& args : {"export " + cut.string() + " -o " + vtu.string(), "diff " + in.string() + " " + cut.string()}) {
+            r = runCli(args);
+            EXPECT_NE(r.exitCode, 0) << args << " at " << fraction;
+            EXPECT_NE(r.err.find("cut.vdb"), std::string::npos) << r.err;
+            EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+            EXPECT_FALSE(fs::exists(vtu));
+        }
+    }
     // Nothing but the input files is left in the folder (no temporaries).
     for (const auto& e : fs::directory_iterator(workDir())) EXPECT_NE(e.path().filename().string().rfind(".limits", 0), 0u) << e.path();
 }
