@@ -175,3 +175,52 @@ TEST(VtkDiff, MismatchedInputsAreReported) {
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.err.find("none.vdb"), std::string::npos) << r.err;
 }
+
+TEST(VtkDiff, BitExactStatusNaNsSignedZerosAndVectors) {
+    openvdb::initialize();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    auto a = openvdb::FloatGrid::create(0.0f);
+    a->setName("s");
+    a->tree().setValueOn(openvdb::Coord(0, 0, 0), nan);
+    a->tree().setValueOn(openvdb::Coord(1, 0, 0), 0.0f);
+    a->tree().setValueOn(openvdb::Coord(2, 0, 0), 3.0f);
+    auto b = a->deepCopy();
+    b->tree().setValueOn(openvdb::Coord(1, 0, 0), -0.0f);  // equal as numbers, not as bits
+    b->tree().setValueOn(openvdb::Coord(2, 0, 0), nan);     // a non-finite error
+    auto va = openvdb::Vec3SGrid::create();
+    va->setName("v");
+    va->tree().setValueOn(openvdb::Coord(5, 5, 5), openvdb::Vec3s(1, 2, 3));
+    va->tree().setValueOn(openvdb::Coord(6, 5, 5), openvdb::Vec3s(0, 0, 0));
+    auto vb = va->deepCopy();
+    vb->tree().setValueOn(openvdb::Coord(5, 5, 5), openvdb::Vec3s(4, 6, 3));  // |(3,4,0)| = 5
+    const fs::path pa = workDir() / "bits_a.vdb", pb = workDir() / "bits_b.vdb", out = workDir() / "bits.vtm";
+    writeGrids(pa, {a, va});
+    writeGrids(pb, {b, vb});
+    const auto r = runCli("diff " + pa.string() + " " + pb.string() + " -o " + out.string() + " --json");
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    const auto report = nlohmann::json::parse(r.out);
+    const nlohmann::json* s = nullptr;
+    const nlohmann::json* v = nullptr;
+    for (const auto& g : report["grids"]) (g["name"] == "s" ? s : v) = &g;
+    ASSERT_TRUE(s && v);
+    EXPECT_EQ(count(*s, "same"), 1u);           // NaN against the same NaN
+    EXPECT_EQ(count(*s, "value_differs"), 2u);  // 0 vs -0, 3 vs NaN
+    EXPECT_EQ((*s)["non_finite_errors"].get<uint64_t>(), 1u);
+    EXPECT_EQ((*s)["max_abs_error"].get<double>(), 0.0);
+    EXPECT_EQ(count(*v, "value_differs"), 1u);
+    EXPECT_DOUBLE_EQ((*v)["max_abs_error"].get<double>(), 5.0);
+    auto blocks = readVtm(out);
+    ASSERT_EQ(blocks->GetNumberOfBlocks(), 2u);
+    for (unsigned i = 0; i < 2; ++i) {
+        auto* ug = vtkUnstructuredGrid::SafeDownCast(blocks->GetBlock(i));
+        ASSERT_NE(ug, nullptr);
+        if (blockName(blocks, i) != "v") continue;
+        vtkDataArray* a3 = ug->GetCellData()->GetArray("a");
+        ASSERT_EQ(a3->GetNumberOfComponents(), 3);
+        for (vtkIdType c = 0; c < ug->GetNumberOfCells(); ++c) {
+            const openvdb::Coord ijk = cellVoxels(ug, c, va->transform()).min();
+            for (int k = 0; k < 3; ++k) EXPECT_EQ(a3->GetComponent(c, k), double(va->tree().getValue(ijk)[k]));
+            EXPECT_DOUBLE_EQ(ug->GetCellData()->GetArray("abs_error")->GetTuple1(c), ijk == openvdb::Coord(5, 5, 5) ? 5.0 : 0.0);
+        }
+    }
+}
