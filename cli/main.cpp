@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
     vdbdag::cli::addRenderCommand(app, exitCode);
     vdbdag::cli::addBenchCommand(app, exitCode);
     vdbdag::cli::addDevicesCommand(app, exitCode);
+    vdbdag::cli::addExportCommand(app, exitCode);
+    vdbdag::cli::addDiffCommand(app, exitCode);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -24,10 +24,18 @@ inline void initializeOpenVdb() {
     });
 }
 
-inline std::string oneLine(std::string s) {
-    for (char& c : s)
-        if (c == '\n' || c == '\r') c = ' ';
-    return s;
+// One short line: whitespace runs collapsed, at most 300 characters (a
+// corrupted file can make OpenVDB quote megabytes of garbage).
+inline std::string oneLine(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        const bool space = c == '\n' || c == '\r' || c == ' ' || c == '\t';
+        if (space && (out.empty() || out.back() == ' ')) continue;
+        out += space ? ' ' : c;
+        if (out.size() >= 300) { out += "..."; break; }
+    }
+    while (!out.empty() && out.back() == ' ') out.pop_back();
+    return out;
 }
 
 // Calls fn(grid, ValueType) with the grid cast to its concrete type; returns

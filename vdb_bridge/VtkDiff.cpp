@@ -1,0 +1,288 @@
+// See VtkDiff.h. The union of the two active topologies comes from
+// OpenVDB's own topologyUnion on MaskTree copies; values come through
+// OpenVDB accessors, so this is independent of the DAG code.
+#include "vdb_bridge/VtkDiff.h"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <fmt/core.h>
+
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkNew.h>
+#include <vtkUnsignedCharArray.h>
+
+#include "src/util/Error.h"
+#include "src/util/Progress.h"
+#include "vdb_bridge/detail/GridSource.h"
+#include "vdb_bridge/detail/OpenVdbSupport.h"
+#include "vdb_bridge/detail/VoxelCells.h"
+#include "vdb_bridge/detail/VtkWriting.h"
+
+namespace vdbdag::bridge {
+namespace {
+
+using detail::LoadedGrid;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+template <typename T>
+bool sameBits(const T& a, const T& b) {
+    if constexpr (std::is_same_v<T, bool>) return a == b;
+    else return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+template <typename T>
+constexpr int componentsOf() {
+    if constexpr (openvdb::VecTraits<T>::IsVec) return 3;
+    else return 1;
+}
+
+template <typename T>
+void toDoubles(const T& v, double* out) {
+    if constexpr (openvdb::VecTraits<T>::IsVec) {
+        for (int c = 0; c < 3; ++c) out[c] = double(v[c]);
+    } else {
+        out[0] = double(v);
+    }
+}
+
+// Tile width of the node at tree depth d (ValueAccessor::getValueDepth: 0 root tile, -1 background).
+template <typename TreeT>
+int64_t widthAtDepth(int d) {
+    using RootChild = typename TreeT::RootNodeType::ChildNodeType;
+    using MidChild = typename RootChild::ChildNodeType;
+    switch (d) {
+        case -1: return std::numeric_limits<int64_t>::max();
+        case 0: return RootChild::DIM;
+        case 1: return MidChild::DIM;
+        case 2: return TreeT::LeafNodeType::DIM;
+        default: return 1;
+    }
+}
+
+// Accumulates statistics and (optionally) cells.
+template <typename GridT>
+class DiffBuilder {
+public:
+    using ValueT = typename GridT::ValueType;
+    static constexpr bool kHasValues = !std::is_same_v<typename GridT::TreeType::LeafNodeType::BuildType, openvdb::ValueMask>;
+    static constexpr int kComps = componentsOf<ValueT>();
+
+    DiffBuilder(const GridT& a, bool buildCells, const DiffOptions& options, const std::string& what)
+        : buildCells_(buildCells), options_(options), what_(what), cells_(a.transform()) {
+        if (kHasValues) {
+            for (auto* arr : {aValues_.Get(), bValues_.Get()}) arr->SetNumberOfComponents(kComps);
+            aValues_->SetName("a");
+            bValues_->SetName("b");
+        }
+        absError_->SetName("abs_error");
+        relError_->SetName("rel_error");
+        status_->SetName("status");
+    }
+
+    void beginLeaf(const openvdb::Coord& origin) { cells_.beginLeaf(origin); }
+
+    // One voxel (box == nullptr) or one uniform box of `weight` voxels.
+    void add(const openvdb::Coord& ijk, const openvdb::CoordBBox* box, uint64_t weight, bool aOn, bool bOn, const ValueT& va, const ValueT& vb) {
+        unsigned status;
+        double da[3] = {kNaN, kNaN, kNaN}, db[3] = {kNaN, kNaN, kNaN};
+        double absErr = kNaN, relErr = kNaN;
+        if (kHasValues) {
+            if (aOn) toDoubles(va, da);
+            if (bOn) toDoubles(vb, db);
+        }
+        if (aOn && bOn) {
+            status = sameBits(va, vb) ? 0 : 1;
+            double sq = 0, na = 0, nb = 0;
+            for (int c = 0; c < kComps; ++c) {
+                sq += (da[c] - db[c]) * (da[c] - db[c]);
+                na += da[c] * da[c];
+                nb += db[c] * db[c];
+            }
+            absErr = status == 0 || !kHasValues ? 0.0 : std::sqrt(sq);
+            const double scale = std::max(std::sqrt(na), std::sqrt(nb));
+            relErr = absErr == 0 ? 0.0 : absErr / scale;
+            if (std::isfinite(absErr)) {
+                maxAbs_ = std::max(maxAbs_, absErr);
+                if (std::isfinite(relErr)) maxRel_ = std::max(maxRel_, relErr);
+                sum_ += absErr * double(weight);
+                sumSq_ += absErr * absErr * double(weight);
+                compared_ += weight;
+            } else {
+                nonFinite_ += weight;
+            }
+        } else {
+            status = aOn ? 2 : 3;
+        }
+        if (aOn && kHasValues) {
+            double mag = 0;
+            if (kComps == 1) mag = da[0];
+            else for (int c = 0; c < kComps; ++c) mag += da[c] * da[c];
+            if (kComps == 3) mag = std::sqrt(mag);
+            if (std::isfinite(mag)) { minA_ = std::min(minA_, mag); maxA_ = std::max(maxA_, mag); }
+        }
+        voxels_[status] += weight;
+        if (!buildCells_ || (options_.onlyDifferences && status == 0)) return;
+        if (cells_.cellCount() >= options_.maxCells)
+            throw Error(fmt::format("{}: the diff has more than {} cells (--max-cells): compare fewer grids with --grid NAME, or use --only-differences",
+                                    what_, options_.maxCells));
+        if (box) cells_.addBox(*box);
+        else cells_.addVoxel(ijk);
+        if (kHasValues) {
+            aValues_->InsertNextTuple(da);
+            bValues_->InsertNextTuple(db);
+        }
+        absError_->InsertNextValue(absErr);
+        relError_->InsertNextValue(relErr);
+        status_->InsertNextValue(static_cast<unsigned char>(status));
+    }
+
+    void finish(GridDiff& d) {
+        d.voxels = voxels_;
+        d.nonFiniteErrors = nonFinite_;
+        d.maxAbsError = maxAbs_;
+        d.maxRelError = maxRel_;
+        d.meanAbsError = compared_ ? sum_ / double(compared_) : 0.0;
+        d.rmsError = compared_ ? std::sqrt(sumSq_ / double(compared_)) : 0.0;
+        d.peak = maxA_ >= minA_ ? maxA_ - minA_ : 0.0;
+        d.psnr = d.rmsError == 0 ? std::numeric_limits<double>::infinity() : d.peak > 0 ? 20.0 * std::log10(d.peak / d.rmsError) : kNaN;
+        d.cells = cells_.cellCount();
+    }
+
+    vtkSmartPointer<vtkUnstructuredGrid> grid() {
+        auto g = cells_.finish();
+        if (kHasValues) {
+            g->GetCellData()->AddArray(aValues_);
+            g->GetCellData()->AddArray(bValues_);
+        }
+        g->GetCellData()->AddArray(absError_);
+        g->GetCellData()->AddArray(relError_);
+        g->GetCellData()->AddArray(status_);
+        g->GetCellData()->SetActiveScalars("status");
+        return g;
+    }
+
+private:
+    bool buildCells_;
+    const DiffOptions& options_;
+    std::string what_;
+    detail::VoxelCellBuilder cells_;
+    vtkNew<vtkDoubleArray> aValues_, bValues_, absError_, relError_;
+    vtkNew<vtkUnsignedCharArray> status_;
+    std::array<uint64_t, 4> voxels_{};
+    uint64_t compared_ = 0, nonFinite_ = 0;
+    double maxAbs_ = 0, maxRel_ = 0, sum_ = 0, sumSq_ = 0;
+    double minA_ = std::numeric_limits<double>::infinity(), maxA_ = -std::numeric_limits<double>::infinity();
+};
+
+template <typename GridT>
+vtkSmartPointer<vtkUnstructuredGrid> diffGrids(const GridT& a, const GridT& b, bool buildCells, const DiffOptions& options, const std::string& what,
+                                               Progress& progress, GridDiff& report) {
+    using TreeT = typename GridT::TreeType;
+    openvdb::MaskTree unionTree(a.tree(), false, openvdb::TopologyCopy());
+    unionTree.topologyUnion(b.tree());
+    auto accA = a.getConstAccessor();
+    auto accB = b.getConstAccessor();
+    DiffBuilder<GridT> builder(a, buildCells, options, what);
+    for (auto leaf = unionTree.cbeginLeaf(); leaf; ++leaf) {
+        progress.advance();
+        builder.beginLeaf(leaf->origin());
+        for (auto v = leaf->cbeginValueOn(); v; ++v) {
+            const openvdb::Coord c = v.getCoord();
+            builder.add(c, nullptr, 1, accA.isValueOn(c), accB.isValueOn(c), accA.getValue(c), accB.getValue(c));
+        }
+    }
+    openvdb::MaskTree::ValueOnCIter tiles = unionTree.cbeginValueOn();
+    tiles.setMaxDepth(openvdb::MaskTree::ValueOnCIter::LEAF_DEPTH - 1);
+    for (; tiles; ++tiles) {
+        if (tiles.isVoxelValue()) continue;
+        const openvdb::CoordBBox box = tiles.getBoundingBox();
+        const int64_t width = box.dim().x();
+        const openvdb::Coord c = box.min();
+        if (widthAtDepth<TreeT>(accA.getValueDepth(c)) >= width && widthAtDepth<TreeT>(accB.getValueDepth(c)) >= width) {
+            builder.add(c, &box, box.volume(), accA.isValueOn(c), accB.isValueOn(c), accA.getValue(c), accB.getValue(c));
+            continue;
+        }
+        // One side is not uniform over the tile: walk its voxels, a leaf-sized block at a time.
+        for (int z0 = box.min().z(); z0 <= box.max().z(); z0 += 8)
+            for (int y0 = box.min().y(); y0 <= box.max().y(); y0 += 8)
+                for (int x0 = box.min().x(); x0 <= box.max().x(); x0 += 8) {
+                    builder.beginLeaf(openvdb::Coord(x0, y0, z0));
+                    for (int z = z0; z < z0 + 8; ++z)
+                        for (int y = y0; y < y0 + 8; ++y)
+                            for (int x = x0; x < x0 + 8; ++x) {
+                                const openvdb::Coord v(x, y, z);
+                                builder.add(v, nullptr, 1, accA.isValueOn(v), accB.isValueOn(v), accA.getValue(v), accB.getValue(v));
+                            }
+                }
+    }
+    builder.finish(report);
+    return buildCells ? builder.grid() : nullptr;
+}
+
+} // namespace
+
+DiffReport diffVolumes(const std::string& pathA, const std::string& pathB, const std::string& output, const DiffOptions& options) {
+    std::string ext;
+    if (!output.empty()) {
+        ext = detail::extensionOf(output);
+        if (ext != ".vtu" && ext != ".vtm") throw Error(output + ": a diff is written as .vtu (one grid) or .vtm (several grids)");
+    }
+    const detail::Compressor compressor = detail::parseCompressor(options.compressor);
+    const std::vector<LoadedGrid> gridsA = detail::loadGrids(pathA, options.grids);
+    const std::vector<LoadedGrid> gridsB = detail::loadGrids(pathB, options.grids);
+    DiffReport report;
+    if (gridsA.size() != gridsB.size())
+        report.headerDifferences.push_back(fmt::format("A has {} grid(s), B has {}; the first {} are compared", gridsA.size(), gridsB.size(),
+                                                       std::min(gridsA.size(), gridsB.size())));
+    const size_t pairs = std::min(gridsA.size(), gridsB.size());
+    if (ext == ".vtu" && pairs > 1)
+        throw Error(fmt::format("{}: {} grid pairs to compare but a .vtu holds one: pick one with --grid NAME or write a .vtm", output, pairs));
+    uint64_t leaves = 0;
+    for (size_t i = 0; i < pairs; ++i) {
+        const auto& a = *gridsA[i].grid;
+        const auto& b = *gridsB[i].grid;
+        if (a.type() != b.type())
+            throw Error(fmt::format("grid {} of {} is {} but grid {} of {} is {}: only grids of the same type are compared", detail::gridLabel(gridsA[i]),
+                                    pathA, a.valueType(), detail::gridLabel(gridsB[i]), pathB, b.valueType()));
+        if (a.transform() != b.transform())
+            report.headerDifferences.push_back(fmt::format("grid {}: the transforms differ; cells are placed with A's", detail::gridLabel(gridsA[i])));
+        leaves += a.baseTree().leafCount();
+    }
+    vtkNew<vtkMultiBlockDataSet> blocks;
+    vtkSmartPointer<vtkDataObject> single;
+    Progress progress("diff", leaves);
+    for (size_t i = 0; i < pairs; ++i) {
+        GridDiff d;
+        d.name = gridsA[i].grid->getName();
+        d.indexA = gridsA[i].fileIndex;
+        d.indexB = gridsB[i].fileIndex;
+        d.valueType = gridsA[i].grid->valueType();
+        vtkSmartPointer<vtkUnstructuredGrid> cells;
+        detail::dispatchGridType(*gridsA[i].grid, [&](const auto& a, ValueType) {
+            using GridT = std::decay_t<decltype(a)>;
+            const auto& b = static_cast<const GridT&>(*gridsB[i].grid);
+            cells = diffGrids(a, b, !output.empty(), options, pathA + " vs " + pathB + ": grid " + detail::gridLabel(gridsA[i]), progress, d);
+        });
+        if (ext == ".vtm") detail::setBlock(blocks, unsigned(i), cells, d.name.empty() ? "grid_" + std::to_string(d.indexA) : d.name);
+        else single = cells;
+        if (d.differs()) report.identical = false;
+        report.grids.push_back(d);
+    }
+    progress.finish();
+    if (!report.headerDifferences.empty()) report.identical = false;
+    if (!output.empty()) {
+        if (ext == ".vtu" && !single) {  // nothing to compare: an empty mesh
+            detail::VoxelCellBuilder empty(*openvdb::math::Transform::createLinearTransform());
+            single = empty.finish();
+        }
+        detail::writeVtk(ext == ".vtm" ? static_cast<vtkDataObject*>(blocks.Get()) : single.Get(), output, compressor);
+        report.bytes = detail::writtenBytes(output);
+    }
+    return report;
+}
+
+} // namespace vdbdag::bridge

@@ -1,0 +1,96 @@
+// See GridSource.h.
+#include "vdb_bridge/detail/GridSource.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "src/format/SsvdagFile.h"
+#include "src/pipeline/GridCodec.h"
+#include "src/util/Error.h"
+#include "vdb_bridge/detail/GridBuilder.h"
+#include "vdb_bridge/detail/OpenVdbSupport.h"
+
+namespace vdbdag::bridge::detail {
+
+bool isSsvdagPath(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".ssvdag";
+}
+
+namespace {
+
+void checkNames(const std::string& path, const std::vector<std::string>& names, const std::vector<std::string>& wanted) {
+    for (const std::string& w : wanted)
+        if (std::find(names.begin(), names.end(), w) == names.end()) {
+            std::string list;
+            for (const auto& n : names) list += (list.empty() ? "'" : ", '") + n + "'";
+            throw Error(path + ": no grid named '" + w + "' (the file has " + (list.empty() ? "no grids" : list) + ")");
+        }
+}
+
+bool selected(const std::vector<std::string>& wanted, const std::string& name) {
+    return wanted.empty() || std::find(wanted.begin(), wanted.end(), name) != wanted.end();
+}
+
+} // namespace
+
+std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std::string>& onlyGrids) {
+    initializeOpenVdb();
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
+    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a .vdb or .ssvdag file");
+    std::vector<LoadedGrid> out;
+    if (isSsvdagPath(path)) {
+        format::SsvdagScene scene = format::readSceneFile(path);
+        std::vector<std::string> names;
+        for (const auto& g : scene.grids) names.push_back(g.record.name);
+        checkNames(path, names, onlyGrids);
+        for (size_t i = 0; i < scene.grids.size(); ++i) {
+            if (!selected(onlyGrids, scene.grids[i].record.name)) continue;
+            const GridRecord record = pipeline::decodeGrid(scene.grids[i]);
+            out.push_back({i, buildGrid(record, path + ": grid " + std::to_string(i))});
+        }
+        return out;
+    }
+    openvdb::GridPtrVecPtr grids;
+    try {
+        // Read as a stream, whole (no delayed loading), so that a file cut
+        // short shows up as a failed stream: OpenVDB itself does not check
+        // and fills missing leaf buffers silently.
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw Error(path + ": cannot be opened");
+        openvdb::io::Stream stream(in, false);
+        grids = stream.getGrids();
+        if (!grids || in.fail()) throw Error(path + ": truncated or corrupted (the file ends inside its grids)");
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
+    }
+    std::vector<std::string> names;
+    for (const auto& g : *grids) names.push_back(g->getName());
+    checkNames(path, names, onlyGrids);
+    for (size_t i = 0; i < grids->size(); ++i) {
+        const auto& g = (*grids)[i];
+        if (!selected(onlyGrids, g->getName())) continue;
+        if (!dispatchGridType(*g, [](const auto&, ValueType) {}))
+            throw Error(path + ": grid " + std::to_string(i) + " '" + g->getName() + "' has type '" + g->type() + "'" + typeHint(*g) +
+                        ", which vdbdag does not convert (pick other grids with --grid NAME)");
+        // OpenVDB reads a truncated file without complaint (missing nodes
+        // are simply absent); its writer's own voxel count gives it away.
+        if (const auto count = g->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
+            if (uint64_t(count->value()) != g->activeVoxelCount())
+                throw Error(path + ": grid " + std::to_string(i) + " '" + g->getName() + "' is truncated or corrupted: it reads as " +
+                            std::to_string(g->activeVoxelCount()) + " active voxels but the file says " + std::to_string(count->value()));
+        out.push_back({i, g});
+    }
+    return out;
+}
+
+std::string gridLabel(const LoadedGrid& grid) {
+    return grid.grid->getName().empty() ? "#" + std::to_string(grid.fileIndex) : "'" + grid.grid->getName() + "'";
+}
+
+} // namespace vdbdag::bridge::detail
