@@ -6,6 +6,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,15 @@ struct GridRecord {
     // background, e.g. a level set's inside; cost grows with what differs.
     GridTopology inactiveTopology;
     LayerValues inactiveValues;
+    // Optional exact normals for shading (`encode --normals K`), computed by
+    // vdb_bridge: one unit vector (3 x float) per active value, in the same
+    // input order as `values`; a zero vector means "no direction".
+    struct Normals {
+        LayerValues vectors;
+        bool fromNormalGrid = false;  // false: the level set's gradient
+        uint64_t oneSided = 0;        // gradient entries where a band edge forced a one-sided difference
+    };
+    std::optional<Normals> normals;
 };
 
 // A whole .vdb file, in file order.
