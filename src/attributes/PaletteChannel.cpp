@@ -12,7 +12,9 @@
 //     it beats direct storage;
 //  2. phase two: the rest is cut left to right; from each start, the longest
 //     block for each ω = 0..8 and a direct block are costed per entry and the
-//     cheapest is taken.
+//     cheapest is taken. The gaps phase one left are cut in parallel (TBB),
+//     which cannot change the result: the output is byte-identical for any
+//     thread count.
 // Costs include each value's share of the material array (its bits divided
 // by its number of occurrences), so unique floats fall back to direct
 // storage and a channel never grows by more than its directory.
@@ -27,6 +29,8 @@
 #include <cstdlib>
 #include <sys/mman.h>
 
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <xxhash.h>
 
 #include "src/format/ByteIO.h"
@@ -157,17 +161,29 @@ public:
 
     std::vector<Segment> run() {
         for (uint8_t omega = 0; omega < 4; ++omega) phaseOne(omega);
-        // Phase two on every gap left, left to right.
+        // Phase two on every gap left. Gaps are independent, so they run in
+        // parallel, each thread with its own stamp array; the result is put
+        // together in gap order, so it is the same for any thread count.
         std::vector<Segment> segments(accepted_.begin(), accepted_.end());
         std::sort(segments.begin(), segments.end(), [](const Segment& a, const Segment& b) { return a.start < b.start; });
-        std::vector<Segment> all;
+        std::vector<std::pair<uint64_t, uint64_t>> gaps;
         uint64_t at = 0;
         for (const Segment& s : segments) {
-            phaseTwo(at, s.start, all);
-            all.push_back(s);
+            gaps.push_back({at, s.start});
             at = s.start + s.length;
         }
-        phaseTwo(at, n_, all);
+        gaps.push_back({at, n_});
+        std::vector<std::vector<Segment>> perGap(gaps.size());
+        tbb::enumerable_thread_specific<Stamps> stamps([&] { return Stamps(stamp_.size()); });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, gaps.size()), [&](const tbb::blocked_range<size_t>& range) {
+            Stamps& local = stamps.local();
+            for (size_t g = range.begin(); g != range.end(); ++g) phaseTwo(gaps[g].first, gaps[g].second, local, perGap[g]);
+        });
+        std::vector<Segment> all;
+        for (size_t g = 0; g < gaps.size(); ++g) {
+            all.insert(all.end(), perGap[g].begin(), perGap[g].end());
+            if (g < segments.size()) all.push_back(segments[g]);
+        }
         // Merge neighbouring direct blocks (one directory entry instead of many).
         std::vector<Segment> merged;
         for (const Segment& s : all) {
@@ -250,7 +266,16 @@ private:
         }
     }
 
-    void phaseTwo(uint64_t begin, uint64_t end, std::vector<Segment>& out) {
+    // Per-thread "seen in the current scan" marks for phase two.
+    struct Stamps {
+        explicit Stamps(size_t distinct) : stamp(distinct, 0) {}
+        std::vector<uint32_t> stamp;
+        uint32_t epoch = 0;
+    };
+
+    void phaseTwo(uint64_t begin, uint64_t end, Stamps& marks, std::vector<Segment>& out) const {
+        std::vector<uint32_t>& stamp_ = marks.stamp;
+        uint32_t& epoch_ = marks.epoch;
         for (uint64_t start = begin; start < end;) {
             const uint64_t stop = std::min(end, start + kMaxBlockEntries);
             // lengthFor[ω]: longest block from `start` with <= 2^ω distinct ids.
