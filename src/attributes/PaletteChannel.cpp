@@ -7,7 +7,8 @@
 //     quadratic, a sliding window gives every maximal window in O(n); the
 //     windows go into a max-heap by length and are accepted largest first,
 //     clipped lazily to the still-free gap they start in (a clipped window is
-//     pushed back with its new length). A block is accepted when it pays:
+//     pushed back with its new length). The window scan runs in parallel over
+//     fixed chunks of starts, with the same windows as a sequential scan. A block is accepted when it pays:
 //     len * ω + palette + directory < len * (ω + 1) (the paper's line 6), and
 //     it beats direct storage;
 //  2. phase two: the rest is cut left to right; from each start, the longest
@@ -153,7 +154,7 @@ class Partitioner {
 public:
     Partitioner(const std::vector<uint32_t>& ids, uint64_t distinct, uint32_t vs)
         : ids_(ids), n_(ids.size()), vs_(vs), materialBits_(std::max(1, int(std::bit_width(distinct > 1 ? distinct - 1 : 1)))),
-          stamp_(distinct, 0), count_(distinct, 0), share_(distinct, 0.0) {
+          distinct_(distinct), share_(distinct, 0.0) {
         std::vector<uint64_t> freq(distinct, 0);
         for (uint32_t id : ids) ++freq[id];
         for (size_t d = 0; d < distinct; ++d) share_[d] = 8.0 * vs / double(freq[d]);
@@ -174,7 +175,7 @@ public:
         }
         gaps.push_back({at, n_});
         std::vector<std::vector<Segment>> perGap(gaps.size());
-        tbb::enumerable_thread_specific<Stamps> stamps([&] { return Stamps(stamp_.size()); });
+        tbb::enumerable_thread_specific<Stamps> stamps([&] { return Stamps(distinct_); });
         tbb::parallel_for(tbb::blocked_range<size_t>(0, gaps.size()), [&](const tbb::blocked_range<size_t>& range) {
             Stamps& local = stamps.local();
             for (size_t g = range.begin(); g != range.end(); ++g) phaseTwo(gaps[g].first, gaps[g].second, local, perGap[g]);
@@ -226,32 +227,62 @@ private:
     void phaseOne(uint8_t omega) {
         const uint64_t limit = uint64_t(1) << omega;
         const double minLength = double(limit) * kPaletteEntryBits + kDirectoryBits;
-        std::priority_queue<std::pair<uint64_t, uint64_t>> heap;  // (length, start)
-        // Maximal windows with <= 2^omega distinct ids, inside each free gap.
-        uint64_t gapStart = 0;
-        auto scanGap = [&](uint64_t begin, uint64_t end) {
-            ++epoch_;
-            uint64_t distinct = 0, right = begin, lastRight = begin;
-            for (uint64_t left = begin; left < end; ++left) {
-                while (right < end) {
-                    const uint32_t id = ids_[right];
-                    const bool fresh = stamp_[id] != epoch_ || count_[id] == 0;
-                    if (fresh && distinct == limit) break;
-                    if (stamp_[id] != epoch_) { stamp_[id] = epoch_; count_[id] = 0; }
-                    if (count_[id]++ == 0) ++distinct;
-                    ++right;
-                }
-                if (right > lastRight && double(right - left) > minLength) heap.push({right - left, left});
-                lastRight = std::max(lastRight, right);
-                const uint32_t id = ids_[left];
-                if (--count_[id] == 0) --distinct;
-            }
+        // Maximal windows with <= 2^omega distinct ids, inside each free gap,
+        // by a sliding window. The gaps are cut into fixed chunks of window
+        // starts scanned in parallel (each chunk restarts its window at its
+        // first start); a chunk's first window is kept only if it is not
+        // inside the previous start's window, exactly as a sequential scan
+        // decides, so the windows do not depend on the thread count.
+        struct Chunk {
+            uint64_t begin, end, gapEnd;
+            uint64_t lastRight = 0;  // right end of the window of start end-1
+            std::vector<std::pair<uint64_t, uint64_t>> windows;  // (length, start)
         };
+        std::vector<Chunk> chunks;
+        auto addGap = [&](uint64_t begin, uint64_t end) {
+            for (uint64_t a = begin; a < end; a += kScanChunk) chunks.push_back(Chunk{a, std::min(end, a + kScanChunk), end, 0, {}});
+        };
+        uint64_t gapStart = 0;
         for (const Segment& s : accepted_) {
-            if (s.start > gapStart) scanGap(gapStart, s.start);
+            if (s.start > gapStart) addGap(gapStart, s.start);
             gapStart = s.start + s.length;
         }
-        if (gapStart < n_) scanGap(gapStart, n_);
+        if (gapStart < n_) addGap(gapStart, n_);
+        tbb::enumerable_thread_specific<WindowCounts> scratch([&] { return WindowCounts(distinct_); });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size()), [&](const tbb::blocked_range<size_t>& range) {
+            WindowCounts& w = scratch.local();
+            for (size_t c = range.begin(); c != range.end(); ++c) {
+                Chunk& chunk = chunks[c];
+                ++w.epoch;
+                uint64_t distinct = 0, right = chunk.begin, lastRight = chunk.begin;
+                for (uint64_t left = chunk.begin; left < chunk.end; ++left) {
+                    while (right < chunk.gapEnd) {
+                        const uint32_t id = ids_[right];
+                        const bool fresh = w.stamp[id] != w.epoch || w.count[id] == 0;
+                        if (fresh && distinct == limit) break;
+                        if (w.stamp[id] != w.epoch) { w.stamp[id] = w.epoch; w.count[id] = 0; }
+                        if (w.count[id]++ == 0) ++distinct;
+                        ++right;
+                    }
+                    if (right > lastRight && double(right - left) > minLength) chunk.windows.push_back({right - left, left});
+                    lastRight = std::max(lastRight, right);
+                    const uint32_t id = ids_[left];
+                    if (--w.count[id] == 0) --distinct;
+                }
+                chunk.lastRight = lastRight;
+            }
+        });
+        std::vector<std::pair<uint64_t, uint64_t>> windows;
+        for (size_t c = 0; c < chunks.size(); ++c) {
+            const Chunk& chunk = chunks[c];
+            size_t from = 0;
+            const bool continuesGap = c > 0 && chunks[c - 1].end == chunk.begin && chunks[c - 1].gapEnd == chunk.gapEnd;
+            if (continuesGap && !chunk.windows.empty() && chunk.windows[0].second == chunk.begin &&
+                chunk.begin + chunk.windows[0].first <= chunks[c - 1].lastRight)
+                from = 1;  // inside the window of the previous start: not maximal
+            windows.insert(windows.end(), chunk.windows.begin() + long(from), chunk.windows.end());
+        }
+        std::priority_queue<std::pair<uint64_t, uint64_t>> heap(std::less<std::pair<uint64_t, uint64_t>>(), std::move(windows));
         while (!heap.empty()) {
             auto [length, start] = heap.top();
             heap.pop();
@@ -266,6 +297,14 @@ private:
         }
     }
 
+    // Per-thread window counts for phase one (stamp == epoch: count valid).
+    struct WindowCounts {
+        explicit WindowCounts(size_t distinct) : stamp(distinct, 0), count(distinct, 0) {}
+        std::vector<uint32_t> stamp, count;
+        uint32_t epoch = 0;
+    };
+    static constexpr uint64_t kScanChunk = uint64_t(1) << 20;
+
     // Per-thread "seen in the current scan" marks for phase two.
     struct Stamps {
         explicit Stamps(size_t distinct) : stamp(distinct, 0) {}
@@ -274,23 +313,22 @@ private:
     };
 
     void phaseTwo(uint64_t begin, uint64_t end, Stamps& marks, std::vector<Segment>& out) const {
-        std::vector<uint32_t>& stamp_ = marks.stamp;
-        uint32_t& epoch_ = marks.epoch;
+        std::vector<uint32_t>& stamp = marks.stamp;
         for (uint64_t start = begin; start < end;) {
             const uint64_t stop = std::min(end, start + kMaxBlockEntries);
             // lengthFor[ω]: longest block from `start` with <= 2^ω distinct ids.
             uint64_t lengthFor[9];
             double shareUpTo[9];
-            ++epoch_;
+            const uint32_t epoch = ++marks.epoch;
             uint64_t distinct = 0, i = start;
             double share = 0;
             for (unsigned omega = 0; omega <= 8; ++omega) {
                 const uint64_t limit = uint64_t(1) << omega;
                 for (; i < stop; ++i) {
                     const uint32_t id = ids_[i];
-                    if (stamp_[id] != epoch_) {
+                    if (stamp[id] != epoch) {
                         if (distinct == limit) break;
-                        stamp_[id] = epoch_;
+                        stamp[id] = epoch;
                         ++distinct;
                     }
                     share += share_[id];
@@ -321,10 +359,8 @@ private:
     uint64_t n_;
     uint32_t vs_;
     int materialBits_;
-    std::vector<uint32_t> stamp_;
-    std::vector<uint32_t> count_;
+    size_t distinct_;
     std::vector<double> share_;
-    uint32_t epoch_ = 0;
     std::set<Segment, SegmentLess> accepted_;
 };
 
