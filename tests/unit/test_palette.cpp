@@ -90,7 +90,7 @@ TEST(Palette, CorruptedSerialisationIsRejected) {
 TEST(Palette, OutputIsByteIdenticalForOneAndTwoThreads) {
     // Coherent plateaus plus noise: many phase-one blocks and many gaps for
     // the parallel phase two.
-    std::vector<float> v(2'000'000);
+    std::vector<float> v(3'500'000);  // several 2^20-entry scan chunks
     std::mt19937 rng(11);
     for (size_t i = 0; i < v.size(); ++i)
         v[i] = float(int(std::sin(double(i) * 3e-4) * 300)) / 300.0f + ((i / 3000) % 5 == 0 ? float(rng() % 40) : 0.0f);
