@@ -32,75 +32,80 @@ struct RawColourHash {
     }
 };
 
-double distance(const Lab& a, const Lab& b) {
+// Squared Euclidean distance in CIELAB (all comparisons below are on
+// squared distances: no square roots in the inner loops).
+double distance2(const Lab& a, const Lab& b) {
     const double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
-    return std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+    return d0 * d0 + d1 * d1 + d2 * d2;
 }
+
+// A cluster member with its colour inline, so scanning a cluster reads
+// memory sequentially.
+struct Member {
+    Lab lab;
+    double dist2;  // squared distance to the cluster's centre (the nearest centre)
+    uint32_t point;
+};
 
 struct Cluster {
     uint32_t centre;
-    std::vector<uint32_t> members;
-    double radius = 0;
+    std::vector<Member> members;
+    double radius2 = 0;  // squared distance of the farthest member
     uint32_t farthest = 0;
 };
 
-void updateRadius(Cluster& c, const std::vector<double>& dist) {
-    c.radius = 0;
+void updateRadius(Cluster& c) {
+    c.radius2 = 0;
     c.farthest = c.centre;
-    for (uint32_t p : c.members)
-        if (dist[p] > c.radius) { c.radius = dist[p]; c.farthest = p; }
+    for (const Member& m : c.members)
+        if (m.dist2 > c.radius2) { c.radius2 = m.dist2; c.farthest = m.point; }
 }
 
 // Returns, for every point, the index of its cluster centre (a point index).
 // `seeds` (point indices) become centres first, in order.
 std::vector<uint32_t> farthestPointClustering(const std::vector<Lab>& points, uint64_t maxClusters, const std::vector<uint32_t>& seeds) {
     const uint32_t n = uint32_t(points.size());
-    std::vector<double> dist(n);
-    std::vector<uint32_t> owner(n, 0);  // cluster index
     std::vector<Cluster> clusters(1);
     const uint32_t first = seeds.empty() ? 0 : seeds[0];
     clusters[0].centre = first;
     clusters[0].members.resize(n);
-    for (uint32_t p = 0; p < n; ++p) {
-        clusters[0].members[p] = p;
-        dist[p] = distance(points[p], points[first]);
-    }
-    updateRadius(clusters[0], dist);
+    for (uint32_t p = 0; p < n; ++p) clusters[0].members[p] = Member{points[p], distance2(points[p], points[first]), p};
+    updateRadius(clusters[0]);
     auto addCentre = [&](uint32_t c) {
-        const uint32_t id = uint32_t(clusters.size());
         Cluster fresh;
         fresh.centre = c;
+        const Lab& centre = points[c];
         for (Cluster& a : clusters) {
             // Triangle inequality: p (|a p| <= radius) can be nearer to c
-            // than to a only if |a c| < 2 |a p| <= 2 radius.
-            if (!(distance(points[a.centre], points[c]) < 2.0 * a.radius)) continue;
+            // than to a only if |a c| < 2 |a p| <= 2 radius (squared: 4 radius^2).
+            if (!(distance2(points[a.centre], centre) < 4.0 * a.radius2)) continue;
             size_t kept = 0;
-            for (uint32_t p : a.members) {
-                const double d = distance(points[p], points[c]);
-                if (d < dist[p]) {
-                    dist[p] = d;
-                    owner[p] = id;
-                    fresh.members.push_back(p);
+            for (Member& m : a.members) {
+                const double d = distance2(m.lab, centre);
+                if (d < m.dist2) {
+                    m.dist2 = d;
+                    fresh.members.push_back(m);
                 } else {
-                    a.members[kept++] = p;
+                    a.members[kept++] = m;
                 }
             }
             a.members.resize(kept);
-            updateRadius(a, dist);
+            updateRadius(a);
         }
-        updateRadius(fresh, dist);
+        updateRadius(fresh);
         clusters.push_back(std::move(fresh));
     };
     for (size_t s = 1; s < seeds.size() && clusters.size() < maxClusters; ++s) addCentre(seeds[s]);
     while (clusters.size() < maxClusters) {
         size_t worst = 0;
         for (size_t a = 1; a < clusters.size(); ++a)
-            if (clusters[a].radius > clusters[worst].radius) worst = a;
-        if (!(clusters[worst].radius > 0)) break;  // every distinct colour is a centre
+            if (clusters[a].radius2 > clusters[worst].radius2) worst = a;
+        if (!(clusters[worst].radius2 > 0)) break;  // every distinct colour is a centre
         addCentre(clusters[worst].farthest);
     }
     std::vector<uint32_t> centreOf(n);
-    for (uint32_t p = 0; p < n; ++p) centreOf[p] = clusters[owner[p]].centre;
+    for (const Cluster& c : clusters)
+        for (const Member& m : c.members) centreOf[m.point] = c.centre;
     return centreOf;
 }
 
