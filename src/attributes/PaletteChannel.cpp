@@ -322,6 +322,19 @@ private:
             const uint32_t epoch = ++marks.epoch;
             uint64_t distinct = 0, i = start;
             double share = 0;
+            // Palette costs per entry as ω grows. Every later candidate costs
+            // strictly more than a floor (ω' bits, materialBits_, 8 valueSize
+            // bits, each plus positive overheads), so once the best palette
+            // so far is at or below all the floors the scan stops: the choice
+            // is the one the full comparison below would make, without
+            // scanning up to 257 distinct values from every start.
+            auto paletteCost = [&](unsigned omega) {
+                const double len = double(lengthFor[omega]);
+                return (len * omega + double(uint64_t(1) << omega) * kPaletteEntryBits + kDirectoryBits + shareUpTo[omega]) / len;
+            };
+            double bestPalette = 0;
+            unsigned bestOmega = 0;
+            bool settled = false;
             for (unsigned omega = 0; omega <= 8; ++omega) {
                 const uint64_t limit = uint64_t(1) << omega;
                 for (; i < stop; ++i) {
@@ -335,6 +348,17 @@ private:
                 }
                 lengthFor[omega] = i - start;
                 shareUpTo[omega] = share;
+                const double cost = paletteCost(omega);
+                if (omega == 0 || cost < bestPalette) { bestPalette = cost; bestOmega = omega; }
+                if (omega < 8 && bestPalette <= double(omega + 1) && bestPalette <= double(materialBits_) && bestPalette <= 8.0 * vs_) {
+                    settled = true;
+                    break;
+                }
+            }
+            if (settled) {
+                out.push_back({start, lengthFor[bestOmega], uint8_t(bestOmega)});
+                start += lengthFor[bestOmega];
+                continue;
             }
             double bestCost = (8.0 * vs_ * double(lengthFor[8]) + kDirectoryBits) / double(lengthFor[8]);
             Segment best{start, lengthFor[8], PaletteBlock::kDirect};
@@ -346,9 +370,8 @@ private:
                 if (bits / double(len) < bestCost) { bestCost = bits / double(len); best = {start, len, kWhole}; }
             }
             for (unsigned omega = 0; omega <= 8; ++omega) {
-                const double len = double(lengthFor[omega]);
-                const double bits = len * omega + double(uint64_t(1) << omega) * kPaletteEntryBits + kDirectoryBits + shareUpTo[omega];
-                if (bits / len < bestCost) { bestCost = bits / len; best = {start, lengthFor[omega], uint8_t(omega)}; }
+                const double cost = paletteCost(omega);
+                if (cost < bestCost) { bestCost = cost; best = {start, lengthFor[omega], uint8_t(omega)}; }
             }
             out.push_back(best);
             start += best.length;
