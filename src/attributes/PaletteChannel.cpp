@@ -25,6 +25,7 @@
 #include <bit>
 #include <cstring>
 #include <map>
+#include <unordered_map>
 #include <queue>
 #include <set>
 #include <cstdlib>
@@ -387,14 +388,40 @@ private:
     std::set<Segment, SegmentLess> accepted_;
 };
 
-void putBits(std::vector<uint64_t>& words, uint64_t bitOffset, uint64_t value, unsigned bits) {
+// Callers size `words` first (reserveBits), so this stays a few instructions.
+inline void putBits(std::vector<uint64_t>& words, uint64_t bitOffset, uint64_t value, unsigned bits) {
     if (bits == 0) return;
     const uint64_t word = bitOffset >> 6;
     const unsigned shift = unsigned(bitOffset & 63);
-    if (words.size() < word + 2) words.resize(word + 2, 0);
     words[word] |= value << shift;
     if (shift + bits > 64) words[word + 1] |= value >> (64 - shift);
 }
+inline void reserveBits(std::vector<uint64_t>& words, uint64_t endBit) {
+    const uint64_t need = (endBit >> 6) + 2;
+    if (words.size() < need) words.resize(std::max<uint64_t>(need, words.size() + words.size() / 2), 0);
+}
+
+// Palettes already stored, found by a hash of their material indices, so
+// blocks with the same palette share it (the first one stored wins).
+class PaletteTable {
+public:
+    // Offset of `palette` in `stored`, appending it if it is new.
+    uint32_t findOrAdd(const std::vector<uint32_t>& palette, std::vector<uint32_t>& stored) {
+        const uint64_t h = XXH3_64bits(palette.data(), palette.size() * sizeof(uint32_t)) ^ palette.size();
+        auto [it, end] = offsets_.equal_range(h);
+        for (; it != end; ++it) {
+            const uint32_t at = it->second.first;
+            if (it->second.second == palette.size() && std::equal(palette.begin(), palette.end(), stored.begin() + at)) return at;
+        }
+        const uint32_t at = uint32_t(stored.size());
+        stored.insert(stored.end(), palette.begin(), palette.end());
+        offsets_.emplace(h, std::make_pair(at, uint32_t(palette.size())));
+        return at;
+    }
+
+private:
+    std::unordered_multimap<uint64_t, std::pair<uint32_t, uint32_t>> offsets_;  // hash -> (offset, size)
+};
 
 uint64_t getBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigned bits) {
     if (bits == 0) return 0;
@@ -419,7 +446,7 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
     const std::vector<Segment> segments = Partitioner(ids, first.size(), valueSize).run();
 
     std::vector<uint32_t> material(first.size(), UINT32_MAX);  // id -> material index
-    std::map<std::vector<uint32_t>, uint32_t> paletteAt;          // shared palettes
+    PaletteTable paletteAt;                                        // shared palettes
     std::vector<uint32_t> local(first.size(), 0);
     std::vector<uint32_t> seen(first.size(), UINT32_MAX);  // block index that last listed this id
     uint64_t bitCursor = 0;
@@ -430,6 +457,7 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
             block.paletteOffset = PaletteBlock::kWholeMaterialArray;
             block.indexBits = uint8_t(bits);
             block.dataOffset = bitCursor;
+            reserveBits(out.indexBits, bitCursor + s.length * bits);
             for (uint64_t i = s.start; i < s.start + s.length; ++i, bitCursor += bits) {
                 uint32_t& m = material[ids[i]];
                 if (m == UINT32_MAX) {
@@ -458,11 +486,10 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
             }
             std::sort(palette.begin(), palette.end());  // at most 256 distinct entries
             const unsigned bits = palette.size() <= 1 ? 0 : unsigned(std::bit_width(palette.size() - 1));
-            auto [it, inserted] = paletteAt.emplace(palette, uint32_t(out.palettes.size()));
-            if (inserted) out.palettes.insert(out.palettes.end(), palette.begin(), palette.end());
-            block.paletteOffset = it->second;
+            block.paletteOffset = paletteAt.findOrAdd(palette, out.palettes);
             block.indexBits = uint8_t(bits);
             block.dataOffset = bitCursor;
+            reserveBits(out.indexBits, bitCursor + s.length * bits);
             for (size_t k = 0; k < palette.size(); ++k) local[palette[k]] = uint32_t(k);
             for (uint64_t i = s.start; i < s.start + s.length; ++i, bitCursor += bits)
                 putBits(out.indexBits, bitCursor, local[material[ids[i]]], bits);
