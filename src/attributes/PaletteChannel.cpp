@@ -254,6 +254,20 @@ private:
             WindowCounts& w = scratch.local();
             for (size_t c = range.begin(); c != range.end(); ++c) {
                 Chunk& chunk = chunks[c];
+                if (omega == 0) {
+                    // One distinct value: the maximal windows are the runs of
+                    // equal ids, found without the window counts.
+                    uint64_t lastRight = chunk.begin;
+                    for (uint64_t left = chunk.begin; left < chunk.end;) {
+                        uint64_t right = left + 1;
+                        while (right < chunk.gapEnd && ids_[right] == ids_[left]) ++right;
+                        if (right > lastRight && double(right - left) > minLength) chunk.windows.push_back({right - left, left});
+                        lastRight = right;
+                        left = right;
+                    }
+                    chunk.lastRight = lastRight;
+                    continue;
+                }
                 ++w.epoch;
                 uint64_t distinct = 0, right = chunk.begin, lastRight = chunk.begin;
                 for (uint64_t left = chunk.begin; left < chunk.end; ++left) {
