@@ -13,6 +13,7 @@
 #include <set>
 
 #include <openvdb/openvdb.h>
+#include <tbb/global_control.h>
 
 #include "src/attributes/CieLab.h"
 #include "src/attributes/ColourQuantizer.h"
@@ -268,4 +269,34 @@ TEST(ColourQuantise, ColourSectionIsStoredOnlyWhenAskedAndCorruptionIsRefused) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("ColourErrors"), std::string::npos) << e.what();
     }
+}
+
+TEST(ColourQuantise, KMeansPassesLowerTheMeanAndKeepTheFarthestPointMaximum) {
+    // 200,000 random colours, quantised to 2^10 with and without refinement.
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<float> v(200000 * 3);
+    for (float& x : v) x = u(rng);
+    std::vector<uint8_t> input(v.size() * 4);
+    std::memcpy(input.data(), v.data(), input.size());
+    auto maxDeltaE76 = [&](const std::vector<uint8_t>& q) {
+        double m = 0;
+        for (size_t i = 0; i < v.size() / 3; ++i) {
+            const auto a = attributes::srgbToLab(attributes::colourOf(&input[i * 12], ValueType::Vec3S));
+            const auto b = attributes::srgbToLab(attributes::colourOf(&q[i * 12], ValueType::Vec3S));
+            m = std::max(m, std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])));
+        }
+        return m;
+    };
+    auto plain = input, refined = input, refinedOneThread = input;
+    const auto plainReport = attributes::quantiseColours(plain, ValueType::Vec3S, 10, "plain", 0);
+    const auto refinedReport = attributes::quantiseColours(refined, ValueType::Vec3S, 10, "refined");
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        attributes::quantiseColours(refinedOneThread, ValueType::Vec3S, 10, "refined");
+    }
+    EXPECT_EQ(refined, refinedOneThread) << "deterministic for any thread count";
+    EXPECT_LT(refinedReport.meanDeltaE94, plainReport.meanDeltaE94 * 0.95);
+    EXPECT_LE(maxDeltaE76(refined), maxDeltaE76(plain) + 1e-9) << "the farthest-point radius still bounds every error";
+    EXPECT_LE(refinedReport.distinctAfter, 1024u);
 }
