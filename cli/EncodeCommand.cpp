@@ -82,9 +82,12 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
             progress.advance();
         };
-        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) {
-            gridName = imported.volume.grids[i].name;
-        });
+        format::SsvdagScene scene;
+        try {
+            scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) { gridName = imported.volume.grids[i].name; });
+        } catch (const Error& e) {
+            throw Error(opt->input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
+        }
         progress.setLabel("encode: writing " + opt->output);
         format::ContainerOptions containerOptions;
         containerOptions.compress = !opt->noCompress;

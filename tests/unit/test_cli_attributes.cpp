@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -105,5 +106,18 @@ TEST(CliAttributes, ColourAndNormalReportsInEncodeAndInfo) {
     r = run("encode " + in.string() + " -o " + bad.string() + " --colour-bits 10 --colour-grid ball");
     EXPECT_NE(r.err.find("not vec3 colours"), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    // A colour grid holding NaN is refused, naming the file and the grid.
+    {
+        auto cd = openvdb::Vec3SGrid::create(openvdb::Vec3s(0));
+        cd->setName("Cd");
+        cd->tree().setValue(openvdb::Coord(1, 2, 3), openvdb::Vec3s(0.5f, std::nanf(""), 0.5f));
+        const fs::path nanFile = dir / "nan_colour.vdb";
+        openvdb::io::File(nanFile.string()).write({cd});
+        r = run("encode " + nanFile.string() + " -o " + bad.string() + " --colour-bits 10");
+        EXPECT_NE(r.exitCode, 0);
+        EXPECT_FALSE(fs::exists(bad));
+        EXPECT_NE(r.err.find(nanFile.string() + ": grid 'Cd'"), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    }
     fs::remove_all(dir);
 }
