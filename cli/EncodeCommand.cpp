@@ -1,12 +1,16 @@
-// `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]`
+// `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]
+//  [--abs-error E | --rel-error R] [--colour-bits K [--colour-grid NAME]...] [--normals K [--normal-grid NAME]]`
+#include <algorithm>
 #include <chrono>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/SceneReport.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/AtomicFile.h"
+#include "src/util/Error.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/VdbImport.h"
 
@@ -19,6 +23,9 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         bool noSymmetry = false, noCompress = false, skipUnsupported = false, json = false, topologyOnly = false;
         int placementTrials = 1;
         double absError = 0, relError = 0;
+        unsigned colourBits = 0, normalBits = 0;
+        std::vector<std::string> colourGrids;
+        std::string normalGrid;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file into an .ssvdag file");
@@ -32,6 +39,14 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
     auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error")->check(CLI::PositiveNumber);
     cmd->add_option("--rel-error", opt->relError, "lossy: every float/double active value within this relative error")->check(CLI::Range(1e-12, 0.5))->excludes(abs);
+    auto* colourBits = cmd->add_option("--colour-bits,--color-bits", opt->colourBits,
+                                       "lossy colours: at most 2^K colours per colour grid, clustered in CIELAB (K = 10, 12, 14; 1..16)")
+                           ->check(CLI::Range(1, 16));
+    cmd->add_option("--colour-grid,--color-grid", opt->colourGrids, "vec3 grid holding colours (repeatable; default: grids named Cd, color, colour, colorGrid, rgb)")
+        ->needs(colourBits);
+    auto* normals = cmd->add_option("--normals", opt->normalBits, "store K-bit octahedral normals (K = 10, 12, 16, 24, 32) from the level-set gradient")
+                        ->check(CLI::IsMember({10u, 12u, 16u, 24u, 32u}));
+    cmd->add_option("--normal-grid", opt->normalGrid, "take the normals from this vec3 grid (stored on its geometry) instead of a gradient")->needs(normals);
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     cmd->callback([opt, &exitCode] {
         const auto start = std::chrono::steady_clock::now();
@@ -39,8 +54,18 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         importOptions.onlyGrids = opt->grids;
         importOptions.skipUnsupported = opt->skipUnsupported;
         importOptions.topologyOnly = opt->topologyOnly;
+        importOptions.normals = opt->normalBits != 0;
+        importOptions.normalGrid = opt->normalGrid;
+        if (opt->colourBits && opt->topologyOnly) throw Error("--colour-bits and --topology-only exclude each other: a topology-only file has no colours");
         const bridge::ImportResult imported = bridge::importVdb(opt->input, importOptions);
         for (const auto& w : imported.warnings) fmt::print(stderr, "vdbdag: warning: {}\n", w);
+        for (const std::string& name : opt->colourGrids) {
+            const auto& grids = imported.volume.grids;
+            const auto it = std::find_if(grids.begin(), grids.end(), [&](const GridRecord& g) { return g.name == name; });
+            if (it == grids.end()) throw Error(opt->input + ": no grid named '" + name + "' among the grids encoded, for --colour-grid");
+            if (!attributes::isVec3Type(it->valueType))
+                throw Error(opt->input + ": --colour-grid '" + name + "' holds " + valueTypeName(it->valueType) + " values, not vec3 colours");
+        }
 
         pipeline::EncodeOptions encodeOptions;
         encodeOptions.symmetry = !opt->noSymmetry;
@@ -48,15 +73,21 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         encodeOptions.computeSvdagStats = true;  // cheap next to I/O; lets `info` show all three node counts
         if (opt->absError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Absolute, opt->absError};
         if (opt->relError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Relative, opt->relError};
+        encodeOptions.colourBits = opt->colourBits;
+        encodeOptions.colourGrids = opt->colourGrids;
+        encodeOptions.normalBits = opt->normalBits;
         Progress progress("encode", imported.volume.grids.size() * pipeline::kEncodeSteps + 1);
         std::string gridName;
         encodeOptions.onStep = [&](const char* step) {
             progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
             progress.advance();
         };
-        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) {
-            gridName = imported.volume.grids[i].name;
-        });
+        format::SsvdagScene scene;
+        try {
+            scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) { gridName = imported.volume.grids[i].name; });
+        } catch (const Error& e) {
+            throw Error(opt->input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
+        }
         progress.setLabel("encode: writing " + opt->output);
         format::ContainerOptions containerOptions;
         containerOptions.compress = !opt->noCompress;
@@ -78,6 +109,12 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                                              {"max_abs_error", g.lossy.maxAbsError}, {"mean_abs_error", g.lossy.meanAbsError},
                                              {"rms_error", g.lossy.rmsError}, {"max_rel_error", g.lossy.maxRelError}});
         }
+        report["grids_colour"] = nlohmann::json::array();
+        report["grids_normals"] = nlohmann::json::array();
+        for (const auto& g : scene.grids) {
+            if (g.colour) report["grids_colour"].push_back(colourJson(g));
+            if (g.normals) report["grids_normals"].push_back(normalsJson(g));
+        }
         if (opt->json) {
             fmt::print("{}\n", report.dump(2));
         } else {
@@ -87,6 +124,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 fmt::print("  grid '{}' {}: {} of {} values changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
                            l["name"].get<std::string>(), l["tolerance"].get<std::string>(), l["changed"].get<uint64_t>(), l["entries"].get<uint64_t>(),
                            l["max_abs_error"].get<double>(), l["mean_abs_error"].get<double>(), l["rms_error"].get<double>(), l["max_rel_error"].get<double>());
+            for (const auto& c : report["grids_colour"]) fmt::print("  {}\n", formatColour(c));
+            for (const auto& n : report["grids_normals"]) fmt::print("  {}\n", formatNormals(n));
         }
         exitCode = 0;
     });

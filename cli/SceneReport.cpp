@@ -7,6 +7,40 @@
 
 namespace vdbdag::cli {
 
+nlohmann::json colourJson(const format::EncodedGrid& grid) {
+    const attributes::ColourReport& c = *grid.colour;
+    return {{"name", grid.record.name}, {"bits", c.bits}, {"entries", c.entries}, {"distinct_before", c.distinctBefore},
+            {"distinct_after", c.distinctAfter}, {"changed", c.changed}, {"mean_abs_error_rgb", c.meanAbsError},
+            {"max_abs_error_rgb", c.maxAbsError}, {"mean_delta_e94", c.meanDeltaE94}, {"max_delta_e94", c.maxDeltaE94}};
+}
+
+nlohmann::json normalsJson(const format::EncodedGrid& grid) {
+    const attributes::NormalChannel& n = *grid.normals;
+    const std::vector<uint8_t> codes = n.codes.decodeAll();
+    return {{"name", grid.record.name}, {"bits", n.bits},
+            {"source", n.report.source == attributes::NormalReport::Source::Gradient ? "gradient" : "normal grid"},
+            {"entries", n.report.entries}, {"zero_length", n.report.zeroLength}, {"one_sided", n.report.oneSided},
+            {"mean_angle_degrees", n.report.meanAngleDegrees}, {"max_angle_degrees", n.report.maxAngleDegrees},
+            {"distinct_codes", attributes::channelStats(codes, 4, n.codes).unique}, {"palette_bytes", n.codes.byteSize()}};
+}
+
+std::string formatColour(const nlohmann::json& c) {
+    const auto mean = c["mean_abs_error_rgb"], max = c["max_abs_error_rgb"];
+    return fmt::format("colours of '{}' ({} bits): {} -> {} distinct, {} of {} values changed; abs error R/G/B (0..255) mean {:.2f}/{:.2f}/{:.2f}, "
+                       "max {:.2f}/{:.2f}/{:.2f}; ΔE94 mean {:.3f}, max {:.3f}",
+                       c["name"].get<std::string>(), c["bits"].get<unsigned>(), c["distinct_before"].get<uint64_t>(), c["distinct_after"].get<uint64_t>(),
+                       c["changed"].get<uint64_t>(), c["entries"].get<uint64_t>(), mean[0].get<double>(), mean[1].get<double>(), mean[2].get<double>(),
+                       max[0].get<double>(), max[1].get<double>(), max[2].get<double>(), c["mean_delta_e94"].get<double>(), c["max_delta_e94"].get<double>());
+}
+
+std::string formatNormals(const nlohmann::json& n) {
+    return fmt::format("normals of '{}' ({}-bit ONV from the {}): {} entries, {} distinct codes, {} palette bytes; {} without direction (+z), "
+                       "{} one-sided at the band edge; angular error mean {:.4f}°, max {:.4f}°",
+                       n["name"].get<std::string>(), n["bits"].get<unsigned>(), n["source"].get<std::string>(), n["entries"].get<uint64_t>(),
+                       n["distinct_codes"].get<uint64_t>(), n["palette_bytes"].get<uint64_t>(), n["zero_length"].get<uint64_t>(),
+                       n["one_sided"].get<uint64_t>(), n["mean_angle_degrees"].get<double>(), n["max_angle_degrees"].get<double>());
+}
+
 nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> fileBytes, const std::string& name) {
     using nlohmann::json;
     const auto sections = format::summarizeContainer(fileBytes, name);
@@ -52,6 +86,11 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
                                      {"material_index_bytes", cs.materialIndexBytes}, {"palette_bytes", cs.paletteBytes},
                                      {"palette_blocks", cs.paletteBlocks}, {"direct_blocks", cs.directBlocks}, {"palettes", cs.palettesStored}});
         }
+        if (grid.normals) {
+            traceable += grid.normals->codes.byteSize();
+            j["normals"] = normalsJson(grid);
+        }
+        if (grid.colour) j["colour"] = colourJson(grid);
         j["traceable_bytes"] = traceable;
         if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
             j["lossy"] = {{"tolerance", attributes::describe(grid.lossy.tolerance)}, {"changed", grid.lossy.changed},
@@ -95,6 +134,8 @@ std::string formatSceneReport(const nlohmann::json& r) {
             out += fmt::format("  lossy values ({}): {} changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
                                g["lossy"]["tolerance"].get<std::string>(), g["lossy"]["changed"].get<uint64_t>(), g["lossy"]["max_abs_error"].get<double>(),
                                g["lossy"]["mean_abs_error"].get<double>(), g["lossy"]["rms_error"].get<double>(), g["lossy"]["max_rel_error"].get<double>());
+        if (g.contains("colour")) out += "  " + formatColour(g["colour"]) + "\n";
+        if (g.contains("normals")) out += "  " + formatNormals(g["normals"]) + "\n";
         out += fmt::format("  total {} bytes in file ({:.4f} bits/active voxel), {} bytes traceable in memory\n", g["stored_bytes"].get<uint64_t>(),
                            g["bits_per_active_voxel"].get<double>(), g["traceable_bytes"].get<uint64_t>());
     }

@@ -15,6 +15,7 @@
 #include <tbb/parallel_for.h>
 
 #include "src/util/Error.h"
+#include "vdb_bridge/detail/NormalEstimation.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 
 namespace vdbdag::bridge {
@@ -108,6 +109,22 @@ void collectLayers(const GridT& grid, GridRecord& record) {
     if constexpr (hasValues) appendValue(record.background, background);
 }
 
+// Exact normals for `--normals` (NormalEstimation.h): the gradient of float
+// and double grids, or the values of the vec3 grid named `normalGrid`.
+template <typename GridT>
+void addNormals(const GridT& grid, GridRecord& record, const std::string& normalGrid, const std::string& path) {
+    using ValueT = typename GridT::ValueType;
+    constexpr bool scalar = std::is_same_v<ValueT, float> || std::is_same_v<ValueT, double>;
+    constexpr bool vec3 = std::is_same_v<ValueT, openvdb::Vec3s> || std::is_same_v<ValueT, openvdb::Vec3d> || std::is_same_v<ValueT, openvdb::Vec3i>;
+    if (normalGrid.empty()) {
+        if constexpr (scalar) record.normals = detail::gradientNormals(grid, record.topology);
+        return;
+    }
+    if (grid.getName() != normalGrid) return;
+    if constexpr (vec3) record.normals = detail::gridNormals(grid, record.topology);
+    else throw Error(path + ": --normal-grid '" + normalGrid + "' has type '" + grid.type() + "', not a vec3 normal grid");
+}
+
 std::vector<uint8_t> descriptorOf(const openvdb::GridBase& grid) {
     openvdb::GridBase::Ptr empty = grid.copyGridWithNewTree();
     std::ostringstream out(std::ios::binary);
@@ -186,6 +203,7 @@ ImportResult importVdb(const std::string& path, const ImportOptions& options) {
                 record.valueType = type;
                 collectLayers(grid, record);
             }
+            if (options.normals) addNormals(grid, record, options.normalGrid, path);
         });
         if (!supported) {
             const std::string message = "grid " + std::to_string(index) + " '" + base->getName() + "' has type '" + base->type() + "'" +
@@ -197,6 +215,11 @@ ImportResult importVdb(const std::string& path, const ImportOptions& options) {
         record.indexToWorld = indexToWorldOf(*base);
         record.vdbDescriptor = descriptorOf(*base);
         result.volume.grids.push_back(std::move(record));
+    }
+    if (options.normals && std::none_of(result.volume.grids.begin(), result.volume.grids.end(), [](const GridRecord& g) { return g.normals.has_value(); })) {
+        if (!options.normalGrid.empty())
+            throw Error(path + ": no grid named '" + options.normalGrid + "' among the grids encoded, for --normal-grid");
+        throw Error(path + ": --normals needs a float or double grid (a level set) to take the gradient of, or a vec3 normal grid named with --normal-grid");
     }
     return result;
 }

@@ -18,6 +18,11 @@ struct ImportOptions {
     // Geometry only: keep each grid's header but import it as a mask (active
     // topology, no values, no inactive layer); it decodes as a MaskGrid.
     bool topologyOnly = false;
+    // Exact shading normals (GridRecord::normals) for `--normals`: by
+    // default the gradient of every float/double grid; with `normalGrid`,
+    // the normalised values of that vec3 grid, on that grid only.
+    bool normals = false;
+    std::string normalGrid;
 };
 
 struct ImportResult {

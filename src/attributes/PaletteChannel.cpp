@@ -7,12 +7,15 @@
 //     quadratic, a sliding window gives every maximal window in O(n); the
 //     windows go into a max-heap by length and are accepted largest first,
 //     clipped lazily to the still-free gap they start in (a clipped window is
-//     pushed back with its new length). A block is accepted when it pays:
+//     pushed back with its new length). The window scan runs in parallel over
+//     fixed chunks of starts, with the same windows as a sequential scan. A block is accepted when it pays:
 //     len * ω + palette + directory < len * (ω + 1) (the paper's line 6), and
 //     it beats direct storage;
 //  2. phase two: the rest is cut left to right; from each start, the longest
 //     block for each ω = 0..8 and a direct block are costed per entry and the
-//     cheapest is taken.
+//     cheapest is taken. The gaps phase one left are cut in parallel (TBB),
+//     which cannot change the result: the output is byte-identical for any
+//     thread count.
 // Costs include each value's share of the material array (its bits divided
 // by its number of occurrences), so unique floats fall back to direct
 // storage and a channel never grows by more than its directory.
@@ -22,11 +25,14 @@
 #include <bit>
 #include <cstring>
 #include <map>
+#include <unordered_map>
 #include <queue>
 #include <set>
 #include <cstdlib>
 #include <sys/mman.h>
 
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <xxhash.h>
 
 #include "src/format/ByteIO.h"
@@ -149,7 +155,7 @@ class Partitioner {
 public:
     Partitioner(const std::vector<uint32_t>& ids, uint64_t distinct, uint32_t vs)
         : ids_(ids), n_(ids.size()), vs_(vs), materialBits_(std::max(1, int(std::bit_width(distinct > 1 ? distinct - 1 : 1)))),
-          stamp_(distinct, 0), count_(distinct, 0), share_(distinct, 0.0) {
+          distinct_(distinct), share_(distinct, 0.0) {
         std::vector<uint64_t> freq(distinct, 0);
         for (uint32_t id : ids) ++freq[id];
         for (size_t d = 0; d < distinct; ++d) share_[d] = 8.0 * vs / double(freq[d]);
@@ -157,17 +163,29 @@ public:
 
     std::vector<Segment> run() {
         for (uint8_t omega = 0; omega < 4; ++omega) phaseOne(omega);
-        // Phase two on every gap left, left to right.
+        // Phase two on every gap left. Gaps are independent, so they run in
+        // parallel, each thread with its own stamp array; the result is put
+        // together in gap order, so it is the same for any thread count.
         std::vector<Segment> segments(accepted_.begin(), accepted_.end());
         std::sort(segments.begin(), segments.end(), [](const Segment& a, const Segment& b) { return a.start < b.start; });
-        std::vector<Segment> all;
+        std::vector<std::pair<uint64_t, uint64_t>> gaps;
         uint64_t at = 0;
         for (const Segment& s : segments) {
-            phaseTwo(at, s.start, all);
-            all.push_back(s);
+            gaps.push_back({at, s.start});
             at = s.start + s.length;
         }
-        phaseTwo(at, n_, all);
+        gaps.push_back({at, n_});
+        std::vector<std::vector<Segment>> perGap(gaps.size());
+        tbb::enumerable_thread_specific<Stamps> stamps([&] { return Stamps(distinct_); });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, gaps.size()), [&](const tbb::blocked_range<size_t>& range) {
+            Stamps& local = stamps.local();
+            for (size_t g = range.begin(); g != range.end(); ++g) phaseTwo(gaps[g].first, gaps[g].second, local, perGap[g]);
+        });
+        std::vector<Segment> all;
+        for (size_t g = 0; g < gaps.size(); ++g) {
+            all.insert(all.end(), perGap[g].begin(), perGap[g].end());
+            if (g < segments.size()) all.push_back(segments[g]);
+        }
         // Merge neighbouring direct blocks (one directory entry instead of many).
         std::vector<Segment> merged;
         for (const Segment& s : all) {
@@ -210,32 +228,76 @@ private:
     void phaseOne(uint8_t omega) {
         const uint64_t limit = uint64_t(1) << omega;
         const double minLength = double(limit) * kPaletteEntryBits + kDirectoryBits;
-        std::priority_queue<std::pair<uint64_t, uint64_t>> heap;  // (length, start)
-        // Maximal windows with <= 2^omega distinct ids, inside each free gap.
-        uint64_t gapStart = 0;
-        auto scanGap = [&](uint64_t begin, uint64_t end) {
-            ++epoch_;
-            uint64_t distinct = 0, right = begin, lastRight = begin;
-            for (uint64_t left = begin; left < end; ++left) {
-                while (right < end) {
-                    const uint32_t id = ids_[right];
-                    const bool fresh = stamp_[id] != epoch_ || count_[id] == 0;
-                    if (fresh && distinct == limit) break;
-                    if (stamp_[id] != epoch_) { stamp_[id] = epoch_; count_[id] = 0; }
-                    if (count_[id]++ == 0) ++distinct;
-                    ++right;
-                }
-                if (right > lastRight && double(right - left) > minLength) heap.push({right - left, left});
-                lastRight = std::max(lastRight, right);
-                const uint32_t id = ids_[left];
-                if (--count_[id] == 0) --distinct;
-            }
+        // Maximal windows with <= 2^omega distinct ids, inside each free gap,
+        // by a sliding window. The gaps are cut into fixed chunks of window
+        // starts scanned in parallel (each chunk restarts its window at its
+        // first start); a chunk's first window is kept only if it is not
+        // inside the previous start's window, exactly as a sequential scan
+        // decides, so the windows do not depend on the thread count.
+        struct Chunk {
+            uint64_t begin, end, gapEnd;
+            uint64_t lastRight = 0;  // right end of the window of start end-1
+            std::vector<std::pair<uint64_t, uint64_t>> windows;  // (length, start)
         };
+        std::vector<Chunk> chunks;
+        auto addGap = [&](uint64_t begin, uint64_t end) {
+            for (uint64_t a = begin; a < end; a += kScanChunk) chunks.push_back(Chunk{a, std::min(end, a + kScanChunk), end, 0, {}});
+        };
+        uint64_t gapStart = 0;
         for (const Segment& s : accepted_) {
-            if (s.start > gapStart) scanGap(gapStart, s.start);
+            if (s.start > gapStart) addGap(gapStart, s.start);
             gapStart = s.start + s.length;
         }
-        if (gapStart < n_) scanGap(gapStart, n_);
+        if (gapStart < n_) addGap(gapStart, n_);
+        tbb::enumerable_thread_specific<WindowCounts> scratch([&] { return WindowCounts(distinct_); });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size()), [&](const tbb::blocked_range<size_t>& range) {
+            WindowCounts& w = scratch.local();
+            for (size_t c = range.begin(); c != range.end(); ++c) {
+                Chunk& chunk = chunks[c];
+                if (omega == 0) {
+                    // One distinct value: the maximal windows are the runs of
+                    // equal ids, found without the window counts.
+                    uint64_t lastRight = chunk.begin;
+                    for (uint64_t left = chunk.begin; left < chunk.end;) {
+                        uint64_t right = left + 1;
+                        while (right < chunk.gapEnd && ids_[right] == ids_[left]) ++right;
+                        if (right > lastRight && double(right - left) > minLength) chunk.windows.push_back({right - left, left});
+                        lastRight = right;
+                        left = right;
+                    }
+                    chunk.lastRight = lastRight;
+                    continue;
+                }
+                ++w.epoch;
+                uint64_t distinct = 0, right = chunk.begin, lastRight = chunk.begin;
+                for (uint64_t left = chunk.begin; left < chunk.end; ++left) {
+                    while (right < chunk.gapEnd) {
+                        const uint32_t id = ids_[right];
+                        const bool fresh = w.stamp[id] != w.epoch || w.count[id] == 0;
+                        if (fresh && distinct == limit) break;
+                        if (w.stamp[id] != w.epoch) { w.stamp[id] = w.epoch; w.count[id] = 0; }
+                        if (w.count[id]++ == 0) ++distinct;
+                        ++right;
+                    }
+                    if (right > lastRight && double(right - left) > minLength) chunk.windows.push_back({right - left, left});
+                    lastRight = std::max(lastRight, right);
+                    const uint32_t id = ids_[left];
+                    if (--w.count[id] == 0) --distinct;
+                }
+                chunk.lastRight = lastRight;
+            }
+        });
+        std::vector<std::pair<uint64_t, uint64_t>> windows;
+        for (size_t c = 0; c < chunks.size(); ++c) {
+            const Chunk& chunk = chunks[c];
+            size_t from = 0;
+            const bool continuesGap = c > 0 && chunks[c - 1].end == chunk.begin && chunks[c - 1].gapEnd == chunk.gapEnd;
+            if (continuesGap && !chunk.windows.empty() && chunk.windows[0].second == chunk.begin &&
+                chunk.begin + chunk.windows[0].first <= chunks[c - 1].lastRight)
+                from = 1;  // inside the window of the previous start: not maximal
+            windows.insert(windows.end(), chunk.windows.begin() + long(from), chunk.windows.end());
+        }
+        std::priority_queue<std::pair<uint64_t, uint64_t>> heap(std::less<std::pair<uint64_t, uint64_t>>(), std::move(windows));
         while (!heap.empty()) {
             auto [length, start] = heap.top();
             heap.pop();
@@ -250,28 +312,68 @@ private:
         }
     }
 
-    void phaseTwo(uint64_t begin, uint64_t end, std::vector<Segment>& out) {
+    // Per-thread window counts for phase one (stamp == epoch: count valid).
+    struct WindowCounts {
+        explicit WindowCounts(size_t distinct) : stamp(distinct, 0), count(distinct, 0) {}
+        std::vector<uint32_t> stamp, count;
+        uint32_t epoch = 0;
+    };
+    static constexpr uint64_t kScanChunk = uint64_t(1) << 20;
+
+    // Per-thread "seen in the current scan" marks for phase two.
+    struct Stamps {
+        explicit Stamps(size_t distinct) : stamp(distinct, 0) {}
+        std::vector<uint32_t> stamp;
+        uint32_t epoch = 0;
+    };
+
+    void phaseTwo(uint64_t begin, uint64_t end, Stamps& marks, std::vector<Segment>& out) const {
+        std::vector<uint32_t>& stamp = marks.stamp;
         for (uint64_t start = begin; start < end;) {
             const uint64_t stop = std::min(end, start + kMaxBlockEntries);
             // lengthFor[ω]: longest block from `start` with <= 2^ω distinct ids.
             uint64_t lengthFor[9];
             double shareUpTo[9];
-            ++epoch_;
+            const uint32_t epoch = ++marks.epoch;
             uint64_t distinct = 0, i = start;
             double share = 0;
+            // Palette costs per entry as ω grows. Every later candidate costs
+            // strictly more than a floor (ω' bits, materialBits_, 8 valueSize
+            // bits, each plus positive overheads), so once the best palette
+            // so far is at or below all the floors the scan stops: the choice
+            // is the one the full comparison below would make, without
+            // scanning up to 257 distinct values from every start.
+            auto paletteCost = [&](unsigned omega) {
+                const double len = double(lengthFor[omega]);
+                return (len * omega + double(uint64_t(1) << omega) * kPaletteEntryBits + kDirectoryBits + shareUpTo[omega]) / len;
+            };
+            double bestPalette = 0;
+            unsigned bestOmega = 0;
+            bool settled = false;
             for (unsigned omega = 0; omega <= 8; ++omega) {
                 const uint64_t limit = uint64_t(1) << omega;
                 for (; i < stop; ++i) {
                     const uint32_t id = ids_[i];
-                    if (stamp_[id] != epoch_) {
+                    if (stamp[id] != epoch) {
                         if (distinct == limit) break;
-                        stamp_[id] = epoch_;
+                        stamp[id] = epoch;
                         ++distinct;
                     }
                     share += share_[id];
                 }
                 lengthFor[omega] = i - start;
                 shareUpTo[omega] = share;
+                const double cost = paletteCost(omega);
+                if (omega == 0 || cost < bestPalette) { bestPalette = cost; bestOmega = omega; }
+                if (omega < 8 && bestPalette <= double(omega + 1) && bestPalette <= double(materialBits_) && bestPalette <= 8.0 * vs_) {
+                    settled = true;
+                    break;
+                }
+            }
+            if (settled) {
+                out.push_back({start, lengthFor[bestOmega], uint8_t(bestOmega)});
+                start += lengthFor[bestOmega];
+                continue;
             }
             double bestCost = (8.0 * vs_ * double(lengthFor[8]) + kDirectoryBits) / double(lengthFor[8]);
             Segment best{start, lengthFor[8], PaletteBlock::kDirect};
@@ -283,9 +385,8 @@ private:
                 if (bits / double(len) < bestCost) { bestCost = bits / double(len); best = {start, len, kWhole}; }
             }
             for (unsigned omega = 0; omega <= 8; ++omega) {
-                const double len = double(lengthFor[omega]);
-                const double bits = len * omega + double(uint64_t(1) << omega) * kPaletteEntryBits + kDirectoryBits + shareUpTo[omega];
-                if (bits / len < bestCost) { bestCost = bits / len; best = {start, lengthFor[omega], uint8_t(omega)}; }
+                const double cost = paletteCost(omega);
+                if (cost < bestCost) { bestCost = cost; best = {start, lengthFor[omega], uint8_t(omega)}; }
             }
             out.push_back(best);
             start += best.length;
@@ -296,21 +397,45 @@ private:
     uint64_t n_;
     uint32_t vs_;
     int materialBits_;
-    std::vector<uint32_t> stamp_;
-    std::vector<uint32_t> count_;
+    size_t distinct_;
     std::vector<double> share_;
-    uint32_t epoch_ = 0;
     std::set<Segment, SegmentLess> accepted_;
 };
 
-void putBits(std::vector<uint64_t>& words, uint64_t bitOffset, uint64_t value, unsigned bits) {
+// Callers size `words` first (reserveBits), so this stays a few instructions.
+inline void putBits(std::vector<uint64_t>& words, uint64_t bitOffset, uint64_t value, unsigned bits) {
     if (bits == 0) return;
     const uint64_t word = bitOffset >> 6;
     const unsigned shift = unsigned(bitOffset & 63);
-    if (words.size() < word + 2) words.resize(word + 2, 0);
     words[word] |= value << shift;
     if (shift + bits > 64) words[word + 1] |= value >> (64 - shift);
 }
+inline void reserveBits(std::vector<uint64_t>& words, uint64_t endBit) {
+    const uint64_t need = (endBit >> 6) + 2;
+    if (words.size() < need) words.resize(std::max<uint64_t>(need, words.size() + words.size() / 2), 0);
+}
+
+// Palettes already stored, found by a hash of their material indices, so
+// blocks with the same palette share it (the first one stored wins).
+class PaletteTable {
+public:
+    // Offset of `palette` in `stored`, appending it if it is new.
+    uint32_t findOrAdd(const std::vector<uint32_t>& palette, std::vector<uint32_t>& stored) {
+        const uint64_t h = XXH3_64bits(palette.data(), palette.size() * sizeof(uint32_t)) ^ palette.size();
+        auto [it, end] = offsets_.equal_range(h);
+        for (; it != end; ++it) {
+            const uint32_t at = it->second.first;
+            if (it->second.second == palette.size() && std::equal(palette.begin(), palette.end(), stored.begin() + at)) return at;
+        }
+        const uint32_t at = uint32_t(stored.size());
+        stored.insert(stored.end(), palette.begin(), palette.end());
+        offsets_.emplace(h, std::make_pair(at, uint32_t(palette.size())));
+        return at;
+    }
+
+private:
+    std::unordered_multimap<uint64_t, std::pair<uint32_t, uint32_t>> offsets_;  // hash -> (offset, size)
+};
 
 uint64_t getBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigned bits) {
     if (bits == 0) return 0;
@@ -335,7 +460,7 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
     const std::vector<Segment> segments = Partitioner(ids, first.size(), valueSize).run();
 
     std::vector<uint32_t> material(first.size(), UINT32_MAX);  // id -> material index
-    std::map<std::vector<uint32_t>, uint32_t> paletteAt;          // shared palettes
+    PaletteTable paletteAt;                                        // shared palettes
     std::vector<uint32_t> local(first.size(), 0);
     std::vector<uint32_t> seen(first.size(), UINT32_MAX);  // block index that last listed this id
     uint64_t bitCursor = 0;
@@ -346,6 +471,7 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
             block.paletteOffset = PaletteBlock::kWholeMaterialArray;
             block.indexBits = uint8_t(bits);
             block.dataOffset = bitCursor;
+            reserveBits(out.indexBits, bitCursor + s.length * bits);
             for (uint64_t i = s.start; i < s.start + s.length; ++i, bitCursor += bits) {
                 uint32_t& m = material[ids[i]];
                 if (m == UINT32_MAX) {
@@ -374,11 +500,10 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
             }
             std::sort(palette.begin(), palette.end());  // at most 256 distinct entries
             const unsigned bits = palette.size() <= 1 ? 0 : unsigned(std::bit_width(palette.size() - 1));
-            auto [it, inserted] = paletteAt.emplace(palette, uint32_t(out.palettes.size()));
-            if (inserted) out.palettes.insert(out.palettes.end(), palette.begin(), palette.end());
-            block.paletteOffset = it->second;
+            block.paletteOffset = paletteAt.findOrAdd(palette, out.palettes);
             block.indexBits = uint8_t(bits);
             block.dataOffset = bitCursor;
+            reserveBits(out.indexBits, bitCursor + s.length * bits);
             for (size_t k = 0; k < palette.size(); ++k) local[palette[k]] = uint32_t(k);
             for (uint64_t i = s.start; i < s.start + s.length; ++i, bitCursor += bits)
                 putBits(out.indexBits, bitCursor, local[material[ids[i]]], bits);

@@ -29,6 +29,8 @@ enum class SectionKind : uint32_t {
     InactiveLeaves = 11,
     InactiveValues = 12,
     ValueErrors = 13,   // per grid, lossy encodings only: the tolerance and the measured errors
+    ColourErrors = 14,  // per colour grid encoded with --colour-bits: bits and the measured colour errors
+    Normals = 15,       // per grid, only with --normals: k-bit ONV codes in attribute order (palette channel) + angular errors
 };
 const char* sectionKindName(SectionKind kind);
 

@@ -15,6 +15,10 @@
 //   Inactive*     the same four for the inactive layer (absent if empty)
 //   ValueErrors   lossy only: u8 mode, f64 bound, u64 entries, changed, kept
 //                 exact, f64 max abs, mean abs, RMS, max relative error
+//   ColourErrors  --colour-bits only: u8 bits, u64 entries, distinct before,
+//                 distinct after, changed, f64[3] mean abs error (R, G, B in
+//                 0..255 units), f64[3] max abs error, f64 mean and max ΔE94
+//   Normals       --normals only: see src/attributes/NormalChannel.cpp
 // Strings are u32 length + bytes. Everything little-endian (ByteIO.h).
 #include "src/format/SsvdagFile.h"
 
@@ -104,6 +108,18 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
             for (double v : {l.maxAbsError, l.meanAbsError, l.rmsError, l.maxRelError}) e.put<double>(v);
             sections.push_back({SectionKind::ValueErrors, g, e.take()});
         }
+        if (grid.colour) {
+            ByteWriter e;
+            const auto& c = *grid.colour;
+            e.put<uint8_t>(uint8_t(c.bits));
+            for (uint64_t v : {c.entries, c.distinctBefore, c.distinctAfter, c.changed}) e.put<uint64_t>(v);
+            for (double v : c.meanAbsError) e.put<double>(v);
+            for (double v : c.maxAbsError) e.put<double>(v);
+            e.put<double>(c.meanDeltaE94);
+            e.put<double>(c.maxDeltaE94);
+            sections.push_back({SectionKind::ColourErrors, g, e.take()});
+        }
+        if (grid.normals) sections.push_back({SectionKind::Normals, g, attributes::serializeNormals(*grid.normals)});
         ByteWriter stats;
         const DagStats& st = grid.stats;
         stats.put<uint32_t>(uint32_t(st.svoNodes.size()));
@@ -222,6 +238,28 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             l.rmsError = r.get<double>();
             l.maxRelError = r.get<double>();
             r.expectEnd();
+        }
+        if (Section* e = find(g, SectionKind::ColourErrors, false)) {
+            ByteReader r(e->data, what + " ColourErrors");
+            attributes::ColourReport c;
+            c.bits = r.get<uint8_t>();
+            if (c.bits < 1 || c.bits > 16) r.fail("colour bits " + std::to_string(c.bits) + " outside 1..16");
+            if (!attributes::isVec3Type(grid.record.valueType)) r.fail("colour errors for a grid that is not a vec3 grid");
+            c.entries = r.get<uint64_t>();
+            c.distinctBefore = r.get<uint64_t>();
+            c.distinctAfter = r.get<uint64_t>();
+            c.changed = r.get<uint64_t>();
+            for (double& v : c.meanAbsError) v = r.get<double>();
+            for (double& v : c.maxAbsError) v = r.get<double>();
+            c.meanDeltaE94 = r.get<double>();
+            c.maxDeltaE94 = r.get<double>();
+            r.expectEnd();
+            if (c.distinctAfter > (uint64_t(1) << c.bits) && c.distinctAfter != c.distinctBefore) r.fail("more colours than the bits allow");
+            grid.colour = c;
+        }
+        if (Section* n = find(g, SectionKind::Normals, false)) {
+            if (grid.dag.empty()) throw Error(what + ": normals for an empty grid");
+            grid.normals = attributes::deserializeNormals(n->data, encoding::decodedSize(grid.dag).attributeEntries, what + " Normals");
         }
         if (Section* st = find(g, SectionKind::DagStats, false)) {
             ByteReader r(st->data, what + " DagStats");

@@ -4,9 +4,12 @@
 // itself before returning, so callers can walk the DAG without checks.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "src/attributes/ColourQuantizer.h"
+#include "src/attributes/NormalChannel.h"
 #include "src/attributes/PaletteChannel.h"
 #include "src/attributes/ScalarTolerance.h"
 #include "src/encoding/CompactDag.h"
@@ -30,6 +33,12 @@ struct EncodedGrid {
     std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
     attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout
     attributes::ToleranceReport lossy;  // what a lossy setting changed (mode Exact: nothing)
+    // Colour grids encoded with --colour-bits: what the CIELAB clustering
+    // changed (the values above already hold the representatives).
+    std::optional<attributes::ColourReport> colour;
+    // --normals K: one k-bit ONV per active attribute entry (NormalChannel.h:
+    // decode entry i with normals->decode(i)). Absent unless asked for.
+    std::optional<attributes::NormalChannel> normals;
     DagStats stats;
     // Inactive voxels/tiles whose value differs from the background.
     uint64_t inactiveVoxels = 0;

@@ -2,6 +2,9 @@
 // root-placement search and the statistics `info` reports.
 #include "src/pipeline/GridCodec.h"
 
+#include <algorithm>
+#include <cstring>
+
 #include "src/dag/DagBuilder.h"
 #include "src/pipeline/AttributeOrder.h"
 
@@ -88,6 +91,12 @@ encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptio
 
 } // namespace
 
+bool isColourGrid(const GridRecord& grid, const EncodeOptions& options) {
+    if (!options.colourBits || !attributes::isVec3Type(grid.valueType)) return false;
+    if (options.colourGrids.empty()) return attributes::hasColourGridName(grid.name);
+    return std::find(options.colourGrids.begin(), options.colourGrids.end(), grid.name) != options.colourGrids.end();
+}
+
 format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) {
     format::EncodedGrid out;
     out.record = grid;
@@ -95,16 +104,29 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
     out.record.values = {};
     out.record.inactiveTopology = {};
     out.record.inactiveValues = {};
+    out.record.normals.reset();
     out.symmetry = options.symmetry;
     const unsigned vs = valueSize(grid.valueType);
     auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };
     out.activeVoxels = grid.topology.activeVoxelCount();
     step("reducing the DAG");
-    if (!grid.topology.empty()) out.dag = encodeLayer(grid.topology, options, vs > 0, &out.stats);
+    const bool withNormals = options.normalBits && grid.normals && !grid.topology.empty();
+    if (!grid.topology.empty()) out.dag = encodeLayer(grid.topology, options, vs > 0 || withNormals, &out.stats);
     step("ordering values");
     if (!grid.topology.empty()) {
         out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
         out.lossy = attributes::applyScalarTolerance(out.attributes, grid.valueType, options.tolerance);
+        if (isColourGrid(grid, options))
+            out.colour = attributes::quantiseColours(out.attributes, grid.valueType, options.colourBits, "grid '" + grid.name + "'");
+    }
+    if (withNormals) {
+        const std::vector<uint8_t> raw = gatherAttributes(out.dag, grid.topology, grid.normals->vectors, sizeof(std::array<float, 3>));
+        std::vector<std::array<float, 3>> exact(raw.size() / sizeof(std::array<float, 3>));
+        if (!raw.empty()) std::memcpy(exact.data(), raw.data(), raw.size());
+        out.normals = attributes::encodeNormals(exact, options.normalBits,
+                                                grid.normals->fromNormalGrid ? attributes::NormalReport::Source::NormalGrid
+                                                                             : attributes::NormalReport::Source::Gradient,
+                                                grid.normals->oneSided);
     }
     step("palette compression");
     if (!grid.topology.empty()) out.values = attributes::compressPalette(out.attributes, vs);

@@ -20,10 +20,22 @@ struct EncodeOptions {
     // Lossy scalar values (float/double active values only; inactive values
     // and other types stay exact). The report lands in EncodedGrid::lossy.
     attributes::ScalarTolerance tolerance;
+    // Lossy colours (ColourQuantizer.h): 0 = exact; else at most 2^colourBits
+    // colours per colour grid. Colour grids: vec3 grids named in
+    // `colourGrids`, or when that is empty, vec3 grids with a colour name
+    // (hasColourGridName). Inactive values stay exact.
+    unsigned colourBits = 0;
+    std::vector<std::string> colourGrids;
+    // k-bit ONV normals (NormalChannel.h) for grids whose record carries
+    // exact normals (GridRecord::normals); 0 = none stored.
+    unsigned normalBits = 0;
     // Called as each step of a grid starts (kEncodeSteps per grid), for progress.
     std::function<void(const char* step)> onStep;
 };
 inline constexpr int kEncodeSteps = 4;
+
+// Whether `grid` is quantised as colours under `options`.
+bool isColourGrid(const GridRecord& grid, const EncodeOptions& options);
 
 format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options = {});
 GridRecord decodeGrid(const format::EncodedGrid& grid);

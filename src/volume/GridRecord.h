@@ -6,6 +6,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,17 @@ struct LayerValues {
     std::vector<uint8_t> tiles;
 };
 
+// Exact normals for shading (`encode --normals K`), computed by vdb_bridge:
+// one unit vector (3 x float) per active value, in the same input order as
+// GridRecord::values; a zero vector means "no direction". (A namespace-level
+// type, not nested: clang cannot default-construct a nested class with member
+// initialisers inside std::optional of its still incomplete enclosing class.)
+struct GridNormals {
+    LayerValues vectors;
+    bool fromNormalGrid = false;  // false: the level set's gradient
+    uint64_t oneSided = 0;        // gradient entries where a band edge forced a one-sided difference
+};
+
 struct GridRecord {
     std::string name;        // may be empty; names may repeat within a file
     std::string gridClass;   // "level set", "fog volume", "staggered", "unknown"
@@ -54,6 +66,9 @@ struct GridRecord {
     // background, e.g. a level set's inside; cost grows with what differs.
     GridTopology inactiveTopology;
     LayerValues inactiveValues;
+    // Optional exact normals for shading (`encode --normals K`).
+    using Normals = GridNormals;
+    std::optional<Normals> normals;
 };
 
 // A whole .vdb file, in file order.

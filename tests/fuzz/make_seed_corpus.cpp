@@ -1,6 +1,9 @@
 // Writes a few valid .ssvdag files (compressed and raw, empty grid, tiles,
-// mirrored bricks) into a folder, as the fuzzer's seed corpus.
+// mirrored bricks, a colour grid with quantised colours and ONV normals)
+// into a folder, as the fuzzer's seed corpus.
+#include <bit>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -19,6 +22,28 @@ int main(int argc, char** argv) {
     format::SsvdagScene scene;
     scene.grids.push_back(pipeline::encodeGrid(record));
     scene.grids.push_back(pipeline::encodeGrid(GridRecord{}));
+    {   // The same geometry as a colour grid with normals: ColourErrors and Normals sections.
+        GridRecord colour = record;
+        colour.name = "Cd";
+        colour.valueType = ValueType::Vec3S;
+        colour.background.assign(12, 0);
+        colour.normals.emplace();
+        uint64_t entries = colour.topology.tiles.size();
+        for (const Brick& b : colour.topology.bricks) entries += uint64_t(std::popcount(b.mask));
+        uint32_t state = 7;
+        auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1u << 24); };
+        for (uint64_t i = 0; i < entries; ++i) {
+            const float rgb[3] = {next(), next(), next()}, n[3] = {next() - 0.5f, next() - 0.5f, next() - 0.5f};
+            auto& values = i + colour.topology.tiles.size() < entries ? colour.values.bricks : colour.values.tiles;
+            auto& normals = i + colour.topology.tiles.size() < entries ? colour.normals->vectors.bricks : colour.normals->vectors.tiles;
+            values.insert(values.end(), reinterpret_cast<const uint8_t*>(rgb), reinterpret_cast<const uint8_t*>(rgb) + 12);
+            normals.insert(normals.end(), reinterpret_cast<const uint8_t*>(n), reinterpret_cast<const uint8_t*>(n) + 12);
+        }
+        pipeline::EncodeOptions options;
+        options.colourBits = 4;
+        options.normalBits = 12;
+        scene.grids.push_back(pipeline::encodeGrid(colour, options));
+    }
     int n = 0;
     for (bool compress : {true, false}) {
         format::ContainerOptions options;

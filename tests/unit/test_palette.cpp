@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <cmath>
 #include <random>
+
+#include <tbb/global_control.h>
 
 #include "src/attributes/PaletteChannel.h"
 #include "src/util/Error.h"
@@ -82,4 +85,21 @@ TEST(Palette, CorruptedSerialisationIsRejected) {
     auto bad = bytes;
     bad[4] ^= 0x40;  // entry count
     EXPECT_THROW(attributes::deserializePalette(bad, "corrupt"), Error);
+}
+
+TEST(Palette, OutputIsByteIdenticalForOneAndTwoThreads) {
+    // Coherent plateaus plus noise: many phase-one blocks and many gaps for
+    // the parallel phase two.
+    std::vector<float> v(3'500'000);  // several 2^20-entry scan chunks
+    std::mt19937 rng(11);
+    for (size_t i = 0; i < v.size(); ++i)
+        v[i] = float(int(std::sin(double(i) * 3e-4) * 300)) / 300.0f + ((i / 3000) % 5 == 0 ? float(rng() % 40) : 0.0f);
+    const auto input = bytesOf(v);
+    auto run = [&](int threads) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        return attributes::serializePalette(attributes::compressPalette(input, 4));
+    };
+    const auto one = run(1), two = run(2);
+    EXPECT_EQ(one, two);
+    expectExact(input, 4, attributes::deserializePalette(two, "two threads"));
 }
