@@ -12,5 +12,6 @@ void addInfoCommand(CLI::App& app, int& exitCode);
 void addVerifyCommand(CLI::App& app, int& exitCode);
 void addRenderCommand(CLI::App& app, int& exitCode);
 void addDevicesCommand(CLI::App& app, int& exitCode);
+void addSelftestCommand(CLI::App& app, int& exitCode);
 
 } // namespace vdbdag::cli

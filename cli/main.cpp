@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     vdbdag::cli::addVerifyCommand(app, exitCode);
     vdbdag::cli::addRenderCommand(app, exitCode);
     vdbdag::cli::addDevicesCommand(app, exitCode);
+    vdbdag::cli::addSelftestCommand(app, exitCode);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
