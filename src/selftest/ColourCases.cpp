@@ -131,7 +131,7 @@ const std::vector<std::pair<const char*, Rgb>>& primaries() {
 
 void addCases(std::vector<SelftestCase>& cases) {
     static constexpr double kLabTolerance = 0.01, kRgbTolerance = 1e-5;
-    cases.push_back({"colours", "primaries-cielab",
+    cases.push_back({"colours", "primaries-cielab", fmt::format("|ΔLab| <= {}", kLabTolerance),
                      fmt::format("black, white, R, G, B, C, M, Y: L*a*b* within {} of published values, back to sRGB within {}, no NaN",
                                  kLabTolerance, kRgbTolerance),
                      [] {
@@ -159,11 +159,11 @@ void addCases(std::vector<SelftestCase>& cases) {
                                  maxRgb = std::max(maxRgb, dr);
                              }
                          }
-                         return checks.result(fmt::format("max |ΔL*a*b*| {:.2g} against published, max sRGB round-trip error {:.2g}", maxLab, maxRgb));
+                         return checks.result(fmt::format("|ΔLab| {:.2g}", maxLab), fmt::format("max |ΔL*a*b*| {:.2g} against published, max sRGB round-trip error {:.2g}", maxLab, maxRgb));
                      }});
 
     static constexpr uint64_t kChannelBound = 64;
-    cases.push_back({"colours", "identical-lossless",
+    cases.push_back({"colours", "identical-lossless", fmt::format("channel <= {} B", kChannelBound),
                      fmt::format("4096 identical vec3s colours (a Cd grid), lossless: bit-exact, value channel <= {} bytes", kChannelBound),
                      [] {
                          SyntheticGrid grid;
@@ -176,17 +176,19 @@ void addCases(std::vector<SelftestCase>& cases) {
                          const std::string diff = firstDifference(flatten(record), flatten(rt.decoded));
                          checks.require(diff.empty(), diff);
                          checks.require(rt.channelBytes() <= kChannelBound, fmt::format("value channel {} bytes", rt.channelBytes()));
-                         return checks.result(fmt::format("value channel {} bytes for 4096 entries, file {} bytes", rt.channelBytes(), rt.fileBytes));
+                         return checks.result(fmt::format("{} B", rt.channelBytes()), fmt::format("value channel {} bytes for 4096 entries, file {} bytes", rt.channelBytes(), rt.fileBytes));
                      }});
 
     for (const ColourQuantiser& q : colourQuantisers()) {
+        const std::string limit = fmt::format("ΔE94 <= {:.2f}", q.maxDeltaE94);
         const std::string bound = fmt::format("ΔE*94 <= {:.3f} ({}), <= 2^{} distinct colours out, no NaN", q.maxDeltaE94, q.boundReason, q.bits);
-        cases.push_back({"colours", "identical-" + q.name, "4096 identical colours: one colour out; " + bound, [q] {
+        cases.push_back({"colours", "identical-" + q.name, "1 colour, " + limit, "4096 identical colours: one colour out; " + bound, [q] {
                              QuantiserFigures f = runQuantiser(q, std::vector<Rgb>(4096, Rgb{0.8, 0.25, 0.1}));
                              f.checks.require(f.distinctOut == 1, fmt::format("{} distinct colours out of one", f.distinctOut));
-                             return f.checks.result(fmt::format("{} colour out, ΔE*94 {:.3f}", f.distinctOut, f.maxDeltaE));
+                             return f.checks.result(fmt::format("{} colour, ΔE94 {:.2f}", f.distinctOut, f.maxDeltaE),
+                                                    fmt::format("{} colour out, ΔE*94 {:.3f}", f.distinctOut, f.maxDeltaE));
                          }});
-        cases.push_back({"colours", "many-unique-" + q.name,
+        cases.push_back({"colours", "many-unique-" + q.name, fmt::format("<= 2^{} colours, {}", q.bits, limit),
                          fmt::format("65536 distinct colours (random, the primaries, black, white) > 2^{}: {}", q.bits, bound), [q] {
                              std::mt19937_64 rng(7);
                              std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -198,17 +200,19 @@ void addCases(std::vector<SelftestCase>& cases) {
                                  if (seen.insert(c).second) colours.push_back(c);
                              }
                              QuantiserFigures f = runQuantiser(q, colours);
-                             return f.checks.result(fmt::format("{} -> {} colours; ΔE*94 max {:.3f} mean {:.3f}; max |ΔRGB| {:.4f} (clamped)", f.distinctIn,
+                             return f.checks.result(fmt::format("{} colours, ΔE94 {:.2f}", f.distinctOut, f.maxDeltaE),
+                                                    fmt::format("{} -> {} colours; ΔE*94 max {:.3f} mean {:.3f}; max |ΔRGB| {:.4f} (clamped)", f.distinctIn,
                                                                 f.distinctOut, f.maxDeltaE, f.meanDeltaE, f.maxRgbError));
                          }});
-        cases.push_back({"colours", "gradient-" + q.name, "a 4096-step gradient dark blue -> orange (banding): " + bound, [q] {
+        cases.push_back({"colours", "gradient-" + q.name, limit, "a 4096-step gradient dark blue -> orange (banding): " + bound, [q] {
                              std::vector<Rgb> colours;
                              for (int i = 0; i < 4096; ++i) {
                                  const double t = double(i) / 4095.0;
                                  colours.push_back({0.05 + 0.9 * t, 0.1 + 0.45 * t, 0.4 - 0.35 * t});
                              }
                              QuantiserFigures f = runQuantiser(q, colours);
-                             return f.checks.result(fmt::format("{} bands; ΔE*94 max {:.3f} mean {:.3f}; largest step between bands ΔE*94 {:.3f}",
+                             return f.checks.result(fmt::format("ΔE94 {:.2f}, {} bands", f.maxDeltaE, f.distinctOut),
+                                                    fmt::format("{} bands; ΔE*94 max {:.3f} mean {:.3f}; largest step between bands ΔE*94 {:.3f}",
                                                                 f.distinctOut, f.maxDeltaE, f.meanDeltaE, f.maxStepDeltaE));
                          }});
     }

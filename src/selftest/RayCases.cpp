@@ -96,14 +96,14 @@ struct RayTally {
         }
     }
     Measurement result(const std::string& extra = {}) const {
-        return checks.result(fmt::format("{} rays, {} hits, {} mismatches, max {} steps{}", rays, hits, mismatches, maxSteps, extra));
+        return checks.result(fmt::format("{} mismatches / {}", mismatches, rays), fmt::format("{} rays, {} hits, {} mismatches, max {} steps{}", rays, hits, mismatches, maxSteps, extra));
     }
 };
 
 uint64_t stepBound(const encoding::CompactDag& dag) { return 6 * (uint64_t(1) << dag.log2Size) + dag.log2Size + 1; }
 
 void addCases(std::vector<SelftestCase>& cases) {
-    cases.push_back({"rays", "axis-face-edge-corner-grazing",
+    cases.push_back({"rays", "axis-face-edge-corner-grazing", "0 mismatches",
                      "4000 rays from lattice corners, face and edge points inside and outside a 24^3 grid of bricks and tiles, axis-parallel "
                      "(+0/-0 components), grazing face planes, exact diagonals: 0 mismatches with the exact reference, steps <= 6 x 2^L + L + 1, no NaN",
                      [] {
@@ -132,7 +132,7 @@ void addCases(std::vector<SelftestCase>& cases) {
                          return tally.result(fmt::format(" (bound {})", stepBound(dag)));
                      }});
 
-    cases.push_back({"rays", "random-dyadic",
+    cases.push_back({"rays", "random-dyadic", "0 mismatches",
                      "4 grids (symmetric and plain DAGs, positive and negative corners) x 1500 random dyadic rays, some with +0/-0 "
                      "components: 0 mismatches, steps <= 6 x 2^L + L + 1, no NaN",
                      [] {
@@ -160,7 +160,7 @@ void addCases(std::vector<SelftestCase>& cases) {
                      }});
 
     for (const int log2Far : {24, 32}) {
-        cases.push_back({"rays", fmt::format("root-2^{}", log2Far),
+        cases.push_back({"rays", fmt::format("root-2^{}", log2Far), "0 mismatches",
                          fmt::format("voxels at both ends of a root spanning 2^{} voxels and near the origin: rays along every axis at each, and the "
                                      "whole diagonal both ways: 0 mismatches, < 64 x L steps (empty space skipped), no NaN",
                                      log2Far),
@@ -196,7 +196,7 @@ void addCases(std::vector<SelftestCase>& cases) {
                          }});
     }
 
-    cases.push_back({"rays", "unit-cube-0.49",
+    cases.push_back({"rays", "unit-cube-0.49", "t = 0.5, 0 mismatches",
                      "one voxel [0,1)^3, origin (0.49, 0.49, -1), direction (0, 0, 2): hit voxel (0,0,0) at t = 0.5 through its -z face; "
                      "x = 0.99999999 and -0 hit, x = 1 and -1e-9 miss (half-open voxel); dyadic variants of x and y agree with the exact reference",
                      [] {
@@ -234,7 +234,7 @@ void addCases(std::vector<SelftestCase>& cases) {
                                                          "xyz"[std::max<int>(0, hit.faceAxis)]));
                      }});
 
-    cases.push_back({"rays", "nan-inf-degenerate",
+    cases.push_back({"rays", "nan-inf-degenerate", "no NaN, no false hit",
                      "NaN and +-Inf in each origin and direction component, zero and -0 directions, huge origins (1e300) and tiny directions "
                      "(1e-300), tMin > tMax: no hit where the ray is undefined, no NaN t, steps <= 6 x 2^L + L + 1; zero-direction point "
                      "queries agree with the exact reference",

@@ -24,16 +24,19 @@ const std::vector<SelftestCase>& selftestCases() {
 }
 
 CaseResult runCase(const SelftestCase& c) {
-    CaseResult result{c.group, c.name, c.bound, {}, false, 0};
+    CaseResult result{c.group, c.name, c.limit, c.bound, {}, {}, false, 0};
     const auto start = std::chrono::steady_clock::now();
     try {
-        Measurement m = c.run ? c.run() : Measurement{"no case function", false};
+        Measurement m = c.run ? c.run() : Measurement{"no case function", "no case function", false};
+        result.value = std::move(m.value);
         result.measured = std::move(m.measured);
         result.passed = m.passed;
     } catch (const std::exception& e) {
+        result.value = "threw";
         result.measured = fmt::format("threw: {}", e.what());
         result.passed = false;
     } catch (...) {
+        result.value = "threw";
         result.measured = "threw a non-standard exception";
         result.passed = false;
     }
@@ -65,9 +68,9 @@ bool Checks::require(bool ok, const std::string& whatFailed) {
     return ok;
 }
 
-Measurement Checks::result(const std::string& figure) const {
-    if (failures_ == 0) return {figure, true};
-    return {fmt::format("{}; VIOLATED: {}{}", figure, first_, failures_ > 1 ? fmt::format(" (+{} more)", failures_ - 1) : ""), false};
+Measurement Checks::result(const std::string& value, const std::string& figure) const {
+    if (failures_ == 0) return {value, figure, true};
+    return {value, fmt::format("{}; VIOLATED: {}{}", figure, first_, failures_ > 1 ? fmt::format(" (+{} more)", failures_ - 1) : ""), false};
 }
 
 } // namespace vdbdag::selftest

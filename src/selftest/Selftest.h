@@ -16,9 +16,12 @@
 
 namespace vdbdag::selftest {
 
-// What running a case measured. `passed` only when every check held;
-// `measured` carries the figure (and, on failure, the first violation).
+// What running a case measured: `value` is the headline figure, short
+// enough for a table column ("max rel 0.001", "0 mismatches"); `measured`
+// the full figures (and, on failure, the first violation). `passed` only
+// when every check held.
 struct Measurement {
+    std::string value;
     std::string measured;
     bool passed = false;
 };
@@ -26,14 +29,15 @@ struct Measurement {
 struct SelftestCase {
     std::string group;  // values, geometry, colours, normals, rays
     std::string name;
-    std::string bound;  // what must hold, fixed before the case runs
+    std::string limit;  // the bound in a few words, for the table ("rel err <= 0.001")
+    std::string bound;  // the bound in full: what must hold, fixed before the case runs
     std::function<Measurement()> run;
 
     std::string id() const { return group + "/" + name; }
 };
 
 struct CaseResult {
-    std::string group, name, bound, measured;
+    std::string group, name, limit, bound, value, measured;
     bool passed = false;
     double seconds = 0;
 
@@ -63,8 +67,9 @@ public:
     // Records a failed check when `ok` is false; returns ok.
     bool require(bool ok, const std::string& whatFailed);
     bool passed() const { return failures_ == 0; }
-    // `figure` followed, on failure, by the first violation and the count.
-    Measurement result(const std::string& figure) const;
+    // `value` (the headline figure) and `figure` (the full figures) followed,
+    // on failure, by the first violation and the count.
+    Measurement result(const std::string& value, const std::string& figure) const;
 
 private:
     std::string first_;

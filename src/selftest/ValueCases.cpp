@@ -56,8 +56,9 @@ Measurement checkLossless(const SyntheticGrid& field, const std::string& what) {
     checks.require(diff.empty(), diff);
     std::set<std::string> distinct;
     for (const auto& [c, v] : want.voxels) distinct.insert(v);
-    return checks.result(fmt::format("{} of {} values bit-identical ({} distinct bit patterns), {} file bytes",
-                                     diff.empty() ? want.voxels.size() : 0, want.voxels.size(), distinct.size(), rt.fileBytes));
+    const size_t same = diff.empty() ? want.voxels.size() : 0;
+    return checks.result(fmt::format("{}/{} identical", same, want.voxels.size()), fmt::format("{} of {} values bit-identical ({} distinct bit patterns), {} file bytes",
+                                     same, want.voxels.size(), distinct.size(), rt.fileBytes));
 }
 
 namespace {
@@ -205,7 +206,7 @@ void addTypedCases(std::vector<SelftestCase>& cases) {
     const std::string t = typeName<T>();
     const bool isFloat = sizeof(T) == 4;
 
-    cases.push_back({"values", "specials-lossless-" + t,
+    cases.push_back({"values", "specials-lossless-" + t, "bit-exact",
                      "bit-exact: every value's bits unchanged (quiet and signalling NaNs with payloads, +-Inf, -0.0, denormals, " +
                          std::string(isFloat ? "FLT_MAX" : "DBL_MAX") + ")",
                      [] {
@@ -214,31 +215,34 @@ void addTypedCases(std::vector<SelftestCase>& cases) {
                      }});
 
     static constexpr double R = 1e-3;
-    cases.push_back({"values", "stiff-rel-" + t,
+    cases.push_back({"values", "stiff-rel-" + t, fmt::format("rel err <= {:g}", R),
                      fmt::format("rel-error {:g} on |v| in 1e-30..1e30: |q-v| <= {:g}|v| for every value; 0, -0, NaN, +-Inf bit-exact", R, R),
                      [] {
                          ToleranceCheck c = checkTolerance(fieldOf(stiffField<T>(20000, 3)), {ScalarTolerance::Mode::Relative, R},
                                                            {ScalarTolerance::Mode::Relative, R});
-                         return c.checks.result(fmt::format("max rel error {:.3g}, {} of {} values changed, {} -> {} distinct; {}", c.maxRelError,
+                         return c.checks.result(fmt::format("max rel {:.3g}", c.maxRelError),
+                                                fmt::format("max rel error {:.3g}, {} of {} values changed, {} -> {} distinct; {}", c.maxRelError,
                                                             c.changed, c.values, c.distinctBefore, c.distinctAfter,
                                                             bytesRatio(c.lossyFileBytes, c.losslessFileBytes)));
                      }});
 
     static constexpr double E = 1e-3;
-    cases.push_back({"values", "stiff-abs-" + t,
+    cases.push_back({"values", "stiff-abs-" + t, fmt::format("abs err <= {:g}", E),
                      fmt::format("abs-error {:g} on |v| in 1e-30..1e30: |q-v| <= {:g} for every value; specials bit-exact "
                                  "(the bound holds but is meaningless below {:g}: reported)",
                                  E, E, E),
                      [] {
                          ToleranceCheck c = checkTolerance(fieldOf(stiffField<T>(20000, 3)), {ScalarTolerance::Mode::Absolute, E},
                                                            {ScalarTolerance::Mode::Absolute, E});
-                         return c.checks.result(fmt::format("max abs error {:.3g}; {} of {} values ({:.1f}%) lost all relative precision "
+                         return c.checks.result(fmt::format("max abs {:.3g}; {:.1f}% lost all precision", c.maxAbsError,
+                                                            100.0 * double(c.lostAllPrecision) / double(c.values)),
+                                                fmt::format("max abs error {:.3g}; {} of {} values ({:.1f}%) lost all relative precision "
                                                             "(max rel error {:.3g}); {}",
                                                             c.maxAbsError, c.lostAllPrecision, c.values, 100.0 * double(c.lostAllPrecision) / double(c.values),
                                                             c.maxRelError, bytesRatio(c.lossyFileBytes, c.losslessFileBytes)));
                      }});
 
-    cases.push_back({"values", "outlier-1e30-abs-" + t,
+    cases.push_back({"values", "outlier-1e30-abs-" + t, fmt::format("abs err <= {:g}", E),
                      fmt::format("abs-error {:g} on 0..1 plus one 1e30: |q-v| <= {:g} for every value (a range-based quantiser "
                                  "would collapse the 0..1 values)",
                                  E, E),
@@ -253,12 +257,13 @@ void addTypedCases(std::vector<SelftestCase>& cases) {
                          const uint64_t levels = uint64_t(1.0 / (2 * E)) + 1;
                          c.checks.require(c.distinctAfter >= levels / 2,
                                           fmt::format("only {} distinct values survive (expected about {})", c.distinctAfter, levels + 1));
-                         return c.checks.result(fmt::format("max abs error {:.3g}, {} -> {} distinct values (about {} levels + the outlier); {}",
+                         return c.checks.result(fmt::format("max abs {:.3g}; {} levels", c.maxAbsError, c.distinctAfter),
+                                                fmt::format("max abs error {:.3g}, {} -> {} distinct values (about {} levels + the outlier); {}",
                                                             c.maxAbsError, c.distinctBefore, c.distinctAfter, levels, bytesRatio(c.lossyFileBytes, c.losslessFileBytes)));
                      }});
 
     static constexpr uint64_t kConstantChannelBound = 64;
-    cases.push_back({"values", "constant-" + t,
+    cases.push_back({"values", "constant-" + t, fmt::format("channel <= {} B", kConstantChannelBound),
                      fmt::format("32^3 voxels of one value: bit-exact, value channel <= {} bytes", kConstantChannelBound),
                      [] {
                          SyntheticGrid grid;
@@ -274,7 +279,8 @@ void addTypedCases(std::vector<SelftestCase>& cases) {
                          checks.require(diff.empty(), diff);
                          checks.require(rt.channelBytes() <= kConstantChannelBound,
                                         fmt::format("value channel {} bytes > {}", rt.channelBytes(), kConstantChannelBound));
-                         return checks.result(fmt::format("value channel {} bytes ({} materials) for 32768 entries; whole file {} bytes",
+                         return checks.result(fmt::format("{} B", rt.channelBytes()),
+                                              fmt::format("value channel {} bytes ({} materials) for 32768 entries; whole file {} bytes",
                                                           rt.channelBytes(), rt.stored.values.materialCount(), rt.fileBytes));
                      }});
 
@@ -286,17 +292,18 @@ void addTypedCases(std::vector<SelftestCase>& cases) {
         return v;
     };
     const double ulp = double(std::nextafter(T(1.0), T(2.0))) - 1.0;
-    cases.push_back({"values", "one-ulp-lossless-" + t, "1 and 1 + ulp: bit-exact, both values stay distinct", [ulpField] {
+    cases.push_back({"values", "one-ulp-lossless-" + t, "bit-exact", "1 and 1 + ulp: bit-exact, both values stay distinct", [ulpField] {
                          return checkLossless(fieldOf(ulpField()), "one ulp");
                      }});
     for (const ScalarTolerance tol : {ScalarTolerance{ScalarTolerance::Mode::Absolute, ulp}, ScalarTolerance{ScalarTolerance::Mode::Relative, ulp}}) {
         const bool abs = tol.mode == ScalarTolerance::Mode::Absolute;
-        cases.push_back({"values", std::string("one-ulp-") + (abs ? "abs-" : "rel-") + t,
+        cases.push_back({"values", std::string("one-ulp-") + (abs ? "abs-" : "rel-") + t, fmt::format("{} err <= 1 ulp", abs ? "abs" : "rel"),
                          fmt::format("1 and 1 + ulp with {}-error {:g} (one ulp): {} for every value (merging them is allowed)",
                                      abs ? "abs" : "rel", ulp, abs ? "|q-v| <= E" : "|q-v| <= R|v|"),
                          [ulpField, tol] {
                              ToleranceCheck c = checkTolerance(fieldOf(ulpField()), tol, tol);
-                             return c.checks.result(fmt::format("{} -> {} distinct ({}), max abs error {:.3g}", c.distinctBefore, c.distinctAfter,
+                             return c.checks.result(fmt::format("max abs {:.3g}, {}", c.maxAbsError, c.distinctAfter == 1 ? "merged" : "kept apart"),
+                                                    fmt::format("{} -> {} distinct ({}), max abs error {:.3g}", c.distinctBefore, c.distinctAfter,
                                                                 c.distinctAfter == 1 ? "merged" : "kept apart", c.maxAbsError));
                          }});
     }

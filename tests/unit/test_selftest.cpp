@@ -58,6 +58,7 @@ TEST(SelftestRegistry, EveryGroupHasCasesAndIdsAreUnique) {
         EXPECT_TRUE(ids.insert(c.id()).second) << c.id();
         EXPECT_TRUE(names.insert(testName(c.id())).second) << "two cases share the test name " << testName(c.id());
         EXPECT_FALSE(c.bound.empty()) << c.id();
+        EXPECT_FALSE(c.limit.empty()) << c.id();
         EXPECT_TRUE(c.run) << c.id();
         groups.insert(c.group);
     }
@@ -68,31 +69,33 @@ TEST(SelftestRegistry, EveryGroupHasCasesAndIdsAreUnique) {
 }
 
 TEST(SelftestRegistry, AFailedCheckOrAThrowingCaseIsReportedAsAFailure) {
-    const SelftestCase failing{"values", "tampered", "x <= 1", [] {
+    const SelftestCase failing{"values", "tampered", "x <= 1", "x <= 1", [] {
                                    Checks checks;
                                    checks.require(true, "never shown");
                                    checks.require(2.0 <= 1.0, "x = 2 > 1");
                                    checks.require(3.0 <= 1.0, "x = 3 > 1");
-                                   return checks.result("x = 2");
+                                   return checks.result("2", "x = 2");
                                }};
     const CaseResult f = runCase(failing);
     EXPECT_FALSE(f.passed);
     EXPECT_EQ(f.bound, "x <= 1");
     EXPECT_NE(f.measured.find("VIOLATED: x = 2 > 1 (+1 more)"), std::string::npos) << f.measured;
 
-    const SelftestCase throwing{"rays", "throws", "no exception", []() -> Measurement { throw std::runtime_error("corrupt DAG"); }};
+    const SelftestCase throwing{"rays", "throws", "no exception", "no exception", []() -> Measurement { throw std::runtime_error("corrupt DAG"); }};
     const CaseResult t = runCase(throwing);
     EXPECT_FALSE(t.passed);
     EXPECT_NE(t.measured.find("corrupt DAG"), std::string::npos);
+    EXPECT_EQ(t.value, "threw");
 
-    const SelftestCase passing{"rays", "ok", "1 <= 1", [] {
+    const SelftestCase passing{"rays", "ok", "1 <= 1", "1 <= 1", [] {
                                    Checks checks;
                                    checks.require(1.0 <= 1.0, "never");
-                                   return checks.result("x = 1");
+                                   return checks.result("1", "x = 1");
                                }};
     const CaseResult p = runCase(passing);
     EXPECT_TRUE(p.passed);
     EXPECT_EQ(p.measured, "x = 1");
+    EXPECT_EQ(p.value, "1");
 }
 
 TEST(SelftestValues, ATamperedToleranceIsCaught) {
@@ -105,11 +108,11 @@ TEST(SelftestValues, ATamperedToleranceIsCaught) {
     using Mode = attributes::ScalarTolerance::Mode;
     const SyntheticGrid field = floatField(v);
     const ToleranceCheck honest = checkTolerance(field, {Mode::Absolute, 1e-3}, {Mode::Absolute, 1e-3});
-    EXPECT_TRUE(honest.checks.passed()) << honest.checks.result("").measured;
+    EXPECT_TRUE(honest.checks.passed()) << honest.checks.result("", "").measured;
     EXPECT_GT(honest.changed, 4000u);
     const ToleranceCheck tampered = checkTolerance(field, {Mode::Absolute, 1e-3}, {Mode::Absolute, 0.25e-3});
     EXPECT_FALSE(tampered.checks.passed());
-    EXPECT_NE(tampered.checks.result("").measured.find("VIOLATED"), std::string::npos);
+    EXPECT_NE(tampered.checks.result("", "").measured.find("VIOLATED"), std::string::npos);
 
     std::vector<double> stiff(4096);
     for (size_t i = 0; i < stiff.size(); ++i) stiff[i] = std::pow(10.0, -30.0 + 60.0 * u(rng)) * (i % 2 ? -1 : 1);
@@ -189,7 +192,7 @@ TEST(SelftestCli, RunsAFilteredSetPrintsJsonAndRejectsAnUnknownFilter) {
 
     r = runVdbdag("selftest --filter rays/unit-cube");
     ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
-    EXPECT_NE(r.out.find("rays/unit-cube-0.49  PASS"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("rays/unit-cube-0.49  t = 0.5, 0 mismatches  0 mismatches / 90  PASS"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("1 of 1 cases passed, 0 failed"), std::string::npos) << r.out;
 
     r = runVdbdag("selftest --list --json");
