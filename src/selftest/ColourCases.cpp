@@ -59,7 +59,9 @@ ColourQuantiser labGridQuantiser(unsigned k) {
     q.name = fmt::format("lab-grid-k{}", k);
     q.bits = k;
     q.maxDeltaE94 = bound;
-    q.boundReason = fmt::format("half the diagonal of a {}x{}x{} cell", sl, sa, sb);
+    q.boundReason = fmt::format("half the diagonal of a {}x{}x{} cell; quantiser: a uniform k-bit L*a*b* grid, standing in until the "
+                                "--colour-bits clustering (branch attrs) is on main",
+                                sl, sa, sb);
     q.quantise = [=](const std::vector<Rgb>& in) {
         std::vector<Rgb> out;
         out.reserve(in.size());
