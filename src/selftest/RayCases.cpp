@@ -22,6 +22,7 @@
 #include "src/dag/DagBuilder.h"
 #include "src/encoding/CompactDag.h"
 #include "src/selftest/CaseGroups.h"
+#include "src/selftest/RayCases.h"
 #include "src/trace/DagTracer.h"
 #include "src/trace/ExactRayReference.h"
 
@@ -283,6 +284,14 @@ void addCases(std::vector<SelftestCase>& cases) {
 }
 
 } // namespace
+
+Measurement compareRays(const encoding::CompactDag& traced, const encoding::CompactDag& reference, std::span<const Ray> rays, uint64_t stepBound) {
+    const trace::DagTracer tracer(traced);
+    const trace::ExactRayReference exact(reference);
+    RayTally tally;
+    for (const Ray& ray : rays) tally.compare(tracer, exact, ray, stepBound);
+    return tally.result();
+}
 
 void addRayCases(std::vector<SelftestCase>& cases) { addCases(cases); }
 

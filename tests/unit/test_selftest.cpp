@@ -16,6 +16,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "src/dag/DagBuilder.h"
+#include "src/encoding/CompactDag.h"
+#include "src/selftest/RayCases.h"
 #include "src/selftest/Selftest.h"
 #include "src/selftest/SyntheticGrid.h"
 #include "src/selftest/ValueCases.h"
@@ -149,6 +152,39 @@ TEST(SelftestValues, TheBruteForceComparisonSeesOneFlippedBit) {
     extra.topology.tiles.push_back({64, 64, 64, 6});
     extra.values.tiles.assign(4, 0);
     EXPECT_NE(firstDifference(want, flatten(extra)).find("appeared"), std::string::npos);
+}
+
+TEST(SelftestRays, AReferenceThatDisagreesOrATooSmallStepBoundIsCaught) {
+    auto compact = [](uint64_t mask) {
+        GridTopology topology;
+        topology.bricks.push_back({0, 0, 0, mask});
+        topology.bricks.push_back({12, 0, 0, 1});
+        return encoding::encodeCompact(dag::buildDag(topology), true);
+    };
+    const encoding::CompactDag full = compact(0xFFFFull), holed = compact(0xFFFEull);
+    std::vector<trace::Ray> rays;
+    for (int x = 0; x < 4; ++x)
+        for (int y = 0; y < 4; ++y) {
+            trace::Ray ray;
+            ray.origin = {x + 0.5, y + 0.5, -3.0};
+            ray.direction = {0.0, -0.0, 1.0};
+            rays.push_back(ray);
+        }
+    const Measurement same = compareRays(full, full, rays, 1000);
+    EXPECT_TRUE(same.passed) << same.measured;
+    EXPECT_EQ(same.value, "0 mismatches / 16");
+    const Measurement differ = compareRays(full, holed, rays, 1000);
+    EXPECT_FALSE(differ.passed);
+    EXPECT_NE(differ.value, "0 mismatches / 16") << differ.measured;  // the hole, and attribute entries shifted by it
+    EXPECT_NE(differ.measured.find("VIOLATED"), std::string::npos);
+    // From x = 4.5 across the empty cells to voxel (12,0,0): the walk leaves
+    // empty nodes behind, so a bound of 0 steps must fail.
+    trace::Ray along;
+    along.origin = {4.5, 0.5, 0.5};
+    along.direction = {1.0, 0.0, 0.0};
+    const std::vector<trace::Ray> one{along};
+    const Measurement tight = compareRays(holed, holed, one, 0);
+    EXPECT_FALSE(tight.passed) << tight.measured;
 }
 
 namespace {
