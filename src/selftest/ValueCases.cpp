@@ -8,7 +8,8 @@
 // would collapse the field; a fixed-step one keeps every value within E); a
 // constant field (a handful of bytes for the value channel); two values one
 // ulp apart (lossless keeps them apart; a tolerance of one ulp may merge
-// them, the bound must still hold).
+// them, the bound must still hold); inactive values (level-set signs, NaN
+// payloads) bit-exact while a tolerance quantises the active ones.
 #include "src/selftest/ValueCases.h"
 
 #include <bit>
@@ -309,11 +310,64 @@ void addTypedCases(std::vector<SelftestCase>& cases) {
     }
 }
 
+// Inactive values (a level set's inside and outside, DESIGN.md invariant 4)
+// stay bit-exact even when a tolerance quantises the active values.
+void addInactiveCase(std::vector<SelftestCase>& cases) {
+    cases.push_back({"values", "inactive-exact-under-abs-float", "inactive bit-exact",
+                     "4096 active values in 0..1 with abs-error 0.001, 4096 inactive values (+-0, +-3 level-set signs, NaN payloads, -Inf, "
+                     "denormals): every inactive value bit-exact, the active ones within 0.001",
+                     [] {
+                         std::mt19937_64 rng(8);
+                         std::uniform_real_distribution<float> u(0.0f, 1.0f);
+                         std::vector<float> active(4096);
+                         for (float& x : active) x = u(rng);
+                         const float inactiveSet[] = {0.0f, -0.0f, 3.0f, -3.0f, std::bit_cast<float>(0x7FC0ABCDu), std::bit_cast<float>(0x7F800042u),
+                                                      -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::denorm_min(), -2.9999998f};
+                         SyntheticGrid inactive;
+                         for (int i = 0; i < 4096; ++i) inactive.addVoxel(i % 32, i / 32 % 32, -1 - i / 1024, &inactiveSet[rng() % std::size(inactiveSet)]);
+                         GridRecord record = toRecord(floatField(active), "level set");
+                         GridRecord inactiveRecord = toRecord(inactive, "level set");
+                         record.gridClass = "level set";
+                         record.inactiveTopology = std::move(inactiveRecord.topology);
+                         record.inactiveValues = std::move(inactiveRecord.values);
+                         pipeline::EncodeOptions options;
+                         options.tolerance = {ScalarTolerance::Mode::Absolute, 1e-3};
+                         const FileRoundTrip rt = roundTripThroughFile(record, options);
+                         auto inactiveLayer = [](const GridRecord& r) {
+                             GridRecord layer = r;
+                             layer.topology = r.inactiveTopology;
+                             layer.values = r.inactiveValues;
+                             return flatten(layer);
+                         };
+                         Checks checks;
+                         const FlatGrid wantInactive = inactiveLayer(record);
+                         const std::string diff = firstDifference(wantInactive, inactiveLayer(rt.decoded));
+                         const size_t n = wantInactive.voxels.size();
+                         checks.require(diff.empty(), "inactive " + diff);
+                         const FlatGrid want = flatten(record), got = flatten(rt.decoded);
+                         checks.require(want.voxels.size() == got.voxels.size(), "the active voxel count changed");
+                         double maxErr = 0;
+                         uint64_t changed = 0;
+                         for (const auto& [c, bytes] : want.voxels) {
+                             const auto it = got.voxels.find(c);
+                             if (!checks.require(it != got.voxels.end(), fmt::format("active voxel ({},{},{}) missing", c[0], c[1], c[2]))) continue;
+                             const double err = std::fabs(valueOf(ValueType::Float, it->second) - valueOf(ValueType::Float, bytes));
+                             checks.require(err <= 1e-3, fmt::format("active voxel ({},{},{}) off by {:.3g}", c[0], c[1], c[2], err));
+                             maxErr = std::max(maxErr, err);
+                             changed += it->second != bytes;
+                         }
+                         return checks.result(fmt::format("{}/{} inactive exact", diff.empty() ? n : 0, n),
+                                              fmt::format("{} of {} inactive values bit-exact; {} of {} active values quantised, max error {:.3g}",
+                                                          diff.empty() ? n : 0, n, changed, want.voxels.size(), maxErr));
+                     }});
+}
+
 } // namespace
 
 void addValueCases(std::vector<SelftestCase>& cases) {
     addTypedCases<float>(cases);
     addTypedCases<double>(cases);
+    addInactiveCase(cases);
 }
 
 } // namespace vdbdag::selftest
