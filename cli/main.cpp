@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     vdbdag::cli::addInfoCommand(app, exitCode);
     vdbdag::cli::addVerifyCommand(app, exitCode);
     vdbdag::cli::addRenderCommand(app, exitCode);
+    vdbdag::cli::addBenchCommand(app, exitCode);
     vdbdag::cli::addDevicesCommand(app, exitCode);
     vdbdag::cli::addSelftestCommand(app, exitCode);
     try {

@@ -109,7 +109,7 @@ ChildPointer readChild(const std::vector<uint16_t>& inner, uint64_t pos, unsigne
     return child;
 }
 
-CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets) {
+CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets, bool compactPointers) {
     CompactDag out;
     if (dag.empty()) return out;
     out.origin = dag.origin;
@@ -159,7 +159,7 @@ CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets) {
                 if (!child) continue;
                 const uint64_t offset = position[dag::childIndex(child)];
                 const uint16_t mirror = uint16_t(dag::childReflection(child) << 13);
-                if (offset < kShortOffsetLimit) {
+                if (offset < kShortOffsetLimit && compactPointers) {
                     header |= uint16_t(1u << (2 * j));
                     words.push_back(uint16_t(mirror | offset));
                 } else if (offset < kLongOffsetLimit) {

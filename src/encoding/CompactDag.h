@@ -39,7 +39,9 @@ struct CompactDag {
 // number of attribute entries of the preceding siblings (Dado et al. §4.1),
 // in the smallest number of 16-bit words that fits the level. Throws
 // vdbdag::Error if a pointer offset does not fit the 30-bit format.
-CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets = false);
+// compactPointers = false writes every pointer in the 32-bit form (the
+// "pointer compaction off" point of `vdbdag bench`; still a valid layout).
+CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets = false, bool compactPointers = true);
 
 // Checks that every header, pointer and offset is in range, that pointers
 // land on node starts of the next level, that the root level holds one node

@@ -64,7 +64,7 @@ encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptio
     for (const auto& origin : placementCandidates(topology, std::max(1, options.placementTrials))) {
         build.origin = origin;
         const dag::ReducedDag reduced = dag::buildDag(topology, build);
-        encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets);
+        encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
         if (first || compact.byteSize() < kept.byteSize()) {
             kept = std::move(compact);
             if (stats) *stats = statsOf(reduced);

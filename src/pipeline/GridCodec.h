@@ -15,6 +15,8 @@ struct EncodeOptions {
     // Try this many root placements (DESIGN.md invariant 1) and keep the
     // smallest encoding; 1 = the bounding box's aligned minimum only.
     int placementTrials = 1;
+    // 16-bit pointers where offsets fit (SSVDAG paper §4.3); false: all 32-bit.
+    bool compactPointers = true;
     // Lossy scalar values (float/double active values only; inactive values
     // and other types stay exact). The report lands in EncodedGrid::lossy.
     attributes::ScalarTolerance tolerance;

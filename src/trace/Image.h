@@ -2,6 +2,7 @@
 // pixel, row-major with row 0 at the top. Written by vdb_bridge/ImageWriter
 // (PNG: sRGB 8-bit colour; EXR: every channel as float).
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <vector>

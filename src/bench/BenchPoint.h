@@ -1,0 +1,47 @@
+// One measured point of `vdbdag bench`: a tool (vdbdag or a peer: OpenVDB,
+// NanoVDB, ZFP) at one setting, with its size, its error and its times, as
+// Benthin et al. ask: error next to memory and run time, never alone.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace vdbdag::bench {
+
+// Repeated timings: median with the spread.
+struct Timing {
+    double medianMs = std::numeric_limits<double>::quiet_NaN();
+    double minMs = std::numeric_limits<double>::quiet_NaN();
+    double maxMs = std::numeric_limits<double>::quiet_NaN();
+    int runs = 0;
+    bool measured() const { return runs > 0; }
+};
+Timing summarise(std::vector<double> samplesMs);
+
+struct BenchPoint {
+    std::string grid;       // grid name
+    std::string tool;       // "vdbdag", "OpenVDB", "NanoVDB", "ZFP"
+    std::string setting;    // e.g. "lossless", "abs 1e-3", "Fp8", "blosc"
+    std::string family;     // points of one family form a curve in the plots (e.g. "vdbdag abs")
+    uint64_t bytes = 0;     // stored size (file, or the peer's compressed stream)
+    uint64_t traceableBytes = 0;  // in-memory traceable size (vdbdag, NanoVDB); 0 if not applicable
+    uint64_t activeVoxels = 0;
+    uint64_t rawBytes = 0;  // active values as a plain array (the rate's denominator)
+    double maxError = 0, rmsError = 0;   // value errors against the input (0 = exact)
+    bool exact = true;                   // bit-exact values
+    double psnr = std::numeric_limits<double>::quiet_NaN();  // render vs the lossless render (dB)
+    double ssim = std::numeric_limits<double>::quiet_NaN();
+    Timing encode, decode, trace;
+    double raysPerSecond = std::numeric_limits<double>::quiet_NaN();
+    std::string note;
+
+    double bitsPerVoxel() const { return activeVoxels ? 8.0 * double(bytes) / double(activeVoxels) : 0; }
+    double rate() const { return rawBytes ? double(bytes) / double(rawBytes) : 0; }
+};
+
+// Indices of the points on the Pareto front of (x, y), both minimised:
+// no other point is at least as good on both and better on one.
+std::vector<size_t> paretoFront(const std::vector<double>& x, const std::vector<double>& y);
+
+} // namespace vdbdag::bench
