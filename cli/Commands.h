@@ -15,5 +15,6 @@ void addBenchCommand(CLI::App& app, int& exitCode);
 void addDevicesCommand(CLI::App& app, int& exitCode);
 void addExportCommand(CLI::App& app, int& exitCode);
 void addDiffCommand(CLI::App& app, int& exitCode);
+void addSelftestCommand(CLI::App& app, int& exitCode);
 
 } // namespace vdbdag::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     vdbdag::cli::addDevicesCommand(app, exitCode);
     vdbdag::cli::addExportCommand(app, exitCode);
     vdbdag::cli::addDiffCommand(app, exitCode);
+    vdbdag::cli::addSelftestCommand(app, exitCode);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
