@@ -68,26 +68,35 @@ struct VulkanTracer::Impl {
     DeviceBuffer params;
     DeviceBuffer counter;
     TraceParamsGpu host{};
-    std::map<uint32_t, std::unique_ptr<ComputePipeline>> pipelines;
+    std::map<uint32_t, ComputePipeline*> pipelines;
 
     Impl(VulkanContext& c) : context(c), params(c, sizeof(TraceParamsGpu), MemoryKind::HostVisible, "trace parameters"),
                              counter(c, 16, MemoryKind::HostVisible, "shadow ray counter") {}
 
     ComputePipeline& pipeline(const trace::RenderGrid& grid, Mode mode, bool levelSet, bool shadows) {
+        // Only what this pipeline reads is specialised, so grids share
+        // pipelines: first-hit rays read no values, hits need no colours.
         const bool fog = mode == Mode::Render && grid.fog;
-        const uint32_t colouring = uint32_t(grid.colouring);
-        const uint32_t key = uint32_t(mode) | (levelSet ? 2u : 0u) | (fog ? 4u : 0u) | (shadows ? 8u : 0u) | (colouring << 4);
+        const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;
+        const bool readsValues = mode == Mode::Render || levelSet;
+        const uint32_t valueType = grid.values && readsValues ? uint32_t(grid.valueType) : 255u;
+        const uint32_t key = uint32_t(mode) | (levelSet ? 2u : 0u) | (fog ? 4u : 0u) | (shadows ? 8u : 0u) | (colouring << 4) | (valueType << 8);
         auto& slot = pipelines[key];
         if (!slot) {
-            SpecConstants constants;
-            constants.setUint(1, uint32_t(mode));
-            constants.setBool(2, levelSet);
-            constants.setUint(3, grid.values ? uint32_t(grid.valueType) : 255u);
-            constants.setBool(4, fog);
-            constants.setUint(5, colouring);
-            constants.setBool(6, shadows);
-            slot = std::make_unique<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
-                                                     "trace.comp");
+            // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
+            std::shared_ptr<void>& shared = context.sharedObjects()[fmt::format("trace.comp/{:x}", key)];
+            if (!shared) {
+                SpecConstants constants;
+                constants.setUint(1, uint32_t(mode));
+                constants.setBool(2, levelSet);
+                constants.setUint(3, valueType);
+                constants.setBool(4, fog);
+                constants.setUint(5, colouring);
+                constants.setBool(6, shadows);
+                shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
+                                                           "trace.comp");
+            }
+            slot = static_cast<ComputePipeline*>(shared.get());
         }
         return *slot;
     }
