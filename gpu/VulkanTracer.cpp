@@ -58,7 +58,7 @@ std::span<const uint8_t> orZeros(std::span<const uint8_t> bytes) {
     return bytes.empty() ? std::span<const uint8_t>(zeros, 16) : bytes;
 }
 
-enum class Mode : uint32_t { Hits = 0, Render = 1 };
+enum class Mode : uint32_t { Hits = 0, Render = 1, Primary = 2 };
 
 } // namespace
 
@@ -77,10 +77,10 @@ struct VulkanTracer::Impl {
         // Only what this pipeline reads is specialised, so grids share
         // pipelines: first-hit rays read no values, hits need no colours.
         const bool fog = mode == Mode::Render && grid.fog;
-        const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;
+        const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
         const bool readsValues = mode == Mode::Render || levelSet;
         const uint32_t valueType = grid.values && readsValues ? uint32_t(grid.valueType) : 255u;
-        const uint32_t key = uint32_t(mode) | (levelSet ? 2u : 0u) | (fog ? 4u : 0u) | (shadows ? 8u : 0u) | (colouring << 4) | (valueType << 8);
+        const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -169,7 +169,26 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid)
 }
 
 VulkanTracer::~VulkanTracer() {
-    impl_.reset();  // before the context it lives on
+    primaryHits_.reset();  // before the context they live on
+    impl_.reset();
+}
+
+// Hits as trace.comp writes them (6 uint64 per ray, see its header).
+void VulkanTracer::unpackHits(const void* words, std::span<trace::RayHit> hits) {
+    const auto* w = static_cast<const uint64_t*>(words);
+    for (size_t i = 0; i < hits.size(); ++i) {
+        trace::RayHit& h = hits[i];
+        const uint64_t flags = w[6 * i];
+        if (!(flags & 1u)) { h = trace::RayHit{}; continue; }
+        h.hit = true;
+        h.faceAxis = int8_t(int((flags >> 8) & 0xFF) - 1);
+        h.faceSign = int8_t(int((flags >> 16) & 0xFF) - 1);
+        h.lodLevel = uint8_t((flags >> 24) & 0xFF);
+        h.steps = uint32_t(flags >> 32);
+        for (int a = 0; a < 3; ++a) h.voxel[a] = int64_t(w[6 * i + 1 + a]);
+        std::memcpy(&h.t, &w[6 * i + 4], 8);
+        h.attribute = w[6 * i + 5];
+    }
 }
 
 const DeviceInfo& VulkanTracer::deviceInfo() const { return impl_->context.deviceInfo(); }
@@ -199,32 +218,14 @@ std::vector<trace::RayHit> VulkanTracer::traceHits(std::span<const trace::Ray> r
         }
         TracePush push{impl.params.address(), rayBuffer.address(), hitBuffer.address(), impl.counter.address(), uint32_t(n), 0};
         lastDeviceMs_ += pipe.dispatch(n, push).deviceMs;
-        const auto* w = static_cast<const uint64_t*>(hitBuffer.mappedData());
-        for (size_t i = 0; i < n; ++i) {
-            trace::RayHit& h = hits[first + i];
-            const uint64_t flags = w[6 * i];
-            h.hit = (flags & 1u) != 0;
-            h.faceAxis = int8_t(int((flags >> 8) & 0xFF) - 1);
-            h.faceSign = int8_t(int((flags >> 16) & 0xFF) - 1);
-            h.lodLevel = uint8_t((flags >> 24) & 0xFF);
-            h.steps = uint32_t(flags >> 32);
-            for (int a = 0; a < 3; ++a) h.voxel[a] = int64_t(w[6 * i + 1 + a]);
-            std::memcpy(&h.t, &w[6 * i + 4], 8);
-            h.attribute = w[6 * i + 5];
-            if (!h.hit) h = trace::RayHit{};
-        }
+        unpackHits(hitBuffer.mappedData(), std::span<trace::RayHit>(hits).subspan(first, n));
     }
     return hits;
 }
 
-trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
-                                  trace::RenderStats& stats) {
-    const auto start = std::chrono::steady_clock::now();
-    if (grid.dag != grid_.dag || grid.values != grid_.values) throw Error("Vulkan tracer: render() got a different grid than the one uploaded");
-    Impl& impl = *impl_;
-    TraceParamsGpu& p = impl.host;
-    const trace::GridFrame frame(grid.indexToWorld);
-
+void VulkanTracer::setCamera(const trace::Camera& camera, double lodPixels) {
+    TraceParamsGpu& p = impl_->host;
+    const trace::GridFrame frame(grid_.indexToWorld);
     // Camera::pixelRay's per-image constants, the same glm expressions.
     const glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
     const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
@@ -234,7 +235,7 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     // GridFrame's inverse linear part, as its constructor computes it.
     glm::dmat3 linear;
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) linear[i][j] = grid.indexToWorld[4 * i + j];
+        for (int j = 0; j < 3; ++j) linear[i][j] = grid_.indexToWorld[4 * i + j];
     const glm::dmat3 inverse = glm::inverse(linear);
     const glm::dmat3 normalMatrix = glm::transpose(inverse);
     const glm::dvec3 light = trace::defaultLight(camera.eye, camera.target, camera.up);
@@ -247,7 +248,6 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
         p.eyeCell[a] = eyeRay.origin[a];
         p.light[a] = light[a];
         p.lightCell[a] = lightRay.direction[a];
-        p.background[a] = options.background[a];
         for (int r = 0; r < 3; ++r) {
             p.inverse[3 * a + r] = inverse[a][r];
             p.normalMatrix[3 * a + r] = normalMatrix[a][r];
@@ -255,12 +255,39 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     }
     p.halfWidth = halfWidth;
     p.halfHeight = halfHeight;
-    p.lodScale = options.lodPixels > 0 ? options.lodPixels * camera.pixelAngle() / frame.voxelSize() : 0;
+    p.lodScale = lodPixels > 0 ? lodPixels * camera.pixelAngle() / frame.voxelSize() : 0;
     p.shadowBias = trace::kShadowBias * frame.voxelSize();
-    p.fogScale = options.densityScale / (grid.valueMax * frame.voxelSize());
     p.width = uint32_t(camera.width);
     p.height = uint32_t(camera.height);
     p.tilesX = (p.width + 7) / 8;
+}
+
+std::vector<trace::RayHit> VulkanTracer::tracePrimary(const trace::Camera& camera, HitKind kind, double lodPixels) {
+    Impl& impl = *impl_;
+    setCamera(camera, lodPixels);
+    impl.writeParams();
+    ComputePipeline& pipe = impl.pipeline(grid_, Mode::Primary, kind == HitKind::Surface && grid_.levelSet, false);
+    const size_t pixels = size_t(camera.width) * size_t(camera.height);
+    if (!primaryHits_ || primaryHits_->size() < pixels * 48)
+        primaryHits_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 48, MemoryKind::HostVisible, "primary ray hits", false);
+    const uint64_t items = uint64_t(impl.host.tilesX) * ((impl.host.height + 7) / 8) * kWorkgroup;
+    TracePush push{impl.params.address(), 0, primaryHits_->address(), impl.counter.address(), uint32_t(items), 0};
+    lastDeviceMs_ = pipe.dispatch(items, push).deviceMs;
+    std::vector<trace::RayHit> hits(pixels);
+    unpackHits(primaryHits_->mappedData(), hits);
+    return hits;
+}
+
+trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
+                                  trace::RenderStats& stats) {
+    const auto start = std::chrono::steady_clock::now();
+    if (grid.dag != grid_.dag || grid.values != grid_.values) throw Error("Vulkan tracer: render() got a different grid than the one uploaded");
+    Impl& impl = *impl_;
+    TraceParamsGpu& p = impl.host;
+    const trace::GridFrame frame(grid.indexToWorld);
+    setCamera(camera, options.lodPixels);
+    for (int a = 0; a < 3; ++a) p.background[a] = options.background[a];
+    p.fogScale = options.densityScale / (grid.valueMax * frame.voxelSize());
     const uint32_t tilesY = (p.height + 7) / 8;
     impl.writeParams();
     std::memset(impl.counter.mappedData(), 0, 16);

@@ -31,6 +31,7 @@
 namespace vdbdag::gpu {
 
 class VulkanContext;
+class DeviceBuffer;
 
 enum class HitKind {
     FirstHit,  // DagTracer::trace: the first occupied voxel, tile or LOD node
@@ -51,6 +52,10 @@ public:
 
     // Traces cell-space rays (Ray.h); `lodScale` as TraceOptions::lodScale.
     std::vector<trace::RayHit> traceHits(std::span<const trace::Ray> rays, HitKind kind = HitKind::FirstHit, double lodScale = 0);
+    // The camera's primary rays (Camera::pixelRay + GridFrame::toCellRay,
+    // generated on the device), traced only: one hit per pixel, row-major.
+    // `lodPixels` as RenderOptions::lodPixels.
+    std::vector<trace::RayHit> tracePrimary(const trace::Camera& camera, HitKind kind = HitKind::FirstHit, double lodPixels = 0);
     // Renders `grid` (the grid given at construction) like trace::renderCpu.
     trace::Image render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
                         trace::RenderStats& stats);
@@ -63,6 +68,9 @@ public:
 private:
     struct Impl;
     void upload(VulkanContext& context, const trace::RenderGrid& grid);
+    void setCamera(const trace::Camera& camera, double lodPixels);
+    static void unpackHits(const void* words, std::span<trace::RayHit> hits);
+    std::unique_ptr<DeviceBuffer> primaryHits_;
     std::unique_ptr<VulkanContext> ownContext_;
     std::unique_ptr<Impl> impl_;
     trace::RenderGrid grid_;

@@ -12,7 +12,9 @@
 //            t (bits), entry;
 //  - render: items are pixels in 8x8 tiles (one workgroup of 64 per tile:
 //            neighbouring rays walk the same nodes); writes 8 floats per
-//            pixel: rgb, alpha, depth, normal xyz.
+//            pixel: rgb, alpha, depth, normal xyz;
+//  - primary: the camera rays of render, traced only (the hits of hits
+//            mode per pixel): what the benchmark measures.
 // Only what the scene has is compiled in: value type, level set, fog,
 // colouring and shadows are specialisation constants.
 //
@@ -24,7 +26,7 @@
 #include "dispatch.glsl"
 #include "trace_params.glsl"
 
-layout(constant_id = 1) const uint MODE = 0u;          // 0: hits, 1: render
+layout(constant_id = 1) const uint MODE = 0u;          // 0: hits, 1: render, 2: primary
 layout(constant_id = 2) const bool LEVEL_SET = false;  // surface = first active voxel with value <= 0
 layout(constant_id = 3) const uint VALUE_TYPE = 255u;  // ValueType; 255: no values
 layout(constant_id = 4) const bool FOG = false;        // render: emission-absorption
@@ -53,12 +55,7 @@ Hit firstSurfaceHit(dvec3 o, dvec3 d, double tMin, double tMax, double ignoreBef
     return walkRay(o, d, tMin, tMax, kVisitZeroCrossing, ignoreBefore, lodScale);
 }
 
-void traceOneRay(uint i) {
-    F64Array rays = F64Array(pc.rays);
-    const uint r = 8u * i;
-    const dvec3 o = dvec3(rays.v[r], rays.v[r + 1u], rays.v[r + 2u]);
-    const dvec3 d = dvec3(rays.v[r + 3u], rays.v[r + 4u], rays.v[r + 5u]);
-    const Hit h = firstSurfaceHit(o, d, rays.v[r + 6u], rays.v[r + 7u], 0.0lf, P.lodScale);
+void writeHit(uint i, Hit h) {
     U64Array res = U64Array(pc.results);
     const uint w = 6u * i;
     res.v[w] = uint64_t(h.hit ? 1u : 0u) | (uint64_t(uint(h.faceAxis + 1)) << 8) | (uint64_t(uint(h.faceSign + 1)) << 16) |
@@ -69,6 +66,14 @@ void traceOneRay(uint i) {
     const uvec2 tb = unpackDouble2x32(h.t);
     res.v[w + 4u] = uint64_t(tb.x) | (uint64_t(tb.y) << 32);
     res.v[w + 5u] = h.entry;
+}
+
+void traceOneRay(uint i) {
+    F64Array rays = F64Array(pc.rays);
+    const uint r = 8u * i;
+    const dvec3 o = dvec3(rays.v[r], rays.v[r + 1u], rays.v[r + 2u]);
+    const dvec3 d = dvec3(rays.v[r + 3u], rays.v[r + 4u], rays.v[r + 5u]);
+    writeHit(i, firstSurfaceHit(o, d, rays.v[r + 6u], rays.v[r + 7u], 0.0lf, P.lodScale));
 }
 
 // ---- shading (Shading.cpp, CpuRenderer.cpp) ----------------------------------
@@ -154,22 +159,43 @@ bool levelSetGradient(Hit hit, out dvec3 g) {
     return true;
 }
 
-void renderPixel(uint i) {
+// Pixel of item i: 8x8 tiles, one per workgroup of 64 (false past the image).
+bool pixelOf(uint i, out uint px, out uint py) {
     const uint tile = i >> 6, within = i & 63u;
-    const uint px = (tile % P.tilesX) * 8u + (within & 7u);
-    const uint py = (tile / P.tilesX) * 8u + (within >> 3);
-    if (px >= P.width || py >= P.height) return;
-    const uint pixel = py * P.width + px;
+    px = (tile % P.tilesX) * 8u + (within & 7u);
+    py = (tile / P.tilesX) * 8u + (within >> 3);
+    return px < P.width && py < P.height;
+}
 
-    // Camera::pixelRay and GridFrame::toCellRay.
+// Camera::pixelRay and GridFrame::toCellRay: the world direction and the cell-space ray.
+void cameraRay(uint px, uint py, out dvec3 dir, out dvec3 o, out dvec3 d) {
     precise double u = ((double(px) + 0.5lf) / double(P.width) * 2.0lf - 1.0lf) * P.halfWidth;
     precise double v = (1.0lf - (double(py) + 0.5lf) / double(P.height) * 2.0lf) * P.halfHeight;
     precise dvec3 sum = vec3At(P.forward) + u * vec3At(P.right) + v * vec3At(P.trueUp);
     const double inv = 1.0lf / sqrt(dot3(sum, sum));
-    const dvec3 dir = sum * inv;
-    const dvec3 o = vec3At(P.eyeCell);
-    const dvec3 d = matTimes(0u, dir);
-    const double tMax = 1e300lf;
+    dir = sum * inv;
+    o = vec3At(P.eyeCell);
+    d = matTimes(0u, dir);
+}
+
+const double kCameraTMax = 1e300lf;  // GridFrame::toCellRay's default
+
+// MODE 2: primary rays only, the hit per pixel as in hits mode.
+void tracePrimary(uint i) {
+    uint px, py;
+    if (!pixelOf(i, px, py)) return;
+    dvec3 dir, o, d;
+    cameraRay(px, py, dir, o, d);
+    writeHit(py * P.width + px, firstSurfaceHit(o, d, 0.0lf, kCameraTMax, 0.0lf, P.lodScale));
+}
+
+void renderPixel(uint i) {
+    uint px, py;
+    if (!pixelOf(i, px, py)) return;
+    const uint pixel = py * P.width + px;
+    dvec3 dir, o, d;
+    cameraRay(px, py, dir, o, d);
+    const double tMax = kCameraTMax;
 
     dvec3 colour = vec3At(P.background);
     float alpha = 0.0, depth = uintBitsToFloat(0x7F800000u);
@@ -235,5 +261,6 @@ void main() {
     if (i >= pc.itemCount) return;
     P = TraceParams(pc.params);
     if (MODE == 0u) traceOneRay(i);
-    else renderPixel(i);
+    else if (MODE == 1u) renderPixel(i);
+    else tracePrimary(i);
 }
