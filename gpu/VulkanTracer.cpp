@@ -80,7 +80,9 @@ struct VulkanTracer::Impl {
         const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
         const bool readsValues = mode == Mode::Render || levelSet;
         const uint32_t valueType = grid.values && readsValues ? uint32_t(grid.valueType) : 255u;
-        const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8);
+        const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
+        const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
+                             (oneChunk ? 1u << 16 : 0u);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -93,6 +95,7 @@ struct VulkanTracer::Impl {
                 constants.setBool(4, fog);
                 constants.setUint(5, colouring);
                 constants.setBool(6, shadows);
+                constants.setBool(7, oneChunk);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
                                                            "trace.comp");
             }

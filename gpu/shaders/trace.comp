@@ -32,6 +32,7 @@ layout(constant_id = 3) const uint VALUE_TYPE = 255u;  // ValueType; 255: no val
 layout(constant_id = 4) const bool FOG = false;        // render: emission-absorption
 layout(constant_id = 5) const uint COLOURING = 0u;     // ValueColouring: none, scalar, colour, vector
 layout(constant_id = 6) const bool SHADOWS = false;    // render: shadow rays
+layout(constant_id = 7) const bool ONE_CHUNK_DAG = false;  // inner words and leaves each in one chunk
 
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
@@ -260,6 +261,7 @@ void main() {
     const uint i = vdbdagItemIndex();
     if (i >= pc.itemCount) return;
     P = TraceParams(pc.params);
+    loadTraceParams();
     if (MODE == 0u) traceOneRay(i);
     else if (MODE == 1u) renderPixel(i);
     else tracePrimary(i);

@@ -43,19 +43,31 @@ dvec3 decodeValueAt(DeviceArray a, uint64_t byteOffset) {
     return value;
 }
 
+uint64_t gBlockHint = 0ul;  // the palette block of the last lookup
+
 // valueAsDoubles(grid, attribute): zeros without values or past the last entry.
 dvec3 valueAsDoubles(uint64_t index) {
     if (VALUE_TYPE == kNoValues || VALUE_TYPE == kValueMask || index >= P.entryCount) return dvec3(0.0lf);
     // The last block whose first entry is <= index (upper_bound - 1).
-    uint64_t lo = 0ul, hi = P.blockCount;
-    while (hi - lo > 1ul) {
-        const uint64_t mid = (lo + hi) >> 1;
-        if (deviceArrayU64(P.blocks, 3ul * mid) <= index) lo = mid;
-        else hi = mid;
+    const DeviceArray blocks = P.blocks;  // one load of the reference, not one per probe
+    const uint64_t blockCount = P.blockCount;
+    // The block of the previous lookup first (PaletteChannel::lookup's hint):
+    // a walk reads nearby entries, so most lookups skip the binary search.
+    uint64_t lo = gBlockHint;
+    uint64_t first = deviceArrayU64(blocks, 3ul * lo);
+    if (!(first <= index && (lo + 1ul == blockCount || index < deviceArrayU64(blocks, 3ul * (lo + 1ul))))) {
+        lo = 0ul;
+        uint64_t hi = blockCount;
+        while (hi - lo > 1ul) {
+            const uint64_t mid = (lo + hi) >> 1;
+            if (deviceArrayU64(blocks, 3ul * mid) <= index) lo = mid;
+            else hi = mid;
+        }
+        gBlockHint = lo;
+        first = deviceArrayU64(blocks, 3ul * lo);
     }
-    const uint64_t first = deviceArrayU64(P.blocks, 3ul * lo);
-    const uint64_t dataOffset = deviceArrayU64(P.blocks, 3ul * lo + 1ul);
-    const uint64_t packed = deviceArrayU64(P.blocks, 3ul * lo + 2ul);
+    const uint64_t dataOffset = deviceArrayU64(blocks, 3ul * lo + 1ul);
+    const uint64_t packed = deviceArrayU64(blocks, 3ul * lo + 2ul);
     const uint paletteOffset = uint(packed & 0xFFFFFFFFul);
     const uint bits = uint(packed >> 32);
     const uint64_t k = index - first;

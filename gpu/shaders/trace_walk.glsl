@@ -14,6 +14,39 @@
 #ifndef VDBDAG_TRACE_WALK_GLSL
 #define VDBDAG_TRACE_WALK_GLSL
 
+// Private copies of what the walk reads at every step (a load through `P`
+// is a memory access each time: the compiler cannot know the buffer does not
+// change), made once per invocation by loadTraceParams().
+i64vec3 gRootOrigin, gBoxLo, gBoxHi;
+uint gLog2Size, gRootReflection, gInnerLevels, gMaxSteps;
+uint64_t gInnerAddress, gLeavesAddress;  // chunk 0 of the DAG arrays
+DeviceArray gInner, gLeaves;
+
+void loadTraceParams() {
+    gRootOrigin = i64vec3(P.origin[0], P.origin[1], P.origin[2]);
+    gBoxLo = i64vec3(P.boxLo[0], P.boxLo[1], P.boxLo[2]);
+    gBoxHi = i64vec3(P.boxHi[0], P.boxHi[1], P.boxHi[2]);
+    gLog2Size = P.log2Size;
+    gRootReflection = P.rootReflection;
+    gInnerLevels = P.innerLevels;
+    gMaxSteps = P.maxSteps;
+    gInner = P.inner;
+    gLeaves = P.leaves;
+    gInnerAddress = gInner.firstChunk;
+    gLeavesAddress = gLeaves.firstChunk;
+}
+
+// The DAG's words; ONE_CHUNK_DAG (specialisation constant: both arrays fit
+// one chunk, the usual case) reads them straight from the chunk's address.
+uint innerWord(uint64_t index) {
+    if (ONE_CHUNK_DAG) return uint(DeviceArrayU16Ptr(gInnerAddress + index * 2ul).value);
+    return deviceArrayU16(gInner, index);
+}
+uint64_t leafMask(uint64_t index) {
+    if (ONE_CHUNK_DAG) return DeviceArrayU64Ptr(gLeavesAddress + index * 8ul).value;
+    return deviceArrayU64(gLeaves, index);
+}
+
 const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u;
 
 struct Hit {
@@ -107,18 +140,18 @@ void readChildPointer(uint64_t pos, uint header, uint j, uint offsetWords, out u
     uint64_t at = pos + 1ul + uint64_t(before) + uint64_t(bitCount((earlier >> 1) & 0x5555u));
     if (before > 1u) at += uint64_t(before - 1u) * uint64_t(offsetWords);
     const uint tag = (header >> (2u * j)) & 3u;
-    const uint w0 = deviceArrayU16(P.inner, at);
+    const uint w0 = innerWord(at);
     reflection = w0 >> 13;
     if (tag == 1u) {
         offset = uint64_t(w0 & 0x1FFFu);
         at += 1ul;
     } else {
-        offset = (uint64_t(tag & 1u) << 29) | (uint64_t(w0 & 0x1FFFu) << 16) | uint64_t(deviceArrayU16(P.inner, at + 1ul));
+        offset = (uint64_t(tag & 1u) << 29) | (uint64_t(w0 & 0x1FFFu) << 16) | uint64_t(innerWord(at + 1ul));
         at += 2ul;
     }
     attributeOffset = 0ul;
     if (before > 0u)
-        for (uint w = 0u; w < offsetWords; ++w) attributeOffset |= uint64_t(deviceArrayU16(P.inner, at + uint64_t(w))) << (16u * w);
+        for (uint w = 0u; w < offsetWords; ++w) attributeOffset |= uint64_t(innerWord(at + uint64_t(w))) << (16u * w);
 }
 
 // Fog state (CpuRenderer.cpp): transmittance, emitted light, first box entered.
@@ -175,7 +208,7 @@ Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, ui
         if (((crossed >> a) & 1u) != 0u && (v[a] & within) == (gD[a] > 0.0lf ? 0l : within)) faceAxis = a;
     Hit h;
     h.hit = true;
-    h.voxel = v + i64vec3(P.origin[0], P.origin[1], P.origin[2]);
+    h.voxel = v + gRootOrigin;
     h.t = t;
     h.entry = entry;
     h.faceAxis = faceAxis;
@@ -191,31 +224,31 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
     const bool firstOnly = visitKind == kVisitFirstHit;
     Hit result = noHit();
     Hit found = noHit();
-    if (P.log2Size == 0u) return result;
+    if (gLog2Size == 0u) return result;
     for (int a = 0; a < 3; ++a) {
         if (isnan(origin[a]) || isinf(origin[a]) || isnan(direction[a]) || isinf(direction[a])) return result;
-        gO[a] = origin[a] - double(P.origin[a]);
+        gO[a] = origin[a] - double(gRootOrigin[a]);
         gD[a] = direction[a];
     }
     if (isnan(tMin) || isnan(tMax)) return result;
-    const uint L = P.log2Size;
+    const uint L = gLog2Size;
 
     double tEnter = tMin, tExit = tMax;
     int enterAxis = -1;
     for (int a = 0; a < 3; ++a) {
         if (gD[a] == 0.0lf) {
-            if (!(gO[a] >= double(P.boxLo[a]) && gO[a] < double(P.boxHi[a]))) return result;
+            if (!(gO[a] >= double(gBoxLo[a]) && gO[a] < double(gBoxHi[a]))) return result;
             continue;
         }
-        const double t0 = crossing(a, gD[a] > 0.0lf ? P.boxLo[a] : P.boxHi[a]);
-        const double t1 = crossing(a, gD[a] > 0.0lf ? P.boxHi[a] : P.boxLo[a]);
+        const double t0 = crossing(a, gD[a] > 0.0lf ? gBoxLo[a] : gBoxHi[a]);
+        const double t1 = crossing(a, gD[a] > 0.0lf ? gBoxHi[a] : gBoxLo[a]);
         if (t0 > tEnter) { tEnter = t0; enterAxis = a; }
         tExit = t1 < tExit ? t1 : tExit;
     }
     if (!(tEnter < tExit)) return result;
 
     i64vec3 v;
-    for (int a = 0; a < 3; ++a) v[a] = voxelAtStart(a, tEnter, P.boxLo[a], P.boxHi[a] - 1l);
+    for (int a = 0; a < 3; ++a) v[a] = voxelAtStart(a, tEnter, gBoxLo[a], gBoxHi[a] - 1l);
     double t = tEnter;
     uint crossed = 0u;
     if (enterAxis >= 0)
@@ -231,8 +264,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
     uint depth = 0u;
     stackPos[0] = 0ul;
     stackBase[0] = 0ul;
-    stackMirror[0] = P.rootReflection;
-    const uint innerLevels = P.innerLevels;
+    stackMirror[0] = gRootReflection;
+    const uint innerLevels = gInnerLevels;
     uint steps = 0u;
     bool inLeaf = false;
     uint64_t leafStored = 0ul, leafSpatial = 0ul, leafBase = 0ul;
@@ -246,7 +279,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             const uint64_t nodePos = stackPos[depth];
             const uint nodeMirror = stackMirror[depth];
             const uint s = L - depth;
-            const uint header = deviceArrayU16(P.inner, nodePos);
+            const uint header = innerWord(nodePos);
             if (header == 0u) {
                 result = makeHit(v, crossed, t, stackBase[depth], s, steps);
                 occupied = true;
@@ -263,7 +296,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             const uint mirror = nodeMirror ^ reflection;
             const uint64_t base = stackBase[depth] + attributeOffset;
             if (depth + 1u == innerLevels) {
-                leafStored = deviceArrayU64(P.leaves, offset);
+                leafStored = leafMask(offset);
                 leafSpatial = reflectBrick(leafStored, mirror);
                 leafMirror = mirror;
                 leafBase = base;
@@ -295,7 +328,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         if (firstOnly && occupied) return result;
         pending = occupied;
 
-        if (++steps > P.maxSteps) return firstOnly ? noHit() : found;
+        if (++steps > gMaxSteps) return firstOnly ? noHit() : found;
         const int64_t cube = int64_t(1) << skip;
         i64vec3 lo, hi;
         double tc[3];
@@ -318,7 +351,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         for (int a = 0; a < 3; ++a) {
             if (tc[a] == tNew) {
                 next[a] = gD[a] > 0.0lf ? hi[a] + 1l : lo[a] - 1l;
-                if (next[a] < P.boxLo[a] || next[a] >= P.boxHi[a]) return firstOnly ? noHit() : found;
+                if (next[a] < gBoxLo[a] || next[a] >= gBoxHi[a]) return firstOnly ? noHit() : found;
                 tNext[a] = crossing(a, gD[a] > 0.0lf ? next[a] + 1l : next[a]);
                 crossed |= 1u << a;
             } else if (tNext[a] > tNew) {
@@ -343,19 +376,19 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
 // DagTracer::find: the entry entry of the active voxel at an index coordinate.
 bool findVoxel(i64vec3 voxel, out uint64_t entry) {
     entry = 0ul;
-    if (P.log2Size == 0u) return false;
-    const int64_t size = int64_t(1) << P.log2Size;
+    if (gLog2Size == 0u) return false;
+    const int64_t size = int64_t(1) << gLog2Size;
     i64vec3 v;
     for (int a = 0; a < 3; ++a) {
-        v[a] = voxel[a] - P.origin[a];
+        v[a] = voxel[a] - gRootOrigin[a];
         if (v[a] < 0l || v[a] >= size) return false;
     }
     uint64_t pos = 0ul, base = 0ul;
-    uint mirror = P.rootReflection;
+    uint mirror = gRootReflection;
     for (uint depth = 0u; depth < kMaxInnerLevels; ++depth) {
-        const uint header = deviceArrayU16(P.inner, pos);
+        const uint header = innerWord(pos);
         if (header == 0u) { entry = base; return true; }
-        const uint halfLog2 = P.log2Size - depth - 1u;
+        const uint halfLog2 = gLog2Size - depth - 1u;
         const uint p = uint((v[0] >> halfLog2) & 1l) | (uint((v[1] >> halfLog2) & 1l) << 1) | (uint((v[2] >> halfLog2) & 1l) << 2);
         const uint j = p ^ mirror;
         if (((header >> (2u * j)) & 3u) == 0u) return false;
@@ -364,8 +397,8 @@ bool findVoxel(i64vec3 voxel, out uint64_t entry) {
         readChildPointer(pos, header, j, P.offsetWords[depth], offset, reflection, attributeOffset);
         mirror ^= reflection;
         base += attributeOffset;
-        if (depth + 1u == P.innerLevels) {
-            const uint64_t mask = deviceArrayU64(P.leaves, offset);
+        if (depth + 1u == gInnerLevels) {
+            const uint64_t mask = leafMask(offset);
             const uint bit = storedBit(uint(v[0] & 3l), uint(v[1] & 3l), uint(v[2] & 3l), mirror);
             if (((mask >> bit) & 1ul) == 0ul) return false;
             entry = base + uint64_t(popcount64(mask & ((uint64_t(1) << bit) - 1ul)));
