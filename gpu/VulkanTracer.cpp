@@ -109,12 +109,14 @@ struct VulkanTracer::Impl {
 
 VulkanTracer::VulkanTracer(const ContextOptions& options, const trace::RenderGrid& grid)
     : ownContext_(std::make_unique<VulkanContext>(options)), grid_(grid) {
-    upload(*ownContext_, grid);
+    upload(*ownContext_, grid, 0);
 }
 
-VulkanTracer::VulkanTracer(VulkanContext& context, const trace::RenderGrid& grid) : grid_(grid) { upload(context, grid); }
+VulkanTracer::VulkanTracer(VulkanContext& context, const trace::RenderGrid& grid, uint32_t chunkShift) : grid_(grid) {
+    upload(context, grid, chunkShift);
+}
 
-void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid) {
+void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid, uint32_t chunkShift) {
     if (!grid.dag || grid.dag->empty()) throw Error("Vulkan tracer: the grid is empty: nothing to trace");
     const encoding::CompactDag& dag = *grid.dag;
     if (dag.innerLevelCount() > kMaxInnerLevels) throw Error(fmt::format("Vulkan tracer: {} inner levels (at most {})", dag.innerLevelCount(), kMaxInnerLevels));
@@ -133,15 +135,17 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid)
         }
     }
     const std::span<const uint8_t> none;
+    DeviceArrayOptions chunks;
+    chunks.chunkShift = chunkShift;
     auto& arrays = impl_->arrays;
     arrays.reserve(7);
-    arrays.emplace_back(context, orZeros(bytesOf(dag.inner)), "DAG inner words");
-    arrays.emplace_back(context, orZeros(bytesOf(dag.leaves)), "DAG leaves");
-    arrays.emplace_back(context, orZeros(values ? bytesOf(values->materials) : none), "palette materials");
-    arrays.emplace_back(context, orZeros(values ? bytesOf(values->palettes) : none), "palettes");
-    arrays.emplace_back(context, orZeros(bytesOf(blocks)), "palette block directory");
-    arrays.emplace_back(context, orZeros(values ? bytesOf(values->indexBits) : none), "palette indices");
-    arrays.emplace_back(context, orZeros(values ? bytesOf(values->direct) : none), "direct values");
+    arrays.emplace_back(context, orZeros(bytesOf(dag.inner)), "DAG inner words", chunks);
+    arrays.emplace_back(context, orZeros(bytesOf(dag.leaves)), "DAG leaves", chunks);
+    arrays.emplace_back(context, orZeros(values ? bytesOf(values->materials) : none), "palette materials", chunks);
+    arrays.emplace_back(context, orZeros(values ? bytesOf(values->palettes) : none), "palettes", chunks);
+    arrays.emplace_back(context, orZeros(bytesOf(blocks)), "palette block directory", chunks);
+    arrays.emplace_back(context, orZeros(values ? bytesOf(values->indexBits) : none), "palette indices", chunks);
+    arrays.emplace_back(context, orZeros(values ? bytesOf(values->direct) : none), "direct values", chunks);
 
     TraceParamsGpu& p = impl_->host;
     p.inner = arrays[0].ref();

@@ -41,8 +41,10 @@ enum class HitKind {
 class VulkanTracer {
 public:
     // Uploads `grid` (its dag and values must outlive the tracer) to the
-    // device of `context` (which must outlive the tracer too).
-    VulkanTracer(VulkanContext& context, const trace::RenderGrid& grid);
+    // device of `context` (which must outlive the tracer too). `chunkShift`
+    // > 0 splits every array into chunks of 2^chunkShift bytes (tests of the
+    // multi-chunk path, which DAGs beyond one allocation take); 0 = the device's largest.
+    VulkanTracer(VulkanContext& context, const trace::RenderGrid& grid, uint32_t chunkShift = 0);
     // The same on a context of its own (`--device N`); throws the context's
     // one-line vdbdag::Error when no usable device exists.
     VulkanTracer(const ContextOptions& options, const trace::RenderGrid& grid);
@@ -67,7 +69,7 @@ public:
 
 private:
     struct Impl;
-    void upload(VulkanContext& context, const trace::RenderGrid& grid);
+    void upload(VulkanContext& context, const trace::RenderGrid& grid, uint32_t chunkShift);
     void setCamera(const trace::Camera& camera, double lodPixels);
     static void unpackHits(const void* words, std::span<trace::RayHit> hits);
     std::unique_ptr<DeviceBuffer> primaryHits_;

@@ -207,7 +207,8 @@ TEST(VulkanTracer, AgreesWithTheCpuTracerOnRandomGridsWithTilesAndMirroredBricks
     for (int g = 0; g < 4; ++g) {
         const encoding::CompactDag dag = compactOf(randomTopology(rng, 6, g % 2 ? -24 : 8), g < 3);
         const trace::DagTracer tracer(dag);
-        gpu::VulkanTracer gpuTracer(*context(), geometryOnly(dag));
+        // The last grid's arrays are split into 256-byte chunks: the path of DAGs beyond one allocation.
+        gpu::VulkanTracer gpuTracer(*context(), geometryOnly(dag), g == 3 ? 8 : 0);
         std::vector<Ray> rays(100000);
         for (size_t i = 0; i < rays.size(); ++i) {
             Ray& ray = rays[i];
@@ -457,6 +458,9 @@ TEST(VulkanTracer, RendersALevelSetSphereLikeTheCpuRenderer) {
     lod.lodPixels = 4;
     trace::RenderStats stats;
     expectSameImage(gpuTracer.render(grid, camera, lod, stats), trace::renderCpu(grid, camera, lod), 1e-6, "sphere LOD 4 px");
+    // Every array (DAG and palette sections) split into 4 KiB chunks.
+    gpu::VulkanTracer chunked(*context(), grid, 12);
+    expectSameImage(chunked.render(grid, camera, {}, stats), trace::renderCpu(grid, camera, {}), 1e-6, "sphere, chunked arrays");
 }
 
 TEST(VulkanTracer, RendersAFogSphereLikeTheCpuRenderer) {
