@@ -262,6 +262,7 @@ void main() {
     if (i >= pc.itemCount) return;
     P = TraceParams(pc.params);
     loadTraceParams();
+    loadValueParams();
     if (MODE == 0u) traceOneRay(i);
     else if (MODE == 1u) renderPixel(i);
     else tracePrimary(i);

@@ -10,13 +10,31 @@
 const uint kValueFloat = 0u, kValueDouble = 1u, kValueInt32 = 2u, kValueInt64 = 3u, kValueBool = 4u, kValueMask = 5u,
            kValueVec3S = 6u, kValueVec3D = 7u, kValueVec3I = 8u, kNoValues = 255u;
 
+// Private copies of the channel's references and sizes (loadValueParams(),
+// once per invocation: a load through `P` is a memory access each time).
+DeviceArray gMaterials, gPalettes, gBlocks, gIndexBits, gDirect;
+uint64_t gEntryCount, gBlockCount;
+uint gValueSize;
+
+void loadValueParams() {
+    if (VALUE_TYPE == kNoValues) return;
+    gMaterials = P.materials;
+    gPalettes = P.palettes;
+    gBlocks = P.blocks;
+    gIndexBits = P.indexBits;
+    gDirect = P.direct;
+    gEntryCount = P.entryCount;
+    gBlockCount = P.blockCount;
+    gValueSize = P.valueSize;
+}
+
 // PaletteChannel.cpp getBits.
 uint64_t paletteBits(uint64_t bitOffset, uint bits) {
     if (bits == 0u) return 0ul;
     const uint64_t word = bitOffset >> 6;
     const uint shift = uint(bitOffset & 63ul);
-    uint64_t v = deviceArrayU64(P.indexBits, word) >> shift;
-    if (shift + bits > 64u) v |= deviceArrayU64(P.indexBits, word + 1ul) << (64u - shift);
+    uint64_t v = deviceArrayU64(gIndexBits, word) >> shift;
+    if (shift + bits > 64u) v |= deviceArrayU64(gIndexBits, word + 1ul) << (64u - shift);
     return v & ((uint64_t(1) << bits) - 1ul);
 }
 
@@ -47,10 +65,10 @@ uint64_t gBlockHint = 0ul;  // the palette block of the last lookup
 
 // valueAsDoubles(grid, attribute): zeros without values or past the last entry.
 dvec3 valueAsDoubles(uint64_t index) {
-    if (VALUE_TYPE == kNoValues || VALUE_TYPE == kValueMask || index >= P.entryCount) return dvec3(0.0lf);
+    if (VALUE_TYPE == kNoValues || VALUE_TYPE == kValueMask || index >= gEntryCount) return dvec3(0.0lf);
     // The last block whose first entry is <= index (upper_bound - 1).
-    const DeviceArray blocks = P.blocks;  // one load of the reference, not one per probe
-    const uint64_t blockCount = P.blockCount;
+    const DeviceArray blocks = gBlocks;
+    const uint64_t blockCount = gBlockCount;
     // The block of the previous lookup first (PaletteChannel::lookup's hint):
     // a walk reads nearby entries, so most lookups skip the binary search.
     uint64_t lo = gBlockHint;
@@ -71,10 +89,10 @@ dvec3 valueAsDoubles(uint64_t index) {
     const uint paletteOffset = uint(packed & 0xFFFFFFFFul);
     const uint bits = uint(packed >> 32);
     const uint64_t k = index - first;
-    if (bits == 0xFFu) return decodeValueAt(P.direct, dataOffset + k * uint64_t(P.valueSize));
+    if (bits == 0xFFu) return decodeValueAt(gDirect, dataOffset + k * uint64_t(gValueSize));
     const uint64_t local = paletteBits(dataOffset + k * uint64_t(bits), bits);
-    const uint64_t m = paletteOffset == 0xFFFFFFFFu ? local : uint64_t(deviceArrayU32(P.palettes, uint64_t(paletteOffset) + local));
-    return decodeValueAt(P.materials, m * uint64_t(P.valueSize));
+    const uint64_t m = paletteOffset == 0xFFFFFFFFu ? local : uint64_t(deviceArrayU32(gPalettes, uint64_t(paletteOffset) + local));
+    return decodeValueAt(gMaterials, m * uint64_t(gValueSize));
 }
 
 #endif
