@@ -1,6 +1,10 @@
 // Backend selection for rendering; see RenderBackend.h.
 #include "cli/RenderBackend.h"
 
+#include <fmt/core.h>
+
+#include "gpu/DeviceInfo.h"
+#include "gpu/VulkanTracer.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::cli {
@@ -15,12 +19,51 @@ public:
     }
 };
 
+// The Vulkan tracer (gpu/VulkanTracer): the device is opened at once (so a
+// missing device is known before rendering), the grid uploaded on the first
+// frame and kept for the next ones.
+class VulkanBackend final : public RenderBackend {
+public:
+    explicit VulkanBackend(int device) {
+        if (device >= 0) options_.deviceIndex = uint32_t(device);
+        info_ = gpu::openDevice(options_);
+    }
+    std::string name() const override { return "vulkan"; }
+    trace::Image render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
+                        trace::RenderStats& stats) override {
+        if (!tracer_ || uploaded_ != grid.dag) {
+            tracer_ = std::make_unique<gpu::VulkanTracer>(options_, grid);
+            uploaded_ = grid.dag;
+            // The first frame compiles the pipeline: warm it up outside the timing.
+            trace::Camera tiny = camera;
+            tiny.width = tiny.height = 8;
+            trace::RenderStats ignored;
+            tracer_->render(grid, tiny, options, ignored);
+        }
+        return tracer_->render(grid, camera, options, stats);
+    }
+
+private:
+    gpu::ContextOptions options_;
+    gpu::DeviceInfo info_;
+    std::unique_ptr<gpu::VulkanTracer> tracer_;
+    const encoding::CompactDag* uploaded_ = nullptr;
+};
+
 } // namespace
 
 std::unique_ptr<RenderBackend> makeRenderBackend(const std::string& kind, int device) {
-    if (kind == "vulkan") throw Error("the Vulkan backend is not available in this build yet: use --backend cpu");
-    (void)device;
-    return std::make_unique<CpuBackend>();
+    if (kind == "cpu") return std::make_unique<CpuBackend>();
+    if (kind == "vulkan") return std::make_unique<VulkanBackend>(device);
+    // auto: Vulkan when a usable device exists, else the CPU with a note (an
+    // explicit --device N that does not work is an error, not a fallback).
+    if (device >= 0) return std::make_unique<VulkanBackend>(device);
+    try {
+        return std::make_unique<VulkanBackend>(device);
+    } catch (const Error& e) {
+        fmt::print(stderr, "note: no Vulkan device ({}); rendering on the CPU\n", e.what());
+        return std::make_unique<CpuBackend>();
+    }
 }
 
 } // namespace vdbdag::cli

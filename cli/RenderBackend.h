@@ -17,7 +17,8 @@ public:
                                 trace::RenderStats& stats) = 0;
 };
 
-// "cpu", "vulkan", or "auto" (Vulkan when a device exists, else the CPU).
+// "cpu", "vulkan", or "auto" (Vulkan when a device exists, else the CPU with
+// a one-line note on stderr); `device` >= 0 picks a Vulkan device (--device N).
 std::unique_ptr<RenderBackend> makeRenderBackend(const std::string& kind, int device);
 
 } // namespace vdbdag::cli

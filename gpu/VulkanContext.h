@@ -19,6 +19,9 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -55,6 +58,12 @@ public:
     // submits it to the queue and waits for it to finish.
     void submitAndWait(const std::function<void(VkCommandBuffer)>& record);
 
+    // Objects that live as long as the device, shared by everything created
+    // from this context (e.g. compiled pipelines reused by several tracers:
+    // lavapipe compiles a large shader in about a second). Released before
+    // the device is destroyed.
+    std::map<std::string, std::shared_ptr<void>>& sharedObjects() { return sharedObjects_; }
+
     // Validation-layer messages of severity error seen so far (0 without validation).
     uint64_t validationErrorCount() const { return validationErrors_.load(); }
     bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
@@ -73,6 +82,7 @@ private:
     VkFence fence_ = VK_NULL_HANDLE;
     VkPhysicalDeviceMemoryProperties memoryProperties_{};
     std::atomic<uint64_t> validationErrors_{0};
+    std::map<std::string, std::shared_ptr<void>> sharedObjects_;
 
     void destroy();
 };

@@ -32,10 +32,6 @@ std::optional<glm::dvec3> levelSetGradient(const RenderGrid& grid, const DagTrac
     return g / len;
 }
 
-// Level sets skip voxels within this many voxel lengths of a shadow ray's
-// start: the narrow band's staircase would otherwise shadow its own surface.
-constexpr double kShadowBias = 3.0;
-
 } // namespace
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {

@@ -23,9 +23,10 @@ struct CommandResult {
     std::string out, err;
 };
 
-CommandResult runCli(const std::string& args) {
+// `envPrefix`: e.g. "env VAR=value " before the binary.
+CommandResult runCli(const std::string& args, const std::string& envPrefix = "") {
     const fs::path errFile = fs::temp_directory_path() / ("vdbdag_cli_err_" + std::to_string(getpid()));
-    const std::string command = std::string(VDBDAG_BINARY) + " " + args + " 2>" + errFile.string();
+    const std::string command = envPrefix + std::string(VDBDAG_BINARY) + " " + args + " 2>" + errFile.string();
     CommandResult r{};
     FILE* pipe = popen(command.c_str(), "r");
     std::array<char, 4096> buffer{};
@@ -192,4 +193,44 @@ TEST(Cli, BadInputsGiveOneLineErrorsAndLeaveNoOutput) {
         EXPECT_NE(r.err.find("PointDataGrid"), std::string::npos) << r.err;
         EXPECT_FALSE(fs::exists(dir / "p.ssvdag"));
     }
+}
+
+TEST(Cli, RenderOnVulkanAndCpuGivesTheSamePngAndAutoFallsBackWithoutADevice) {
+    const fs::path encoded = workDir() / "render_ball.ssvdag";
+    ASSERT_EQ(runCli("encode " + sphereFile().string() + " -o " + encoded.string()).exitCode, 0);
+    const fs::path cpuPng = workDir() / "ball_cpu.png", vulkanPng = workDir() / "ball_vulkan.png";
+    CommandResult r = runCli("render " + encoded.string() + " -o " + cpuPng.string() + " --backend cpu --width 96 --height 64 --shadows --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    auto report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["backend"], "cpu");
+    EXPECT_EQ(report["primary_rays"], 96 * 64);
+    // No driver: auto renders on the CPU with a one-line note; --backend vulkan is a one-line error and writes nothing.
+    const std::string noDriver = "env -u VK_ADD_DRIVER_FILES -u VDBDAG_VULKAN_VALIDATION VK_ICD_FILENAMES=/nonexistent/vdbdag_icd.json "
+                                 "VK_DRIVER_FILES=/nonexistent/vdbdag_icd.json ";
+    const fs::path fallbackPng = workDir() / "ball_fallback.png";
+    r = runCli("render " + encoded.string() + " -o " + fallbackPng.string() + " --width 96 --height 64 --json", noDriver);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["backend"], "cpu");
+    EXPECT_TRUE(r.err.starts_with("note: no Vulkan device")) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    r = runCli("render " + encoded.string() + " -o " + vulkanPng.string() + " --backend vulkan", noDriver);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_TRUE(r.err.starts_with("vdbdag: no Vulkan device found")) << r.err;
+    EXPECT_FALSE(fs::exists(vulkanPng));
+    // With the device (when there is one): the same pixels, so the same PNG bytes.
+    r = runCli("render " + encoded.string() + " -o " + vulkanPng.string() + " --backend vulkan --width 96 --height 64 --shadows --json");
+    if (r.exitCode != 0 && r.err.find("no Vulkan device") != std::string::npos) GTEST_SKIP() << "no Vulkan device on this machine";
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["backend"], "vulkan");
+    EXPECT_GT(report["secondary_rays"].get<int>(), 0);
+    auto slurp = [](const fs::path& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    EXPECT_FALSE(slurp(cpuPng).empty());
+    EXPECT_EQ(slurp(cpuPng), slurp(vulkanPng)) << "the Vulkan and CPU renders differ";
+    r = runCli("render " + encoded.string() + " -o " + vulkanPng.string() + " --backend vulkan --device 99");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }

@@ -1,0 +1,328 @@
+// The Vulkan tracer: uploads, pipelines, dispatches; see VulkanTracer.h. The
+// camera and shading constants are computed here exactly as Camera.cpp and
+// CpuRenderer.cpp compute them (same glm expressions, no contraction), so
+// the shader's per-pixel rays are bit-identical to the CPU's.
+#include "gpu/VulkanTracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include <fmt/core.h>
+
+#include "gpu/ComputePipeline.h"
+#include "gpu/DeviceArray.h"
+#include "gpu/DeviceBuffer.h"
+#include "gpu/EmbeddedShaders.h"
+#include "gpu/VulkanContext.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::gpu {
+namespace {
+
+constexpr unsigned kMaxInnerLevels = 40;  // trace_params.glsl
+constexpr uint32_t kWorkgroup = 64;       // render: one 8x8 pixel tile per workgroup
+constexpr size_t kRayBatch = size_t(1) << 20;
+
+// gpu/shaders/trace_params.glsl, std430: 8-byte members first, then 4-byte ones.
+struct TraceParamsGpu {
+    DeviceArrayRef inner, leaves, materials, palettes, blocks, indexBits, direct;
+    int64_t origin[3], boxLo[3], boxHi[3];
+    uint64_t levelStart[kMaxInnerLevels];
+    uint64_t entryCount, blockCount;
+    double lodScale, valueMin, valueMax;
+    double forward[3], right[3], trueUp[3];
+    double halfWidth, halfHeight;
+    double eyeCell[3], inverse[9], normalMatrix[9], light[3], lightCell[3], background[3];
+    double shadowBias, fogScale;
+    uint32_t offsetWords[kMaxInnerLevels];
+    uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, valueSize;
+};
+static_assert(sizeof(TraceParamsGpu) == 1136, "must match trace_params.glsl");
+
+struct TracePush {
+    uint64_t params, rays, results, counter;
+    uint32_t itemCount, pad;
+};
+static_assert(sizeof(TracePush) == 40);
+
+template <class T>
+std::span<const uint8_t> bytesOf(const std::vector<T>& v) {
+    return {reinterpret_cast<const uint8_t*>(v.data()), v.size() * sizeof(T)};
+}
+
+// Empty sections still get a (zero) array so every address is valid.
+std::span<const uint8_t> orZeros(std::span<const uint8_t> bytes) {
+    static const uint8_t zeros[16] = {};
+    return bytes.empty() ? std::span<const uint8_t>(zeros, 16) : bytes;
+}
+
+enum class Mode : uint32_t { Hits = 0, Render = 1, Primary = 2 };
+
+} // namespace
+
+struct VulkanTracer::Impl {
+    VulkanContext& context;
+    std::vector<DeviceArray> arrays;  // inner, leaves, materials, palettes, blocks, indexBits, direct
+    DeviceBuffer params;
+    DeviceBuffer counter;
+    TraceParamsGpu host{};
+    std::map<uint32_t, ComputePipeline*> pipelines;
+
+    Impl(VulkanContext& c) : context(c), params(c, sizeof(TraceParamsGpu), MemoryKind::HostVisible, "trace parameters"),
+                             counter(c, 16, MemoryKind::HostVisible, "shadow ray counter") {}
+
+    ComputePipeline& pipeline(const trace::RenderGrid& grid, Mode mode, bool levelSet, bool shadows) {
+        // Only what this pipeline reads is specialised, so grids share
+        // pipelines: first-hit rays read no values, hits need no colours.
+        const bool fog = mode == Mode::Render && grid.fog;
+        const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
+        const bool readsValues = mode == Mode::Render || levelSet;
+        const uint32_t valueType = grid.values && readsValues ? uint32_t(grid.valueType) : 255u;
+        const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
+        const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
+                             (oneChunk ? 1u << 16 : 0u);
+        auto& slot = pipelines[key];
+        if (!slot) {
+            // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
+            std::shared_ptr<void>& shared = context.sharedObjects()[fmt::format("trace.comp/{:x}", key)];
+            if (!shared) {
+                SpecConstants constants;
+                constants.setUint(1, uint32_t(mode));
+                constants.setBool(2, levelSet);
+                constants.setUint(3, valueType);
+                constants.setBool(4, fog);
+                constants.setUint(5, colouring);
+                constants.setBool(6, shadows);
+                constants.setBool(7, oneChunk);
+                shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
+                                                           "trace.comp");
+            }
+            slot = static_cast<ComputePipeline*>(shared.get());
+        }
+        return *slot;
+    }
+
+    void writeParams() { std::memcpy(params.mappedData(), &host, sizeof(host)); }
+};
+
+VulkanTracer::VulkanTracer(const ContextOptions& options, const trace::RenderGrid& grid)
+    : ownContext_(std::make_unique<VulkanContext>(options)), grid_(grid) {
+    upload(*ownContext_, grid, 0);
+}
+
+VulkanTracer::VulkanTracer(VulkanContext& context, const trace::RenderGrid& grid, uint32_t chunkShift) : grid_(grid) {
+    upload(context, grid, chunkShift);
+}
+
+void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid, uint32_t chunkShift) {
+    if (!grid.dag || grid.dag->empty()) throw Error("Vulkan tracer: the grid is empty: nothing to trace");
+    const encoding::CompactDag& dag = *grid.dag;
+    if (dag.innerLevelCount() > kMaxInnerLevels) throw Error(fmt::format("Vulkan tracer: {} inner levels (at most {})", dag.innerLevelCount(), kMaxInnerLevels));
+    if (!grid.values && grid.colouring != trace::ValueColouring::None) throw Error("Vulkan tracer: colouring without values");
+    impl_ = std::make_unique<Impl>(context);
+    box_ = trace::occupiedBox(dag);
+
+    std::vector<uint64_t> blocks;
+    const attributes::PaletteChannel* values = grid.values;
+    if (values) {
+        blocks.reserve(values->blocks.size() * 3);
+        for (const attributes::PaletteBlock& b : values->blocks) {
+            blocks.push_back(b.firstEntry);
+            blocks.push_back(b.dataOffset);
+            blocks.push_back(uint64_t(b.paletteOffset) | (uint64_t(b.indexBits) << 32));
+        }
+    }
+    const std::span<const uint8_t> none;
+    DeviceArrayOptions chunks;
+    chunks.chunkShift = chunkShift;
+    auto& arrays = impl_->arrays;
+    arrays.reserve(7);
+    arrays.emplace_back(context, orZeros(bytesOf(dag.inner)), "DAG inner words", chunks);
+    arrays.emplace_back(context, orZeros(bytesOf(dag.leaves)), "DAG leaves", chunks);
+    arrays.emplace_back(context, orZeros(values ? bytesOf(values->materials) : none), "palette materials", chunks);
+    arrays.emplace_back(context, orZeros(values ? bytesOf(values->palettes) : none), "palettes", chunks);
+    arrays.emplace_back(context, orZeros(bytesOf(blocks)), "palette block directory", chunks);
+    arrays.emplace_back(context, orZeros(values ? bytesOf(values->indexBits) : none), "palette indices", chunks);
+    arrays.emplace_back(context, orZeros(values ? bytesOf(values->direct) : none), "direct values", chunks);
+
+    TraceParamsGpu& p = impl_->host;
+    p.inner = arrays[0].ref();
+    p.leaves = arrays[1].ref();
+    p.materials = arrays[2].ref();
+    p.palettes = arrays[3].ref();
+    p.blocks = arrays[4].ref();
+    p.indexBits = arrays[5].ref();
+    p.direct = arrays[6].ref();
+    for (int a = 0; a < 3; ++a) {
+        p.origin[a] = dag.origin[a];
+        p.boxLo[a] = box_.lo[a];
+        p.boxHi[a] = box_.hi[a];
+    }
+    for (size_t i = 0; i < dag.innerLevelCount(); ++i) {
+        p.levelStart[i] = dag.levelStart[i];
+        p.offsetWords[i] = dag.offsetWords[i];
+    }
+    p.entryCount = values ? values->entryCount : 0;
+    p.blockCount = values ? values->blocks.size() : 0;
+    p.valueMin = grid.valueMin;
+    p.valueMax = grid.valueMax;
+    p.log2Size = dag.log2Size;
+    p.rootReflection = dag.rootReflection;
+    p.innerLevels = uint32_t(dag.innerLevelCount());
+    p.maxSteps = trace::TraceOptions{}.maxSteps;
+    p.valueSize = values ? values->valueSize : 0;
+}
+
+VulkanTracer::~VulkanTracer() {
+    primaryHits_.reset();  // before the context they live on
+    impl_.reset();
+}
+
+// Hits as trace.comp writes them (6 uint64 per ray, see its header).
+void VulkanTracer::unpackHits(const void* words, std::span<trace::RayHit> hits) {
+    const auto* w = static_cast<const uint64_t*>(words);
+    for (size_t i = 0; i < hits.size(); ++i) {
+        trace::RayHit& h = hits[i];
+        const uint64_t flags = w[6 * i];
+        if (!(flags & 1u)) { h = trace::RayHit{}; continue; }
+        h.hit = true;
+        h.faceAxis = int8_t(int((flags >> 8) & 0xFF) - 1);
+        h.faceSign = int8_t(int((flags >> 16) & 0xFF) - 1);
+        h.lodLevel = uint8_t((flags >> 24) & 0xFF);
+        h.steps = uint32_t(flags >> 32);
+        for (int a = 0; a < 3; ++a) h.voxel[a] = int64_t(w[6 * i + 1 + a]);
+        std::memcpy(&h.t, &w[6 * i + 4], 8);
+        h.attribute = w[6 * i + 5];
+    }
+}
+
+const DeviceInfo& VulkanTracer::deviceInfo() const { return impl_->context.deviceInfo(); }
+
+std::vector<trace::RayHit> VulkanTracer::traceHits(std::span<const trace::Ray> rays, HitKind kind, double lodScale) {
+    std::vector<trace::RayHit> hits(rays.size());
+    if (rays.empty()) return hits;
+    Impl& impl = *impl_;
+    impl.host.lodScale = lodScale;
+    impl.writeParams();
+    ComputePipeline& pipe = impl.pipeline(grid_, Mode::Hits, kind == HitKind::Surface && grid_.levelSet, false);
+    const size_t batch = std::min(rays.size(), kRayBatch);
+    DeviceBuffer rayBuffer(impl.context, batch * 64, MemoryKind::HostVisible, "rays", false);
+    DeviceBuffer hitBuffer(impl.context, batch * 48, MemoryKind::HostVisible, "ray hits", false);
+    lastDeviceMs_ = 0;
+    for (size_t first = 0; first < rays.size(); first += batch) {
+        const size_t n = std::min(batch, rays.size() - first);
+        auto* r = static_cast<double*>(rayBuffer.mappedData());
+        for (size_t i = 0; i < n; ++i) {
+            const trace::Ray& ray = rays[first + i];
+            for (int a = 0; a < 3; ++a) {
+                r[8 * i + a] = ray.origin[a];
+                r[8 * i + 3 + a] = ray.direction[a];
+            }
+            r[8 * i + 6] = ray.tMin;
+            r[8 * i + 7] = ray.tMax;
+        }
+        TracePush push{impl.params.address(), rayBuffer.address(), hitBuffer.address(), impl.counter.address(), uint32_t(n), 0};
+        lastDeviceMs_ += pipe.dispatch(n, push).deviceMs;
+        unpackHits(hitBuffer.mappedData(), std::span<trace::RayHit>(hits).subspan(first, n));
+    }
+    return hits;
+}
+
+void VulkanTracer::setCamera(const trace::Camera& camera, double lodPixels) {
+    TraceParamsGpu& p = impl_->host;
+    const trace::GridFrame frame(grid_.indexToWorld);
+    // Camera::pixelRay's per-image constants, the same glm expressions.
+    const glm::dvec3 forward = glm::normalize(camera.target - camera.eye);
+    const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
+    const glm::dvec3 trueUp = glm::cross(right, forward);
+    const double halfHeight = std::tan(glm::radians(camera.fovDegrees) / 2);
+    const double halfWidth = halfHeight * double(camera.width) / double(camera.height);
+    // GridFrame's inverse linear part, as its constructor computes it.
+    glm::dmat3 linear;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) linear[i][j] = grid_.indexToWorld[4 * i + j];
+    const glm::dmat3 inverse = glm::inverse(linear);
+    const glm::dmat3 normalMatrix = glm::transpose(inverse);
+    const glm::dvec3 light = trace::defaultLight(camera.eye, camera.target, camera.up);
+    const trace::Ray eyeRay = frame.toCellRay(camera.eye, forward);
+    const trace::Ray lightRay = frame.toCellRay(glm::dvec3(0), light);
+    for (int a = 0; a < 3; ++a) {
+        p.forward[a] = forward[a];
+        p.right[a] = right[a];
+        p.trueUp[a] = trueUp[a];
+        p.eyeCell[a] = eyeRay.origin[a];
+        p.light[a] = light[a];
+        p.lightCell[a] = lightRay.direction[a];
+        for (int r = 0; r < 3; ++r) {
+            p.inverse[3 * a + r] = inverse[a][r];
+            p.normalMatrix[3 * a + r] = normalMatrix[a][r];
+        }
+    }
+    p.halfWidth = halfWidth;
+    p.halfHeight = halfHeight;
+    p.lodScale = lodPixels > 0 ? lodPixels * camera.pixelAngle() / frame.voxelSize() : 0;
+    p.shadowBias = trace::kShadowBias * frame.voxelSize();
+    p.width = uint32_t(camera.width);
+    p.height = uint32_t(camera.height);
+    p.tilesX = (p.width + 7) / 8;
+}
+
+std::vector<trace::RayHit> VulkanTracer::tracePrimary(const trace::Camera& camera, HitKind kind, double lodPixels) {
+    Impl& impl = *impl_;
+    setCamera(camera, lodPixels);
+    impl.writeParams();
+    ComputePipeline& pipe = impl.pipeline(grid_, Mode::Primary, kind == HitKind::Surface && grid_.levelSet, false);
+    const size_t pixels = size_t(camera.width) * size_t(camera.height);
+    if (!primaryHits_ || primaryHits_->size() < pixels * 48)
+        primaryHits_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 48, MemoryKind::HostVisible, "primary ray hits", false);
+    const uint64_t items = uint64_t(impl.host.tilesX) * ((impl.host.height + 7) / 8) * kWorkgroup;
+    TracePush push{impl.params.address(), 0, primaryHits_->address(), impl.counter.address(), uint32_t(items), 0};
+    lastDeviceMs_ = pipe.dispatch(items, push).deviceMs;
+    std::vector<trace::RayHit> hits(pixels);
+    unpackHits(primaryHits_->mappedData(), hits);
+    return hits;
+}
+
+trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
+                                  trace::RenderStats& stats) {
+    const auto start = std::chrono::steady_clock::now();
+    if (grid.dag != grid_.dag || grid.values != grid_.values) throw Error("Vulkan tracer: render() got a different grid than the one uploaded");
+    Impl& impl = *impl_;
+    TraceParamsGpu& p = impl.host;
+    const trace::GridFrame frame(grid.indexToWorld);
+    setCamera(camera, options.lodPixels);
+    for (int a = 0; a < 3; ++a) p.background[a] = options.background[a];
+    p.fogScale = options.densityScale / (grid.valueMax * frame.voxelSize());
+    const uint32_t tilesY = (p.height + 7) / 8;
+    impl.writeParams();
+    std::memset(impl.counter.mappedData(), 0, 16);
+
+    ComputePipeline& pipe = impl.pipeline(grid_, Mode::Render, grid_.levelSet, options.shadows && !grid_.fog);
+    const size_t pixels = size_t(camera.width) * size_t(camera.height);
+    DeviceBuffer out(impl.context, pixels * 32, MemoryKind::HostVisible, "rendered pixels", false);
+    const uint64_t items = uint64_t(p.tilesX) * tilesY * kWorkgroup;
+    TracePush push{impl.params.address(), 0, out.address(), impl.counter.address(), uint32_t(items), 0};
+    lastDeviceMs_ = pipe.dispatch(items, push).deviceMs;
+
+    trace::Image image;
+    image.resize(camera.width, camera.height);
+    const auto* f = static_cast<const float*>(out.mappedData());
+    for (size_t i = 0; i < pixels; ++i) {
+        for (int a = 0; a < 3; ++a) {
+            image.rgb[3 * i + a] = f[8 * i + a];
+            image.normal[3 * i + a] = f[8 * i + 5 + a];
+        }
+        image.alpha[i] = f[8 * i + 3];
+        image.depth[i] = f[8 * i + 4];
+    }
+    uint32_t secondary = 0;
+    std::memcpy(&secondary, impl.counter.mappedData(), 4);
+    stats.primaryRays = pixels;
+    stats.secondaryRays = secondary;
+    stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return image;
+}
+
+} // namespace vdbdag::gpu

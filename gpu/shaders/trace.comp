@@ -1,0 +1,269 @@
+#version 460
+// The Vulkan tracer over the compact SSVDAG (gpu/VulkanTracer.h), a port of
+// the CPU reference tracer (src/trace/): DagWalk.h in trace_walk.glsl,
+// palette lookup and value decode in trace_values.glsl, and here the camera
+// (Camera::pixelRay, GridFrame::toCellRay), the surface choice
+// (SurfaceHit.cpp) and the shading of CpuRenderer.cpp / Shading.cpp.
+//
+// Two modes (specialisation constant MODE):
+//  - hits:   item i traces cell-space ray i (8 doubles: origin, direction,
+//            tMin, tMax) and writes 6 uint64: flags (hit | (faceAxis+1) << 8
+//            | (faceSign+1) << 16 | lodLevel << 24 | steps << 32), voxel xyz,
+//            t (bits), entry;
+//  - render: items are pixels in 8x8 tiles (one workgroup of 64 per tile:
+//            neighbouring rays walk the same nodes); writes 8 floats per
+//            pixel: rgb, alpha, depth, normal xyz;
+//  - primary: the camera rays of render, traced only (the hits of hits
+//            mode per pixel): what the benchmark measures.
+// Only what the scene has is compiled in: value type, level set, fog,
+// colouring and shadows are specialisation constants.
+//
+// Double-precision arithmetic is `precise` wherever the CPU could contract a
+// product and a sum, so camera rays, crossing times and shading match the
+// CPU tracer bit for bit (exp, for fog, is a polynomial here: ~1e-15).
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "dispatch.glsl"
+#include "trace_params.glsl"
+
+layout(constant_id = 1) const uint MODE = 0u;          // 0: hits, 1: render, 2: primary
+layout(constant_id = 2) const bool LEVEL_SET = false;  // surface = first active voxel with value <= 0
+layout(constant_id = 3) const uint VALUE_TYPE = 255u;  // ValueType; 255: no values
+layout(constant_id = 4) const bool FOG = false;        // render: emission-absorption
+layout(constant_id = 5) const uint COLOURING = 0u;     // ValueColouring: none, scalar, colour, vector
+layout(constant_id = 6) const bool SHADOWS = false;    // render: shadow rays
+layout(constant_id = 7) const bool ONE_CHUNK_DAG = false;  // inner words and leaves each in one chunk
+
+layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
+
+layout(push_constant, std430) uniform Push {
+    uint64_t params;  // TraceParams
+    uint64_t rays;    // hits: F64Array, 8 per ray
+    uint64_t results; // hits: U64Array, 6 per ray; render: F32Array, 8 per pixel
+    uint64_t counter; // render: U32Array[1], shadow rays cast
+    uint itemCount;
+    uint pad;
+} pc;
+
+TraceParams P;
+
+#include "trace_values.glsl"
+#include "trace_walk.glsl"
+
+// SurfaceHit.cpp firstSurfaceHit.
+Hit firstSurfaceHit(dvec3 o, dvec3 d, double tMin, double tMax, double ignoreBefore, double lodScale) {
+    if (!LEVEL_SET) return walkRay(o, d, tMin < ignoreBefore ? ignoreBefore : tMin, tMax, kVisitFirstHit, 0.0lf, lodScale);
+    return walkRay(o, d, tMin, tMax, kVisitZeroCrossing, ignoreBefore, lodScale);
+}
+
+void writeHit(uint i, Hit h) {
+    U64Array res = U64Array(pc.results);
+    const uint w = 6u * i;
+    res.v[w] = uint64_t(h.hit ? 1u : 0u) | (uint64_t(uint(h.faceAxis + 1)) << 8) | (uint64_t(uint(h.faceSign + 1)) << 16) |
+               (uint64_t(h.lodLevel) << 24) | (uint64_t(h.steps) << 32);
+    res.v[w + 1u] = uint64_t(h.voxel.x);
+    res.v[w + 2u] = uint64_t(h.voxel.y);
+    res.v[w + 3u] = uint64_t(h.voxel.z);
+    const uvec2 tb = unpackDouble2x32(h.t);
+    res.v[w + 4u] = uint64_t(tb.x) | (uint64_t(tb.y) << 32);
+    res.v[w + 5u] = h.entry;
+}
+
+void traceOneRay(uint i) {
+    F64Array rays = F64Array(pc.rays);
+    const uint r = 8u * i;
+    const dvec3 o = dvec3(rays.v[r], rays.v[r + 1u], rays.v[r + 2u]);
+    const dvec3 d = dvec3(rays.v[r + 3u], rays.v[r + 4u], rays.v[r + 5u]);
+    writeHit(i, firstSurfaceHit(o, d, rays.v[r + 6u], rays.v[r + 7u], 0.0lf, P.lodScale));
+}
+
+// ---- shading (Shading.cpp, CpuRenderer.cpp) ----------------------------------
+
+const double kAmbient = 0.2lf;
+const dvec3 kMaterial = dvec3(0.80lf, 0.78lf, 0.74lf);
+
+double dot3(dvec3 a, dvec3 b) {
+    precise double r = a.x * b.x + a.y * b.y + a.z * b.z;
+    return r;
+}
+dvec3 vec3At(double m[3]) { return dvec3(m[0], m[1], m[2]); }
+
+// glm mat3 (column-major, m[3c + r] = column c, row r) times a vector.
+dvec3 matTimes(uint which, dvec3 v) {
+    precise dvec3 r;
+    for (int row = 0; row < 3; ++row) {
+        const double m0 = which == 0u ? P.inverse[row] : P.normalMatrix[row];
+        const double m1 = which == 0u ? P.inverse[3 + row] : P.normalMatrix[3 + row];
+        const double m2 = which == 0u ? P.inverse[6 + row] : P.normalMatrix[6 + row];
+        r[row] = m0 * v.x + m1 * v.y + m2 * v.z;
+    }
+    return r;
+}
+
+// GridFrame::normalToWorld.
+dvec3 normalToWorld(dvec3 n) {
+    const dvec3 w = matTimes(1u, n);
+    const double len = sqrt(dot3(w, w));
+    return len > 0.0lf ? w / len : dvec3(0.0lf, 0.0lf, 1.0lf);
+}
+
+double clampUnit(double x) { return x < 0.0lf ? 0.0lf : (1.0lf < x ? 1.0lf : x); }
+bool finite(double x) { return !isnan(x) && !isinf(x); }
+
+dvec3 mixD(dvec3 x, dvec3 y, double a) {
+    precise dvec3 r = x * (1.0lf - a) + y * a;
+    return r;
+}
+
+// Shading.cpp baseColour.
+dvec3 baseColour(uint64_t entry) {
+    if (COLOURING == 1u) {
+        const double v = valueAsDoubles(entry).x;
+        double s = (v - P.valueMin) / (P.valueMax - P.valueMin);
+        s = finite(s) ? clampUnit(s) : 0.0lf;
+        const dvec3 cool = dvec3(0.23lf, 0.30lf, 0.75lf), mid = dvec3(0.87lf, 0.87lf, 0.87lf), warm = dvec3(0.71lf, 0.02lf, 0.15lf);
+        return s < 0.5lf ? mixD(cool, mid, s * 2.0lf) : mixD(mid, warm, s * 2.0lf - 1.0lf);
+    }
+    if (COLOURING == 2u) {
+        const dvec3 c = valueAsDoubles(entry);
+        const double scale = VALUE_TYPE == kValueVec3I ? 1.0lf / 255.0lf : 1.0lf;
+        dvec3 o;
+        for (int a = 0; a < 3; ++a) o[a] = finite(c[a]) ? clampUnit(c[a] * scale) : 0.0lf;
+        return o;
+    }
+    if (COLOURING == 3u) {
+        const dvec3 c = valueAsDoubles(entry);
+        const double len = sqrt(dot3(c, c));
+        if (!(len > 0.0lf) || !finite(len)) return dvec3(0.5lf);
+        return dvec3(0.5lf) + (0.5lf * c) / len;
+    }
+    return kMaterial;
+}
+
+// CpuRenderer.cpp levelSetGradient: central differences of the stored values.
+bool levelSetGradient(Hit hit, out dvec3 g) {
+    const double centre = valueAsDoubles(hit.entry).x;
+    g = dvec3(0.0lf);
+    for (int a = 0; a < 3; ++a) {
+        i64vec3 plus = hit.voxel, minus = hit.voxel;
+        plus[a] += 1l;
+        minus[a] -= 1l;
+        uint64_t pa, ma;
+        const bool p = findVoxel(plus, pa), m = findVoxel(minus, ma);
+        if (p && m) g[a] = (valueAsDoubles(pa).x - valueAsDoubles(ma).x) * 0.5lf;
+        else if (p) g[a] = valueAsDoubles(pa).x - centre;
+        else if (m) g[a] = centre - valueAsDoubles(ma).x;
+    }
+    const double len = sqrt(dot3(g, g));
+    if (!(len > 0.0lf) || !finite(len)) return false;
+    g = g / len;
+    return true;
+}
+
+// Pixel of item i: 8x8 tiles, one per workgroup of 64 (false past the image).
+bool pixelOf(uint i, out uint px, out uint py) {
+    const uint tile = i >> 6, within = i & 63u;
+    px = (tile % P.tilesX) * 8u + (within & 7u);
+    py = (tile / P.tilesX) * 8u + (within >> 3);
+    return px < P.width && py < P.height;
+}
+
+// Camera::pixelRay and GridFrame::toCellRay: the world direction and the cell-space ray.
+void cameraRay(uint px, uint py, out dvec3 dir, out dvec3 o, out dvec3 d) {
+    precise double u = ((double(px) + 0.5lf) / double(P.width) * 2.0lf - 1.0lf) * P.halfWidth;
+    precise double v = (1.0lf - (double(py) + 0.5lf) / double(P.height) * 2.0lf) * P.halfHeight;
+    precise dvec3 sum = vec3At(P.forward) + u * vec3At(P.right) + v * vec3At(P.trueUp);
+    const double inv = 1.0lf / sqrt(dot3(sum, sum));
+    dir = sum * inv;
+    o = vec3At(P.eyeCell);
+    d = matTimes(0u, dir);
+}
+
+const double kCameraTMax = 1e300lf;  // GridFrame::toCellRay's default
+
+// MODE 2: primary rays only, the hit per pixel as in hits mode.
+void tracePrimary(uint i) {
+    uint px, py;
+    if (!pixelOf(i, px, py)) return;
+    dvec3 dir, o, d;
+    cameraRay(px, py, dir, o, d);
+    writeHit(py * P.width + px, firstSurfaceHit(o, d, 0.0lf, kCameraTMax, 0.0lf, P.lodScale));
+}
+
+void renderPixel(uint i) {
+    uint px, py;
+    if (!pixelOf(i, px, py)) return;
+    const uint pixel = py * P.width + px;
+    dvec3 dir, o, d;
+    cameraRay(px, py, dir, o, d);
+    const double tMax = kCameraTMax;
+
+    dvec3 colour = vec3At(P.background);
+    float alpha = 0.0, depth = uintBitsToFloat(0x7F800000u);
+    vec3 normalOut = vec3(0.0);
+    if (FOG) {
+        gFogTransmittance = 1.0lf;
+        gFogFirstHit = -1.0lf;
+        gFogSum = dvec3(0.0lf);
+        walkRay(o, d, 0.0lf, tMax, kVisitFog, 0.0lf, P.lodScale);
+        precise dvec3 c = gFogSum + gFogTransmittance * vec3At(P.background);
+        colour = c;
+        alpha = float(1.0lf - gFogTransmittance);
+        if (gFogFirstHit >= 0.0lf) depth = float(gFogFirstHit);
+    } else {
+        const Hit hit = firstSurfaceHit(o, d, 0.0lf, tMax, 0.0lf, P.lodScale);
+        if (hit.hit) {
+            dvec3 normal;
+            dvec3 g;
+            const bool gradient = LEVEL_SET && hit.lodLevel == 0u && levelSetGradient(hit, g);
+            if (gradient) {
+                normal = normalToWorld(g);
+            } else if (hit.faceAxis >= 0) {
+                dvec3 n = dvec3(0.0lf);
+                n[hit.faceAxis] = double(hit.faceSign);
+                normal = normalToWorld(n);
+            } else {
+                normal = -dir;
+            }
+            if (dot3(normal, dir) > 0.0lf && !gradient) normal = -normal;
+            const double lambertRaw = dot3(normal, vec3At(P.light));
+            double lambert = 0.0lf < lambertRaw ? lambertRaw : 0.0lf;
+            if (SHADOWS && lambert > 0.0lf && hit.faceAxis >= 0) {
+                precise dvec3 so = o + hit.t * d;
+                const dvec3 sd = vec3At(P.lightCell);
+                const int f = hit.faceAxis;
+                so[f] = double(hit.faceSign < 0 ? hit.voxel[f] : hit.voxel[f] + 1l);
+                if ((sd[f] > 0.0lf) == (hit.faceSign > 0) && sd[f] != 0.0lf) {
+                    atomicAdd(U32Array(pc.counter).v[0], 1u);
+                    if (firstSurfaceHit(so, sd, 0.0lf, infinity(), LEVEL_SET ? P.shadowBias : 0.0lf, 0.0lf).hit) lambert = 0.0lf;
+                }
+            }
+            precise dvec3 shaded = baseColour(hit.entry) * (kAmbient + (1.0lf - kAmbient) * lambert);
+            colour = shaded;
+            alpha = 1.0;
+            depth = float(hit.t);
+            normalOut = vec3(normal);
+        }
+    }
+    F32Array res = F32Array(pc.results);
+    const uint w = 8u * pixel;
+    res.v[w] = float(colour.x);
+    res.v[w + 1u] = float(colour.y);
+    res.v[w + 2u] = float(colour.z);
+    res.v[w + 3u] = alpha;
+    res.v[w + 4u] = depth;
+    res.v[w + 5u] = normalOut.x;
+    res.v[w + 6u] = normalOut.y;
+    res.v[w + 7u] = normalOut.z;
+}
+
+void main() {
+    const uint i = vdbdagItemIndex();
+    if (i >= pc.itemCount) return;
+    P = TraceParams(pc.params);
+    loadTraceParams();
+    loadValueParams();
+    if (MODE == 0u) traceOneRay(i);
+    else if (MODE == 1u) renderPixel(i);
+    else tracePrimary(i);
+}

@@ -1,0 +1,49 @@
+// The parameter block of trace.comp (gpu::TraceParamsGpu in
+// gpu/VulkanTracer.cpp, same std430 layout: every 8-byte member first, then
+// the 4-byte ones), reached through a buffer device address: the compact DAG
+// (src/encoding/CompactDag.cpp layout), the palette channel
+// (src/attributes/PaletteChannel.h) and the camera and shading constants.
+#ifndef VDBDAG_TRACE_PARAMS_GLSL
+#define VDBDAG_TRACE_PARAMS_GLSL
+
+#include "device_array.glsl"
+
+const uint kMaxInnerLevels = 40u;  // encoder limit: log2Size <= 40
+
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer TraceParams {
+    DeviceArray inner;      // uint16 words, all inner levels
+    DeviceArray leaves;     // uint64 4^3 bricks
+    DeviceArray materials;  // palette material array, valueSize bytes each
+    DeviceArray palettes;   // uint32 material indices
+    DeviceArray blocks;     // 3 uint64 per block: firstEntry, dataOffset, paletteOffset | indexBits << 32
+    DeviceArray indexBits;  // uint64 bit-packed indices
+    DeviceArray direct;     // directly stored values
+    int64_t origin[3];      // index coordinate of the root cube's corner
+    int64_t boxLo[3];       // occupied box, relative to the root corner
+    int64_t boxHi[3];
+    uint64_t levelStart[kMaxInnerLevels];
+    uint64_t entryCount;
+    uint64_t blockCount;
+    double lodScale;        // 0: no LOD cut-off
+    double valueMin, valueMax;
+    // Camera (Camera::pixelRay), precomputed on the host exactly as the CPU does.
+    double forward[3], right[3], trueUp[3];
+    double halfWidth, halfHeight;
+    double eyeCell[3];      // GridFrame::toCellRay(eye).origin
+    double inverse[9];      // GridFrame's inverse linear part, glm column-major
+    double normalMatrix[9]; // transpose(inverse), glm column-major
+    double light[3];        // world direction towards the light
+    double lightCell[3];    // the same in cell space (the shadow rays' direction)
+    double background[3];
+    double shadowBias;      // level sets: boxes entered before this are ignored by shadow rays
+    double fogScale;        // densityScale / (valueMax * voxelSize)
+    uint offsetWords[kMaxInnerLevels];
+    uint log2Size;
+    uint rootReflection;
+    uint innerLevels;
+    uint maxSteps;
+    uint width, height, tilesX;
+    uint valueSize;
+};
+
+#endif

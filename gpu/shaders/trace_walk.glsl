@@ -1,0 +1,412 @@
+// The traversal, a line-by-line port of src/trace/DagWalk.h (walkRay) and
+// DagTracer::find: an integer DDA over the compact SSVDAG with a stack of
+// (node, mirror mask, entry base) (SSVDAG paper §5, Listing 1; Dado et
+// al. §4.1 for the offsets). Every crossing time is (boundary - o) / d in
+// double from an exact integer boundary, and every product-plus-sum is
+// `precise` (no contraction into an FMA), as the CPU build (-ffp-contract=off
+// on src/trace): both tracers return the same voxels and bit-identical t.
+//
+// GLSL has no templates or lambdas: the visitor of the segment walk is a
+// `visitKind` argument (constant at every call site, so the optimiser keeps
+// only the path it needs): first hit; first box with value <= 0 entered at or
+// after `ignoreBefore` (SurfaceHit.cpp); fog emission-absorption (CpuRenderer.cpp),
+// whose running state lives in the gFog* globals.
+#ifndef VDBDAG_TRACE_WALK_GLSL
+#define VDBDAG_TRACE_WALK_GLSL
+
+// Private copies of what the walk reads at every step (a load through `P`
+// is a memory access each time: the compiler cannot know the buffer does not
+// change), made once per invocation by loadTraceParams().
+i64vec3 gRootOrigin, gBoxLo, gBoxHi;
+uint gLog2Size, gRootReflection, gInnerLevels, gMaxSteps;
+uint64_t gInnerAddress, gLeavesAddress;  // chunk 0 of the DAG arrays
+DeviceArray gInner, gLeaves;
+
+void loadTraceParams() {
+    gRootOrigin = i64vec3(P.origin[0], P.origin[1], P.origin[2]);
+    gBoxLo = i64vec3(P.boxLo[0], P.boxLo[1], P.boxLo[2]);
+    gBoxHi = i64vec3(P.boxHi[0], P.boxHi[1], P.boxHi[2]);
+    gLog2Size = P.log2Size;
+    gRootReflection = P.rootReflection;
+    gInnerLevels = P.innerLevels;
+    gMaxSteps = P.maxSteps;
+    gInner = P.inner;
+    gLeaves = P.leaves;
+    gInnerAddress = gInner.firstChunk;
+    gLeavesAddress = gLeaves.firstChunk;
+}
+
+// The DAG's words; ONE_CHUNK_DAG (specialisation constant: both arrays fit
+// one chunk, the usual case) reads them straight from the chunk's address.
+uint innerWord(uint64_t index) {
+    if (ONE_CHUNK_DAG) return uint(DeviceArrayU16Ptr(gInnerAddress + index * 2ul).value);
+    return deviceArrayU16(gInner, index);
+}
+uint64_t leafMask(uint64_t index) {
+    if (ONE_CHUNK_DAG) return DeviceArrayU64Ptr(gLeavesAddress + index * 8ul).value;
+    return deviceArrayU64(gLeaves, index);
+}
+
+const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u;
+
+struct Hit {
+    bool hit;
+    i64vec3 voxel;      // index coordinate
+    double t;
+    uint64_t entry;
+    int faceAxis;       // -1: started inside
+    int faceSign;
+    uint lodLevel;
+    uint steps;
+};
+
+Hit noHit() { return Hit(false, i64vec3(0), 0.0lf, 0ul, -1, 0, 0u, 0u); }
+
+double infinity() { return packDouble2x32(uvec2(0u, 0x7FF00000u)); }
+
+// The ray in the root cube's frame (LocalRay).
+dvec3 gO, gD;
+
+double crossing(int a, int64_t boundary) { return (double(boundary) - gO[a]) / gD[a]; }
+
+int64_t clamp64(int64_t c, int64_t lo, int64_t hi) { return c < lo ? lo : (hi < c ? hi : c); }
+
+int64_t voxelAt(int a, double t, int64_t lo, int64_t hi, out double tIn, out double tOut) {
+    precise double p = gO[a] + t * gD[a];
+    int64_t c;
+    if (!(p > double(lo) - 1.0lf)) c = lo;  // also NaN
+    else if (!(p < double(hi) + 2.0lf)) c = hi;
+    else c = gD[a] > 0.0lf ? int64_t(floor(p)) : int64_t(ceil(p)) - 1l;
+    c = clamp64(c, lo, hi);
+    if (gD[a] > 0.0lf) {
+        tOut = crossing(a, c + 1l);
+        while (c < hi && tOut <= t) { ++c; tOut = crossing(a, c + 1l); }
+        tIn = crossing(a, c);
+        while (c > lo && tIn > t) { --c; tOut = tIn; tIn = crossing(a, c); }
+    } else {
+        tOut = crossing(a, c);
+        while (c > lo && tOut <= t) { --c; tOut = crossing(a, c); }
+        tIn = crossing(a, c + 1l);
+        while (c < hi && tIn > t) { ++c; tOut = tIn; tIn = crossing(a, c + 1l); }
+    }
+    return c;
+}
+
+int64_t voxelAtStart(int a, double t, int64_t lo, int64_t hi) {
+    if (gD[a] == 0.0lf) return clamp64(int64_t(floor(gO[a])), lo, hi);
+    double tIn, tOut;
+    return voxelAt(a, t, lo, hi, tIn, tOut);
+}
+
+uint popcount64(uint64_t x) {
+    const uvec2 h = unpackUint2x32(x);
+    return uint(bitCount(h.x) + bitCount(h.y));
+}
+
+uint bitWidth64(uint64_t x) {
+    const uvec2 h = unpackUint2x32(x);
+    return h.y != 0u ? uint(findMSB(h.y)) + 33u : (h.x != 0u ? uint(findMSB(h.x)) + 1u : 0u);
+}
+
+// dag::reflectBrick.
+uint64_t reflectBrick(uint64_t mask, uint m) {
+    if ((m & 1u) != 0u) {
+        mask = ((mask & 0x3333333333333333ul) << 2) | ((mask >> 2) & 0x3333333333333333ul);
+        mask = ((mask & 0x5555555555555555ul) << 1) | ((mask >> 1) & 0x5555555555555555ul);
+    }
+    if ((m & 2u) != 0u) {
+        mask = ((mask & 0x00FF00FF00FF00FFul) << 8) | ((mask >> 8) & 0x00FF00FF00FF00FFul);
+        mask = ((mask & 0x0F0F0F0F0F0F0F0Ful) << 4) | ((mask >> 4) & 0x0F0F0F0F0F0F0F0Ful);
+    }
+    if ((m & 4u) != 0u) {
+        mask = (mask << 32) | (mask >> 32);
+        mask = ((mask & 0x0000FFFF0000FFFFul) << 16) | ((mask >> 16) & 0x0000FFFF0000FFFFul);
+    }
+    return mask;
+}
+
+uint storedBit(uint x, uint y, uint z, uint m) {
+    if ((m & 1u) != 0u) x = 3u - x;
+    if ((m & 2u) != 0u) y = 3u - y;
+    if ((m & 4u) != 0u) z = 3u - z;
+    return x + 4u * y + 16u * z;
+}
+
+// DagWalk.h readChildPointer: stored child slot j of the node at `pos`.
+void readChildPointer(uint64_t pos, uint header, uint j, uint offsetWords, out uint64_t offset, out uint reflection,
+                      out uint64_t attributeOffset) {
+    const uint earlier = header & ((1u << (2u * j)) - 1u);
+    const uint before = uint(bitCount((earlier | (earlier >> 1)) & 0x5555u));
+    uint64_t at = pos + 1ul + uint64_t(before) + uint64_t(bitCount((earlier >> 1) & 0x5555u));
+    if (before > 1u) at += uint64_t(before - 1u) * uint64_t(offsetWords);
+    const uint tag = (header >> (2u * j)) & 3u;
+    const uint w0 = innerWord(at);
+    reflection = w0 >> 13;
+    if (tag == 1u) {
+        offset = uint64_t(w0 & 0x1FFFu);
+        at += 1ul;
+    } else {
+        offset = (uint64_t(tag & 1u) << 29) | (uint64_t(w0 & 0x1FFFu) << 16) | uint64_t(innerWord(at + 1ul));
+        at += 2ul;
+    }
+    attributeOffset = 0ul;
+    if (before > 0u)
+        for (uint w = 0u; w < offsetWords; ++w) attributeOffset |= uint64_t(innerWord(at + uint64_t(w))) << (16u * w);
+}
+
+// Fog state (CpuRenderer.cpp): transmittance, emitted light, first box entered.
+double gFogTransmittance, gFogFirstHit;
+dvec3 gFogSum;
+const dvec3 kFogEmission = dvec3(0.92lf, 0.92lf, 0.95lf);
+
+// exp(x) in double (GLSL has exp for float only): x = k ln2 + r, |r| <= ln2/2,
+// a degree-13 Taylor polynomial, then ldexp. Relative error ~1e-15.
+double expDouble(double x) {
+    if (!(x > -745.0lf)) return x != x ? x : 0.0lf;
+    if (x > 709.0lf) return infinity();
+    const double k = floor(x * 1.4426950408889634lf + 0.5lf);
+    precise double r = (x - k * 0.693147180369123816490lf) - k * 1.90821492927058770002e-10lf;
+    precise double p = 1.0lf / 6227020800.0lf;
+    p = p * r + 1.0lf / 479001600.0lf;
+    p = p * r + 1.0lf / 39916800.0lf;
+    p = p * r + 1.0lf / 3628800.0lf;
+    p = p * r + 1.0lf / 362880.0lf;
+    p = p * r + 1.0lf / 40320.0lf;
+    p = p * r + 1.0lf / 5040.0lf;
+    p = p * r + 1.0lf / 720.0lf;
+    p = p * r + 1.0lf / 120.0lf;
+    p = p * r + 1.0lf / 24.0lf;
+    p = p * r + 1.0lf / 6.0lf;
+    p = p * r + 0.5lf;
+    p = p * r + 1.0lf;
+    p = p * r + 1.0lf;
+    return ldexp(p, int(k));
+}
+
+// The visitor of the segment walks; true stops the walk.
+bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore, inout Hit found) {
+    if (visitKind == kVisitZeroCrossing) {
+        if (box.t < ignoreBefore || !(valueAsDoubles(box.entry).x <= 0.0lf)) return false;
+        found = box;
+        return true;
+    }
+    // kVisitFog
+    if (gFogFirstHit < 0.0lf) gFogFirstHit = box.t;
+    const double v = valueAsDoubles(box.entry).x;
+    const double density = 0.0lf < v ? v : 0.0lf;
+    precise double alpha = 1.0lf - expDouble(-P.fogScale * density * (tLeave - box.t));
+    precise dvec3 add = (gFogTransmittance * alpha) * kFogEmission;
+    gFogSum = gFogSum + add;
+    gFogTransmittance *= 1.0lf - alpha;
+    return gFogTransmittance < 1e-3lf;
+}
+
+Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, uint steps) {
+    int faceAxis = -1;
+    const int64_t within = (int64_t(1) << lodLevel) - 1l;
+    for (int a = 0; a < 3 && faceAxis < 0; ++a)
+        if (((crossed >> a) & 1u) != 0u && (v[a] & within) == (gD[a] > 0.0lf ? 0l : within)) faceAxis = a;
+    Hit h;
+    h.hit = true;
+    h.voxel = v + gRootOrigin;
+    h.t = t;
+    h.entry = entry;
+    h.faceAxis = faceAxis;
+    h.faceSign = faceAxis < 0 ? 0 : (gD[faceAxis] > 0.0lf ? -1 : 1);
+    h.lodLevel = lodLevel;
+    h.steps = steps;
+    return h;
+}
+
+// walkRay. kVisitFirstHit returns the first occupied box, kVisitZeroCrossing
+// the first box the visitor accepts, kVisitFog the last box (unused).
+Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitKind, double ignoreBefore, double lodScale) {
+    const bool firstOnly = visitKind == kVisitFirstHit;
+    Hit result = noHit();
+    Hit found = noHit();
+    if (gLog2Size == 0u) return result;
+    for (int a = 0; a < 3; ++a) {
+        if (isnan(origin[a]) || isinf(origin[a]) || isnan(direction[a]) || isinf(direction[a])) return result;
+        gO[a] = origin[a] - double(gRootOrigin[a]);
+        gD[a] = direction[a];
+    }
+    if (isnan(tMin) || isnan(tMax)) return result;
+    const uint L = gLog2Size;
+
+    double tEnter = tMin, tExit = tMax;
+    int enterAxis = -1;
+    for (int a = 0; a < 3; ++a) {
+        if (gD[a] == 0.0lf) {
+            if (!(gO[a] >= double(gBoxLo[a]) && gO[a] < double(gBoxHi[a]))) return result;
+            continue;
+        }
+        const double t0 = crossing(a, gD[a] > 0.0lf ? gBoxLo[a] : gBoxHi[a]);
+        const double t1 = crossing(a, gD[a] > 0.0lf ? gBoxHi[a] : gBoxLo[a]);
+        if (t0 > tEnter) { tEnter = t0; enterAxis = a; }
+        tExit = t1 < tExit ? t1 : tExit;
+    }
+    if (!(tEnter < tExit)) return result;
+
+    i64vec3 v;
+    for (int a = 0; a < 3; ++a) v[a] = voxelAtStart(a, tEnter, gBoxLo[a], gBoxHi[a] - 1l);
+    double t = tEnter;
+    uint crossed = 0u;
+    if (enterAxis >= 0)
+        for (int a = 0; a < 3; ++a)
+            if (gD[a] != 0.0lf && crossing(a, gD[a] > 0.0lf ? v[a] : v[a] + 1l) == t) crossed |= 1u << a;
+
+    double tNext[3];
+    for (int a = 0; a < 3; ++a) tNext[a] = gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? v[a] + 1l : v[a]);
+
+    uint64_t stackPos[kMaxInnerLevels];
+    uint64_t stackBase[kMaxInnerLevels];
+    uint stackMirror[kMaxInnerLevels];
+    uint depth = 0u;
+    stackPos[0] = 0ul;
+    stackBase[0] = 0ul;
+    stackMirror[0] = gRootReflection;
+    const uint innerLevels = gInnerLevels;
+    uint steps = 0u;
+    bool inLeaf = false;
+    uint64_t leafStored = 0ul, leafSpatial = 0ul, leafBase = 0ul;
+    uint leafMirror = 0u;
+    bool pending = false;
+
+    while (true) {
+        uint skip = 0u;
+        bool occupied = false;
+        while (!inLeaf) {
+            const uint64_t nodePos = stackPos[depth];
+            const uint nodeMirror = stackMirror[depth];
+            const uint s = L - depth;
+            const uint header = innerWord(nodePos);
+            if (header == 0u) {
+                result = makeHit(v, crossed, t, stackBase[depth], s, steps);
+                occupied = true;
+                skip = s;
+                break;
+            }
+            const uint halfLog2 = s - 1u;
+            const uint p = uint((v[0] >> halfLog2) & 1l) | (uint((v[1] >> halfLog2) & 1l) << 1) | (uint((v[2] >> halfLog2) & 1l) << 2);
+            const uint j = p ^ nodeMirror;
+            if (((header >> (2u * j)) & 3u) == 0u) { skip = halfLog2; break; }
+            uint64_t offset, attributeOffset;
+            uint reflection;
+            readChildPointer(nodePos, header, j, P.offsetWords[depth], offset, reflection, attributeOffset);
+            const uint mirror = nodeMirror ^ reflection;
+            const uint64_t base = stackBase[depth] + attributeOffset;
+            if (depth + 1u == innerLevels) {
+                leafStored = leafMask(offset);
+                leafSpatial = reflectBrick(leafStored, mirror);
+                leafMirror = mirror;
+                leafBase = base;
+                inLeaf = true;
+                break;
+            }
+            if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * t) {
+                result = makeHit(v, crossed, t, base, halfLog2, steps);
+                occupied = true;
+                skip = halfLog2;
+                break;
+            }
+            stackPos[depth + 1u] = P.levelStart[depth + 1u] + offset;
+            stackBase[depth + 1u] = base;
+            stackMirror[depth + 1u] = mirror;
+            ++depth;
+        }
+        if (inLeaf && !occupied && skip == 0u) {
+            const uint x = uint(v[0] & 3l), y = uint(v[1] & 3l), z = uint(v[2] & 3l);
+            if (((leafSpatial >> (x + 4u * y + 16u * z)) & 1ul) != 0ul) {
+                const uint bit = storedBit(x, y, z, leafMirror);
+                result = makeHit(v, crossed, t, leafBase + uint64_t(popcount64(leafStored & ((uint64_t(1) << bit) - 1ul))), 0u, steps);
+                occupied = true;
+            } else {
+                const uint corner = (x & 2u) + 4u * (y & 2u) + 16u * (z & 2u);
+                if ((leafSpatial & (uint64_t(0x330033) << corner)) == 0ul) skip = 1u;
+            }
+        }
+        if (firstOnly && occupied) return result;
+        pending = occupied;
+
+        if (++steps > gMaxSteps) return firstOnly ? noHit() : found;
+        const int64_t cube = int64_t(1) << skip;
+        i64vec3 lo, hi;
+        double tc[3];
+        double tNew = infinity();
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = v[a] & ~(cube - 1l);
+            hi[a] = lo[a] + cube - 1l;
+            if (gD[a] == 0.0lf) tc[a] = infinity();
+            else if (gD[a] > 0.0lf) tc[a] = v[a] == hi[a] ? tNext[a] : crossing(a, hi[a] + 1l);
+            else tc[a] = v[a] == lo[a] ? tNext[a] : crossing(a, lo[a]);
+            tNew = tc[a] < tNew ? tc[a] : tNew;
+        }
+        if (!firstOnly && pending) {
+            pending = false;
+            if (visitBox(visitKind, result, tExit < tNew ? tExit : tNew, ignoreBefore, found)) return found;
+        }
+        if (!(tNew < tExit)) return firstOnly ? noHit() : found;
+        i64vec3 next;
+        crossed = 0u;
+        for (int a = 0; a < 3; ++a) {
+            if (tc[a] == tNew) {
+                next[a] = gD[a] > 0.0lf ? hi[a] + 1l : lo[a] - 1l;
+                if (next[a] < gBoxLo[a] || next[a] >= gBoxHi[a]) return firstOnly ? noHit() : found;
+                tNext[a] = crossing(a, gD[a] > 0.0lf ? next[a] + 1l : next[a]);
+                crossed |= 1u << a;
+            } else if (tNext[a] > tNew) {
+                next[a] = v[a];
+            } else {
+                double tIn, tOut;
+                next[a] = gD[a] > 0.0lf ? voxelAt(a, tNew, v[a], hi[a], tIn, tOut) : voxelAt(a, tNew, lo[a], v[a], tIn, tOut);
+                tNext[a] = tOut;
+                if (next[a] != v[a] && tIn == tNew) crossed |= 1u << a;
+            }
+        }
+        const uint64_t changed = uint64_t(next[0] ^ v[0]) | uint64_t(next[1] ^ v[1]) | uint64_t(next[2] ^ v[2]);
+        const uint keepLog2 = bitWidth64(changed);
+        if (keepLog2 > 2u) inLeaf = false;
+        if (L - depth < keepLog2) depth = L - keepLog2;
+        v = next;
+        t = tNew;
+    }
+    return result;
+}
+
+// DagTracer::find: the entry entry of the active voxel at an index coordinate.
+bool findVoxel(i64vec3 voxel, out uint64_t entry) {
+    entry = 0ul;
+    if (gLog2Size == 0u) return false;
+    const int64_t size = int64_t(1) << gLog2Size;
+    i64vec3 v;
+    for (int a = 0; a < 3; ++a) {
+        v[a] = voxel[a] - gRootOrigin[a];
+        if (v[a] < 0l || v[a] >= size) return false;
+    }
+    uint64_t pos = 0ul, base = 0ul;
+    uint mirror = gRootReflection;
+    for (uint depth = 0u; depth < kMaxInnerLevels; ++depth) {
+        const uint header = innerWord(pos);
+        if (header == 0u) { entry = base; return true; }
+        const uint halfLog2 = gLog2Size - depth - 1u;
+        const uint p = uint((v[0] >> halfLog2) & 1l) | (uint((v[1] >> halfLog2) & 1l) << 1) | (uint((v[2] >> halfLog2) & 1l) << 2);
+        const uint j = p ^ mirror;
+        if (((header >> (2u * j)) & 3u) == 0u) return false;
+        uint64_t offset, attributeOffset;
+        uint reflection;
+        readChildPointer(pos, header, j, P.offsetWords[depth], offset, reflection, attributeOffset);
+        mirror ^= reflection;
+        base += attributeOffset;
+        if (depth + 1u == gInnerLevels) {
+            const uint64_t mask = leafMask(offset);
+            const uint bit = storedBit(uint(v[0] & 3l), uint(v[1] & 3l), uint(v[2] & 3l), mirror);
+            if (((mask >> bit) & 1ul) == 0ul) return false;
+            entry = base + uint64_t(popcount64(mask & ((uint64_t(1) << bit) - 1ul)));
+            return true;
+        }
+        pos = P.levelStart[depth + 1u] + offset;
+    }
+    return false;
+}
+
+#endif
