@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     vdbdag::cli::addDecodeCommand(app, exitCode);
     vdbdag::cli::addInfoCommand(app, exitCode);
     vdbdag::cli::addVerifyCommand(app, exitCode);
+    vdbdag::cli::addImportCommand(app, exitCode);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

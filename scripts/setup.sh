@@ -11,7 +11,7 @@ PACKAGES=(
   libvtk9-dev python3-vtk9 libglm-dev
   mesa-vulkan-drivers libvulkan-dev glslc glslang-tools spirv-tools vulkan-tools
   libtbb-dev libblosc-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils
+  libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils zlib1g-dev
   libzfp-dev
 )
 

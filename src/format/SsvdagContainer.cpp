@@ -241,6 +241,8 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::InactiveLeaves: return "InactiveLeaves";
         case SectionKind::InactiveValues: return "InactiveValues";
         case SectionKind::ValueErrors: return "ValueErrors";
+        case SectionKind::PredictedValues: return "PredictedValues";
+        case SectionKind::InactivePredictedValues: return "InactivePredictedValues";
     }
     return "unknown";
 }

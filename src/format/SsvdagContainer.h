@@ -29,6 +29,9 @@ enum class SectionKind : uint32_t {
     InactiveLeaves = 11,
     InactiveValues = 12,
     ValueErrors = 13,   // per grid, lossy encodings only: the tolerance and the measured errors
+    // 14-19: reserved for another branch.
+    PredictedValues = 20,          // per grid: integer active values predicted in attribute order (instead of Values)
+    InactivePredictedValues = 21,  // the same for the inactive layer (instead of InactiveValues)
 };
 const char* sectionKindName(SectionKind kind);
 

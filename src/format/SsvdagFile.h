@@ -29,6 +29,10 @@ struct EncodedGrid {
     encoding::CompactDag dag;
     std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
     attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout
+    // Integer channels only, when smaller at rest: the same values predicted
+    // (attributes/PredictedChannel.h); the file then stores this instead of
+    // the palettes, which a reader rebuilds.
+    std::vector<uint8_t> predictedValues;
     attributes::ToleranceReport lossy;  // what a lossy setting changed (mode Exact: nothing)
     DagStats stats;
     // Inactive voxels/tiles whose value differs from the background.
@@ -36,6 +40,7 @@ struct EncodedGrid {
     encoding::CompactDag inactiveDag;
     std::vector<uint8_t> inactiveAttributes;
     attributes::PaletteChannel inactiveValues;
+    std::vector<uint8_t> inactivePredictedValues;
 };
 
 struct SsvdagScene {

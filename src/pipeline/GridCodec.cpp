@@ -2,7 +2,11 @@
 // root-placement search and the statistics `info` reports.
 #include "src/pipeline/GridCodec.h"
 
+#include <zstd.h>
+
+#include "src/attributes/PredictedChannel.h"
 #include "src/dag/DagBuilder.h"
+#include "src/encoding/AttributeLayout.h"
 #include "src/pipeline/AttributeOrder.h"
 
 namespace vdbdag::pipeline {
@@ -50,6 +54,26 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const GridTopology& topo
     return candidates;
 }
 
+// Bytes after a fast zstd pass: the yardstick for choosing a channel coding
+// (the container compresses harder, by about the same factor for both).
+size_t zstdEstimate(const std::vector<uint8_t>& bytes) {
+    std::vector<uint8_t> out(ZSTD_compressBound(bytes.size()));
+    const size_t n = ZSTD_compress(out.data(), out.size(), bytes.data(), bytes.size(), 1);
+    return ZSTD_isError(n) ? bytes.size() : n;
+}
+
+// The predicted coding of an integer channel if it beats its palettes at
+// rest, else empty.
+std::vector<uint8_t> predictedIfSmaller(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes,
+                                        const attributes::PaletteChannel& palettes, ValueType type, const EncodeOptions& options) {
+    if (!options.predictIntegers || (type != ValueType::Int32 && type != ValueType::Int64) || attributes.empty()) return {};
+    std::vector<uint8_t> predicted = attributes::encodePredicted(attributes, valueSize(type), encoding::attributeLayout(dag));
+    const size_t predictedBytes = zstdEstimate(predicted);
+    const size_t paletteBytes = zstdEstimate(attributes::serializePalette(palettes));
+    if (predictedBytes < paletteBytes) return predicted;
+    return {};
+}
+
 } // namespace
 
 namespace {
@@ -90,11 +114,13 @@ encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptio
 
 format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) {
     format::EncodedGrid out;
-    out.record = grid;
-    out.record.topology = {};
-    out.record.values = {};
-    out.record.inactiveTopology = {};
-    out.record.inactiveValues = {};
+    // The header only: copying the voxels first would double peak memory.
+    out.record.name = grid.name;
+    out.record.gridClass = grid.gridClass;
+    out.record.valueType = grid.valueType;
+    out.record.indexToWorld = grid.indexToWorld;
+    out.record.vdbDescriptor = grid.vdbDescriptor;
+    out.record.background = grid.background;
     out.symmetry = options.symmetry;
     const unsigned vs = valueSize(grid.valueType);
     auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };
@@ -107,13 +133,17 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
         out.lossy = attributes::applyScalarTolerance(out.attributes, grid.valueType, options.tolerance);
     }
     step("palette compression");
-    if (!grid.topology.empty()) out.values = attributes::compressPalette(out.attributes, vs);
+    if (!grid.topology.empty()) {
+        out.values = attributes::compressPalette(out.attributes, vs);
+        out.predictedValues = predictedIfSmaller(out.dag, out.attributes, out.values, grid.valueType, options);
+    }
     out.inactiveVoxels = grid.inactiveTopology.activeVoxelCount();
     step("inactive values");
     if (!grid.inactiveTopology.empty()) {
         out.inactiveDag = encodeLayer(grid.inactiveTopology, options, vs > 0, nullptr);
         out.inactiveAttributes = gatherAttributes(out.inactiveDag, grid.inactiveTopology, grid.inactiveValues, vs);
         out.inactiveValues = attributes::compressPalette(out.inactiveAttributes, vs);
+        out.inactivePredictedValues = predictedIfSmaller(out.inactiveDag, out.inactiveAttributes, out.inactiveValues, grid.valueType, options);
     }
     return out;
 }

@@ -18,6 +18,10 @@ struct EncodeOptions {
     // Lossy scalar values (float/double active values only; inactive values
     // and other types stay exact). The report lands in EncodedGrid::lossy.
     attributes::ScalarTolerance tolerance;
+    // Integer (int32/int64) channels: also code the values with the brick
+    // predictor (attributes/PredictedChannel.h) and store whichever of
+    // palettes and residuals zstd makes smaller.
+    bool predictIntegers = true;
     // Called as each step of a grid starts (kEncodeSteps per grid), for progress.
     std::function<void(const char* step)> onStep;
 };
