@@ -82,9 +82,19 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
             progress.advance();
         };
-        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) {
-            gridName = imported.volume.grids[i].name;
+        std::vector<std::string> gridNames;
+        for (const auto& g : imported.volume.grids) gridNames.push_back(g.name);
+        format::SsvdagScene scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, [&](size_t i, size_t) {
+            gridName = gridNames[i];
         });
+        // Neither the input voxels nor the attribute arrays are written:
+        // release them before the sections are built (a 512x512x999 scan
+        // holds 1 GB in each).
+        imported.volume = {};
+        for (auto& g : scene.grids) {
+            std::vector<uint8_t>().swap(g.attributes);
+            std::vector<uint8_t>().swap(g.inactiveAttributes);
+        }
         progress.setLabel("encode: writing " + opt->output);
         format::ContainerOptions containerOptions;
         containerOptions.compress = !opt->noCompress;

@@ -93,38 +93,43 @@ DenseSampleStream::DenseSampleStream(const DenseVolume& volume) : volume_(volume
         throw Error(volume_.headerPath + ": data file " + data + " does not exist");
     if (std::filesystem::is_directory(data, ec)) throw Error(volume_.headerPath + ": data file " + data + " is a directory");
     const uint64_t fileSize = std::filesystem::file_size(data, ec);
-    if (ec) throw Error(data + ": cannot read the file size (" + ec.message() + ")");
+    if (ec) throw Error(where() + ": cannot read the file size (" + ec.message() + ")");
     const uint64_t need = volume_.sampleCount() * sampleBytes(volume_.type);
     file_ = std::fopen(data.c_str(), "rb");
-    if (!file_) throw Error(data + ": cannot open (" + std::strerror(errno) + ")");
+    if (!file_) throw Error(where() + ": cannot open (" + std::strerror(errno) + ")");
     int64_t offset = volume_.dataOffset;
     if (volume_.encoding == DataEncoding::Raw) {
         if (offset == DenseVolume::kSkipToEnd) {
             if (fileSize < need)
-                throw Error(data + ": holds " + std::to_string(fileSize) + " bytes, fewer than the " + std::to_string(need) + " the header describes");
+                throw Error(where() + ": holds " + std::to_string(fileSize) + " bytes, fewer than the " + std::to_string(need) + " the header describes");
             offset = int64_t(fileSize - need);
         }
-        if (offset < 0 || uint64_t(offset) > fileSize) throw Error(data + ": data offset " + std::to_string(offset) + " is beyond the end of the file");
-        if (std::fseek(file_, long(offset), SEEK_SET) != 0) throw Error(data + ": cannot seek to byte " + std::to_string(offset));
+        if (offset < 0 || uint64_t(offset) > fileSize) throw Error(where() + ": data offset " + std::to_string(offset) + " is beyond the end of the file");
+        if (std::fseek(file_, long(offset), SEEK_SET) != 0) throw Error(where() + ": cannot seek to byte " + std::to_string(offset));
         for (int64_t l = 0; l < volume_.lineSkip; ++l) {
             int c;
             while ((c = std::fgetc(file_)) != EOF && c != '\n') {}
-            if (c == EOF) throw Error(data + ": ends before the " + std::to_string(volume_.lineSkip) + " lines to skip");
+            if (c == EOF) throw Error(where() + ": ends before the " + std::to_string(volume_.lineSkip) + " lines to skip");
         }
         const uint64_t at = uint64_t(std::ftell(file_)) + uint64_t(volume_.decodedSkip);
         if (fileSize < at || fileSize - at < need)
-            throw Error(data + ": too short: " + std::to_string(fileSize < at ? 0 : fileSize - at) + " bytes of samples, the header describes " +
+            throw Error(where() + ": too short: " + std::to_string(fileSize < at ? 0 : fileSize - at) + " bytes of samples, the header describes " +
                         std::to_string(volume_.dims[0]) + "x" + std::to_string(volume_.dims[1]) + "x" + std::to_string(volume_.dims[2]) + " " +
                         sampleTypeName(volume_.type) + " = " + std::to_string(need) + " bytes");
         if (volume_.decodedSkip && std::fseek(file_, long(volume_.decodedSkip), SEEK_CUR) != 0)
-            throw Error(data + ": cannot skip " + std::to_string(volume_.decodedSkip) + " bytes");
+            throw Error(where() + ": cannot skip " + std::to_string(volume_.decodedSkip) + " bytes");
     } else {
-        if (offset < 0 || uint64_t(offset) > fileSize) throw Error(data + ": compressed data offset is beyond the end of the file");
-        if (std::fseek(file_, long(offset), SEEK_SET) != 0) throw Error(data + ": cannot seek to byte " + std::to_string(offset));
+        if (offset < 0 || uint64_t(offset) > fileSize) throw Error(where() + ": compressed data offset is beyond the end of the file");
+        if (std::fseek(file_, long(offset), SEEK_SET) != 0) throw Error(where() + ": cannot seek to byte " + std::to_string(offset));
         inflater_ = std::make_unique<Inflater>();
-        if (inflateInit2(&inflater_->z, 15 + 32) != Z_OK) throw Error(data + ": cannot start zlib");
+        if (inflateInit2(&inflater_->z, 15 + 32) != Z_OK) throw Error(where() + ": cannot start zlib");
         skipDecoded(uint64_t(volume_.decodedSkip));
     }
+}
+
+std::string DenseSampleStream::where() const {
+    if (volume_.dataPath == volume_.headerPath) return volume_.dataPath;
+    return volume_.headerPath + ": data file " + volume_.dataPath;
 }
 
 DenseSampleStream::~DenseSampleStream() {
@@ -133,7 +138,7 @@ DenseSampleStream::~DenseSampleStream() {
 
 void DenseSampleStream::readBytes(uint8_t* out, size_t n) {
     if (!inflater_) {
-        if (std::fread(out, 1, n, file_) != n) throw Error(volume_.dataPath + ": short read (the file ended or could not be read)");
+        if (std::fread(out, 1, n, file_) != n) throw Error(where() + ": short read (the file ended or could not be read)");
         return;
     }
     Inflater& inf = *inflater_;
@@ -146,10 +151,10 @@ void DenseSampleStream::readBytes(uint8_t* out, size_t n) {
         inf.z.avail_out = unsigned(chunk);
         while (inf.z.avail_out) {
             if (inf.ended)
-                throw Error(volume_.dataPath + ": the compressed data ends early (" + std::to_string(volume_.sampleCount()) + " samples expected)");
+                throw Error(where() + ": the compressed data ends early (" + std::to_string(volume_.sampleCount()) + " samples expected)");
             if (inf.z.avail_in == 0) {
                 const size_t got = std::fread(inf.input.data(), 1, inf.input.size(), file_);
-                if (got == 0) throw Error(volume_.dataPath + ": the compressed data is truncated");
+                if (got == 0) throw Error(where() + ": the compressed data is truncated");
                 inf.z.next_in = inf.input.data();
                 inf.z.avail_in = unsigned(got);
             }
@@ -157,7 +162,7 @@ void DenseSampleStream::readBytes(uint8_t* out, size_t n) {
             if (rc == Z_STREAM_END) {
                 inf.ended = true;
             } else if (rc != Z_OK && rc != Z_BUF_ERROR) {
-                throw Error(volume_.dataPath + ": the compressed data is corrupt (zlib: " + (inf.z.msg ? inf.z.msg : "error") + ")");
+                throw Error(where() + ": the compressed data is corrupt (zlib: " + (inf.z.msg ? inf.z.msg : "error") + ")");
             }
         }
         left -= chunk;

@@ -65,6 +65,7 @@ public:
 
 private:
     void readBytes(uint8_t* out, size_t n);
+    std::string where() const;  // "HEADER: data file DATA", or the file itself
     void skipDecoded(uint64_t n);
     DenseVolume volume_;
     std::FILE* file_ = nullptr;

@@ -57,18 +57,24 @@ void walk(std::span<const uint64_t> layout, uint64_t entries, Fn&& fn) {
 }
 
 template <typename U>
+inline U zigzag(U r) {
+    return U(r << 1) ^ U(std::make_signed_t<U>(r) >> (sizeof(U) * 8 - 1));
+}
+
+// Two walks (the first finds the residual width, the second writes the
+// planes), so memory holds the output only, not a residual array as well.
+template <typename U>
 std::vector<uint8_t> encodeTyped(std::span<const uint8_t> values, std::span<const uint64_t> layout) {
-    constexpr unsigned bits = sizeof(U) * 8;
     const uint64_t n = values.size() / sizeof(U);
-    std::vector<U> zig(n);
-    U widest = 0;
-    walk<U>(layout, n, [&](uint64_t e, U p) {
+    auto valueAt = [&](uint64_t e) {
         U v;
         std::memcpy(&v, values.data() + e * sizeof(U), sizeof(U));
-        const U r = U(v - p);
-        const U z = U(r << 1) ^ U(std::make_signed_t<U>(r) >> (bits - 1));
-        zig[e] = z;
-        widest |= z;
+        return v;
+    };
+    U widest = 0;
+    walk<U>(layout, n, [&](uint64_t e, U p) {
+        const U v = valueAt(e);
+        widest |= zigzag<U>(U(v - p));
         return v;
     });
     const uint64_t wide = uint64_t(widest);
@@ -78,10 +84,13 @@ std::vector<uint8_t> encodeTyped(std::span<const uint8_t> values, std::span<cons
     out[1] = uint8_t(sizeof(U));
     out[2] = width;
     std::memcpy(out.data() + 3, &n, 8);
-    for (unsigned plane = 0; plane < width; ++plane) {
-        uint8_t* dst = out.data() + 11 + plane * n;
-        for (uint64_t i = 0; i < n; ++i) dst[i] = uint8_t(zig[i] >> (8 * plane));
-    }
+    uint8_t* planes = out.data() + 11;
+    walk<U>(layout, n, [&](uint64_t e, U p) {
+        const U v = valueAt(e);
+        const U z = zigzag<U>(U(v - p));
+        for (unsigned plane = 0; plane < width; ++plane) planes[plane * n + e] = uint8_t(z >> (8 * plane));
+        return v;
+    });
     return out;
 }
 

@@ -56,10 +56,22 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const GridTopology& topo
 
 // Bytes after a fast zstd pass: the yardstick for choosing a channel coding
 // (the container compresses harder, by about the same factor for both).
+// Streams through a 1 MiB buffer that is overwritten, so it costs no memory.
 size_t zstdEstimate(const std::vector<uint8_t>& bytes) {
-    std::vector<uint8_t> out(ZSTD_compressBound(bytes.size()));
-    const size_t n = ZSTD_compress(out.data(), out.size(), bytes.data(), bytes.size(), 1);
-    return ZSTD_isError(n) ? bytes.size() : n;
+    ZSTD_CCtx* cctx = ZSTD_createCCtx();
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, 1);
+    std::vector<uint8_t> buffer(1u << 20);
+    ZSTD_inBuffer in{bytes.data(), bytes.size(), 0};
+    size_t total = 0;
+    for (;;) {
+        ZSTD_outBuffer out{buffer.data(), buffer.size(), 0};
+        const size_t left = ZSTD_compressStream2(cctx, &out, &in, ZSTD_e_end);
+        if (ZSTD_isError(left)) { total = bytes.size(); break; }
+        total += out.pos;
+        if (left == 0) break;
+    }
+    ZSTD_freeCCtx(cctx);
+    return total;
 }
 
 // The predicted coding of an integer channel if it beats its palettes at
@@ -112,7 +124,11 @@ encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptio
 
 } // namespace
 
-format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) {
+namespace {
+
+// `release`: the same grid, non-const, whose voxels may be dropped once
+// they are in attribute order (nullptr: keep them).
+format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& options, GridRecord* release) {
     format::EncodedGrid out;
     // The header only: copying the voxels first would double peak memory.
     out.record.name = grid.name;
@@ -130,6 +146,10 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
     step("ordering values");
     if (!grid.topology.empty()) {
         out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
+        if (release) {
+            std::vector<uint8_t>().swap(release->values.bricks);
+            std::vector<uint8_t>().swap(release->values.tiles);
+        }
         out.lossy = attributes::applyScalarTolerance(out.attributes, grid.valueType, options.tolerance);
     }
     step("palette compression");
@@ -145,8 +165,13 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
         out.inactiveValues = attributes::compressPalette(out.inactiveAttributes, vs);
         out.inactivePredictedValues = predictedIfSmaller(out.inactiveDag, out.inactiveAttributes, out.inactiveValues, grid.valueType, options);
     }
+    if (release) *release = GridRecord{};  // everything the scene needs is copied
     return out;
 }
+
+} // namespace
+
+format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) { return encodeGridImpl(grid, options, nullptr); }
 
 GridRecord decodeGrid(const format::EncodedGrid& grid) {
     GridRecord record = grid.record;
@@ -161,6 +186,15 @@ format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& opti
     for (size_t g = 0; g < volume.grids.size(); ++g) {
         if (onGrid) onGrid(g, volume.grids.size());
         scene.grids.push_back(encodeGrid(volume.grids[g], options));
+    }
+    return scene;
+}
+
+format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options, const GridProgress& onGrid) {
+    format::SsvdagScene scene;
+    for (size_t g = 0; g < volume.grids.size(); ++g) {
+        if (onGrid) onGrid(g, volume.grids.size());
+        scene.grids.push_back(encodeGridImpl(volume.grids[g], options, &volume.grids[g]));
     }
     return scene;
 }

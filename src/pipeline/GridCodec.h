@@ -33,6 +33,10 @@ GridRecord decodeGrid(const format::EncodedGrid& grid);
 // Whole volumes; `onGrid(index, count)` is called before each grid (progress).
 using GridProgress = std::function<void(size_t index, size_t count)>;
 format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
+// The same, releasing each grid's voxels as soon as they are in attribute
+// order (a dense 512x512x999 scan then never holds its values twice); the
+// grids keep their headers, their voxels are gone afterwards.
+format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
 Volume decodeScene(const format::SsvdagScene& scene, const GridProgress& onGrid = {});
 
 } // namespace vdbdag::pipeline
