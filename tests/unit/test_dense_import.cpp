@@ -245,13 +245,18 @@ TEST(DenseSharedData, EveryScanRoundTripsExactly) {
 
 TEST(DenseSharedData, HeaderTransformsAndLosslessSizeBeatZstd) {
     if (!haveSharedData()) GTEST_SKIP() << "shared data not present";
-    // Cranium: spacings 0.957 0.957 1.5, origin 0.
     const fs::path ss = workDir() / "cranium_size.ssvdag";
     auto r = runCli("encode " + (denseDir() / "cranium_256x256x108_int16le.nhdr").string() + " -o " + ss.string() + " --json");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     // The lossless file must be below half the raw bytes (zstd -19 of the raw
     // file is 0.47x; scripts/dense_size_report.sh measures it in one run).
     EXPECT_LT(fs::file_size(ss), fs::file_size(denseDir() / "cranium_256x256x108_int16le.raw") * 47 / 100);
+    // ... and below OpenVDB's own .vdb of the same dense grid (blosc, as `import` writes it).
+    const fs::path craniumVdb = workDir() / "cranium_size.vdb";
+    r = runCli("import " + (denseDir() / "cranium_256x256x108_int16le.nhdr").string() + " -o " + craniumVdb.string());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_LT(fs::file_size(ss), fs::file_size(craniumVdb));
+    expectTransform(*readOnlyGrid(craniumVdb), {0, 0, 0}, {{{0.957, 0, 0}, {0, 0.957, 0}, {0, 0, 1.5}}}, {256, 256, 108}, "cranium");
     const fs::path vdb = workDir() / "flair.vdb";
     r = runCli("import " + (denseDir() / "FLAIR.nrrd").string() + " -o " + vdb.string());
     ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -457,22 +462,28 @@ TEST(DenseThreshold, BackgroundBelowReportsTheExactCost) {
     EXPECT_EQ(report["max_abs_change"].get<double>(), maxAbs);
     EXPECT_NEAR(report["mean_abs_change"].get<double>(), sumAbs / double(v.size()), 1e-9);
     EXPECT_NEAR(report["psnr_db"].get<double>(), 10 * std::log10((mx - mn) * (mx - mn) / mse), 1e-9);
-    // The grid: kept samples active and exact, the rest inactive background.
-    auto grid = openvdb::gridPtrCast<openvdb::Int32Grid>(readOnlyGrid(out));
-    ASSERT_TRUE(grid);
-    EXPECT_EQ(grid->background(), int(background));
-    EXPECT_EQ(grid->activeVoxelCount(), v.size() - removed);
-    auto acc = grid->getConstAccessor();
-    size_t bad = 0;
-    for (int z = 0; z < dims[2]; ++z)
-        for (int y = 0; y < dims[1]; ++y)
-            for (int x = 0; x < dims[0]; ++x) {
-                const int16_t s = v[(size_t(z) * dims[1] + y) * dims[0] + x];
-                const openvdb::Coord c(x, y, z);
-                if (s < 500) bad += acc.isValueOn(c) || acc.getValue(c) != int(background);
-                else bad += !acc.isValueOn(c) || acc.getValue(c) != s;
-            }
-    EXPECT_EQ(bad, 0u);
+    // The grid, from `import` and from `encode` + `decode`: kept samples
+    // active and exact, the rest inactive background.
+    const fs::path ss = workDir() / "thr.ssvdag", dec = workDir() / "thr_decoded.vdb";
+    ASSERT_EQ(runCli("encode " + raw.string() + " --background-below 500 -o " + ss.string()).exitCode, 0);
+    ASSERT_EQ(runCli("decode " + ss.string() + " -o " + dec.string()).exitCode, 0);
+    for (const fs::path& file : {out, dec}) {
+        auto grid = openvdb::gridPtrCast<openvdb::Int32Grid>(readOnlyGrid(file));
+        ASSERT_TRUE(grid) << file;
+        EXPECT_EQ(grid->background(), int(background));
+        EXPECT_EQ(grid->activeVoxelCount(), v.size() - removed);
+        auto acc = grid->getConstAccessor();
+        size_t bad = 0;
+        for (int z = 0; z < dims[2]; ++z)
+            for (int y = 0; y < dims[1]; ++y)
+                for (int x = 0; x < dims[0]; ++x) {
+                    const int16_t s = v[(size_t(z) * dims[1] + y) * dims[0] + x];
+                    const openvdb::Coord c(x, y, z);
+                    if (s < 500) bad += acc.isValueOn(c) || acc.getValue(c) != int(background);
+                    else bad += !acc.isValueOn(c) || acc.getValue(c) != s;
+                }
+        EXPECT_EQ(bad, 0u) << file;
+    }
 }
 
 TEST(PredictedChannel, RoundTripsIntegersExactlyAndRejectsCorruption) {
