@@ -1,5 +1,5 @@
 // Writes a few valid .ssvdag files (compressed and raw, empty grid, tiles,
-// mirrored bricks) into a folder, as the fuzzer's seed corpus.
+// mirrored bricks, predicted int32 values) into a folder, as the fuzzer's seed corpus.
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -19,6 +19,18 @@ int main(int argc, char** argv) {
     format::SsvdagScene scene;
     scene.grids.push_back(pipeline::encodeGrid(record));
     scene.grids.push_back(pipeline::encodeGrid(GridRecord{}));
+    // An int32 grid with smooth, distinct values: stored as a PredictedValues section.
+    GridRecord ints = record;
+    ints.valueType = ValueType::Int32;
+    ints.background = {0, 0, 0, 0};
+    uint64_t entries = 1;  // the tile
+    for (const Brick& b : ints.topology.bricks) entries += uint64_t(__builtin_popcountll(b.mask));
+    for (uint64_t i = 0; i < entries; ++i) {
+        const int32_t v = int32_t(1000 + 7 * i + (i * 2654435761u) % 3);
+        const auto* p = reinterpret_cast<const uint8_t*>(&v);
+        (i + 1 < entries ? ints.values.bricks : ints.values.tiles).insert(i + 1 < entries ? ints.values.bricks.end() : ints.values.tiles.end(), p, p + 4);
+    }
+    scene.grids.push_back(pipeline::encodeGrid(ints));
     int n = 0;
     for (bool compress : {true, false}) {
         format::ContainerOptions options;
