@@ -127,6 +127,10 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
 }
 
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName) {
+    return sectionsToScene(std::move(sections), sourceName, ReadOptions{});
+}
+
+SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options) {
     const Section* fileInfo = nullptr;
     std::map<std::pair<uint32_t, SectionKind>, Section*> byGrid;
     for (Section& s : sections) {
@@ -215,7 +219,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 if (attributes.size() != size.attributeEntries * vs)
                     throw Error(what + ": " + layer + " predicted values hold " + std::to_string(attributes.size() / vs) + " entries, expected " +
                                 std::to_string(size.attributeEntries));
-                channel = attributes::compressPalette(attributes, vs);  // the traceable layout, rebuilt
+                if (options.rebuildPalettes) channel = attributes::compressPalette(attributes, vs);  // the traceable layout, rebuilt
             } else if (vs && !dag.empty()) {
                 channel = attributes::deserializePalette(find(g, kinds.values, true)->data, what + " " + layer + " values");
                 if (channel.valueSize != vs || channel.entryCount != size.attributeEntries)
@@ -269,9 +273,15 @@ SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceN
     return sectionsToScene(readContainer(bytes, sourceName), sourceName);
 }
 
-SsvdagScene readSceneFile(const std::string& path) {
-    const std::vector<uint8_t> bytes = readFileBytes(path);
-    return readScene(bytes, path);
+SsvdagScene readSceneFile(const std::string& path) { return readSceneFile(path, ReadOptions{}); }
+
+SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
+    std::vector<Section> sections;
+    {
+        const std::vector<uint8_t> bytes = readFileBytes(path);  // released before the sections are parsed
+        sections = readContainer(bytes, path);
+    }
+    return sectionsToScene(std::move(sections), path, options);
 }
 
 } // namespace vdbdag::format

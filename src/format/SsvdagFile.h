@@ -49,9 +49,17 @@ struct SsvdagScene {
 
 std::vector<Section> sceneToSections(const SsvdagScene& scene);
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName);
+// What a reader builds beyond the values themselves.
+struct ReadOptions {
+    // For PredictedValues sections: rebuild the palette channel (the
+    // traceable layout). A plain decode to .vdb needs only the values.
+    bool rebuildPalettes = true;
+};
+SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options);
 
 std::vector<uint8_t> writeScene(const SsvdagScene& scene, const ContainerOptions& options = {});
 SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName);
 SsvdagScene readSceneFile(const std::string& path);
+SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options);
 
 } // namespace vdbdag::format
