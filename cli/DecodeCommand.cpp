@@ -15,10 +15,15 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("input", opt->input, "input .ssvdag file")->required();
     cmd->add_option("-o,--output", opt->output, "output .vdb file")->required();
     cmd->callback([opt, &exitCode] {
-        const format::SsvdagScene scene = format::readSceneFile(opt->input);
-        Progress progress("decode", scene.grids.size());
-        const Volume volume = pipeline::decodeScene(scene, [&](size_t i, size_t) { progress.set(i); });
-        progress.finish();
+        format::ReadOptions readOptions;
+        readOptions.rebuildPalettes = false;  // only the values are needed
+        Volume volume;
+        {
+            const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);
+            Progress progress("decode", scene.grids.size());
+            volume = pipeline::decodeScene(scene, [&](size_t i, size_t) { progress.set(i); });
+            progress.finish();
+        }  // the scene is released before OpenVDB builds the grids
         bridge::exportVdb(volume, opt->output);
         exitCode = 0;
     });

@@ -1,6 +1,9 @@
 // `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]
 //  [--abs-error E | --rel-error R] [--colour-bits K [--colour-grid NAME]...] [--normals K [--normal-grid NAME]]`
 #include <algorithm>
+// `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]`
+// Dense scans (.raw, .nrrd, .nhdr, .mhd, .mha, by extension) are read by
+// vdb_bridge/DenseImport.h instead, with the raw layout and threshold options.
 #include <chrono>
 
 #include <fmt/core.h>
@@ -8,10 +11,13 @@
 
 #include "cli/Commands.h"
 #include "cli/SceneReport.h"
+#include "cli/DenseInputOptions.h"
 #include "src/pipeline/GridCodec.h"
+#include "src/util/Error.h"
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 #include "src/util/Progress.h"
+#include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/VdbImport.h"
 
 namespace vdbdag::cli {
@@ -20,20 +26,22 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string input, output;
         std::vector<std::string> grids;
-        bool noSymmetry = false, noCompress = false, skipUnsupported = false, json = false, topologyOnly = false;
+        bool noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
         int placementTrials = 1;
         double absError = 0, relError = 0;
         unsigned colourBits = 0, normalBits = 0;
         std::vector<std::string> colourGrids;
         std::string normalGrid;
+        DenseInputOptions dense;
     };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file into an .ssvdag file");
-    cmd->add_option("input", opt->input, "input .vdb file")->required();
+    CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha scan) into an .ssvdag file");
+    cmd->add_option("input", opt->input, "input .vdb file or dense scan")->required();
     cmd->add_option("-o,--output", opt->output, "output .ssvdag file")->required();
     cmd->add_option("--grid", opt->grids, "encode only grids with this name (repeatable)");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "plain SVDAG: merge identical subtrees only");
     cmd->add_flag("--no-compress", opt->noCompress, "store sections without zstd");
+    cmd->add_flag("--no-predict", opt->noPredict, "integer values: always palettes, never the brick predictor");
     cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the smallest (1-64)")->check(CLI::Range(1, 64));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
@@ -48,6 +56,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                         ->check(CLI::IsMember({10u, 12u, 16u, 24u, 32u}));
     cmd->add_option("--normal-grid", opt->normalGrid, "take the normals from this vec3 grid (stored on its geometry) instead of a gradient")->needs(normals);
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
+    opt->dense.addTo(*cmd);
     cmd->callback([opt, &exitCode] {
         const auto start = std::chrono::steady_clock::now();
         bridge::ImportOptions importOptions;
@@ -58,6 +67,26 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         importOptions.normalGrid = opt->normalGrid;
         if (opt->colourBits && opt->topologyOnly) throw Error("--colour-bits and --topology-only exclude each other: a topology-only file has no colours");
         const bridge::ImportResult imported = bridge::importVdb(opt->input, importOptions);
+        bridge::ImportResult imported;
+        bridge::ThresholdReport threshold;
+        if (bridge::denseFormatOf(opt->input) != bridge::DenseFormat::None) {
+            if (!opt->grids.empty()) throw Error(opt->input + ": --grid applies to .vdb inputs only (a dense scan has one grid)");
+            bridge::DenseImportResult dense = bridge::importDense(opt->input, opt->dense.resolve(opt->input));
+            threshold = dense.threshold;
+            imported.volume = std::move(dense.volume);
+            if (opt->topologyOnly)
+                for (GridRecord& g : imported.volume.grids) {
+                    g.valueType = ValueType::Mask;
+                    g.values = {};
+                    g.background.clear();
+                }
+        } else {
+            if (!opt->dense.dims.empty() || !opt->dense.type.empty() || !opt->dense.endian.empty() || !opt->dense.spacing.empty() ||
+                !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
+                throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
+                                         "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
+            imported = bridge::importVdb(opt->input, importOptions);
+        }
         for (const auto& w : imported.warnings) fmt::print(stderr, "vdbdag: warning: {}\n", w);
         for (const std::string& name : opt->colourGrids) {
             const auto& grids = imported.volume.grids;
@@ -70,6 +99,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         pipeline::EncodeOptions encodeOptions;
         encodeOptions.symmetry = !opt->noSymmetry;
         encodeOptions.placementTrials = opt->placementTrials;
+        encodeOptions.predictIntegers = !opt->noPredict;
         encodeOptions.computeSvdagStats = true;  // cheap next to I/O; lets `info` show all three node counts
         if (opt->absError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Absolute, opt->absError};
         if (opt->relError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Relative, opt->relError};
@@ -87,6 +117,18 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) { gridName = imported.volume.grids[i].name; });
         } catch (const Error& e) {
             throw Error(opt->input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
+        std::vector<std::string> gridNames;
+        for (const auto& g : imported.volume.grids) gridNames.push_back(g.name);
+        format::SsvdagScene scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, [&](size_t i, size_t) {
+            gridName = gridNames[i];
+        });
+        // Neither the input voxels nor the attribute arrays are written:
+        // release them before the sections are built (a 512x512x999 scan
+        // holds 1 GB in each).
+        imported.volume = {};
+        for (auto& g : scene.grids) {
+            std::vector<uint8_t>().swap(g.attributes);
+            std::vector<uint8_t>().swap(g.inactiveAttributes);
         }
         progress.setLabel("encode: writing " + opt->output);
         format::ContainerOptions containerOptions;
@@ -101,6 +143,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"bytes", bytes.size()}, {"grids", scene.grids.size()},
                               {"active_voxels", voxels}, {"seconds", seconds},
                               {"bits_per_active_voxel", voxels ? 8.0 * double(bytes.size()) / double(voxels) : 0.0}};
+        if (threshold.applied) report["threshold"] = thresholdJson(threshold);
         report["grids_lossy"] = nlohmann::json::array();
         for (const auto& g : scene.grids) {
             if (g.lossy.tolerance.mode == attributes::ScalarTolerance::Mode::Exact) continue;
@@ -120,6 +163,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         } else {
             fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output,
                        scene.grids.size(), voxels, bytes.size(), report["bits_per_active_voxel"].get<double>(), seconds);
+            fmt::print("{}", thresholdText(threshold));
             for (const auto& l : report["grids_lossy"])
                 fmt::print("  grid '{}' {}: {} of {} values changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
                            l["name"].get<std::string>(), l["tolerance"].get<std::string>(), l["changed"].get<uint64_t>(), l["entries"].get<uint64_t>(),

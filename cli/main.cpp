@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
     vdbdag::cli::addExportCommand(app, exitCode);
     vdbdag::cli::addDiffCommand(app, exitCode);
     vdbdag::cli::addSelftestCommand(app, exitCode);
+    vdbdag::cli::addImportCommand(app, exitCode);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

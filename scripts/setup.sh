@@ -13,6 +13,8 @@ PACKAGES=(
   libtbb-dev libblosc-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils
   libzfp-dev fonts-dejavu-core
+  libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils zlib1g-dev
+  libzfp-dev
 )
 
 missing=()

@@ -212,8 +212,8 @@ ImportResult importVdb(const std::string& path, const ImportOptions& options) {
             result.warnings.push_back(path + ": skipped " + message);
             continue;
         }
-        record.indexToWorld = indexToWorldOf(*base);
-        record.vdbDescriptor = descriptorOf(*base);
+        record.indexToWorld = detail::indexToWorldOf(*base);
+        record.vdbDescriptor = detail::descriptorOf(*base);
         result.volume.grids.push_back(std::move(record));
     }
     if (options.normals && std::none_of(result.volume.grids.begin(), result.volume.grids.end(), [](const GridRecord& g) { return g.normals.has_value(); })) {

@@ -243,6 +243,8 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::ValueErrors: return "ValueErrors";
         case SectionKind::ColourErrors: return "ColourErrors";
         case SectionKind::Normals: return "Normals";
+        case SectionKind::PredictedValues: return "PredictedValues";
+        case SectionKind::InactivePredictedValues: return "InactivePredictedValues";
     }
     return "unknown";
 }

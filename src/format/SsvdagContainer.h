@@ -31,6 +31,9 @@ enum class SectionKind : uint32_t {
     ValueErrors = 13,   // per grid, lossy encodings only: the tolerance and the measured errors
     ColourErrors = 14,  // per colour grid encoded with --colour-bits: bits and the measured colour errors
     Normals = 15,       // per grid, only with --normals: k-bit ONV codes in attribute order (palette channel) + angular errors
+    // 14-19: reserved for another branch.
+    PredictedValues = 20,          // per grid: integer active values predicted in attribute order (instead of Values)
+    InactivePredictedValues = 21,  // the same for the inactive layer (instead of InactiveValues)
 };
 const char* sectionKindName(SectionKind kind);
 

@@ -12,7 +12,11 @@
 //   DagStats      u32 n, u8 hasSvdag, then n x (u64 svo, u64 svdag, u64 stored)
 //   Values        the active values in attribute order as a palette channel
 //                 (serializePalette in src/attributes/PaletteChannel.cpp)
-//   Inactive*     the same four for the inactive layer (absent if empty)
+//   PredictedValues  instead of Values, for int32/int64 channels when it is
+//                 smaller: the same values as brick-MED residuals
+//                 (src/attributes/PredictedChannel.h); the reader decodes them
+//                 along the DAG and rebuilds the palette channel
+//   Inactive*     the same for the inactive layer (absent if empty)
 //   ValueErrors   lossy only: u8 mode, f64 bound, u64 entries, changed, kept
 //                 exact, f64 max abs, mean abs, RMS, max relative error
 //   ColourErrors  --colour-bits only: u8 bits, u64 entries, distinct before,
@@ -24,7 +28,9 @@
 
 #include <map>
 
+#include "src/attributes/PredictedChannel.h"
 #include "src/format/ByteIO.h"
+#include "src/encoding/AttributeLayout.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::format {
@@ -48,13 +54,14 @@ std::vector<T> fromRawBytes(const std::vector<uint8_t>& bytes, uint64_t expected
 }
 
 struct LayerKinds {
-    SectionKind levels, inner, leaves, values;
+    SectionKind levels, inner, leaves, values, predicted;
 };
-constexpr LayerKinds kActive{SectionKind::DagLevels, SectionKind::DagInner, SectionKind::DagLeaves, SectionKind::Values};
-constexpr LayerKinds kInactive{SectionKind::InactiveLevels, SectionKind::InactiveInner, SectionKind::InactiveLeaves, SectionKind::InactiveValues};
+constexpr LayerKinds kActive{SectionKind::DagLevels, SectionKind::DagInner, SectionKind::DagLeaves, SectionKind::Values, SectionKind::PredictedValues};
+constexpr LayerKinds kInactive{SectionKind::InactiveLevels, SectionKind::InactiveInner, SectionKind::InactiveLeaves, SectionKind::InactiveValues,
+                               SectionKind::InactivePredictedValues};
 
 void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, const encoding::CompactDag& dag,
-              const attributes::PaletteChannel& channel, unsigned valueSize) {
+              const attributes::PaletteChannel& channel, const std::vector<uint8_t>& predicted, unsigned valueSize) {
     ByteWriter levels;
     for (int64_t o : dag.origin) levels.put<int64_t>(o);
     levels.put<uint8_t>(dag.log2Size);
@@ -68,7 +75,8 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
     if (!dag.empty()) {
         sections.push_back({kinds.inner, g, rawBytes(dag.inner)});
         if (!dag.leaves.empty()) sections.push_back({kinds.leaves, g, rawBytes(dag.leaves)});
-        if (valueSize) sections.push_back({kinds.values, g, attributes::serializePalette(channel)});
+        if (valueSize && !predicted.empty()) sections.push_back({kinds.predicted, g, predicted});
+        else if (valueSize) sections.push_back({kinds.values, g, attributes::serializePalette(channel)});
     }
 }
 
@@ -97,8 +105,8 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
         sections.push_back({SectionKind::VdbDescriptor, g, grid.record.vdbDescriptor});
 
         const unsigned vs = valueSize(grid.record.valueType);
-        putLayer(sections, g, kActive, grid.dag, grid.values, vs);
-        if (!grid.inactiveDag.empty()) putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveValues, vs);
+        putLayer(sections, g, kActive, grid.dag, grid.values, grid.predictedValues, vs);
+        if (!grid.inactiveDag.empty()) putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveValues, grid.inactivePredictedValues, vs);
         if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact) {
             ByteWriter e;
             const auto& l = grid.lossy;
@@ -135,6 +143,10 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
 }
 
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName) {
+    return sectionsToScene(std::move(sections), sourceName, ReadOptions{});
+}
+
+SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options) {
     const Section* fileInfo = nullptr;
     std::map<std::pair<uint32_t, SectionKind>, Section*> byGrid;
     for (Section& s : sections) {
@@ -185,7 +197,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         grid.record.vdbDescriptor = std::move(find(g, SectionKind::VdbDescriptor, true)->data);
         const unsigned vs = valueSize(grid.record.valueType);
         auto readLayer = [&](const LayerKinds& kinds, encoding::CompactDag& dag, std::vector<uint8_t>& attributes,
-                             attributes::PaletteChannel& channel, uint64_t expectedVoxels, const std::string& layer) {
+                             attributes::PaletteChannel& channel, std::vector<uint8_t>& predicted, uint64_t expectedVoxels, const std::string& layer) {
             uint64_t innerWords = 0, leafCount = 0;
             {
                 ByteReader r(find(g, kinds.levels, true)->data, what + " " + layer + " levels");
@@ -212,7 +224,19 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             if (size.activeVoxels != expectedVoxels)
                 throw Error(what + ": the " + layer + " DAG holds " + std::to_string(size.activeVoxels) + " voxels but the header says " +
                             std::to_string(expectedVoxels) + "; the file is corrupted");
-            if (vs && !dag.empty()) {
+            Section* predictedSection = find(g, kinds.predicted, false);
+            if (predictedSection && (!vs || dag.empty() || find(g, kinds.values, false)))
+                throw Error(what + ": unexpected " + layer + " predicted-values section");
+            if (predictedSection) {
+                if (grid.record.valueType != ValueType::Int32 && grid.record.valueType != ValueType::Int64)
+                    throw Error(what + ": predicted values for a " + valueTypeName(grid.record.valueType) + " grid");
+                predicted = std::move(predictedSection->data);
+                attributes = attributes::decodePredicted(predicted, vs, encoding::attributeLayout(dag), what + " " + layer + " values");
+                if (attributes.size() != size.attributeEntries * vs)
+                    throw Error(what + ": " + layer + " predicted values hold " + std::to_string(attributes.size() / vs) + " entries, expected " +
+                                std::to_string(size.attributeEntries));
+                if (options.rebuildPalettes) channel = attributes::compressPalette(attributes, vs);  // the traceable layout, rebuilt
+            } else if (vs && !dag.empty()) {
                 channel = attributes::deserializePalette(find(g, kinds.values, true)->data, what + " " + layer + " values");
                 if (channel.valueSize != vs || channel.entryCount != size.attributeEntries)
                     throw Error(what + ": " + layer + " values hold " + std::to_string(channel.entryCount) + " entries of " +
@@ -220,9 +244,9 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 attributes = channel.decodeAll();
             }
         };
-        readLayer(kActive, grid.dag, grid.attributes, grid.values, grid.activeVoxels, "active");
+        readLayer(kActive, grid.dag, grid.attributes, grid.values, grid.predictedValues, grid.activeVoxels, "active");
         if (grid.inactiveVoxels || find(g, kInactive.levels, false))
-            readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveValues, grid.inactiveVoxels, "inactive");
+            readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveValues, grid.inactivePredictedValues, grid.inactiveVoxels, "inactive");
         if (Section* e = find(g, SectionKind::ValueErrors, false)) {
             ByteReader r(e->data, what + " ValueErrors");
             auto& l = grid.lossy;
@@ -287,9 +311,15 @@ SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceN
     return sectionsToScene(readContainer(bytes, sourceName), sourceName);
 }
 
-SsvdagScene readSceneFile(const std::string& path) {
-    const std::vector<uint8_t> bytes = readFileBytes(path);
-    return readScene(bytes, path);
+SsvdagScene readSceneFile(const std::string& path) { return readSceneFile(path, ReadOptions{}); }
+
+SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
+    std::vector<Section> sections;
+    {
+        const std::vector<uint8_t> bytes = readFileBytes(path);  // released before the sections are parsed
+        sections = readContainer(bytes, path);
+    }
+    return sectionsToScene(std::move(sections), path, options);
 }
 
 } // namespace vdbdag::format

@@ -32,6 +32,10 @@ struct EncodedGrid {
     encoding::CompactDag dag;
     std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
     attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout
+    // Integer channels only, when smaller at rest: the same values predicted
+    // (attributes/PredictedChannel.h); the file then stores this instead of
+    // the palettes, which a reader rebuilds.
+    std::vector<uint8_t> predictedValues;
     attributes::ToleranceReport lossy;  // what a lossy setting changed (mode Exact: nothing)
     // Colour grids encoded with --colour-bits: what the CIELAB clustering
     // changed (the values above already hold the representatives).
@@ -45,6 +49,7 @@ struct EncodedGrid {
     encoding::CompactDag inactiveDag;
     std::vector<uint8_t> inactiveAttributes;
     attributes::PaletteChannel inactiveValues;
+    std::vector<uint8_t> inactivePredictedValues;
 };
 
 struct SsvdagScene {
@@ -53,9 +58,17 @@ struct SsvdagScene {
 
 std::vector<Section> sceneToSections(const SsvdagScene& scene);
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName);
+// What a reader builds beyond the values themselves.
+struct ReadOptions {
+    // For PredictedValues sections: rebuild the palette channel (the
+    // traceable layout). A plain decode to .vdb needs only the values.
+    bool rebuildPalettes = true;
+};
+SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options);
 
 std::vector<uint8_t> writeScene(const SsvdagScene& scene, const ContainerOptions& options = {});
 SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName);
 SsvdagScene readSceneFile(const std::string& path);
+SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options);
 
 } // namespace vdbdag::format

@@ -5,7 +5,11 @@
 #include <algorithm>
 #include <cstring>
 
+#include <zstd.h>
+
+#include "src/attributes/PredictedChannel.h"
 #include "src/dag/DagBuilder.h"
+#include "src/encoding/AttributeLayout.h"
 #include "src/pipeline/AttributeOrder.h"
 
 namespace vdbdag::pipeline {
@@ -51,6 +55,38 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const GridTopology& topo
         candidates.push_back({base[0] - ((axes & 1u) ? step : 0), base[1] - ((axes & 2u) ? step : 0), base[2] - ((axes & 4u) ? step : 0)});
     }
     return candidates;
+}
+
+// Bytes after a fast zstd pass: the yardstick for choosing a channel coding
+// (the container compresses harder, by about the same factor for both).
+// Streams through a 1 MiB buffer that is overwritten, so it costs no memory.
+size_t zstdEstimate(const std::vector<uint8_t>& bytes) {
+    ZSTD_CCtx* cctx = ZSTD_createCCtx();
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, 1);
+    std::vector<uint8_t> buffer(1u << 20);
+    ZSTD_inBuffer in{bytes.data(), bytes.size(), 0};
+    size_t total = 0;
+    for (;;) {
+        ZSTD_outBuffer out{buffer.data(), buffer.size(), 0};
+        const size_t left = ZSTD_compressStream2(cctx, &out, &in, ZSTD_e_end);
+        if (ZSTD_isError(left)) { total = bytes.size(); break; }
+        total += out.pos;
+        if (left == 0) break;
+    }
+    ZSTD_freeCCtx(cctx);
+    return total;
+}
+
+// The predicted coding of an integer channel if it beats its palettes at
+// rest, else empty.
+std::vector<uint8_t> predictedIfSmaller(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes,
+                                        const attributes::PaletteChannel& palettes, ValueType type, const EncodeOptions& options) {
+    if (!options.predictIntegers || (type != ValueType::Int32 && type != ValueType::Int64) || attributes.empty()) return {};
+    std::vector<uint8_t> predicted = attributes::encodePredicted(attributes, valueSize(type), encoding::attributeLayout(dag));
+    const size_t predictedBytes = zstdEstimate(predicted);
+    const size_t paletteBytes = zstdEstimate(attributes::serializePalette(palettes));
+    if (predictedBytes < paletteBytes) return predicted;
+    return {};
 }
 
 } // namespace
@@ -105,6 +141,19 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
     out.record.inactiveTopology = {};
     out.record.inactiveValues = {};
     out.record.normals.reset();
+namespace {
+
+// `release`: the same grid, non-const, whose voxels may be dropped once
+// they are in attribute order (nullptr: keep them).
+format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& options, GridRecord* release) {
+    format::EncodedGrid out;
+    // The header only: copying the voxels first would double peak memory.
+    out.record.name = grid.name;
+    out.record.gridClass = grid.gridClass;
+    out.record.valueType = grid.valueType;
+    out.record.indexToWorld = grid.indexToWorld;
+    out.record.vdbDescriptor = grid.vdbDescriptor;
+    out.record.background = grid.background;
     out.symmetry = options.symmetry;
     const unsigned vs = valueSize(grid.valueType);
     auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };
@@ -115,6 +164,10 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
     step("ordering values");
     if (!grid.topology.empty()) {
         out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
+        if (release) {
+            std::vector<uint8_t>().swap(release->values.bricks);
+            std::vector<uint8_t>().swap(release->values.tiles);
+        }
         out.lossy = attributes::applyScalarTolerance(out.attributes, grid.valueType, options.tolerance);
         if (isColourGrid(grid, options))
             out.colour = attributes::quantiseColours(out.attributes, grid.valueType, options.colourBits, "grid '" + grid.name + "'");
@@ -129,16 +182,25 @@ format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& opti
                                                 grid.normals->oneSided);
     }
     step("palette compression");
-    if (!grid.topology.empty()) out.values = attributes::compressPalette(out.attributes, vs);
+    if (!grid.topology.empty()) {
+        out.values = attributes::compressPalette(out.attributes, vs);
+        out.predictedValues = predictedIfSmaller(out.dag, out.attributes, out.values, grid.valueType, options);
+    }
     out.inactiveVoxels = grid.inactiveTopology.activeVoxelCount();
     step("inactive values");
     if (!grid.inactiveTopology.empty()) {
         out.inactiveDag = encodeLayer(grid.inactiveTopology, options, vs > 0, nullptr);
         out.inactiveAttributes = gatherAttributes(out.inactiveDag, grid.inactiveTopology, grid.inactiveValues, vs);
         out.inactiveValues = attributes::compressPalette(out.inactiveAttributes, vs);
+        out.inactivePredictedValues = predictedIfSmaller(out.inactiveDag, out.inactiveAttributes, out.inactiveValues, grid.valueType, options);
     }
+    if (release) *release = GridRecord{};  // everything the scene needs is copied
     return out;
 }
+
+} // namespace
+
+format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) { return encodeGridImpl(grid, options, nullptr); }
 
 GridRecord decodeGrid(const format::EncodedGrid& grid) {
     GridRecord record = grid.record;
@@ -153,6 +215,15 @@ format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& opti
     for (size_t g = 0; g < volume.grids.size(); ++g) {
         if (onGrid) onGrid(g, volume.grids.size());
         scene.grids.push_back(encodeGrid(volume.grids[g], options));
+    }
+    return scene;
+}
+
+format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options, const GridProgress& onGrid) {
+    format::SsvdagScene scene;
+    for (size_t g = 0; g < volume.grids.size(); ++g) {
+        if (onGrid) onGrid(g, volume.grids.size());
+        scene.grids.push_back(encodeGridImpl(volume.grids[g], options, &volume.grids[g]));
     }
     return scene;
 }

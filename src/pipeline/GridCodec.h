@@ -29,6 +29,10 @@ struct EncodeOptions {
     // k-bit ONV normals (NormalChannel.h) for grids whose record carries
     // exact normals (GridRecord::normals); 0 = none stored.
     unsigned normalBits = 0;
+    // Integer (int32/int64) channels: also code the values with the brick
+    // predictor (attributes/PredictedChannel.h) and store whichever of
+    // palettes and residuals zstd makes smaller.
+    bool predictIntegers = true;
     // Called as each step of a grid starts (kEncodeSteps per grid), for progress.
     std::function<void(const char* step)> onStep;
 };
@@ -43,6 +47,10 @@ GridRecord decodeGrid(const format::EncodedGrid& grid);
 // Whole volumes; `onGrid(index, count)` is called before each grid (progress).
 using GridProgress = std::function<void(size_t index, size_t count)>;
 format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
+// The same, releasing each grid's voxels as soon as they are in attribute
+// order (a dense 512x512x999 scan then never holds its values twice); the
+// grids keep their headers, their voxels are gone afterwards.
+format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
 Volume decodeScene(const format::SsvdagScene& scene, const GridProgress& onGrid = {});
 
 } // namespace vdbdag::pipeline

@@ -2,6 +2,7 @@
 // mirrored bricks, a colour grid with quantised colours and ONV normals)
 // into a folder, as the fuzzer's seed corpus.
 #include <bit>
+// mirrored bricks, predicted int32 values) into a folder, as the fuzzer's seed corpus.
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -44,6 +45,18 @@ int main(int argc, char** argv) {
         options.normalBits = 12;
         scene.grids.push_back(pipeline::encodeGrid(colour, options));
     }
+    // An int32 grid with smooth, distinct values: stored as a PredictedValues section.
+    GridRecord ints = record;
+    ints.valueType = ValueType::Int32;
+    ints.background = {0, 0, 0, 0};
+    uint64_t entries = 1;  // the tile
+    for (const Brick& b : ints.topology.bricks) entries += uint64_t(__builtin_popcountll(b.mask));
+    for (uint64_t i = 0; i < entries; ++i) {
+        const int32_t v = int32_t(1000 + 7 * i + (i * 2654435761u) % 3);
+        const auto* p = reinterpret_cast<const uint8_t*>(&v);
+        (i + 1 < entries ? ints.values.bricks : ints.values.tiles).insert(i + 1 < entries ? ints.values.bricks.end() : ints.values.tiles.end(), p, p + 4);
+    }
+    scene.grids.push_back(pipeline::encodeGrid(ints));
     int n = 0;
     for (bool compress : {true, false}) {
         format::ContainerOptions options;

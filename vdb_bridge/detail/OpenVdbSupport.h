@@ -2,6 +2,7 @@
 // initialisation, dispatch over the supported grid types, descriptor
 // (de)serialisation. Not to be included outside vdb_bridge/ and tests/.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <mutex>
 #include <sstream>
@@ -89,6 +90,37 @@ inline openvdb::GridBase::Ptr readDescriptor(const std::vector<uint8_t>& bytes, 
     } catch (const std::ios_base::failure& e) {
         throw Error(what + ": grid descriptor is corrupted (" + oneLine(e.what()) + ")");
     }
+}
+
+// OpenVDB's own serialisation of an empty copy of `grid` (metadata,
+// transform, background, class, half-float flag): GridRecord::vdbDescriptor.
+inline std::vector<uint8_t> descriptorOf(const openvdb::GridBase& grid) {
+    openvdb::GridBase::Ptr empty = grid.copyGridWithNewTree();
+    std::ostringstream out(std::ios::binary);
+    openvdb::io::Stream stream(out);
+    stream.setGridStatsMetadataEnabled(false);
+    stream.write(openvdb::GridCPtrVec{empty});
+    std::string s = out.str();
+    // The stream header carries a random UUID (36 ASCII characters after the
+    // 8-byte magic, u32 file version, 2 x u32 library version and a flag
+    // byte). Fix it so the same input always gives a byte-identical file.
+    constexpr size_t kUuidOffset = 21, kUuidLength = 36;
+    if (s.size() < kUuidOffset + kUuidLength || s[kUuidOffset + 8] != '-')
+        throw Error("internal error: unexpected OpenVDB stream header layout");
+    s.replace(kUuidOffset, kUuidLength, "00000000-0000-0000-0000-000000000000");
+    return std::vector<uint8_t>(s.begin(), s.end());
+}
+
+// The affine index-to-world matrix of a linear transform (identity otherwise).
+inline std::array<double, 16> indexToWorldOf(const openvdb::GridBase& grid) {
+    std::array<double, 16> m{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    const auto map = grid.transform().baseMap();
+    if (map && map->isLinear()) {
+        const openvdb::Mat4d mat = map->getAffineMap()->getMat4();
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c) m[size_t(4 * r + c)] = mat(r, c);
+    }
+    return m;
 }
 
 } // namespace vdbdag::bridge::detail

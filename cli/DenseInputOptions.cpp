@@ -1,0 +1,60 @@
+// See DenseInputOptions.h.
+#include "cli/DenseInputOptions.h"
+
+#include <cmath>
+
+#include <fmt/core.h>
+
+#include "src/util/Error.h"
+
+namespace vdbdag::cli {
+
+void DenseInputOptions::addTo(CLI::App& cmd) {
+    cmd.add_option("--dims", dims, "raw input: samples along x y z (x fastest)")->expected(3);
+    cmd.add_option("--type", type, "raw input: sample type u8|i8|u16|i16|u32|i32|f32|f64");
+    cmd.add_option("--endian", endian, "raw input: little (default) or big")->check(CLI::IsMember({"little", "big"}));
+    cmd.add_option("--spacing", spacing, "raw input: voxel spacing sx sy sz (default 1 1 1)")->expected(3);
+    cmd.add_option("--origin", origin, "raw input: world position of sample (0,0,0) (default 0 0 0)")->expected(3);
+    belowOption = cmd.add_option("--background-below", below, "dense input: samples below V become inactive background (lossy; the cost is reported)");
+    aboveOption = cmd.add_option("--background-above", above, "dense input: samples above V become inactive background (lossy; the cost is reported)");
+}
+
+bridge::DenseImportOptions DenseInputOptions::resolve(const std::string& path) const {
+    bridge::DenseImportOptions o;
+    const bool rawInput = bridge::denseFormatOf(path) == bridge::DenseFormat::Raw;
+    if (!rawInput && (!dims.empty() || !type.empty() || !endian.empty() || !spacing.empty() || !origin.empty()))
+        throw Error(path + ": --dims/--type/--endian/--spacing/--origin apply to .raw inputs only (this file has a header)");
+    if (!dims.empty()) o.raw.dims = std::array<int64_t, 3>{dims[0], dims[1], dims[2]};
+    if (!type.empty()) o.raw.type = bridge::parseSampleType(type, path);
+    if (!endian.empty()) o.raw.bigEndian = endian == "big";
+    if (!spacing.empty()) o.raw.spacing = {spacing[0], spacing[1], spacing[2]};
+    if (!origin.empty()) o.raw.origin = {origin[0], origin[1], origin[2]};
+    if (belowOption && belowOption->count()) o.backgroundBelow = below;
+    if (aboveOption && aboveOption->count()) o.backgroundAbove = above;
+    return o;
+}
+
+nlohmann::json thresholdJson(const bridge::ThresholdReport& r) {
+    if (!r.applied) return nullptr;
+    return {{"samples", r.samples},
+            {"inactive_samples", r.inactive},
+            {"changed_samples", r.changed},
+            {"background_value", r.background},
+            {"input_min", r.inputMin},
+            {"input_max", r.inputMax},
+            {"max_abs_change", r.maxAbsChange},
+            {"mean_abs_change", r.meanAbsChange},
+            {"rms_change", r.rmsChange},
+            {"psnr_db", std::isfinite(r.psnr) ? nlohmann::json(r.psnr) : nlohmann::json(nullptr)}};
+}
+
+std::string thresholdText(const bridge::ThresholdReport& r) {
+    if (!r.applied) return "";
+    return fmt::format("  background {}: {} of {} samples inactive ({:.1f}%), {} changed; max |change| {:.6g}, mean {:.6g}, RMS {:.6g}; "
+                       "PSNR {} (peak = input range {:.6g}..{:.6g})\n",
+                       r.background, r.inactive, r.samples, r.samples ? 100.0 * double(r.inactive) / double(r.samples) : 0.0, r.changed,
+                       r.maxAbsChange, r.meanAbsChange, r.rmsChange, std::isfinite(r.psnr) ? fmt::format("{:.2f} dB", r.psnr) : "inf (lossless)",
+                       r.inputMin, r.inputMax);
+}
+
+} // namespace vdbdag::cli

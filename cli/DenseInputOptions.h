@@ -1,0 +1,33 @@
+// The options shared by `import` and `encode` for dense inputs (raw, NRRD,
+// MetaImage): the raw layout (--dims, --type, --endian, --spacing, --origin)
+// and the background thresholds, plus the text/JSON form of the threshold
+// report (what making air background costs).
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "vdb_bridge/DenseImport.h"
+
+namespace vdbdag::cli {
+
+struct DenseInputOptions {
+    std::vector<int64_t> dims;
+    std::string type, endian;
+    std::vector<double> spacing, origin;
+    double below = 0, above = 0;
+    CLI::Option* belowOption = nullptr;
+    CLI::Option* aboveOption = nullptr;
+
+    void addTo(CLI::App& cmd);
+    // Throws vdbdag::Error naming `path` for inconsistent values.
+    bridge::DenseImportOptions resolve(const std::string& path) const;
+};
+
+nlohmann::json thresholdJson(const bridge::ThresholdReport& report);
+std::string thresholdText(const bridge::ThresholdReport& report);
+
+} // namespace vdbdag::cli

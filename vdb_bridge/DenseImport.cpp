@@ -1,0 +1,226 @@
+// See DenseImport.h. Each slab of 4 slices is cut into 4^3 bricks (bit
+// x + 4y + 16z, GridTopology.h), rows of bricks in parallel with per-row
+// buffers appended in order, so the result does not depend on the thread
+// count. Bricks at the volume's far faces are partial (their mask says so).
+#include "vdb_bridge/DenseImport.h"
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+
+#include <openvdb/openvdb.h>
+#include <tbb/parallel_for.h>
+
+#include "src/util/Error.h"
+#include "src/util/Progress.h"
+#include "vdb_bridge/MetaImageHeader.h"
+#include "vdb_bridge/NrrdHeader.h"
+#include "vdb_bridge/detail/OpenVdbSupport.h"
+
+namespace vdbdag::bridge {
+namespace {
+
+constexpr int64_t kSlab = 4;
+
+struct Thresholds {
+    bool below = false, above = false;
+    double belowValue = 0, aboveValue = 0;
+    bool any() const { return below || above; }
+    bool removes(double x) const { return (below && x < belowValue) || (above && x > aboveValue); }
+};
+
+// What one pass accumulates (per brick row, then reduced in row order).
+struct PassStats {
+    uint64_t removed = 0, changed = 0;
+    double removedSum = 0;
+    double min = std::numeric_limits<double>::infinity(), max = -std::numeric_limits<double>::infinity();
+    double maxAbs = 0, sumAbs = 0, sumSq = 0;
+    void add(const PassStats& o) {
+        removed += o.removed;
+        changed += o.changed;
+        removedSum += o.removedSum;
+        min = std::min(min, o.min);
+        max = std::max(max, o.max);
+        maxAbs = std::max(maxAbs, o.maxAbs);
+        sumAbs += o.sumAbs;
+        sumSq += o.sumSq;
+    }
+};
+
+template <typename S>
+void forEachSlab(const DenseVolume& v, Progress* progress, const std::function<void(int64_t z0, int64_t nz, const S* samples)>& fn) {
+    DenseSampleStream stream(v);
+    std::vector<uint8_t> slab;
+    for (int64_t z0 = 0; z0 < v.dims[2]; z0 += kSlab) {
+        const int64_t nz = std::min(kSlab, v.dims[2] - z0);
+        stream.readSlices(nz, slab);
+        fn(z0, nz, reinterpret_cast<const S*>(slab.data()));
+        if (progress) progress->advance();
+    }
+}
+
+template <typename S, typename V>
+DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueType valueType, bool showProgress) {
+    const int64_t nx = v.dims[0], ny = v.dims[1];
+    const int64_t slabs = (v.dims[2] + kSlab - 1) / kSlab;
+    const int64_t rows = (ny + 3) / 4, cols = (nx + 3) / 4;
+    const std::string name = std::filesystem::path(v.headerPath).filename().string();
+    std::unique_ptr<Progress> progress;
+    if (showProgress) progress = std::make_unique<Progress>("import " + name, uint64_t(slabs) * (th.any() ? 2 : 1));
+
+    // Pass 1 (thresholds only): the removed samples' mean and the input range.
+    PassStats first;
+    V background = V(0);
+    if (th.any()) {
+        if (progress) progress->setLabel("import " + name + ": background statistics");
+        forEachSlab<S>(v, progress.get(), [&](int64_t, int64_t nz, const S* s) {
+            const uint64_t n = uint64_t(nz) * uint64_t(nx * ny);
+            PassStats st;
+            for (uint64_t i = 0; i < n; ++i) {
+                const double x = double(s[i]);
+                if (std::isfinite(x)) { st.min = std::min(st.min, x); st.max = std::max(st.max, x); }
+                if (th.removes(x)) { ++st.removed; st.removedSum += x; }
+            }
+            first.add(st);
+        });
+        if (first.removed) {
+            const double mean = first.removedSum / double(first.removed);
+            if constexpr (std::is_integral_v<V>) background = V(std::llround(mean));
+            else background = V(mean);
+        }
+    }
+
+    // Pass 2: bricks and values.
+    GridRecord record;
+    record.valueType = valueType;
+    const uint64_t expectedKept = v.sampleCount() - first.removed;
+    record.values.bricks.reserve(size_t(expectedKept * sizeof(V)));
+    record.topology.bricks.reserve(size_t(uint64_t(slabs) * uint64_t(rows) * uint64_t(cols)));
+    PassStats second;
+    struct Row {
+        std::vector<Brick> bricks;
+        std::vector<V> values;
+        PassStats stats;
+    };
+    std::vector<Row> rowOut(static_cast<size_t>(rows));
+    if (progress) progress->setLabel("import " + name + ": bricks");
+    forEachSlab<S>(v, progress.get(), [&](int64_t z0, int64_t nz, const S* s) {
+        tbb::parallel_for(int64_t(0), rows, [&](int64_t by) {
+            Row& row = rowOut[size_t(by)];
+            row.bricks.clear();
+            row.values.clear();
+            row.stats = PassStats{};
+            for (int64_t bx = 0; bx < cols; ++bx) {
+                uint64_t mask = 0;
+                for (int bit = 0; bit < 64; ++bit) {
+                    const int64_t x = bx * 4 + (bit & 3), y = by * 4 + ((bit >> 2) & 3), z = bit >> 4;
+                    if (x >= nx || y >= ny || z >= nz) continue;
+                    const S sample = s[(z * ny + y) * nx + x];
+                    const double d = double(sample);
+                    if (th.any() && th.removes(d)) {
+                        const double change = std::abs(d - double(background));
+                        if (change != 0) ++row.stats.changed;
+                        row.stats.maxAbs = std::max(row.stats.maxAbs, change);
+                        row.stats.sumAbs += change;
+                        row.stats.sumSq += change * change;
+                        continue;
+                    }
+                    mask |= uint64_t(1) << bit;
+                    row.values.push_back(V(sample));
+                }
+                if (mask) row.bricks.push_back({int32_t(bx * 4), int32_t(by * 4), int32_t(z0), mask});
+            }
+        });
+        for (Row& row : rowOut) {
+            record.topology.bricks.insert(record.topology.bricks.end(), row.bricks.begin(), row.bricks.end());
+            const auto* p = reinterpret_cast<const uint8_t*>(row.values.data());
+            record.values.bricks.insert(record.values.bricks.end(), p, p + row.values.size() * sizeof(V));
+            second.add(row.stats);
+        }
+    });
+    if (progress) progress->finish();
+
+    DenseImportResult result;
+    result.source = v;
+    ThresholdReport& r = result.threshold;
+    r.samples = v.sampleCount();
+    if (th.any()) {
+        r.applied = true;
+        r.inactive = first.removed;
+        r.changed = second.changed;
+        r.background = double(background);
+        r.inputMin = std::isfinite(first.min) ? first.min : 0;
+        r.inputMax = std::isfinite(first.max) ? first.max : 0;
+        r.maxAbsChange = second.maxAbs;
+        r.meanAbsChange = second.sumAbs / double(r.samples);
+        const double mse = second.sumSq / double(r.samples);
+        r.rmsChange = std::sqrt(mse);
+        const double peak = r.inputMax - r.inputMin;
+        r.psnr = mse == 0 ? std::numeric_limits<double>::infinity() : (peak > 0 ? 10 * std::log10(peak * peak / mse) : 0.0);
+    }
+
+    // The grid header: OpenVDB's own serialisation of an empty grid.
+    detail::initializeOpenVdb();
+    using GridT = openvdb::Grid<typename openvdb::tree::Tree4<V, 5, 4, 3>::Type>;
+    typename GridT::Ptr grid = GridT::create(background);
+    grid->setName(std::filesystem::path(v.headerPath).stem().string());
+    grid->setGridClass(openvdb::GRID_UNKNOWN);
+    openvdb::Mat4d m = openvdb::Mat4d::identity();
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) m(a, c) = v.axes[size_t(a)][size_t(c)];
+    for (int c = 0; c < 3; ++c) m(3, c) = v.origin[size_t(c)];
+    grid->setTransform(openvdb::math::Transform::Ptr(new openvdb::math::Transform(openvdb::math::MapBase::Ptr(new openvdb::math::AffineMap(m)))));
+    grid->insertMeta("source_file", openvdb::StringMetadata(name));
+    grid->insertMeta("source_sample_type", openvdb::StringMetadata(sampleTypeName(v.type)));
+    if (th.below) grid->insertMeta("background_below", openvdb::DoubleMetadata(th.belowValue));
+    if (th.above) grid->insertMeta("background_above", openvdb::DoubleMetadata(th.aboveValue));
+    record.name = grid->getName();
+    record.gridClass = openvdb::GridBase::gridClassToString(grid->getGridClass());
+    record.indexToWorld = detail::indexToWorldOf(*grid);
+    record.vdbDescriptor = detail::descriptorOf(*grid);
+    const auto* bg = reinterpret_cast<const uint8_t*>(&background);
+    record.background.assign(bg, bg + sizeof(V));
+    result.volume.grids.push_back(std::move(record));
+    return result;
+}
+
+} // namespace
+
+DenseVolume describeDense(const std::string& path, const RawLayout& raw) {
+    switch (denseFormatOf(path)) {
+        case DenseFormat::Raw: return describeRaw(path, raw);
+        case DenseFormat::Nrrd: return readNrrdHeader(path);
+        case DenseFormat::MetaImage: return readMetaImageHeader(path);
+        case DenseFormat::None: break;
+    }
+    throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
+}
+
+DenseImportResult importDense(const std::string& path, const DenseImportOptions& options) {
+    const DenseVolume v = describeDense(path, options.raw);
+    Thresholds th;
+    for (auto [set, value, flag] : {std::tuple{&th.below, &th.belowValue, options.backgroundBelow},
+                                    std::tuple{&th.above, &th.aboveValue, options.backgroundAbove}}) {
+        if (!flag) continue;
+        if (!std::isfinite(*flag)) throw Error(path + ": a background threshold must be a finite number");
+        *set = true;
+        *value = *flag;
+    }
+    if (th.below && th.above && th.aboveValue < th.belowValue)
+        throw Error(path + ": --background-above is below --background-below: every sample would become background");
+    const bool p = options.showProgress;
+    switch (v.type) {
+        case SampleType::U8: return importTyped<uint8_t, int32_t>(v, th, ValueType::Int32, p);
+        case SampleType::I8: return importTyped<int8_t, int32_t>(v, th, ValueType::Int32, p);
+        case SampleType::U16: return importTyped<uint16_t, int32_t>(v, th, ValueType::Int32, p);
+        case SampleType::I16: return importTyped<int16_t, int32_t>(v, th, ValueType::Int32, p);
+        case SampleType::U32: return importTyped<uint32_t, int64_t>(v, th, ValueType::Int64, p);
+        case SampleType::I32: return importTyped<int32_t, int32_t>(v, th, ValueType::Int32, p);
+        case SampleType::F32: return importTyped<float, float>(v, th, ValueType::Float, p);
+        case SampleType::F64: return importTyped<double, double>(v, th, ValueType::Double, p);
+    }
+    throw Error(path + ": unsupported sample type");
+}
+
+} // namespace vdbdag::bridge

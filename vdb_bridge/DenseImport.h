@@ -1,0 +1,59 @@
+// Dense scans (raw, NRRD, MetaImage) -> vdbdag's Volume: one grid whose
+// voxels are the samples, streamed in z-slabs of 4 slices straight into 4^3
+// bricks, so memory holds the grid's values once plus one slab.
+//
+// Value type (DESIGN.md invariant 4, samples come back exactly): u8, i8,
+// u16, i16 and i32 samples become an Int32 grid; u32 an Int64 grid (its
+// values need 32 bits unsigned); f32 a Float grid, f64 a Double grid (bit
+// for bit, NaN payloads included). Integer samples are never stored as
+// floats. Grid class "unknown", background 0; the transform is the affine map
+// of the header's spacing, directions and origin; metadata records the
+// source file and sample type.
+//
+// Thresholds (--background-below V / --background-above V): samples < V (or
+// > V) become inactive background, so the DAG's sparsity applies. The
+// background value is the mean of the removed samples (rounded for integer
+// grids), the least-squares choice; a first pass over the data finds it. The
+// report states what that costs against the input: samples changed, max,
+// mean and RMS absolute change, PSNR with peak = the input's value range.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "src/volume/GridRecord.h"
+#include "vdb_bridge/DenseVolume.h"
+#include "vdb_bridge/RawVolume.h"
+
+namespace vdbdag::bridge {
+
+struct DenseImportOptions {
+    RawLayout raw;  // layout of .raw inputs (ignored for NRRD / MetaImage)
+    std::optional<double> backgroundBelow, backgroundAbove;
+    bool showProgress = true;  // a Progress line on a terminal
+};
+
+struct ThresholdReport {
+    bool applied = false;
+    uint64_t samples = 0;       // input samples
+    uint64_t inactive = 0;      // samples turned into background
+    uint64_t changed = 0;       // of those, samples whose value differs from the background
+    double background = 0;      // the background value chosen
+    double inputMin = 0, inputMax = 0;  // finite input range (peak = max - min)
+    double maxAbsChange = 0, meanAbsChange = 0, rmsChange = 0;  // over all samples
+    double psnr = 0;            // dB; +inf when nothing changed
+};
+
+struct DenseImportResult {
+    Volume volume;  // one grid
+    DenseVolume source;
+    ThresholdReport threshold;
+};
+
+// The header of `path`, by extension (see DenseVolume.h's denseFormatOf).
+DenseVolume describeDense(const std::string& path, const RawLayout& raw);
+
+// Throws vdbdag::Error naming the file on any malformed header, missing or
+// short data, unsupported type or bad threshold.
+DenseImportResult importDense(const std::string& path, const DenseImportOptions& options);
+
+} // namespace vdbdag::bridge

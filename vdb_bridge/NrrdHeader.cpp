@@ -1,0 +1,188 @@
+// See NrrdHeader.h. Parsing is strict: a field whose value cannot be read is
+// an error, never a silent default; unknown fields and key/value pairs
+// ("key:=value") are ignored, as the NRRD specification allows.
+#include "vdb_bridge/NrrdHeader.h"
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "src/util/Error.h"
+#include "vdb_bridge/detail/HeaderText.h"
+
+namespace vdbdag::bridge {
+namespace {
+
+constexpr size_t kMaxHeaderBytes = 1u << 20;
+
+SampleType nrrdType(const std::string& raw, const std::string& what) {
+    const std::string t = detail::lower(detail::trim(raw));
+    static const std::map<std::string, SampleType> types{
+        {"signed char", SampleType::I8}, {"int8", SampleType::I8}, {"int8_t", SampleType::I8},
+        {"uchar", SampleType::U8}, {"unsigned char", SampleType::U8}, {"uint8", SampleType::U8}, {"uint8_t", SampleType::U8},
+        {"short", SampleType::I16}, {"short int", SampleType::I16}, {"signed short", SampleType::I16}, {"signed short int", SampleType::I16},
+        {"int16", SampleType::I16}, {"int16_t", SampleType::I16},
+        {"ushort", SampleType::U16}, {"unsigned short", SampleType::U16}, {"unsigned short int", SampleType::U16}, {"uint16", SampleType::U16},
+        {"uint16_t", SampleType::U16},
+        {"int", SampleType::I32}, {"signed int", SampleType::I32}, {"int32", SampleType::I32}, {"int32_t", SampleType::I32},
+        {"uint", SampleType::U32}, {"unsigned int", SampleType::U32}, {"uint32", SampleType::U32}, {"uint32_t", SampleType::U32},
+        {"float", SampleType::F32}, {"double", SampleType::F64}};
+    const auto it = types.find(t);
+    if (it == types.end()) throw Error(what + ": unsupported NRRD type '" + detail::trim(raw) + "' (8-, 16- and 32-bit integers, float and double are)");
+    return it->second;
+}
+
+// "(a,b,c) (d,e,f) none" -> one entry per axis; "none" -> empty vector.
+std::vector<std::vector<double>> parseVectors(const std::string& s, const std::string& what) {
+    std::vector<std::vector<double>> out;
+    size_t i = 0;
+    while (i < s.size()) {
+        if (std::isspace(static_cast<unsigned char>(s[i]))) { ++i; continue; }
+        if (s[i] == '(') {
+            const size_t close = s.find(')', i);
+            if (close == std::string::npos) throw Error(what + ": unbalanced '(' in '" + detail::trim(s) + "'");
+            std::string inner = s.substr(i + 1, close - i - 1);
+            std::vector<double> v;
+            size_t start = 0;
+            while (true) {
+                const size_t comma = inner.find(',', start);
+                v.push_back(detail::parseNumber(detail::trim(inner.substr(start, comma - start)), what));
+                if (comma == std::string::npos) break;
+                start = comma + 1;
+            }
+            out.push_back(v);
+            i = close + 1;
+        } else if (s.compare(i, 4, "none") == 0) {
+            out.emplace_back();
+            i += 4;
+        } else {
+            throw Error(what + ": cannot read '" + detail::trim(s) + "' as vectors");
+        }
+    }
+    return out;
+}
+
+} // namespace
+
+DenseVolume readNrrdHeader(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
+    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a NRRD file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path + ": cannot open");
+    std::string line;
+    if (!std::getline(in, line) || line.rfind("NRRD000", 0) != 0)
+        throw Error(path + ": not a NRRD file (it does not start with the magic 'NRRD000X')");
+
+    std::map<std::string, std::string> fields;
+    bool blankLineSeen = false;
+    size_t headerBytes = line.size() + 1;
+    while (std::getline(in, line)) {
+        headerBytes += line.size() + 1;
+        if (headerBytes > kMaxHeaderBytes) throw Error(path + ": NRRD header longer than 1 MiB (no blank line ends it?)");
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) { blankLineSeen = true; break; }
+        if (line[0] == '#') continue;
+        const size_t kv = line.find(":=");
+        const size_t colon = line.find(": ");
+        if (kv != std::string::npos && (colon == std::string::npos || kv < colon)) continue;  // key/value pair
+        if (colon == std::string::npos) throw Error(path + ": malformed NRRD header line '" + line + "' (expected 'field: value')");
+        std::string key = detail::lower(detail::trim(line.substr(0, colon)));
+        // Field names may be written with or without their spaces ("datafile").
+        static const std::map<std::string, std::string> aliases{{"datafile", "data file"}, {"byteskip", "byte skip"}, {"lineskip", "line skip"},
+                                                                {"spacedirections", "space directions"}, {"spaceorigin", "space origin"},
+                                                                {"spacedimension", "space dimension"}, {"centerings", "centers"}};
+        if (auto a = aliases.find(key); a != aliases.end()) key = a->second;
+        if (!fields.emplace(key, line.substr(colon + 2)).second) throw Error(path + ": NRRD field '" + key + "' appears twice");
+    }
+    const int64_t attachedOffset = blankLineSeen ? int64_t(in.tellg()) : -1;
+    auto field = [&](const std::string& key) -> const std::string* {
+        auto it = fields.find(key);
+        return it == fields.end() ? nullptr : &it->second;
+    };
+    auto required = [&](const std::string& key) -> const std::string& {
+        if (const std::string* v = field(key)) return *v;
+        throw Error(path + ": NRRD header has no '" + key + "' field");
+    };
+
+    DenseVolume v;
+    v.headerPath = path;
+    const int64_t dimension = detail::parseInteger(detail::trim(required("dimension")), path + ": dimension");
+    if (dimension != 3) throw Error(path + ": NRRD dimension " + std::to_string(dimension) + " is not supported (only 3-D scalar volumes)");
+    v.type = nrrdType(required("type"), path);
+    const std::vector<std::string> sizes = detail::tokens(required("sizes"));
+    if (sizes.size() != 3) throw Error(path + ": 'sizes' has " + std::to_string(sizes.size()) + " values, dimension is 3");
+    for (int a = 0; a < 3; ++a) v.dims[size_t(a)] = detail::parseInteger(sizes[size_t(a)], path + ": sizes");
+
+    const std::string encoding = detail::lower(detail::trim(required("encoding")));
+    if (encoding == "raw") v.encoding = DataEncoding::Raw;
+    else if (encoding == "gzip" || encoding == "gz") v.encoding = DataEncoding::Zlib;
+    else throw Error(path + ": NRRD encoding '" + encoding + "' is not supported (raw and gzip are)");
+
+    if (const std::string* e = field("endian")) {
+        const std::string endian = detail::lower(detail::trim(*e));
+        if (endian == "big") v.bigEndian = true;
+        else if (endian == "little") v.bigEndian = false;
+        else throw Error(path + ": endian '" + detail::trim(*e) + "' is neither 'little' nor 'big'");
+    } else if (sampleBytes(v.type) > 1) {
+        throw Error(path + ": NRRD header has no 'endian' field, required for " + std::to_string(8 * sampleBytes(v.type)) + "-bit samples");
+    }
+
+    if (const std::string* sd = field("space dimension")) {
+        if (detail::parseInteger(detail::trim(*sd), path + ": space dimension") != 3)
+            throw Error(path + ": space dimension " + detail::trim(*sd) + " is not supported (3 is)");
+    }
+    if (const std::string* dirs = field("space directions")) {
+        if (field("spacings")) throw Error(path + ": NRRD header has both 'space directions' and 'spacings'");
+        const auto vectors = parseVectors(*dirs, path + ": space directions");
+        if (vectors.size() != 3) throw Error(path + ": 'space directions' has " + std::to_string(vectors.size()) + " entries, dimension is 3");
+        for (int a = 0; a < 3; ++a) {
+            if (vectors[size_t(a)].empty()) throw Error(path + ": axis " + std::to_string(a) + " has space direction 'none' (non-spatial axes are not supported)");
+            if (vectors[size_t(a)].size() != 3) throw Error(path + ": space direction of axis " + std::to_string(a) + " does not have 3 components");
+            for (int c = 0; c < 3; ++c) v.axes[size_t(a)][size_t(c)] = vectors[size_t(a)][size_t(c)];
+        }
+    } else if (const std::string* sp = field("spacings")) {
+        const std::vector<std::string> t = detail::tokens(*sp);
+        if (t.size() != 3) throw Error(path + ": 'spacings' has " + std::to_string(t.size()) + " values, dimension is 3");
+        for (int a = 0; a < 3; ++a) {
+            // NRRD writes "nan" for an unknown spacing: take 1.
+            const double s = detail::lower(t[size_t(a)]) == "nan" ? 1.0 : detail::parseNumber(t[size_t(a)], path + ": spacings");
+            v.axes[size_t(a)] = {0, 0, 0};
+            v.axes[size_t(a)][size_t(a)] = s;
+        }
+    }
+    if (const std::string* o = field("space origin")) {
+        const auto vectors = parseVectors(*o, path + ": space origin");
+        if (vectors.size() != 1 || vectors[0].size() != 3) throw Error(path + ": 'space origin' must be one 3-vector '(x,y,z)'");
+        for (int c = 0; c < 3; ++c) v.origin[size_t(c)] = vectors[0][size_t(c)];
+    }
+
+    int64_t byteSkip = 0, lineSkip = 0;
+    if (const std::string* b = field("byte skip")) byteSkip = detail::parseInteger(detail::trim(*b), path + ": byte skip");
+    if (const std::string* l = field("line skip")) lineSkip = detail::parseInteger(detail::trim(*l), path + ": line skip");
+    if (byteSkip < -1) throw Error(path + ": byte skip " + std::to_string(byteSkip) + " is invalid");
+    if (lineSkip < 0) throw Error(path + ": line skip " + std::to_string(lineSkip) + " is invalid");
+    if (byteSkip == -1 && v.encoding != DataEncoding::Raw) throw Error(path + ": byte skip -1 is only allowed with raw encoding");
+    if (lineSkip && v.encoding != DataEncoding::Raw) throw Error(path + ": line skip with compressed data is not supported");
+
+    if (const std::string* df = field("data file")) {
+        const std::string name = detail::trim(*df);
+        if (name.rfind("LIST", 0) == 0 || detail::tokens(name).size() != 1)
+            throw Error(path + ": multi-file NRRD data ('data file: " + name + "') is not supported");
+        std::filesystem::path p(name);
+        if (p.is_relative()) p = std::filesystem::path(path).parent_path() / p;
+        v.dataPath = p.string();
+        v.dataOffset = 0;
+    } else {
+        if (attachedOffset < 0) throw Error(path + ": NRRD header has neither a 'data file' field nor a blank line before attached data");
+        v.dataPath = path;
+        v.dataOffset = attachedOffset;
+    }
+    if (byteSkip == -1) v.dataOffset = DenseVolume::kSkipToEnd;
+    else v.decodedSkip = byteSkip;
+    v.lineSkip = lineSkip;
+    v.validate();
+    return v;
+}
+
+} // namespace vdbdag::bridge
