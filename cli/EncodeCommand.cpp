@@ -66,7 +66,6 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         importOptions.normals = opt->normalBits != 0;
         importOptions.normalGrid = opt->normalGrid;
         if (opt->colourBits && opt->topologyOnly) throw Error("--colour-bits and --topology-only exclude each other: a topology-only file has no colours");
-        const bridge::ImportResult imported = bridge::importVdb(opt->input, importOptions);
         bridge::ImportResult imported;
         bridge::ThresholdReport threshold;
         if (bridge::denseFormatOf(opt->input) != bridge::DenseFormat::None) {
@@ -112,16 +111,14 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
             progress.advance();
         };
-        format::SsvdagScene scene;
-        try {
-            scene = pipeline::encodeVolume(imported.volume, encodeOptions, [&](size_t i, size_t) { gridName = imported.volume.grids[i].name; });
-        } catch (const Error& e) {
-            throw Error(opt->input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
         std::vector<std::string> gridNames;
         for (const auto& g : imported.volume.grids) gridNames.push_back(g.name);
-        format::SsvdagScene scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, [&](size_t i, size_t) {
-            gridName = gridNames[i];
-        });
+        format::SsvdagScene scene;
+        try {
+            scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, [&](size_t i, size_t) { gridName = gridNames[i]; });
+        } catch (const Error& e) {
+            throw Error(opt->input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
+        }
         // Neither the input voxels nor the attribute arrays are written:
         // release them before the sections are built (a 512x512x999 scan
         // holds 1 GB in each).

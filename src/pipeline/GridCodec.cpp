@@ -133,14 +133,6 @@ bool isColourGrid(const GridRecord& grid, const EncodeOptions& options) {
     return std::find(options.colourGrids.begin(), options.colourGrids.end(), grid.name) != options.colourGrids.end();
 }
 
-format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) {
-    format::EncodedGrid out;
-    out.record = grid;
-    out.record.topology = {};
-    out.record.values = {};
-    out.record.inactiveTopology = {};
-    out.record.inactiveValues = {};
-    out.record.normals.reset();
 namespace {
 
 // `release`: the same grid, non-const, whose voxels may be dropped once
