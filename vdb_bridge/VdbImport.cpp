@@ -125,34 +125,6 @@ void addNormals(const GridT& grid, GridRecord& record, const std::string& normal
     else throw Error(path + ": --normal-grid '" + normalGrid + "' has type '" + grid.type() + "', not a vec3 normal grid");
 }
 
-std::vector<uint8_t> descriptorOf(const openvdb::GridBase& grid) {
-    openvdb::GridBase::Ptr empty = grid.copyGridWithNewTree();
-    std::ostringstream out(std::ios::binary);
-    openvdb::io::Stream stream(out);
-    stream.setGridStatsMetadataEnabled(false);
-    stream.write(openvdb::GridCPtrVec{empty});
-    std::string s = out.str();
-    // The stream header carries a random UUID (36 ASCII characters after the
-    // 8-byte magic, u32 file version, 2 x u32 library version and a flag
-    // byte). Fix it so the same input always gives a byte-identical file.
-    constexpr size_t kUuidOffset = 21, kUuidLength = 36;
-    if (s.size() < kUuidOffset + kUuidLength || s[kUuidOffset + 8] != '-')
-        throw Error("internal error: unexpected OpenVDB stream header layout");
-    s.replace(kUuidOffset, kUuidLength, "00000000-0000-0000-0000-000000000000");
-    return std::vector<uint8_t>(s.begin(), s.end());
-}
-
-std::array<double, 16> indexToWorldOf(const openvdb::GridBase& grid) {
-    std::array<double, 16> m{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    const auto map = grid.transform().baseMap();
-    if (map && map->isLinear()) {
-        const openvdb::Mat4d mat = map->getAffineMap()->getMat4();
-        for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c) m[size_t(4 * r + c)] = mat(r, c);
-    }
-    return m;
-}
-
 } // namespace
 
 ImportResult importVdb(const std::string& path, const ImportOptions& options) {

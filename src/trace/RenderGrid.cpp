@@ -1,6 +1,8 @@
 // Shading choices and value access for renderers; see RenderGrid.h.
 #include "src/trace/RenderGrid.h"
 
+#include "src/trace/DagTracer.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -29,38 +31,6 @@ std::array<double, 3> decodeValue(ValueType type, const uint8_t* bytes) {
     case ValueType::Vec3I: { int32_t i[3]; std::memcpy(i, bytes, 12); out = {double(i[0]), double(i[1]), double(i[2])}; break; }
     }
     return out;
-}
-
-// Bounds of the occupied cells, from the nodes down to `maxDepth` levels
-// below the root (a conservative box, cheap for any DAG size).
-void occupiedBounds(const encoding::CompactDag& dag, std::array<double, 3>& lo, std::array<double, 3>& hi) {
-    std::array<int64_t, 3> bmin{INT64_MAX, INT64_MAX, INT64_MAX}, bmax{INT64_MIN, INT64_MIN, INT64_MIN};
-    const unsigned maxDepth = std::min<unsigned>(unsigned(dag.innerLevelCount()) - 1, 5);
-    struct Walk {
-        const encoding::CompactDag& dag;
-        unsigned maxDepth;
-        std::array<int64_t, 3>& bmin;
-        std::array<int64_t, 3>& bmax;
-        void visit(unsigned depth, uint64_t pos, unsigned mirror, int64_t x, int64_t y, int64_t z) {
-            const unsigned log2 = dag.log2Size - depth;
-            const uint16_t header = dag.inner[pos];
-            if (header == 0 || depth == maxDepth) {
-                const int64_t c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a) { bmin[a] = std::min(bmin[a], c[a]); bmax[a] = std::max(bmax[a], c[a] + (int64_t(1) << log2)); }
-                return;
-            }
-            const int64_t half = int64_t(1) << (log2 - 1);
-            for (unsigned j = 0; j < 8; ++j) {
-                if (((header >> (2 * j)) & 3u) == 0) continue;
-                const encoding::ChildPointer child = encoding::readChild(dag.inner, pos, j, dag.offsetWords[depth]);
-                const unsigned p = j ^ mirror;
-                visit(depth + 1, dag.levelStart[depth + 1] + child.offset, mirror ^ child.reflection, x + ((p & 1) ? half : 0),
-                      y + ((p & 2) ? half : 0), z + ((p & 4) ? half : 0));
-            }
-        }
-    };
-    Walk{dag, maxDepth, bmin, bmax}.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
-    for (int a = 0; a < 3; ++a) { lo[a] = double(bmin[a]); hi[a] = double(bmax[a]); }
 }
 
 } // namespace
@@ -105,7 +75,13 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
         out.valueMax = std::isfinite(hi) && hi > 0 ? hi : 1;
         out.valueMin = 0;
     }
-    if (!grid.dag.empty()) occupiedBounds(grid.dag, out.cellLo, out.cellHi);
+    if (!grid.dag.empty()) {
+        const OccupiedBox box = occupiedBox(grid.dag, 5);
+        for (int a = 0; a < 3; ++a) {
+            out.cellLo[a] = double(box.lo[a] + grid.dag.origin[a]);
+            out.cellHi[a] = double(box.hi[a] + grid.dag.origin[a]);
+        }
+    }
     return out;
 }
 

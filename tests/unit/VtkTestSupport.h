@@ -22,32 +22,14 @@
 #include <vtkXMLImageDataReader.h>
 #include <vtkXMLMultiBlockDataReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
+#include "tests/unit/CliRunner.h"
 
 namespace vtktest {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-    int exitCode;
-    std::string out, err;
-};
-
-inline CommandResult runCli(const std::string& args) {
-    static int counter = 0;
-    const fs::path errFile = fs::temp_directory_path() / ("vdbdag_vtk_err_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
-    const std::string command = std::string(VDBDAG_BINARY) + " " + args + " 2>" + errFile.string();
-    CommandResult r{};
-    FILE* pipe = popen(command.c_str(), "r");
-    std::array<char, 4096> buffer{};
-    size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(errFile);
-    r.err.assign(std::istreambuf_iterator<char>(in), {});
-    fs::remove(errFile);
-    return r;
-}
+using vdbdag::testing::CommandResult;
+using vdbdag::testing::runCli;
 
 inline fs::path workDir() {
     static const fs::path dir = [] {

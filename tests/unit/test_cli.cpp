@@ -12,33 +12,15 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
+#include "tests/unit/CliRunner.h"
 #include "vdb_bridge/VdbCompare.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct CommandResult {
-    int exitCode;
-    std::string out, err;
-};
-
-// `envPrefix`: e.g. "env VAR=value " before the binary.
-CommandResult runCli(const std::string& args, const std::string& envPrefix = "") {
-    const fs::path errFile = fs::temp_directory_path() / ("vdbdag_cli_err_" + std::to_string(getpid()));
-    const std::string command = envPrefix + std::string(VDBDAG_BINARY) + " " + args + " 2>" + errFile.string();
-    CommandResult r{};
-    FILE* pipe = popen(command.c_str(), "r");
-    std::array<char, 4096> buffer{};
-    size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(errFile);
-    r.err.assign(std::istreambuf_iterator<char>(in), {});
-    fs::remove(errFile);
-    return r;
-}
+using vdbdag::testing::CommandResult;
+using vdbdag::testing::runCli;
 
 fs::path workDir() {
     static const fs::path dir = [] {

@@ -14,30 +14,14 @@
 #include <nlohmann/json.hpp>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
+#include "tests/unit/CliRunner.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int exitCode;
-    std::string out, err;
-};
-
-CliRun run(const std::string& args) {
-    const fs::path errFile = fs::temp_directory_path() / ("vdbdag_cliattr_err_" + std::to_string(getpid()));
-    FILE* pipe = popen((std::string(VDBDAG_BINARY) + " " + args + " 2>" + errFile.string()).c_str(), "r");
-    CliRun r{};
-    std::array<char, 4096> buffer{};
-    size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(errFile);
-    r.err.assign(std::istreambuf_iterator<char>(in), {});
-    fs::remove(errFile);
-    return r;
-}
+using CliRun = vdbdag::testing::CommandResult;
+inline CliRun run(const std::string& args) { return vdbdag::testing::runCli(args); }
 
 // A level set "ball" and a random vec3s colour grid "Cd" (8,000 colours).
 fs::path inputFile(const fs::path& dir) {

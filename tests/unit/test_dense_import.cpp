@@ -21,6 +21,7 @@
 #include <openvdb/openvdb.h>
 #include <zlib.h>
 
+#include "tests/unit/CliRunner.h"
 #include "src/attributes/PredictedChannel.h"
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
@@ -31,26 +32,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CommandResult {
-    int exitCode;
-    std::string out, err;
-};
-
-CommandResult runCli(const std::string& args) {
-    const fs::path errFile = fs::temp_directory_path() / ("vdbdag_dense_err_" + std::to_string(getpid()));
-    const std::string command = std::string(VDBDAG_BINARY) + " " + args + " 2>" + errFile.string();
-    CommandResult r{};
-    FILE* pipe = popen(command.c_str(), "r");
-    std::array<char, 4096> buffer{};
-    size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(errFile);
-    r.err.assign(std::istreambuf_iterator<char>(in), {});
-    fs::remove(errFile);
-    return r;
-}
+using vdbdag::testing::CommandResult;
+using vdbdag::testing::runCli;
 
 fs::path workDir() {
     static const fs::path dir = [] {

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/CliRunner.h"
 #include "src/dag/DagBuilder.h"
 #include "src/encoding/CompactDag.h"
 #include "src/selftest/RayCases.h"
@@ -189,26 +190,8 @@ TEST(SelftestRays, AReferenceThatDisagreesOrATooSmallStepBoundIsCaught) {
 
 namespace {
 
-struct CommandResult {
-    int exitCode;
-    std::string out, err;
-};
-
-CommandResult runVdbdag(const std::string& args) {
-    const fs::path errFile = fs::temp_directory_path() / ("vdbdag_selftest_err_" + std::to_string(getpid()));
-    const std::string command = std::string(VDBDAG_BINARY) + " " + args + " 2>" + errFile.string();
-    CommandResult r{};
-    FILE* pipe = popen(command.c_str(), "r");
-    std::array<char, 4096> buffer{};
-    size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(errFile);
-    r.err.assign(std::istreambuf_iterator<char>(in), {});
-    fs::remove(errFile);
-    return r;
-}
+using vdbdag::testing::CommandResult;
+inline CommandResult runVdbdag(const std::string& args) { return vdbdag::testing::runCli(args); }
 
 } // namespace
 

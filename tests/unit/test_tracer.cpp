@@ -12,6 +12,7 @@
 #include "src/encoding/CompactDag.h"
 #include "src/trace/DagTracer.h"
 #include "src/trace/ExactRayReference.h"
+#include "tests/unit/TracerTestGrids.h"
 
 using namespace vdbdag;
 using trace::Ray;
@@ -19,36 +20,8 @@ using trace::RayHit;
 
 namespace {
 
-encoding::CompactDag compactOf(const GridTopology& topology, bool symmetry = true) {
-    dag::BuildOptions options;
-    options.symmetry = symmetry;
-    encoding::CompactDag dag = encoding::encodeCompact(dag::buildDag(topology, options), true);
-    encoding::validateCompact(dag, "test dag");
-    return dag;
-}
-
-// Random 8^3 cells: empty, an active 8^3 tile, or up to 8 random bricks
-// (half of them mirror images of each other, so symmetry merges them).
-GridTopology randomTopology(std::mt19937_64& rng, int cells, int32_t corner = 0) {
-    GridTopology topology;
-    std::uniform_int_distribution<int> kind(0, 9);
-    for (int cz = 0; cz < cells; ++cz)
-        for (int cy = 0; cy < cells; ++cy)
-            for (int cx = 0; cx < cells; ++cx) {
-                const int k = kind(rng);
-                const int32_t x = corner + 8 * cx, y = corner + 8 * cy, z = corner + 8 * cz;
-                if (k <= 4) continue;
-                if (k == 5) { topology.tiles.push_back({x, y, z, 3}); continue; }
-                for (int b = 0; b < 8; ++b) {
-                    if (rng() % 3 == 0) continue;
-                    uint64_t mask = rng() & rng() & rng();
-                    if (b >= 4 && (rng() & 1)) mask = 0x0000000000000F01ull << (rng() % 4);
-                    if (!mask) mask = 1;
-                    topology.bricks.push_back({x + 4 * (b & 1), y + 4 * ((b >> 1) & 1), z + 4 * (b >> 2), mask});
-                }
-            }
-    return topology;
-}
+using vdbdag::testing::compactOf;
+using vdbdag::testing::randomTopology;
 
 double dyadic(std::mt19937_64& rng, double lo, double hi, int fractionBits) {
     std::uniform_real_distribution<double> u(lo, hi);

@@ -27,6 +27,7 @@
 #include "gpu/EmbeddedShaders.h"
 #include "gpu/VulkanContext.h"
 #include "src/util/Error.h"
+#include "tests/unit/CliRunner.h"
 
 using namespace vdbdag;
 using namespace vdbdag::gpu;
@@ -122,25 +123,8 @@ void gatherAndCompare(VulkanContext& ctx, const DeviceArray& array, std::span<co
     EXPECT_EQ(bad, 0u);
 }
 
-struct CommandResult {
-    int exitCode;
-    std::string out, err;
-};
-
-CommandResult runShell(const std::string& command) {
-    const std::filesystem::path errFile = std::filesystem::temp_directory_path() / ("vdbdag_vk_err_" + std::to_string(getpid()));
-    CommandResult r{};
-    FILE* pipe = popen((command + " 2>" + errFile.string()).c_str(), "r");
-    std::array<char, 4096> buffer{};
-    size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(errFile);
-    r.err.assign(std::istreambuf_iterator<char>(in), {});
-    std::filesystem::remove(errFile);
-    return r;
-}
+using vdbdag::testing::CommandResult;
+using vdbdag::testing::runShell;
 
 } // namespace
 

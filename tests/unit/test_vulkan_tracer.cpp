@@ -28,6 +28,7 @@
 #include "src/trace/CpuRenderer.h"
 #include "src/trace/DagTracer.h"
 #include "src/trace/ExactRayReference.h"
+#include "tests/unit/TracerTestGrids.h"
 #include "src/trace/SurfaceHit.h"
 #include "src/util/Error.h"
 #include "vdb_bridge/VdbImport.h"
@@ -57,36 +58,8 @@ gpu::VulkanContext* context() {
 #define VULKAN_OR_SKIP()                                                         \
     if (!context()) GTEST_SKIP() << "no Vulkan device on this machine";
 
-encoding::CompactDag compactOf(const GridTopology& topology, bool symmetry = true) {
-    dag::BuildOptions options;
-    options.symmetry = symmetry;
-    encoding::CompactDag dag = encoding::encodeCompact(dag::buildDag(topology, options), true);
-    encoding::validateCompact(dag, "test dag");
-    return dag;
-}
-
-// Random 8^3 cells: empty, an active 8^3 tile, or up to 8 random bricks,
-// some of them mirror images of each other (as test_tracer.cpp).
-GridTopology randomTopology(std::mt19937_64& rng, int cells, int32_t corner = 0) {
-    GridTopology topology;
-    std::uniform_int_distribution<int> kind(0, 9);
-    for (int cz = 0; cz < cells; ++cz)
-        for (int cy = 0; cy < cells; ++cy)
-            for (int cx = 0; cx < cells; ++cx) {
-                const int k = kind(rng);
-                const int32_t x = corner + 8 * cx, y = corner + 8 * cy, z = corner + 8 * cz;
-                if (k <= 4) continue;
-                if (k == 5) { topology.tiles.push_back({x, y, z, 3}); continue; }
-                for (int b = 0; b < 8; ++b) {
-                    if (rng() % 3 == 0) continue;
-                    uint64_t mask = rng() & rng() & rng();
-                    if (b >= 4 && (rng() & 1)) mask = 0x0000000000000F01ull << (rng() % 4);
-                    if (!mask) mask = 1;
-                    topology.bricks.push_back({x + 4 * (b & 1), y + 4 * ((b >> 1) & 1), z + 4 * (b >> 2), mask});
-                }
-            }
-    return topology;
-}
+using vdbdag::testing::compactOf;
+using vdbdag::testing::randomTopology;
 
 trace::RenderGrid geometryOnly(const encoding::CompactDag& dag) {
     trace::RenderGrid grid;
