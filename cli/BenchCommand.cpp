@@ -37,6 +37,7 @@ struct Setting {
     std::string name, family;
     pipeline::EncodeOptions options;
     double lodPixels = 0;  // > 0: the lossless encoding rendered with this LOD cut-off
+    std::string metric = bench::kValueError;
 };
 
 struct Sweep {
@@ -44,12 +45,19 @@ struct Sweep {
     std::vector<double> absFractions;  // of the largest |value|
     std::vector<double> relBounds;
     std::vector<double> lodPixels;
+    std::vector<unsigned> colourBits;  // colour grids: at most 2^k colours (Dado et al. Table 2)
+    std::vector<unsigned> normalBits;  // level sets: k-bit ONV normals (Dado et al. Table 5)
 };
 
 Sweep sweepFor(const std::string& name) {
-    if (name == "quick") return {1, {1e-1, 1e-2}, {1e-2}, {2}};
-    if (name == "full") return {5, {1e-1, 1e-2, 1e-3, 1e-4, 1e-5}, {1e-2, 1e-3, 1e-4, 1e-5}, {1, 2, 4, 8}};
-    return {3, {1e-1, 1e-2, 1e-3}, {1e-2, 1e-3, 1e-4}, {1, 2, 4}};
+    if (name == "quick") return {1, {1e-1, 1e-2}, {1e-2}, {2}, {12}, {16}};
+    if (name == "full") return {5, {1e-1, 1e-2, 1e-3, 1e-4, 1e-5}, {1e-2, 1e-3, 1e-4, 1e-5}, {1, 2, 4, 8}, {16, 14, 12, 10, 8}, {32, 24, 16, 12, 10}};
+    return {3, {1e-1, 1e-2, 1e-3}, {1e-2, 1e-3, 1e-4}, {1, 2, 4}, {14, 12, 10}, {32, 16, 12, 10}};
+}
+
+// Level sets get the ONV-normal rows: their normals are the gradient.
+bool takesNormals(const GridRecord& grid) {
+    return grid.gridClass == "level set" && (grid.valueType == ValueType::Float || grid.valueType == ValueType::Double);
 }
 
 // Largest finite |value| of a float/double grid's active values (0 otherwise).
@@ -142,6 +150,31 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                     settings.push_back(s);
                 }
             }
+            pipeline::EncodeOptions colourProbe;
+            colourProbe.colourBits = 8;
+            if (pipeline::isColourGrid(grid, colourProbe))
+                for (unsigned bits : sweep.colourBits) {
+                    Setting s{fmt::format("colour {} bits", bits), "vdbdag colour", {}, 0, bench::kColourError};
+                    s.options.colourBits = bits;
+                    settings.push_back(s);
+                }
+            // The exact gradient normals, imported once for this grid only
+            // (their computation is import work, not counted in encode time).
+            std::optional<GridRecord> withNormals;
+            if (takesNormals(grid) && !sweep.normalBits.empty()) {
+                bridge::ImportOptions importOptions;
+                importOptions.onlyGrids = {grid.name};
+                importOptions.normals = true;
+                Volume again = bridge::importVdb(opt->input, importOptions).volume;
+                for (GridRecord& g : again.grids)
+                    if (g.name == grid.name && g.normals) withNormals = std::move(g);
+                if (withNormals)
+                    for (unsigned bits : sweep.normalBits) {
+                        Setting s{fmt::format("normals ONV {} bits", bits), "vdbdag normals", {}, 0, bench::kNormalError};
+                        s.options.normalBits = bits;
+                        settings.push_back(s);
+                    }
+            }
             for (double px : sweep.lodPixels) settings.push_back({fmt::format("LOD {:g} px", px), "vdbdag lod", {}, px});
 
             const size_t steps = settings.size() + 1;
@@ -158,6 +191,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                 p.tool = "vdbdag";
                 p.setting = setting.name;
                 p.family = setting.family;
+                p.metric = setting.metric;
                 p.activeVoxels = voxels;
                 p.rawBytes = voxels * valueSize(grid.valueType);
                 std::optional<format::EncodedGrid> encoded;
@@ -165,11 +199,12 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                     encoded = *losslessGrid;
                     p.note = "the lossless encoding, traced with an LOD cut-off";
                 } else {
+                    const GridRecord& source = setting.options.normalBits ? *withNormals : grid;
                     std::vector<double> encodeMs, decodeMs;
                     for (int r = 0; r < run.repeats; ++r) {
                         auto t0 = Clock::now();
                         format::SsvdagScene scene;
-                        scene.grids.push_back(pipeline::encodeGrid(grid, setting.options));
+                        scene.grids.push_back(pipeline::encodeGrid(source, setting.options));
                         const std::vector<uint8_t> bytes = format::writeScene(scene);
                         encodeMs.push_back(msSince(t0));
                         t0 = Clock::now();
@@ -188,6 +223,25 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                     p.rmsError = lossy.rmsError;
                     if (lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
                         p.note = fmt::format("{} of {} values changed; max rel error {:.3g}", lossy.changed, lossy.entries, lossy.maxRelError);
+                    if (encoded->colour) {  // Dado et al.'s colour metrics: ΔE94, and per channel in 0..255 units
+                        const attributes::ColourReport& c = *encoded->colour;
+                        p.exact = c.changed == 0;
+                        p.maxError = c.maxDeltaE94;
+                        p.meanError = c.meanDeltaE94;
+                        p.rmsError = std::numeric_limits<double>::quiet_NaN();
+                        p.note = fmt::format("{} -> {} distinct colours, {} of {} entries changed; max |d| R,G,B {:.2f}, {:.2f}, {:.2f} of 255",
+                                             c.distinctBefore, c.distinctAfter, c.changed, c.entries, c.maxAbsError[0], c.maxAbsError[1],
+                                             c.maxAbsError[2]);
+                    }
+                    if (encoded->normals) {  // angle between the stored ONV and the exact gradient normal
+                        const attributes::NormalReport& nr = encoded->normals->report;
+                        p.exact = false;
+                        p.maxError = nr.maxAngleDegrees;
+                        p.meanError = nr.meanAngleDegrees;
+                        p.rmsError = std::numeric_limits<double>::quiet_NaN();
+                        p.note = fmt::format("values exact; {} normals ({} without direction); render against the lossless render (gradient normals)",
+                                             nr.entries, nr.zeroLength);
+                    }
                     if (k == 0) losslessGrid = *encoded;
                 }
                 // Trace: the CPU renderer's frame, timed; image error against the lossless render.

@@ -52,6 +52,26 @@ std::vector<size_t> pointsOf(const BenchRun& run, const std::string& grid) {
     return ids;
 }
 
+// Metrics present among `ids`, the value error first.
+std::vector<std::string> metricsOf(const BenchRun& run, const std::vector<size_t>& ids) {
+    std::vector<std::string> metrics;
+    for (size_t i : ids)
+        if (std::find(metrics.begin(), metrics.end(), run.points[i].metric) == metrics.end()) metrics.push_back(run.points[i].metric);
+    std::stable_partition(metrics.begin(), metrics.end(), [](const std::string& m) { return m == bench::kValueError; });
+    return metrics;
+}
+
+// The points of one metric: errors of different metrics are not comparable.
+// Colour and normal rows are compared with the lossless point (error 0).
+std::vector<size_t> comparable(const BenchRun& run, const std::vector<size_t>& ids, const std::string& metric) {
+    std::vector<size_t> out;
+    for (size_t i : ids) {
+        const auto& p = run.points[i];
+        if (p.metric == metric || (metric != bench::kValueError && p.tool == "vdbdag" && p.setting == "lossless")) out.push_back(i);
+    }
+    return out;
+}
+
 // Front over (x, max error), exact points counting as error 0.
 std::set<size_t> frontOf(const BenchRun& run, const std::vector<size_t>& ids, bool byTime) {
     std::vector<double> x, y;
@@ -70,7 +90,8 @@ std::array<float, 3> familyColour(const std::string& family) {
     static const std::map<std::string, std::array<float, 3>> colours{
         {"vdbdag", {0.84f, 0.15f, 0.16f}},      {"vdbdag abs", {0.89f, 0.47f, 0.76f}}, {"vdbdag rel", {0.55f, 0.34f, 0.29f}},
         {"vdbdag lod", {0.58f, 0.40f, 0.74f}},  {"OpenVDB", {0.12f, 0.47f, 0.71f}},    {"NanoVDB", {0.17f, 0.63f, 0.17f}},
-        {"NanoVDB Fp", {0.60f, 0.80f, 0.20f}},  {"NanoVDB FpN", {0.00f, 0.40f, 0.00f}}, {"ZFP", {1.00f, 0.50f, 0.05f}}, {"vdbdag matched", {0.98f, 0.60f, 0.60f}}};
+        {"NanoVDB Fp", {0.60f, 0.80f, 0.20f}},  {"NanoVDB FpN", {0.00f, 0.40f, 0.00f}}, {"ZFP", {1.00f, 0.50f, 0.05f}}, {"vdbdag matched", {0.98f, 0.60f, 0.60f}},
+        {"vdbdag colour", {0.09f, 0.75f, 0.81f}}, {"vdbdag normals", {0.74f, 0.74f, 0.13f}}};
     const auto it = colours.find(family);
     return it != colours.end() ? it->second : std::array<float, 3>{0.5f, 0.5f, 0.5f};
 }
@@ -81,7 +102,14 @@ std::string fileSafe(std::string s) {
     return s.empty() ? "unnamed" : s;
 }
 
-void plot(const BenchRun& run, const std::vector<size_t>& ids, bool byTime, const std::string& path, const std::string& grid) {
+std::string errorLabel(const std::string& metric) {
+    if (metric == bench::kColourError) return "max colour error (CIELAB dE94)";
+    if (metric == bench::kNormalError) return "max normal error (degrees)";
+    return "max abs error";
+}
+
+void plot(const BenchRun& run, const std::vector<size_t>& ids, bool byTime, const std::string& path, const std::string& grid,
+          const std::string& metric) {
     std::vector<bridge::PlotSeries> series;
     std::map<std::string, size_t> seriesOf;
     std::map<size_t, std::pair<size_t, size_t>> where;
@@ -95,9 +123,9 @@ void plot(const BenchRun& run, const std::vector<size_t>& ids, bool byTime, cons
         s.y.push_back(p.exact ? 0.0 : p.maxError);
     }
     bridge::PlotSpec spec;
-    spec.title = fmt::format("{} - max error against {}", grid, byTime ? "decode time" : "size");
+    spec.title = fmt::format("{} - {} against {}", grid, metric == bench::kValueError ? "max error" : metric, byTime ? "decode time" : "size");
     spec.xLabel = byTime ? "decode time (ms, median)" : "size (bytes)";
-    spec.yLabel = "max abs error";
+    spec.yLabel = errorLabel(metric);
     for (size_t i : frontOf(run, ids, byTime)) spec.front.push_back(where[i]);
     bridge::writeScatterPlot(path, series, spec);
 }
@@ -116,9 +144,11 @@ nlohmann::json benchToJson(const BenchRun& run) {
                           {"active_voxels", p.activeVoxels},
                           {"bits_per_voxel", p.bitsPerVoxel()},
                           {"rate_vs_raw", p.rate()},
+                          {"metric", p.metric},
                           {"exact", p.exact},
                           {"max_error", p.maxError},
-                          {"rms_error", p.rmsError},
+                          {"rms_error", numberOrNull(p.rmsError)},
+                          {"mean_error", numberOrNull(p.meanError)},
                           {"render_psnr_db", numberOrNull(p.psnr)},
                           {"render_ssim", numberOrNull(p.ssim)},
                           {"encode", timingJson(p.encode)},
@@ -138,12 +168,13 @@ void writeBenchReport(const BenchRun& run, const std::string& directory) {
     writeFileAtomically((dir / "report.json").string(), std::vector<uint8_t>(json.begin(), json.end()));
 
     std::string csv =
-        "grid,tool,setting,bytes,traceable_bytes,active_voxels,bits_per_voxel,rate_vs_raw,exact,max_error,rms_error,render_psnr_db,render_ssim,"
+        "grid,tool,setting,bytes,traceable_bytes,active_voxels,bits_per_voxel,rate_vs_raw,metric,exact,max_error,rms_error,mean_error,render_psnr_db,render_ssim,"
         "encode_ms,encode_min_ms,encode_max_ms,decode_ms,decode_min_ms,decode_max_ms,trace_ms,rays_per_second\n";
     auto num = [](double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(); };
     for (const auto& p : run.points)
-        csv += fmt::format("\"{}\",{},\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", p.grid, p.tool, p.setting, p.bytes, p.traceableBytes,
-                           p.activeVoxels, num(p.bitsPerVoxel()), num(p.rate()), p.exact ? 1 : 0, num(p.maxError), num(p.rmsError), num(p.psnr),
+        csv += fmt::format("\"{}\",{},\"{}\",{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", p.grid, p.tool, p.setting, p.bytes,
+                           p.traceableBytes, p.activeVoxels, num(p.bitsPerVoxel()), num(p.rate()), p.metric, p.exact ? 1 : 0, num(p.maxError),
+                           num(p.rmsError), num(p.meanError), num(p.psnr),
                            num(p.ssim), num(p.encode.medianMs), num(p.encode.minMs), num(p.encode.maxMs), num(p.decode.medianMs),
                            num(p.decode.minMs), num(p.decode.maxMs), num(p.trace.medianMs), num(p.raysPerSecond));
     writeFileAtomically((dir / "report.csv").string(), std::vector<uint8_t>(csv.begin(), csv.end()));
@@ -151,19 +182,31 @@ void writeBenchReport(const BenchRun& run, const std::string& directory) {
     std::string md = fmt::format("# vdbdag bench: {}\n\nSweep `{}`, timings are the median of {} run(s) with [min–max]; renders {}x{} on the CPU tracer; "
                                  "{:.0f} s in all. Machine: {}.\n\n",
                                  run.input, run.sweep, run.repeats, run.renderWidth, run.renderHeight, run.seconds, run.machine);
-    md += "Errors are over the active voxels against the input (max and RMS absolute; vec3: the largest component). "
+    md += "Errors are over the active voxels against the input, in the row's metric: `value` = the grid's values (max and RMS absolute; "
+          "vec3: the largest component), `colour dE94` = CIELAB ΔE94 of the quantised colours (max and mean), `normal angle deg` = the "
+          "angle between the stored ONV normal and the exact gradient normal (max and mean; the values stay exact). "
           "PSNR/SSIM compare the setting's render with the lossless full-resolution render. "
-          "P = on the Pareto front of (size, max error); T = on the front of (decode time, max error).\n\n";
+          "P = on the Pareto front of (size, max error); T = on the front of (decode time, max error); fronts are taken within one metric, "
+          "the lossless point counting as error 0 in each.\n\n";
     for (const std::string& grid : gridsOf(run)) {
         const std::vector<size_t> ids = pointsOf(run, grid);
-        const auto sizeFront = frontOf(run, ids, false), timeFront = frontOf(run, ids, true);
+        const std::vector<std::string> metrics = metricsOf(run, ids);
+        std::set<size_t> sizeFront, timeFront;
+        for (const std::string& metric : metrics) {
+            const std::vector<size_t> same = comparable(run, ids, metric);
+            for (size_t i : frontOf(run, same, false))
+                if (run.points[i].metric == metric) sizeFront.insert(i);
+            for (size_t i : frontOf(run, same, true))
+                if (run.points[i].metric == metric) timeFront.insert(i);
+        }
         md += fmt::format("## Grid `{}`\n\n", grid);
-        md += "| tool | setting | bytes | bits/voxel | rate | max error | RMS error | PSNR dB | SSIM | encode ms | decode ms | trace Mrays/s | front |\n";
-        md += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+        md += "| tool | setting | bytes | bits/voxel | rate | metric | max error | RMS / mean error | PSNR dB | SSIM | encode ms | decode ms | trace Mrays/s | front |\n";
+        md += "|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---|\n";
         for (size_t i : ids) {
             const auto& p = run.points[i];
-            md += fmt::format("| {} | {} | {} | {:.2f} | {:.3f} | {} | {} | {} | {} | {} | {} | {} | {}{} |\n", p.tool, p.setting, p.bytes, p.bitsPerVoxel(),
-                              p.rate(), fmtError(p, p.maxError), fmtError(p, p.rmsError), fmtOptional(p.psnr, "{:.1f}"),
+            const std::string spread = std::isfinite(p.rmsError) ? fmtError(p, p.rmsError) : fmtError(p, p.meanError) + " (mean)";
+            md += fmt::format("| {} | {} | {} | {:.2f} | {:.3f} | {} | {} | {} | {} | {} | {} | {} | {} | {}{} |\n", p.tool, p.setting, p.bytes,
+                              p.bitsPerVoxel(), p.rate(), p.metric, fmtError(p, p.maxError), spread, fmtOptional(p.psnr, "{:.1f}"),
                               fmtOptional(p.ssim, "{:.4f}"), fmtTiming(p.encode), fmtTiming(p.decode),
                               fmtOptional(p.raysPerSecond / 1e6, "{:.2f}"), sizeFront.count(i) ? "P" : "", timeFront.count(i) ? "T" : "");
         }
@@ -187,11 +230,16 @@ void writeBenchReport(const BenchRun& run, const std::string& directory) {
                   "|---|---:|---:|---:|---:|---:|---|\n" +
                   matched;
         }
-        const std::string stem = fileSafe(grid);
-        const std::string sizePlot = "error_vs_size_" + stem + ".png", timePlot = "error_vs_time_" + stem + ".png";
-        plot(run, ids, false, (dir / sizePlot).string(), grid);
-        plot(run, ids, true, (dir / timePlot).string(), grid);
-        md += fmt::format("\n![error against size]({})\n![error against decode time]({})\n\n", sizePlot, timePlot);
+        md += "\n";
+        for (const std::string& metric : metrics) {
+            const std::string stem = fileSafe(grid) + (metric == bench::kValueError ? "" : "_" + fileSafe(metric));
+            const std::string sizePlot = "error_vs_size_" + stem + ".png", timePlot = "error_vs_time_" + stem + ".png";
+            const std::vector<size_t> same = comparable(run, ids, metric);
+            plot(run, same, false, (dir / sizePlot).string(), grid, metric);
+            plot(run, same, true, (dir / timePlot).string(), grid, metric);
+            md += fmt::format("![{} against size]({})\n![{} against decode time]({})\n", metric, sizePlot, metric, timePlot);
+        }
+        md += "\n";
     }
     writeFileAtomically((dir / "report.md").string(), std::vector<uint8_t>(md.begin(), md.end()));
 }

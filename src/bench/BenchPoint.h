@@ -19,6 +19,10 @@ struct Timing {
 };
 Timing summarise(std::vector<double> samplesMs);
 
+inline const std::string kValueError = "value";
+inline const std::string kColourError = "colour dE94";
+inline const std::string kNormalError = "normal angle deg";
+
 struct BenchPoint {
     std::string grid;       // grid name
     std::string tool;       // "vdbdag", "OpenVDB", "NanoVDB", "ZFP"
@@ -28,8 +32,15 @@ struct BenchPoint {
     uint64_t traceableBytes = 0;  // in-memory traceable size (vdbdag, NanoVDB); 0 if not applicable
     uint64_t activeVoxels = 0;
     uint64_t rawBytes = 0;  // active values as a plain array (the rate's denominator)
-    double maxError = 0, rmsError = 0;   // value errors against the input (0 = exact)
-    bool exact = true;                   // bit-exact values
+    // What maxError/rmsError/meanError measure: kValueError (the grid's
+    // values, absolute, in the grid's units), kColourError (CIELAB ΔE94 of
+    // the colour grid's quantised colours, Dado et al. §4) or kNormalError
+    // (angle in degrees between the stored ONV normal and the exact one).
+    // Points are only compared (fronts, plots) within one metric.
+    std::string metric = kValueError;
+    double maxError = 0, rmsError = 0;   // errors against the input (0 = exact)
+    double meanError = std::numeric_limits<double>::quiet_NaN();  // mean of the metric, where it is reported
+    bool exact = true;                   // bit-exact in the metric's channel
     double psnr = std::numeric_limits<double>::quiet_NaN();  // render vs the lossless render (dB)
     double ssim = std::numeric_limits<double>::quiet_NaN();
     Timing encode, decode, trace;

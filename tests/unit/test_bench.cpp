@@ -65,14 +65,25 @@ TEST(Bench, CommandWritesTheReportAndHoldsItsBounds) {
         EXPECT_TRUE(fs::exists(report / name)) << name;
     std::ifstream in(report / "report.json");
     const nlohmann::json j = nlohmann::json::parse(in);
-    int lossless = 0, fpn = 0, matched = 0;
+    int lossless = 0, fpn = 0, matched = 0, normalRows = 0;
+    uint64_t losslessBytes = 0;
     std::map<std::string, double> peerError;
     for (const auto& p : j["points"]) {
         const std::string tool = p["tool"], setting = p["setting"], family = p["family"];
         EXPECT_GT(p["bytes"].get<uint64_t>(), 0u) << tool << " " << setting;
         if (tool == "vdbdag" && setting == "lossless") {
             ++lossless;
+            losslessBytes = p["bytes"].get<uint64_t>();
             EXPECT_TRUE(p["exact"].get<bool>());
+            EXPECT_EQ(p["metric"], "value");
+        }
+        if (family == "vdbdag normals") {  // quick sweep: 16-bit ONVs, within the octahedral bound 0.95 * 2^((16-k)/2) degrees
+            ++normalRows;
+            EXPECT_EQ(setting, "normals ONV 16 bits");
+            EXPECT_EQ(p["metric"], "normal angle deg");
+            EXPECT_GT(p["max_error"].get<double>(), 0.0);
+            EXPECT_LE(p["max_error"].get<double>(), 0.95);
+            EXPECT_LE(p["mean_error"].get<double>(), p["max_error"].get<double>());
         }
         if (family == "vdbdag abs") {  // "abs E": every value within E
             const double bound = std::stod(setting.substr(4));
@@ -88,8 +99,55 @@ TEST(Bench, CommandWritesTheReportAndHoldsItsBounds) {
             EXPECT_LE(p["max_error"].get<double>(), peerError[p["note"].get<std::string>()]);
         }
     EXPECT_EQ(lossless, 1);
+    EXPECT_EQ(normalRows, 1);
+    for (const auto& p : j["points"])  // the normals cost bytes on top of the exact values
+        if (p["family"] == "vdbdag normals") EXPECT_GT(p["bytes"].get<uint64_t>(), losslessBytes);
+    EXPECT_TRUE(fs::exists(report / "error_vs_size_sphere_normal_angle_deg.png"));
     EXPECT_GE(fpn, 2);
     EXPECT_GE(matched, fpn);
+    fs::remove_all(dir);
+}
+
+TEST(Bench, ColourGridGetsColourRowsWithinTheirPaletteSize) {
+    // A smooth RGB gradient of 32^3 distinct colours: the quick sweep's
+    // 12-bit row keeps at most 4096 colours, with a positive ΔE94.
+    openvdb::initialize();
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_bench_colour_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path input = dir / "cd.vdb";
+    {
+        auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3f(0.f));
+        grid->setName("Cd");
+        auto acc = grid->getAccessor();
+        for (int x = 0; x < 32; ++x)
+            for (int y = 0; y < 32; ++y)
+                for (int z = 0; z < 32; ++z) acc.setValue({x, y, z}, openvdb::Vec3f(x / 31.f, y / 31.f, z / 31.f));
+        openvdb::io::File file(input.string());
+        file.write({grid});
+    }
+    const fs::path report = dir / "report";
+    const std::string command = std::string(VDBDAG_BINARY) + " bench " + input.string() + " -o " + report.string() +
+                                " --sweep quick --width 48 --height 32 > /dev/null";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    std::ifstream in(report / "report.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    int colourRows = 0;
+    for (const auto& p : j["points"])
+        if (p["family"] == "vdbdag colour") {
+            ++colourRows;
+            EXPECT_EQ(p["setting"], "colour 12 bits");
+            EXPECT_EQ(p["metric"], "colour dE94");
+            EXPECT_FALSE(p["exact"].get<bool>());
+            EXPECT_GT(p["max_error"].get<double>(), 0.0);
+            EXPECT_LE(p["mean_error"].get<double>(), p["max_error"].get<double>());
+            const std::string note = p["note"];
+            EXPECT_NE(note.find("32768 -> "), std::string::npos) << note;
+            const uint64_t after = std::stoull(note.substr(note.find("-> ") + 3));
+            EXPECT_LE(after, 4096u) << note;
+            EXPECT_GT(p["render_psnr_db"].get<double>(), 20.0);
+        }
+    EXPECT_EQ(colourRows, 1);
+    EXPECT_TRUE(fs::exists(report / "error_vs_size_Cd_colour_dE94.png"));
     fs::remove_all(dir);
 }
 
