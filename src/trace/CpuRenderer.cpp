@@ -32,6 +32,16 @@ std::optional<glm::dvec3> levelSetGradient(const RenderGrid& grid, const DagTrac
     return g / len;
 }
 
+// The stored ONV normal of the hit's attribute entry, when the grid has
+// normals. Gradient-sourced normals point outwards like the level-set
+// gradient; a normal grid's vectors have no such orientation.
+std::optional<glm::dvec3> storedNormal(const RenderGrid& grid, const RayHit& hit, bool& oriented) {
+    if (!grid.normals || hit.attribute >= grid.normals->entryCount()) return std::nullopt;
+    const std::array<float, 3> n = grid.normals->decode(hit.attribute);
+    oriented = grid.normals->report.source == attributes::NormalReport::Source::Gradient;
+    return glm::dvec3(n[0], n[1], n[2]);
+}
+
 } // namespace
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {
@@ -75,10 +85,14 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
                     const RayHit hit = firstSurfaceHit(grid, tracer, ray, 0);
                     if (hit.hit) {
                         glm::dvec3 normal;
-                        std::optional<glm::dvec3> gradient;
-                        if (grid.levelSet && hit.lodLevel == 0) gradient = levelSetGradient(grid, tracer, hit, hit.attribute);
-                        if (gradient) {
-                            normal = frame.normalToWorld(*gradient);
+                        bool oriented = false;  // outward already: not flipped towards the viewer
+                        std::optional<glm::dvec3> smoothNormal = storedNormal(grid, hit, oriented);
+                        if (!smoothNormal && grid.levelSet && hit.lodLevel == 0) {
+                            smoothNormal = levelSetGradient(grid, tracer, hit, hit.attribute);
+                            oriented = smoothNormal.has_value();
+                        }
+                        if (smoothNormal) {
+                            normal = frame.normalToWorld(*smoothNormal);
                         } else if (hit.faceAxis >= 0) {
                             glm::dvec3 n(0);
                             n[hit.faceAxis] = hit.faceSign;
@@ -86,7 +100,7 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
                         } else {
                             normal = -dir;
                         }
-                        if (glm::dot(normal, dir) > 0 && !gradient) normal = -normal;
+                        if (glm::dot(normal, dir) > 0 && !oriented) normal = -normal;
                         double lambert = std::max(0.0, glm::dot(normal, light));
                         if (options.shadows && lambert > 0 && hit.faceAxis >= 0) {
                             // From the hit point, exactly on the entry face, towards the light.

@@ -44,6 +44,7 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
     out.levelSet = grid.record.gridClass == "level set" && scalarFloat;
     out.fog = grid.record.gridClass == "fog volume" && scalarFloat;
     if (valueSize(out.valueType) > 0 && grid.values.entryCount > 0) out.values = &grid.values;
+    if (grid.normals && grid.normals->entryCount() > 0) out.normals = &*grid.normals;
     switch (out.valueType) {
     case ValueType::Vec3I: out.colouring = ValueColouring::Colour; break;
     case ValueType::Vec3S:

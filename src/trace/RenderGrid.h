@@ -22,6 +22,10 @@ enum class ValueColouring {
 struct RenderGrid {
     const encoding::CompactDag* dag = nullptr;
     const attributes::PaletteChannel* values = nullptr;  // null when the grid stores none
+    // ONV shading normals (`encode --normals K`, Dado et al. §4.3), one per
+    // attribute entry; null when the grid stores none. Preferred to the
+    // level-set gradient and the face normal when present.
+    const attributes::NormalChannel* normals = nullptr;
     ValueType valueType = ValueType::Mask;
     bool levelSet = false;  // grid class "level set" with float/double values: smooth gradient normals
     bool fog = false;       // grid class "fog volume": emission-absorption
