@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <map>
 #include <optional>
 #include <cmath>
 #include <filesystem>
@@ -83,6 +84,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
         std::string input, output, sweep = "default";
         std::vector<std::string> grids;
         int width = 480, height = 360, repeats = 0;
+        double budgetSeconds = 3;
         bool json = false;
     };
     auto opt = std::make_shared<Options>();
@@ -94,6 +96,9 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--width", opt->width, "render width for trace time and image error")->check(CLI::Range(16, 4096));
     cmd->add_option("--height", opt->height, "render height")->check(CLI::Range(16, 4096));
     cmd->add_option("--repeats", opt->repeats, "timed runs per measurement (default: by sweep)")->check(CLI::Range(1, 50));
+    cmd->add_option("--time-budget", opt->budgetSeconds,
+                    "seconds per measurement after which no further repeat is timed (at least one run; default 3)")
+        ->check(CLI::Range(0.0, 3600.0));
     cmd->add_flag("--json", opt->json, "print the whole report as JSON on stdout");
     cmd->callback([opt, &exitCode] {
         const auto start = Clock::now();
@@ -102,6 +107,8 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
         run.input = opt->input;
         run.sweep = opt->sweep;
         run.repeats = opt->repeats ? opt->repeats : sweep.repeats;
+        run.budgetSeconds = opt->budgetSeconds;
+        const double budgetMs = opt->budgetSeconds * 1000.0;
         run.renderWidth = opt->width;
         run.renderHeight = opt->height;
         run.machine = fmt::format("{} hardware threads", std::thread::hardware_concurrency());
@@ -136,11 +143,13 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
             wide.options.compactPointers = false;
             settings.push_back(wide);
             std::vector<double> absTolerances;
+            std::map<std::string, double> absBoundOf;  // setting name -> its absolute bound
             if (scalar && largest > 0) {
                 for (double f : sweep.absFractions) {
                     const double tolerance = std::stod(roundTolerance(largest * f));
                     absTolerances.push_back(tolerance);
                     Setting s{fmt::format("abs {}", roundTolerance(tolerance)), "vdbdag abs", {}, 0};
+                    absBoundOf[s.name] = tolerance;
                     s.options.tolerance = {attributes::ScalarTolerance::Mode::Absolute, tolerance};
                     settings.push_back(s);
                 }
@@ -201,7 +210,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                 } else {
                     const GridRecord& source = setting.options.normalBits ? *withNormals : grid;
                     std::vector<double> encodeMs, decodeMs;
-                    for (int r = 0; r < run.repeats; ++r) {
+                    for (int r = 0; bench::repeatAgain(r, run.repeats, bench::totalMs(encodeMs) + bench::totalMs(decodeMs), budgetMs); ++r) {
                         auto t0 = Clock::now();
                         format::SsvdagScene scene;
                         scene.grids.push_back(pipeline::encodeGrid(source, setting.options));
@@ -254,7 +263,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                     std::vector<double> traceMs;
                     trace::Image image;
                     trace::RenderStats stats;
-                    for (int r = 0; r < run.repeats; ++r) {
+                    for (int r = 0; bench::repeatAgain(r, run.repeats, bench::totalMs(traceMs), budgetMs); ++r) {
                         image = trace::renderCpu(renderGrid, camera, options, &stats);
                         traceMs.push_back(stats.milliseconds);
                     }
@@ -279,6 +288,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
             bridge::PeerOptions peers;
             peers.absTolerances = absTolerances;
             peers.repeats = run.repeats;
+            peers.budgetMs = budgetMs;
             peers.scratchDirectory = scratch.string();
             const std::vector<bench::BenchPoint> peerPoints = bridge::measurePeers(opt->input, chosen[n], peers);
             for (bench::BenchPoint p : peerPoints) {
@@ -300,8 +310,22 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                 p.activeVoxels = voxels;
                 p.rawBytes = voxels * valueSize(grid.valueType);
                 p.note = "matched to " + peer.tool + " " + peer.setting;
+                // The sweep already encoded this bound (FpN usually reaches its tolerance exactly): the same point again.
+                const auto same = std::find_if(run.points.begin(), run.points.end(), [&](const bench::BenchPoint& q) {
+                    return q.grid == gridName && q.family == "vdbdag abs" && absBoundOf.count(q.setting) && absBoundOf.at(q.setting) == peer.maxError;
+                });
+                if (same != run.points.end()) {
+                    bench::BenchPoint copy = *same;
+                    copy.setting = p.setting;
+                    copy.family = p.family;
+                    copy.note = p.note + " (the sweep's point with this bound)";
+                    copy.psnr = copy.ssim = copy.raysPerSecond = std::numeric_limits<double>::quiet_NaN();
+                    copy.trace = {};
+                    run.points.push_back(copy);
+                    continue;
+                }
                 std::vector<double> encodeMs, decodeMs;
-                for (int r = 0; r < run.repeats; ++r) {
+                for (int r = 0; bench::repeatAgain(r, run.repeats, bench::totalMs(encodeMs) + bench::totalMs(decodeMs), budgetMs); ++r) {
                     auto t0 = Clock::now();
                     format::SsvdagScene scene;
                     scene.grids.push_back(pipeline::encodeGrid(grid, options));

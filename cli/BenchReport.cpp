@@ -156,7 +156,7 @@ nlohmann::json benchToJson(const BenchRun& run) {
                           {"trace", timingJson(p.trace)},
                           {"rays_per_second", numberOrNull(p.raysPerSecond)},
                           {"note", p.note}});
-    return {{"input", run.input},   {"sweep", run.sweep},     {"repeats", run.repeats}, {"render_width", run.renderWidth},
+    return {{"input", run.input},   {"sweep", run.sweep},     {"repeats", run.repeats}, {"time_budget_s", run.budgetSeconds}, {"render_width", run.renderWidth},
             {"render_height", run.renderHeight}, {"seconds", run.seconds}, {"machine", run.machine}, {"points", points}};
 }
 
@@ -179,9 +179,10 @@ void writeBenchReport(const BenchRun& run, const std::string& directory) {
                            num(p.decode.minMs), num(p.decode.maxMs), num(p.trace.medianMs), num(p.raysPerSecond));
     writeFileAtomically((dir / "report.csv").string(), std::vector<uint8_t>(csv.begin(), csv.end()));
 
-    std::string md = fmt::format("# vdbdag bench: {}\n\nSweep `{}`, timings are the median of {} run(s) with [min–max]; renders {}x{} on the CPU tracer; "
-                                 "{:.0f} s in all. Machine: {}.\n\n",
-                                 run.input, run.sweep, run.repeats, run.renderWidth, run.renderHeight, run.seconds, run.machine);
+    std::string md = fmt::format("# vdbdag bench: {}\n\nSweep `{}`, timings are the median of up to {} run(s) with [min–max] "
+                                 "(no further run once a measurement has taken {:g} s; a time without a range is a single run); "
+                                 "renders {}x{} on the CPU tracer; {:.0f} s in all. Machine: {}.\n\n",
+                                 run.input, run.sweep, run.repeats, run.budgetSeconds, run.renderWidth, run.renderHeight, run.seconds, run.machine);
     md += "Errors are over the active voxels against the input, in the row's metric: `value` = the grid's values (max and RMS absolute; "
           "vec3: the largest component), `colour dE94` = CIELAB ΔE94 of the quantised colours (max and mean), `normal angle deg` = the "
           "angle between the stored ONV normal and the exact gradient normal (max and mean; the values stay exact). "

@@ -15,6 +15,7 @@ namespace vdbdag::cli {
 struct BenchRun {
     std::string input, sweep, machine;
     int repeats = 1, renderWidth = 0, renderHeight = 0;
+    double budgetSeconds = 0;  // no repeat after a measurement took this long
     double seconds = 0;
     std::vector<bench::BenchPoint> points;
 };

@@ -89,7 +89,7 @@ void measureOpenVdb(const GridT& grid, const PeerOptions& options, std::vector<b
         copy->setSaveFloatAsHalf(mode.half);
         std::vector<double> encode, decode;
         typename GridT::Ptr readBack;
-        for (int r = 0; r < options.repeats; ++r) {
+        for (int r = 0; bench::repeatAgain(r, options.repeats, bench::totalMs(encode) + bench::totalMs(decode), options.budgetMs); ++r) {
             auto start = Clock::now();
             {
                 openvdb::io::File file(path.string());
@@ -122,7 +122,7 @@ void measureNano(const openvdb::FloatGrid& grid, const std::string& setting, con
     bench::BenchPoint p = basePoint(grid, "NanoVDB", setting, family);
     std::vector<double> encode, decode;
     nanovdb::GridHandle<nanovdb::HostBuffer> handle;
-    for (int r = 0; r < options.repeats; ++r) {
+    for (int r = 0; bench::repeatAgain(r, options.repeats, bench::totalMs(encode) + bench::totalMs(decode), options.budgetMs); ++r) {
         auto start = Clock::now();
         nanovdb::OpenToNanoVDB<float, NanoBuildT, nanovdb::AbsDiff> convert;
         if (tolerance > 0) convert.oracle() = nanovdb::AbsDiff(float(tolerance));
@@ -167,7 +167,7 @@ void measureZfp(const GridT& grid, double tolerance, const PeerOptions& options,
     std::vector<std::array<ValueT, 512>> decoded(leaves.size());
     std::vector<double> encode, decode;
     uint64_t bytes = 0;
-    for (int r = 0; r < options.repeats; ++r) {
+    for (int r = 0; bench::repeatAgain(r, options.repeats, bench::totalMs(encode) + bench::totalMs(decode), options.budgetMs); ++r) {
         auto start = Clock::now();
         bytes = tiles * (12 + sizeof(ValueT) + 1);
         for (size_t i = 0; i < leaves.size(); ++i) {

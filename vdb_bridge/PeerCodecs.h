@@ -5,7 +5,7 @@
 // at the same tolerances (per 8^3 leaf, float and double grids). Each point
 // gets its size, its max and RMS error over the active voxels (read back
 // through the peer's own decoder or accessor), and its encode and decode
-// times (median of `repeats`).
+// times (median of up to `repeats`, within `budgetMs` per measurement).
 #pragma once
 #include <string>
 #include <vector>
@@ -17,6 +17,7 @@ namespace vdbdag::bridge {
 struct PeerOptions {
     std::vector<double> absTolerances;  // for NanoVDB FpN and ZFP
     int repeats = 3;
+    double budgetMs = 1e300;            // bench::repeatAgain: no further repeat once a measurement took this long
     std::string scratchDirectory;       // for the .vdb files written (removed afterwards)
 };
 

@@ -437,7 +437,9 @@ private:
     std::unordered_multimap<uint64_t, std::pair<uint32_t, uint32_t>> offsets_;  // hash -> (offset, size)
 };
 
-uint64_t getBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigned bits) {
+} // namespace
+
+uint64_t readPackedBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigned bits) {
     if (bits == 0) return 0;
     const uint64_t word = bitOffset >> 6;
     const unsigned shift = unsigned(bitOffset & 63);
@@ -446,7 +448,6 @@ uint64_t getBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigne
     return v & ((uint64_t(1) << bits) - 1);
 }
 
-} // namespace
 
 PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSize) {
     PaletteChannel out;
@@ -533,7 +534,7 @@ void PaletteChannel::lookup(uint64_t index, uint8_t* out, size_t& hint) const {
     if (b.indexBits == PaletteBlock::kDirect) {
         std::memcpy(out, &direct[b.dataOffset + k * valueSize], valueSize);
     } else {
-        const uint64_t local = getBits(indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
+        const uint64_t local = readPackedBits(indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
         const uint64_t m = b.paletteOffset == PaletteBlock::kWholeMaterialArray ? local : palettes[b.paletteOffset + local];
         std::memcpy(out, &materials[m * valueSize], valueSize);
     }
@@ -549,7 +550,7 @@ std::vector<uint8_t> PaletteChannel::decodeAll() const {
             continue;
         }
         for (uint64_t e = b.firstEntry; e < end; ++e) {
-            const uint64_t local = getBits(indexBits, b.dataOffset + (e - b.firstEntry) * b.indexBits, b.indexBits);
+            const uint64_t local = readPackedBits(indexBits, b.dataOffset + (e - b.firstEntry) * b.indexBits, b.indexBits);
             const uint64_t m = b.paletteOffset == PaletteBlock::kWholeMaterialArray ? local : palettes[b.paletteOffset + local];
             std::memcpy(&out[e * valueSize], &materials[m * valueSize], valueSize);
         }
@@ -642,13 +643,13 @@ PaletteChannel deserializePalette(std::span<const uint8_t> bytes, const std::str
         if (b.indexBits > (whole ? 32 : 8)) r.fail("block " + std::to_string(i) + " has " + std::to_string(b.indexBits) + "-bit indices");
         if (!whole && b.paletteOffset > c.palettes.size()) r.fail("palette of block " + std::to_string(i) + " out of range");
         const uint64_t available = whole ? materialsCount : std::min<uint64_t>(uint64_t(1) << b.indexBits, c.palettes.size() - b.paletteOffset);
-        // getBits may read one word past a block's last bit: the writer keeps a spare word.
+        // readPackedBits may read one word past a block's last bit: the writer keeps a spare word.
         if (c.indexBits.empty() || len > (uint64_t(1) << 40) || b.dataOffset > (uint64_t(1) << 62) ||
             b.dataOffset + len * b.indexBits > (c.indexBits.size() - 1) * 64)
             r.fail("indices of block " + std::to_string(i) + " out of range");
         // Every index must land in the palette and every palette entry in M.
         for (uint64_t k = 0; k < len; ++k) {
-            const uint64_t local = getBits(c.indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
+            const uint64_t local = readPackedBits(c.indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
             if (local >= available) r.fail("index out of its palette in block " + std::to_string(i));
         }
     }

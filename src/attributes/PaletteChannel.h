@@ -46,6 +46,10 @@ struct PaletteChannel {
     std::vector<uint8_t> decodeAll() const;
 };
 
+// The `bits`-bit field (0..63 bits) at `bitOffset` of a bit-packed array
+// such as PaletteChannel::indexBits.
+uint64_t readPackedBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigned bits);
+
 // Compresses `values` (entries of `valueSize` bytes) with the two-phase
 // greedy partition of Dado et al. Alg. 1, in O(n log n). Besides ω = 0..8
 // palettes and direct storage, a block may index the material array

@@ -100,11 +100,22 @@ inline unsigned storedBit(unsigned x, unsigned y, unsigned z, unsigned m) {
     return x + 4 * y + 16 * z;
 }
 
+// Leaf filter of walkRay that keeps every leaf.
+struct EveryLeaf {
+    bool operator()(uint64_t, unsigned) const { return true; }
+};
+
 // The traversal. With kFirstHitOnly it returns the first occupied box;
 // otherwise it calls visit(hit, tLeave) for every occupied box (voxel, tile
 // or LOD node) along the ray, in order, until visit returns true.
-template <bool kFirstHitOnly, class Visitor>
-RayHit walkRay(const encoding::CompactDag& dag, const TraceOptions& options, const OccupiedBox& box, const Ray& ray, Visitor&& visit) {
+// `keepLeaf(firstEntry, entries)` may drop a 4^3 leaf whose voxels the
+// caller would reject anyway (their attribute entries are the contiguous
+// range [firstEntry, firstEntry + entries)): the walk then crosses it as
+// empty space. The boxes visited after it are the same, with the same t and
+// face, as a skip lands on the same voxel boundaries a voxel walk would.
+template <bool kFirstHitOnly, class Visitor, class LeafFilter = EveryLeaf>
+RayHit walkRay(const encoding::CompactDag& dag, const TraceOptions& options, const OccupiedBox& box, const Ray& ray, Visitor&& visit,
+               LeafFilter&& keepLeaf = {}) {
     RayHit result;
     if (dag.empty()) return result;
     LocalRay r;
@@ -207,6 +218,7 @@ RayHit walkRay(const encoding::CompactDag& dag, const TraceOptions& options, con
             const uint64_t base = node.base + attributeOffset;
             if (depth + 1 == innerLevels) {  // the child is a 4^3 leaf
                 leafStored = leaves[offset];
+                if (!keepLeaf(base, unsigned(std::popcount(leafStored)))) { skip = half; break; }
                 leafSpatial = dag::reflectBrick(leafStored, mirror);
                 leafMirror = mirror;
                 leafBase = base;

@@ -45,6 +45,7 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
     out.fog = grid.record.gridClass == "fog volume" && scalarFloat;
     if (valueSize(out.valueType) > 0 && grid.values.entryCount > 0) out.values = &grid.values;
     if (grid.normals && grid.normals->entryCount() > 0) out.normals = &*grid.normals;
+    if (out.levelSet && out.values) out.inside = std::make_shared<const InsideBits>(insideBitsOf(*out.values, out.valueType));
     switch (out.valueType) {
     case ValueType::Vec3I: out.colouring = ValueColouring::Colour; break;
     case ValueType::Vec3S:

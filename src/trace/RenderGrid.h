@@ -4,11 +4,13 @@
 // the CPU renderer and the Vulkan backend.
 #pragma once
 #include <array>
+#include <memory>
 #include <optional>
 
 #include "src/attributes/PaletteChannel.h"
 #include "src/encoding/CompactDag.h"
 #include "src/format/SsvdagFile.h"
+#include "src/trace/InsideBits.h"
 
 namespace vdbdag::trace {
 
@@ -28,6 +30,9 @@ struct RenderGrid {
     const attributes::NormalChannel* normals = nullptr;
     ValueType valueType = ValueType::Mask;
     bool levelSet = false;  // grid class "level set" with float/double values: smooth gradient normals
+    // Level sets with values: value <= 0 per entry (InsideBits.h), for the
+    // zero-crossing test; shared so that copies stay cheap.
+    std::shared_ptr<const InsideBits> inside;
     bool fog = false;       // grid class "fog volume": emission-absorption
     ValueColouring colouring = ValueColouring::None;
     double valueMin = 0, valueMax = 1;  // over the stored values (finite ones)
