@@ -33,8 +33,10 @@ std::optional<glm::dvec3> levelSetGradient(const RenderGrid& grid, const DagTrac
 }
 
 // The stored ONV normal of the hit's attribute entry, when the grid has
-// normals. Gradient-sourced normals point outwards like the level-set
-// gradient; a normal grid's vectors have no such orientation.
+// normals: world space (vdb_bridge computes the gradient normals through the
+// grid's transform; normal grids hold world vectors). Gradient-sourced
+// normals point outwards like the level-set gradient; a normal grid's
+// vectors have no such orientation.
 std::optional<glm::dvec3> storedNormal(const RenderGrid& grid, const RayHit& hit, bool& oriented) {
     if (!grid.normals || hit.attribute >= grid.normals->entryCount()) return std::nullopt;
     const std::array<float, 3> n = grid.normals->decode(hit.attribute);
@@ -86,13 +88,12 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
                     if (hit.hit) {
                         glm::dvec3 normal;
                         bool oriented = false;  // outward already: not flipped towards the viewer
-                        std::optional<glm::dvec3> smoothNormal = storedNormal(grid, hit, oriented);
-                        if (!smoothNormal && grid.levelSet && hit.lodLevel == 0) {
-                            smoothNormal = levelSetGradient(grid, tracer, hit, hit.attribute);
-                            oriented = smoothNormal.has_value();
-                        }
-                        if (smoothNormal) {
-                            normal = frame.normalToWorld(*smoothNormal);
+                        if (const std::optional<glm::dvec3> stored = storedNormal(grid, hit, oriented)) {
+                            normal = *stored;  // world space already
+                        } else if (const std::optional<glm::dvec3> gradient =
+                                       grid.levelSet && hit.lodLevel == 0 ? levelSetGradient(grid, tracer, hit, hit.attribute) : std::nullopt) {
+                            normal = frame.normalToWorld(*gradient);
+                            oriented = true;
                         } else if (hit.faceAxis >= 0) {
                             glm::dvec3 n(0);
                             n[hit.faceAxis] = hit.faceSign;
