@@ -2,7 +2,7 @@
 # Set up, then run the main job on a bundled sample: generate the samples,
 # encode to .ssvdag, verify the lossless round trip, decode back to .vdb,
 # write the VTK diff of the decode against the sample (torus_diff.vtu, for
-# ParaView) and print a summary. Outputs go to demo_output/.
+# ParaView), render the .ssvdag (torus.png) and print a summary. Outputs go to demo_output/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -18,6 +18,8 @@ echo "== decode"
 build/vdbdag decode "$OUT/torus.ssvdag" -o "$OUT/torus_decoded.vdb"
 echo "== VTK diff of the lossless decode (for ParaView; exits non-zero if anything differs)"
 build/vdbdag diff "$SAMPLE" "$OUT/torus_decoded.vdb" -o "$OUT/torus_diff.vtu"
+echo "== render (Vulkan when a device exists, else the CPU tracer)"
+build/vdbdag render "$OUT/torus.ssvdag" -o "$OUT/torus.png" --shadows
 echo "== summary"
 build/vdbdag info "$OUT/torus.ssvdag"
-ls -l "$SAMPLE" "$OUT/torus.ssvdag" "$OUT/torus_decoded.vdb" "$OUT/torus_diff.vtu"
+ls -l "$SAMPLE" "$OUT/torus.ssvdag" "$OUT/torus_decoded.vdb" "$OUT/torus_diff.vtu" "$OUT/torus.png"
