@@ -1,6 +1,8 @@
 // Backend selection for rendering; see RenderBackend.h.
 #include "cli/RenderBackend.h"
 
+#include <thread>
+
 #include <fmt/core.h>
 
 #include "gpu/DeviceInfo.h"
@@ -13,6 +15,7 @@ namespace {
 class CpuBackend final : public RenderBackend {
 public:
     std::string name() const override { return "cpu"; }
+    std::string device() const override { return fmt::format("CPU, {} hardware threads", std::thread::hardware_concurrency()); }
     trace::Image render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
                         trace::RenderStats& stats) override {
         return trace::renderCpu(grid, camera, options, &stats);
@@ -29,6 +32,7 @@ public:
         info_ = gpu::openDevice(options_);
     }
     std::string name() const override { return "vulkan"; }
+    std::string device() const override { return info_.name; }
     trace::Image render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
                         trace::RenderStats& stats) override {
         if (!tracer_ || uploaded_ != grid.dag) {

@@ -13,6 +13,8 @@ class RenderBackend {
 public:
     virtual ~RenderBackend() = default;
     virtual std::string name() const = 0;
+    // What ran the frames: the Vulkan device's name, or the CPU's thread count.
+    virtual std::string device() const = 0;
     virtual trace::Image render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
                                 trace::RenderStats& stats) = 0;
 };

@@ -99,14 +99,14 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         const double raysPerSecond = double(stats.primaryRays + stats.secondaryRays) / (ms / 1000.0);
         if (opt->json) {
             nlohmann::json j{{"input", opt->input},       {"output", opt->output},          {"grid", chosen->record.name},
-                             {"backend", backend->name()}, {"width", opt->width},           {"height", opt->height},
+                             {"backend", backend->name()}, {"device", backend->device()}, {"width", opt->width},           {"height", opt->height},
                              {"frames", opt->frames},      {"ms_per_frame", ms},            {"ms_min", times.front()},
                              {"ms_max", times.back()},     {"primary_rays", stats.primaryRays}, {"secondary_rays", stats.secondaryRays},
                              {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows}};
             fmt::print("{}\n", j.dump(2));
         } else {
-            fmt::print("render '{}' ({}x{}) on {}: {:.1f} ms per frame (median of {}), {:.2f} M rays/s ({} primary, {} shadow) -> {}\n",
-                       chosen->record.name, opt->width, opt->height, backend->name(), ms, opt->frames, raysPerSecond / 1e6,
+            fmt::print("render '{}' ({}x{}) on {} ({}): {:.1f} ms per frame (median of {}), {:.2f} M rays/s ({} primary, {} shadow) -> {}\n",
+                       chosen->record.name, opt->width, opt->height, backend->name(), backend->device(), ms, opt->frames, raysPerSecond / 1e6,
                        stats.primaryRays, stats.secondaryRays, opt->output);
         }
         exitCode = 0;

@@ -205,6 +205,14 @@ TEST(Cli, RenderOnVulkanAndCpuGivesTheSamePngAndAutoFallsBackWithoutADevice) {
     ASSERT_EQ(r.exitCode, 0) << r.err;
     report = nlohmann::json::parse(r.out);
     EXPECT_EQ(report["backend"], "vulkan");
+    {  // the device that ran it, as `vdbdag devices --json` names its default
+        const CommandResult devices = runCli("devices --json");
+        ASSERT_EQ(devices.exitCode, 0) << devices.err;
+        const std::string listed = devices.out;
+        const std::string device = report["device"].get<std::string>();
+        EXPECT_FALSE(device.empty());
+        EXPECT_NE(listed.find(device), std::string::npos) << device << " not in " << listed;
+    }
     EXPECT_GT(report["secondary_rays"].get<int>(), 0);
     auto slurp = [](const fs::path& p) {
         std::ifstream in(p, std::ios::binary);
