@@ -14,6 +14,7 @@
 #include "gpu/ComputePipeline.h"
 #include "gpu/DeviceArray.h"
 #include "gpu/DeviceBuffer.h"
+#include "gpu/DevicePaletteChannel.h"
 #include "gpu/EmbeddedShaders.h"
 #include "gpu/VulkanContext.h"
 #include "src/util/Error.h"
@@ -27,19 +28,19 @@ constexpr size_t kRayBatch = size_t(1) << 20;
 
 // gpu/shaders/trace_params.glsl, std430: 8-byte members first, then 4-byte ones.
 struct TraceParamsGpu {
-    DeviceArrayRef inner, leaves, materials, palettes, blocks, indexBits, direct;
+    DeviceArrayRef inner, leaves;
+    PaletteChannelGpu values, normals;
     int64_t origin[3], boxLo[3], boxHi[3];
     uint64_t levelStart[kMaxInnerLevels];
-    uint64_t entryCount, blockCount;
     double lodScale, valueMin, valueMax;
     double forward[3], right[3], trueUp[3];
     double halfWidth, halfHeight;
     double eyeCell[3], inverse[9], normalMatrix[9], light[3], lightCell[3], background[3];
     double shadowBias, fogScale;
     uint32_t offsetWords[kMaxInnerLevels];
-    uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, valueSize;
+    uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, pad;
 };
-static_assert(sizeof(TraceParamsGpu) == 1136, "must match trace_params.glsl");
+static_assert(sizeof(TraceParamsGpu) == 1296, "must match trace_params.glsl");
 
 struct TracePush {
     uint64_t params, rays, results, counter;
@@ -64,7 +65,8 @@ enum class Mode : uint32_t { Hits = 0, Render = 1, Primary = 2 };
 
 struct VulkanTracer::Impl {
     VulkanContext& context;
-    std::vector<DeviceArray> arrays;  // inner, leaves, materials, palettes, blocks, indexBits, direct
+    std::vector<DeviceArray> arrays;  // inner, leaves
+    std::vector<DevicePaletteChannel> channels;  // values, then normals when the grid has them
     DeviceBuffer params;
     DeviceBuffer counter;
     TraceParamsGpu host{};
@@ -81,8 +83,9 @@ struct VulkanTracer::Impl {
         const bool readsValues = mode == Mode::Render || levelSet;
         const uint32_t valueType = grid.values && readsValues ? uint32_t(grid.valueType) : 255u;
         const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
+        const bool normals = mode == Mode::Render && !fog && grid.normals;  // only surface shading reads them
         const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
-                             (oneChunk ? 1u << 16 : 0u);
+                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -96,6 +99,7 @@ struct VulkanTracer::Impl {
                 constants.setUint(5, colouring);
                 constants.setBool(6, shadows);
                 constants.setBool(7, oneChunk);
+                constants.setBool(8, normals);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
                                                            "trace.comp");
             }
@@ -124,37 +128,28 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid,
     impl_ = std::make_unique<Impl>(context);
     box_ = trace::occupiedBox(dag);
 
-    std::vector<uint64_t> blocks;
-    const attributes::PaletteChannel* values = grid.values;
-    if (values) {
-        blocks.reserve(values->blocks.size() * 3);
-        for (const attributes::PaletteBlock& b : values->blocks) {
-            blocks.push_back(b.firstEntry);
-            blocks.push_back(b.dataOffset);
-            blocks.push_back(uint64_t(b.paletteOffset) | (uint64_t(b.indexBits) << 32));
-        }
-    }
-    const std::span<const uint8_t> none;
     DeviceArrayOptions chunks;
     chunks.chunkShift = chunkShift;
     auto& arrays = impl_->arrays;
-    arrays.reserve(7);
+    arrays.reserve(2);
     arrays.emplace_back(context, orZeros(bytesOf(dag.inner)), "DAG inner words", chunks);
     arrays.emplace_back(context, orZeros(bytesOf(dag.leaves)), "DAG leaves", chunks);
-    arrays.emplace_back(context, orZeros(values ? bytesOf(values->materials) : none), "palette materials", chunks);
-    arrays.emplace_back(context, orZeros(values ? bytesOf(values->palettes) : none), "palettes", chunks);
-    arrays.emplace_back(context, orZeros(bytesOf(blocks)), "palette block directory", chunks);
-    arrays.emplace_back(context, orZeros(values ? bytesOf(values->indexBits) : none), "palette indices", chunks);
-    arrays.emplace_back(context, orZeros(values ? bytesOf(values->direct) : none), "direct values", chunks);
+    // The normal channel only when the grid has one: its pipelines are the
+    // only ones that read it (HAS_NORMALS); otherwise its reference stays zero.
+    auto& channels = impl_->channels;
+    channels.reserve(2);
+    channels.emplace_back(context, grid.values, "values", chunks);
+    if (grid.normals) channels.emplace_back(context, &grid.normals->codes, "ONV normals", chunks);
 
     TraceParamsGpu& p = impl_->host;
     p.inner = arrays[0].ref();
     p.leaves = arrays[1].ref();
-    p.materials = arrays[2].ref();
-    p.palettes = arrays[3].ref();
-    p.blocks = arrays[4].ref();
-    p.indexBits = arrays[5].ref();
-    p.direct = arrays[6].ref();
+    p.values = channels[0].ref();
+    if (grid.normals) {
+        p.normals = channels[1].ref();
+        p.normalBits = grid.normals->bits;
+        p.normalsOriented = grid.normals->report.source == attributes::NormalReport::Source::Gradient ? 1u : 0u;
+    }
     for (int a = 0; a < 3; ++a) {
         p.origin[a] = dag.origin[a];
         p.boxLo[a] = box_.lo[a];
@@ -164,15 +159,12 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid,
         p.levelStart[i] = dag.levelStart[i];
         p.offsetWords[i] = dag.offsetWords[i];
     }
-    p.entryCount = values ? values->entryCount : 0;
-    p.blockCount = values ? values->blocks.size() : 0;
     p.valueMin = grid.valueMin;
     p.valueMax = grid.valueMax;
     p.log2Size = dag.log2Size;
     p.rootReflection = dag.rootReflection;
     p.innerLevels = uint32_t(dag.innerLevelCount());
     p.maxSteps = trace::TraceOptions{}.maxSteps;
-    p.valueSize = values ? values->valueSize : 0;
 }
 
 VulkanTracer::~VulkanTracer() {
@@ -288,7 +280,7 @@ std::vector<trace::RayHit> VulkanTracer::tracePrimary(const trace::Camera& camer
 trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
                                   trace::RenderStats& stats) {
     const auto start = std::chrono::steady_clock::now();
-    if (grid.dag != grid_.dag || grid.values != grid_.values) throw Error("Vulkan tracer: render() got a different grid than the one uploaded");
+    if (grid.dag != grid_.dag || grid.values != grid_.values || grid.normals != grid_.normals) throw Error("Vulkan tracer: render() got a different grid than the one uploaded");
     Impl& impl = *impl_;
     TraceParamsGpu& p = impl.host;
     const trace::GridFrame frame(grid.indexToWorld);

@@ -3,12 +3,13 @@
 // shader straight over the compact SSVDAG (SSVDAG paper §5).
 //
 // The grid is uploaded once: the DAG's 16-bit inner words and 64-bit leaves,
-// and the palette channel's sections (materials, palettes, block directory,
-// packed indices, direct values), each as a DeviceArray reached by buffer
-// device address (no 128 MiB binding limit); the level table, offset widths,
-// root corner and occupied box go into a small parameter buffer. Pipelines
-// are specialised for what the grid has (value type, level set, fog,
-// colouring, shadows) and cached.
+// and the sections of its palette channels (DevicePaletteChannel: the values,
+// and the ONV normal codes when the grid stores normals), each as a
+// DeviceArray reached by buffer device address (no 128 MiB binding limit);
+// the level table, offset widths, root corner, occupied box and ONV bit
+// count and source go into a small parameter buffer. Pipelines are
+// specialised for what the grid has (value type, level set, fog, colouring,
+// shadows, stored normals) and cached.
 //
 // Contract (tests/unit/test_vulkan_tracer.cpp): for the same ray, traceHits
 // returns exactly what DagTracer::trace (FirstHit) or firstSurfaceHit

@@ -1,7 +1,8 @@
 #version 460
 // The Vulkan tracer over the compact SSVDAG (gpu/VulkanTracer.h), a port of
 // the CPU reference tracer (src/trace/): DagWalk.h in trace_walk.glsl,
-// palette lookup and value decode in trace_values.glsl, and here the camera
+// palette lookup in palette_channel.glsl, value decode in trace_values.glsl,
+// stored ONV normals in trace_normals.glsl, and here the camera
 // (Camera::pixelRay, GridFrame::toCellRay), the surface choice
 // (SurfaceHit.cpp) and the shading of CpuRenderer.cpp / Shading.cpp.
 //
@@ -16,7 +17,7 @@
 //  - primary: the camera rays of render, traced only (the hits of hits
 //            mode per pixel): what the benchmark measures.
 // Only what the scene has is compiled in: value type, level set, fog,
-// colouring and shadows are specialisation constants.
+// colouring, shadows and stored normals are specialisation constants.
 //
 // Double-precision arithmetic is `precise` wherever the CPU could contract a
 // product and a sum, so camera rays, crossing times and shading match the
@@ -33,6 +34,7 @@ layout(constant_id = 4) const bool FOG = false;        // render: emission-absor
 layout(constant_id = 5) const uint COLOURING = 0u;     // ValueColouring: none, scalar, colour, vector
 layout(constant_id = 6) const bool SHADOWS = false;    // render: shadow rays
 layout(constant_id = 7) const bool ONE_CHUNK_DAG = false;  // inner words and leaves each in one chunk
+layout(constant_id = 8) const bool HAS_NORMALS = false;    // render: shade with the stored ONV normals
 
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
@@ -48,6 +50,7 @@ layout(push_constant, std430) uniform Push {
 TraceParams P;
 
 #include "trace_values.glsl"
+#include "trace_normals.glsl"
 #include "trace_walk.glsl"
 
 // SurfaceHit.cpp firstSurfaceHit.
@@ -213,11 +216,19 @@ void renderPixel(uint i) {
     } else {
         const Hit hit = firstSurfaceHit(o, d, 0.0lf, tMax, 0.0lf, P.lodScale);
         if (hit.hit) {
+            // CpuRenderer.cpp's precedence: the stored normal, else the
+            // level-set gradient (finest level only), else the entry face.
             dvec3 normal;
-            dvec3 g;
-            const bool gradient = LEVEL_SET && hit.lodLevel == 0u && levelSetGradient(hit, g);
-            if (gradient) {
-                normal = normalToWorld(g);
+            dvec3 smoothNormal;
+            bool oriented = false;  // outward already: not flipped towards the viewer
+            bool haveSmooth = storedNormal(hit.entry, smoothNormal);
+            if (haveSmooth) oriented = gNormalsOriented;
+            else if (LEVEL_SET && hit.lodLevel == 0u) {
+                haveSmooth = levelSetGradient(hit, smoothNormal);
+                oriented = haveSmooth;
+            }
+            if (haveSmooth) {
+                normal = normalToWorld(smoothNormal);
             } else if (hit.faceAxis >= 0) {
                 dvec3 n = dvec3(0.0lf);
                 n[hit.faceAxis] = double(hit.faceSign);
@@ -225,7 +236,7 @@ void renderPixel(uint i) {
             } else {
                 normal = -dir;
             }
-            if (dot3(normal, dir) > 0.0lf && !gradient) normal = -normal;
+            if (dot3(normal, dir) > 0.0lf && !oriented) normal = -normal;
             const double lambertRaw = dot3(normal, vec3At(P.light));
             double lambert = 0.0lf < lambertRaw ? lambertRaw : 0.0lf;
             if (SHADOWS && lambert > 0.0lf && hit.faceAxis >= 0) {
@@ -263,6 +274,7 @@ void main() {
     P = TraceParams(pc.params);
     loadTraceParams();
     loadValueParams();
+    if (MODE == 1u) loadNormalParams();
     if (MODE == 0u) traceOneRay(i);
     else if (MODE == 1u) renderPixel(i);
     else tracePrimary(i);

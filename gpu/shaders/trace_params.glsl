@@ -1,29 +1,26 @@
 // The parameter block of trace.comp (gpu::TraceParamsGpu in
 // gpu/VulkanTracer.cpp, same std430 layout: every 8-byte member first, then
 // the 4-byte ones), reached through a buffer device address: the compact DAG
-// (src/encoding/CompactDag.cpp layout), the palette channel
-// (src/attributes/PaletteChannel.h) and the camera and shading constants.
+// (src/encoding/CompactDag.cpp layout), the value channel and the ONV normal
+// codes (palette channels, palette_channel.glsl) and the camera and shading
+// constants.
 #ifndef VDBDAG_TRACE_PARAMS_GLSL
 #define VDBDAG_TRACE_PARAMS_GLSL
 
 #include "device_array.glsl"
+#include "palette_channel.glsl"
 
 const uint kMaxInnerLevels = 40u;  // encoder limit: log2Size <= 40
 
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer TraceParams {
     DeviceArray inner;      // uint16 words, all inner levels
     DeviceArray leaves;     // uint64 4^3 bricks
-    DeviceArray materials;  // palette material array, valueSize bytes each
-    DeviceArray palettes;   // uint32 material indices
-    DeviceArray blocks;     // 3 uint64 per block: firstEntry, dataOffset, paletteOffset | indexBits << 32
-    DeviceArray indexBits;  // uint64 bit-packed indices
-    DeviceArray direct;     // directly stored values
+    PaletteChannel values;  // entryCount 0 when the grid stores none
+    PaletteChannel normals; // uint32 ONV codes (NormalChannel::codes); entryCount 0 when the grid stores none
     int64_t origin[3];      // index coordinate of the root cube's corner
     int64_t boxLo[3];       // occupied box, relative to the root corner
     int64_t boxHi[3];
     uint64_t levelStart[kMaxInnerLevels];
-    uint64_t entryCount;
-    uint64_t blockCount;
     double lodScale;        // 0: no LOD cut-off
     double valueMin, valueMax;
     // Camera (Camera::pixelRay), precomputed on the host exactly as the CPU does.
@@ -43,7 +40,8 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Tra
     uint innerLevels;
     uint maxSteps;
     uint width, height, tilesX;
-    uint valueSize;
+    uint normalBits;        // k of the ONV codes
+    uint normalsOriented;   // 1: gradient-sourced normals (outward: not flipped towards the viewer)
 };
 
 #endif

@@ -224,3 +224,25 @@ TEST(Cli, RenderOnVulkanAndCpuGivesTheSamePngAndAutoFallsBackWithoutADevice) {
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
+
+// `encode --normals 10`: both backends shade with the stored ONV normals, so
+// the PNGs are the same bytes, and differ from the render without normals.
+TEST(Cli, RenderWithOnvNormalsOnVulkanAndCpuGivesTheSamePng) {
+    const fs::path plain = workDir() / "onv_ball_plain.ssvdag", withNormals = workDir() / "onv_ball_10.ssvdag";
+    ASSERT_EQ(runCli("encode " + sphereFile().string() + " -o " + plain.string()).exitCode, 0);
+    ASSERT_EQ(runCli("encode " + sphereFile().string() + " --normals 10 -o " + withNormals.string()).exitCode, 0);
+    const std::string size = " --width 96 --height 64";
+    const fs::path plainPng = workDir() / "onv_ball_plain.png", cpuPng = workDir() / "onv_ball_cpu.png", vulkanPng = workDir() / "onv_ball_vulkan.png";
+    ASSERT_EQ(runCli("render " + plain.string() + " -o " + plainPng.string() + " --backend cpu" + size).exitCode, 0);
+    ASSERT_EQ(runCli("render " + withNormals.string() + " -o " + cpuPng.string() + " --backend cpu" + size).exitCode, 0);
+    const CommandResult r = runCli("render " + withNormals.string() + " -o " + vulkanPng.string() + " --backend vulkan" + size);
+    if (r.exitCode != 0 && r.err.find("no Vulkan device") != std::string::npos) GTEST_SKIP() << "no Vulkan device on this machine";
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    auto slurp = [](const fs::path& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    EXPECT_FALSE(slurp(cpuPng).empty());
+    EXPECT_EQ(slurp(cpuPng), slurp(vulkanPng)) << "the Vulkan and CPU renders with ONV normals differ";
+    EXPECT_NE(slurp(cpuPng), slurp(plainPng)) << "the stored normals changed nothing";
+}

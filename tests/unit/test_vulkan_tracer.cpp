@@ -7,7 +7,9 @@
 // bit-identical t; the adversarial rays of test_tracer.cpp (axis-parallel
 // with +-0 components, on faces, edges and corners, grazing, roots spanning
 // 2^24 and 2^32) agree with ExactRayReference; rendered images of a level-set
-// sphere (with shadows) and a fog sphere match the CPU renderer's.
+// sphere (with shadows, with and without stored ONV normals), a sphere shell
+// shaded by a normal grid's ONV normals and a fog sphere match the CPU
+// renderer's.
 // Every test skips cleanly when no Vulkan device exists.
 #include <gtest/gtest.h>
 
@@ -22,6 +24,7 @@
 
 #include "gpu/VulkanContext.h"
 #include "gpu/VulkanTracer.h"
+#include "src/attributes/OctahedralNormal.h"
 #include "src/dag/DagBuilder.h"
 #include "src/encoding/CompactDag.h"
 #include "src/pipeline/GridCodec.h"
@@ -381,14 +384,19 @@ TEST(VulkanTracer, AgreesWithTheCpuTracerOnTheSharedLevelSets) {
 
 namespace {
 
-format::EncodedGrid encodeVdbGrid(openvdb::GridBase::Ptr grid, const std::string& name) {
+// Writes `grids` to a temporary .vdb and imports it back.
+bridge::ImportResult importVdbGrids(const openvdb::GridPtrVec& grids, const std::string& name, const bridge::ImportOptions& options = {}) {
     const fs::path path = fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".vdb");
     openvdb::io::File file(path.string());
-    file.write({grid});
+    file.write(grids);
     file.close();
-    const auto imported = bridge::importVdb(path.string());
+    auto imported = bridge::importVdb(path.string(), options);
     fs::remove(path);
-    return pipeline::encodeGrid(imported.volume.grids.at(0));
+    return imported;
+}
+
+format::EncodedGrid encodeVdbGrid(openvdb::GridBase::Ptr grid, const std::string& name) {
+    return pipeline::encodeGrid(importVdbGrids({grid}, name).volume.grids.at(0));
 }
 
 // Compares two renders: identical coverage, small colour difference.
@@ -410,6 +418,26 @@ void expectSameImage(const trace::Image& gpu, const trace::Image& cpu, double ma
     EXPECT_GT(covered, cpu.alpha.size() / 10) << label;
     EXPECT_EQ(coverageDiff, 0u) << label;
     EXPECT_LE(worst, maxColourDiff) << label;
+}
+
+// Float components of two renders' normals that differ (bit for bit).
+size_t differingNormals(const trace::Image& a, const trace::Image& b) {
+    size_t n = 0;
+    for (size_t i = 0; i < a.normal.size(); ++i) n += a.normal[i] != b.normal[i];
+    return n;
+}
+
+// The largest angle (degrees) between the normals of two renders of the same
+// scene, over the pixels both cover.
+double maxNormalAngle(const trace::Image& a, const trace::Image& b) {
+    double worst = 0;
+    for (size_t i = 0; i < a.alpha.size(); ++i) {
+        if (!(a.alpha[i] > 0) || !(b.alpha[i] > 0)) continue;
+        const std::array<float, 3> na{a.normal[3 * i], a.normal[3 * i + 1], a.normal[3 * i + 2]};
+        const std::array<float, 3> nb{b.normal[3 * i], b.normal[3 * i + 1], b.normal[3 * i + 2]};
+        worst = std::max(worst, attributes::angleDegrees(na, nb));
+    }
+    return worst;
 }
 
 } // namespace
@@ -464,4 +492,102 @@ TEST(VulkanTracer, RendersAFogSphereLikeTheCpuRenderer) {
     trace::RenderStats stats;
     // exp() differs in the last bits (a polynomial on the GPU): colours agree to ~1e-6.
     expectSameImage(gpuTracer.render(grid, camera, options, stats), trace::renderCpu(grid, camera, options), 1e-5, "fog sphere");
+}
+
+// `encode --normals K` on a level set: the GPU decodes the stored ONV codes
+// (palette lookup, octahedral unfold) bit for bit as the CPU does and shades
+// with them, gradient-sourced so never flipped.
+TEST(VulkanTracer, ShadesWithStoredOnvNormalsLikeTheCpuRenderer) {
+    VULKAN_OR_SKIP();
+    openvdb::initialize();
+    auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.1f, -0.2f, 0.3f), 1.0f / 40.0f, 3.0f);
+    sphere->setName("sphere");
+    bridge::ImportOptions io;
+    io.normals = true;
+    const auto imported = importVdbGrids({sphere}, "vdbdag_vk_onv_sphere", io);
+    const GridRecord& record = imported.volume.grids.at(0);
+    ASSERT_TRUE(record.normals.has_value());
+    trace::RenderOptions options;
+    options.shadows = true;
+    trace::RenderStats stats;
+
+    // The same grid without stored normals: shaded by the level-set gradient.
+    const format::EncodedGrid plainEncoded = pipeline::encodeGrid(record);
+    ASSERT_FALSE(plainEncoded.normals.has_value());
+    const trace::RenderGrid plainGrid = trace::makeRenderGrid(plainEncoded);
+    const trace::Camera camera = trace::frameBounds(trace::GridFrame(plainGrid.indexToWorld), plainGrid.cellLo, plainGrid.cellHi, 160, 120);
+    gpu::VulkanTracer plainTracer(*context(), plainGrid);
+    const trace::Image plain = plainTracer.render(plainGrid, camera, options, stats);
+
+    for (unsigned bits : {10u, 32u}) {
+        const std::string label = "sphere with " + std::to_string(bits) + "-bit ONV normals";
+        pipeline::EncodeOptions eo;
+        eo.normalBits = bits;
+        const format::EncodedGrid encoded = pipeline::encodeGrid(record, eo);
+        ASSERT_TRUE(encoded.normals.has_value());
+        EXPECT_EQ(encoded.normals->report.source, attributes::NormalReport::Source::Gradient);
+        const trace::RenderGrid grid = trace::makeRenderGrid(encoded);
+        ASSERT_EQ(grid.normals, &*encoded.normals);
+        gpu::VulkanTracer gpuTracer(*context(), grid);
+        const trace::Image gpu = gpuTracer.render(grid, camera, options, stats);
+        const trace::Image cpu = trace::renderCpu(grid, camera, options);
+        expectSameImage(gpu, cpu, 1e-6, label);
+        EXPECT_EQ(differingNormals(gpu, cpu), 0u) << label << ": the decoded normals are not bit-identical";
+        const double angle = maxNormalAngle(gpu, plain);
+        if (bits == 10) EXPECT_GT(angle, 0.5) << label << ": the stored normals are not used";
+        else EXPECT_LT(angle, 5.0) << label << ": far from the level set's own gradient";
+    }
+}
+
+// Normals from a normal grid (`--normal-grid`) have no orientation: like face
+// normals they are flipped towards the viewer. Inward vectors here, so every
+// visible one is flipped; on its own thin shell, with 16-bit codes.
+TEST(VulkanTracer, ShadesWithNormalGridOnvNormalsFlippedLikeTheCpuRenderer) {
+    VULKAN_OR_SKIP();
+    openvdb::initialize();
+    const openvdb::Vec3f centre(0.1f, -0.2f, 0.3f);
+    auto ls = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, centre, 1.0f / 24.0f, 3.0f);
+    ls->setName("sphere");
+    auto inward = openvdb::Vec3SGrid::create(openvdb::Vec3s(0));
+    inward->setName("N");
+    inward->setTransform(ls->transform().copy());
+    auto acc = inward->getAccessor();
+    for (auto it = ls->cbeginValueOn(); it; ++it) {
+        if (std::fabs(*it) > 0.6f) continue;  // a thin shell only
+        const openvdb::Vec3d d = ls->indexToWorld(it.getCoord()) - openvdb::Vec3d(centre);
+        acc.setValue(it.getCoord(), openvdb::Vec3s(d * -3.0));
+    }
+    bridge::ImportOptions io;
+    io.normals = true;
+    io.normalGrid = "N";
+    const auto imported = importVdbGrids({inward}, "vdbdag_vk_onv_normal_grid", io);
+    pipeline::EncodeOptions eo;
+    eo.normalBits = 16;
+    const format::EncodedGrid encoded = pipeline::encodeGrid(imported.volume.grids.at(0), eo);
+    ASSERT_TRUE(encoded.normals.has_value());
+    EXPECT_EQ(encoded.normals->report.source, attributes::NormalReport::Source::NormalGrid);
+    const trace::RenderGrid grid = trace::makeRenderGrid(encoded);
+    ASSERT_NE(grid.normals, nullptr);
+    const trace::Camera camera = trace::frameBounds(trace::GridFrame(grid.indexToWorld), grid.cellLo, grid.cellHi, 96, 72);
+    gpu::VulkanTracer gpuTracer(*context(), grid);
+    trace::RenderOptions options;
+    trace::RenderStats stats;
+    const trace::Image gpu = gpuTracer.render(grid, camera, options, stats);
+    const trace::Image cpu = trace::renderCpu(grid, camera, options);
+    expectSameImage(gpu, cpu, 1e-6, "shell with normal-grid ONV normals");
+    EXPECT_EQ(differingNormals(gpu, cpu), 0u);
+    // Flipped: every visible normal faces the viewer, i.e. points outwards
+    // here, against the stored (inward) vectors.
+    size_t facing = 0, covered = 0;
+    for (int py = 0; py < camera.height; ++py)
+        for (int px = 0; px < camera.width; ++px) {
+            const size_t i = size_t(py) * camera.width + px;
+            if (!(gpu.alpha[i] > 0)) continue;
+            ++covered;
+            glm::dvec3 eye, dir;
+            camera.pixelRay(px, py, eye, dir);
+            facing += dir[0] * gpu.normal[3 * i] + dir[1] * gpu.normal[3 * i + 1] + dir[2] * gpu.normal[3 * i + 2] <= 1e-6;  // float normals at grazing pixels
+        }
+    EXPECT_GT(covered, 100u);
+    EXPECT_EQ(facing, covered);
 }
