@@ -219,16 +219,13 @@ void renderPixel(uint i) {
             // CpuRenderer.cpp's precedence: the stored normal, else the
             // level-set gradient (finest level only), else the entry face.
             dvec3 normal;
-            dvec3 smoothNormal;
+            dvec3 g;
             bool oriented = false;  // outward already: not flipped towards the viewer
-            bool haveSmooth = storedNormal(hit.entry, smoothNormal);
-            if (haveSmooth) oriented = gNormalsOriented;
-            else if (LEVEL_SET && hit.lodLevel == 0u) {
-                haveSmooth = levelSetGradient(hit, smoothNormal);
-                oriented = haveSmooth;
-            }
-            if (haveSmooth) {
-                normal = normalToWorld(smoothNormal);
+            if (storedNormal(hit.entry, normal)) {
+                oriented = gNormalsOriented;  // world space already (CpuRenderer.cpp storedNormal)
+            } else if (LEVEL_SET && hit.lodLevel == 0u && levelSetGradient(hit, g)) {
+                normal = normalToWorld(g);
+                oriented = true;
             } else if (hit.faceAxis >= 0) {
                 dvec3 n = dvec3(0.0lf);
                 n[hit.faceAxis] = double(hit.faceSign);

@@ -23,8 +23,9 @@ void loadNormalParams() {
     gNormalsOriented = P.normalsOriented != 0u;
 }
 
-// CpuRenderer.cpp storedNormal: entry `index`'s decoded normal (index space,
-// as a double vector) when the grid has one for it.
+// CpuRenderer.cpp storedNormal: entry `index`'s decoded normal (world space:
+// vdb_bridge computes it through the grid's transform), as a double vector,
+// when the grid has one for it.
 bool storedNormal(uint64_t index, out dvec3 n) {
     n = dvec3(0.0lf);
     if (!HAS_NORMALS || index >= gNormals.entryCount) return false;
