@@ -30,6 +30,7 @@ constexpr size_t kRayBatch = size_t(1) << 20;
 struct TraceParamsGpu {
     DeviceArrayRef inner, leaves;
     PaletteChannelGpu values, normals;
+    DeviceArrayRef inside;
     int64_t origin[3], boxLo[3], boxHi[3];
     uint64_t levelStart[kMaxInnerLevels];
     double lodScale, valueMin, valueMax;
@@ -40,7 +41,7 @@ struct TraceParamsGpu {
     uint32_t offsetWords[kMaxInnerLevels];
     uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, pad;
 };
-static_assert(sizeof(TraceParamsGpu) == 1296, "must match trace_params.glsl");
+static_assert(sizeof(TraceParamsGpu) == 1320, "must match trace_params.glsl");
 
 struct TracePush {
     uint64_t params, rays, results, counter;
@@ -65,7 +66,7 @@ enum class Mode : uint32_t { Hits = 0, Render = 1, Primary = 2 };
 
 struct VulkanTracer::Impl {
     VulkanContext& context;
-    std::vector<DeviceArray> arrays;  // inner, leaves
+    std::vector<DeviceArray> arrays;  // inner, leaves, then the inside bits when the grid has them
     std::vector<DevicePaletteChannel> channels;  // values, then normals when the grid has them
     DeviceBuffer params;
     DeviceBuffer counter;
@@ -131,9 +132,10 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid,
     DeviceArrayOptions chunks;
     chunks.chunkShift = chunkShift;
     auto& arrays = impl_->arrays;
-    arrays.reserve(2);
+    arrays.reserve(3);
     arrays.emplace_back(context, orZeros(bytesOf(dag.inner)), "DAG inner words", chunks);
     arrays.emplace_back(context, orZeros(bytesOf(dag.leaves)), "DAG leaves", chunks);
+    if (grid.inside) arrays.emplace_back(context, orZeros(bytesOf(grid.inside->words)), "inside bits", chunks);
     // The normal channel only when the grid has one: its pipelines are the
     // only ones that read it (HAS_NORMALS); otherwise its reference stays zero.
     auto& channels = impl_->channels;
@@ -145,6 +147,7 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid,
     p.inner = arrays[0].ref();
     p.leaves = arrays[1].ref();
     p.values = channels[0].ref();
+    if (grid.inside) p.inside = arrays[2].ref();
     if (grid.normals) {
         p.normals = channels[1].ref();
         p.normalBits = grid.normals->bits;

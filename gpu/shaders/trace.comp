@@ -51,6 +51,7 @@ TraceParams P;
 
 #include "trace_values.glsl"
 #include "trace_normals.glsl"
+#include "trace_inside.glsl"
 #include "trace_walk.glsl"
 
 // SurfaceHit.cpp firstSurfaceHit.
@@ -271,6 +272,7 @@ void main() {
     P = TraceParams(pc.params);
     loadTraceParams();
     loadValueParams();
+    loadInsideParams();
     if (MODE == 1u) loadNormalParams();
     if (MODE == 0u) traceOneRay(i);
     else if (MODE == 1u) renderPixel(i);

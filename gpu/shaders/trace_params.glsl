@@ -17,6 +17,7 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Tra
     DeviceArray leaves;     // uint64 4^3 bricks
     PaletteChannel values;  // entryCount 0 when the grid stores none
     PaletteChannel normals; // uint32 ONV codes (NormalChannel::codes); entryCount 0 when the grid stores none
+    DeviceArray inside;     // uint64 words of InsideBits (level sets with values); firstChunk 0 otherwise
     int64_t origin[3];      // index coordinate of the root cube's corner
     int64_t boxLo[3];       // occupied box, relative to the root corner
     int64_t boxHi[3];

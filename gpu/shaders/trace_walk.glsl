@@ -186,7 +186,8 @@ double expDouble(double x) {
 // The visitor of the segment walks; true stops the walk.
 bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore, inout Hit found) {
     if (visitKind == kVisitZeroCrossing) {
-        if (box.t < ignoreBefore || !(valueAsDoubles(box.entry).x <= 0.0lf)) return false;
+        if (box.t < ignoreBefore) return false;
+        if (gHasInside ? !insideAt(box.entry) : !(valueAsDoubles(box.entry).x <= 0.0lf)) return false;
         found = box;
         return true;
     }
@@ -297,6 +298,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             const uint64_t base = stackBase[depth] + attributeOffset;
             if (depth + 1u == innerLevels) {
                 leafStored = leafMask(offset);
+                // A leaf with no inside voxel is empty space to the zero crossing (DagWalk.h keepLeaf).
+                if (visitKind == kVisitZeroCrossing && gHasInside && !anyInside(base, popcount64(leafStored))) { skip = halfLog2; break; }
                 leafSpatial = reflectBrick(leafStored, mirror);
                 leafMirror = mirror;
                 leafBase = base;
