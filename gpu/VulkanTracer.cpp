@@ -264,7 +264,7 @@ void VulkanTracer::setCamera(const trace::Camera& camera, double lodPixels) {
     p.tilesX = (p.width + 7) / 8;
 }
 
-std::vector<trace::RayHit> VulkanTracer::tracePrimary(const trace::Camera& camera, HitKind kind, double lodPixels) {
+const std::vector<trace::RayHit>& VulkanTracer::tracePrimary(const trace::Camera& camera, HitKind kind, double lodPixels) {
     Impl& impl = *impl_;
     setCamera(camera, lodPixels);
     impl.writeParams();
@@ -275,9 +275,9 @@ std::vector<trace::RayHit> VulkanTracer::tracePrimary(const trace::Camera& camer
     const uint64_t items = uint64_t(impl.host.tilesX) * ((impl.host.height + 7) / 8) * kWorkgroup;
     TracePush push{impl.params.address(), 0, primaryHits_->address(), impl.counter.address(), uint32_t(items), 0};
     lastDeviceMs_ = pipe.dispatch(items, push).deviceMs;
-    std::vector<trace::RayHit> hits(pixels);
-    unpackHits(primaryHits_->mappedData(), hits);
-    return hits;
+    primaryHitsHost_.resize(pixels);
+    unpackHits(primaryHits_->mappedData(), primaryHitsHost_);
+    return primaryHitsHost_;
 }
 
 trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,

@@ -158,7 +158,7 @@ void vulkanPrimary(benchmark::State& state, const vdbdag::format::EncodedGrid& e
     uint64_t hits = 0;
     double deviceMs = 0;
     for (auto _ : state) {
-        const std::vector<vdbdag::trace::RayHit> result = tracer.tracePrimary(scene().camera, kind);
+        const std::vector<vdbdag::trace::RayHit>& result = tracer.tracePrimary(scene().camera, kind);
         deviceMs += tracer.lastDeviceMs();
         hits = 0;
         for (const auto& h : result) hits += h.hit;
