@@ -172,6 +172,7 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid,
 
 VulkanTracer::~VulkanTracer() {
     primaryHits_.reset();  // before the context they live on
+    renderedPixels_.reset();
     impl_.reset();
 }
 
@@ -296,7 +297,9 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
 
     ComputePipeline& pipe = impl.pipeline(grid_, Mode::Render, grid_.levelSet, options.shadows && !grid_.fog);
     const size_t pixels = size_t(camera.width) * size_t(camera.height);
-    DeviceBuffer out(impl.context, pixels * 32, MemoryKind::HostVisible, "rendered pixels", false);
+    if (!renderedPixels_ || renderedPixels_->size() < pixels * 32)  // reused between frames, like the primary hits
+        renderedPixels_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 32, MemoryKind::HostVisible, "rendered pixels", false);
+    DeviceBuffer& out = *renderedPixels_;
     const uint64_t items = uint64_t(p.tilesX) * tilesY * kWorkgroup;
     TracePush push{impl.params.address(), 0, out.address(), impl.counter.address(), uint32_t(items), 0};
     lastDeviceMs_ = pipe.dispatch(items, push).deviceMs;

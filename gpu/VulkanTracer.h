@@ -77,6 +77,7 @@ private:
     static void unpackHits(const void* words, std::span<trace::RayHit> hits);
     std::unique_ptr<DeviceBuffer> primaryHits_;
     std::vector<trace::RayHit> primaryHitsHost_;
+    std::unique_ptr<DeviceBuffer> renderedPixels_;
     std::unique_ptr<VulkanContext> ownContext_;
     std::unique_ptr<Impl> impl_;
     trace::RenderGrid grid_;
