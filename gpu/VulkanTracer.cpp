@@ -81,7 +81,8 @@ struct VulkanTracer::Impl {
         // pipelines: first-hit rays read no values, hits need no colours.
         const bool fog = mode == Mode::Render && grid.fog;
         const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
-        const bool readsValues = mode == Mode::Render || levelSet;
+        // Level-set hits test inside bits (trace_inside.glsl), not values; renders read values for gradients and colours.
+        const bool readsValues = mode == Mode::Render || (levelSet && !grid.inside);
         const uint32_t valueType = grid.values && readsValues ? uint32_t(grid.valueType) : 255u;
         const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
         const bool normals = mode == Mode::Render && !fog && grid.normals;  // only surface shading reads them
