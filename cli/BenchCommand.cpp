@@ -175,8 +175,14 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                 importOptions.onlyGrids = {grid.name};
                 importOptions.normals = true;
                 Volume again = bridge::importVdb(opt->input, importOptions).volume;
+                // Names may repeat: take the grid of the same rank among its namesakes (both imports keep file order).
+                size_t rank = 0;
+                for (size_t g = 0; g < chosen[n]; ++g) rank += volume.grids[g].name == grid.name;
                 for (GridRecord& g : again.grids)
-                    if (g.name == grid.name && g.normals) withNormals = std::move(g);
+                    if (g.name == grid.name && rank-- == 0) {
+                        if (g.normals) withNormals = std::move(g);
+                        break;
+                    }
                 if (withNormals)
                     for (unsigned bits : sweep.normalBits) {
                         Setting s{fmt::format("normals ONV {} bits", bits), "vdbdag normals", {}, 0, bench::kNormalError};
