@@ -77,6 +77,35 @@ double largestMagnitude(const GridRecord& grid) {
 
 std::string roundTolerance(double v) { return fmt::format("{:.2g}", v); }
 
+// One setting's encoding, timed: encode + write, then read + decode, repeated
+// within the budget (bench::repeatAgain). Keeps the last run's encoding.
+struct TimedEncoding {
+    format::EncodedGrid grid;
+    uint64_t fileBytes = 0;
+    bench::Timing encode, decode;
+};
+
+TimedEncoding timedEncode(const GridRecord& source, const pipeline::EncodeOptions& options, int repeats, double budgetMs) {
+    TimedEncoding out;
+    std::vector<double> encodeMs, decodeMs;
+    for (int r = 0; bench::repeatAgain(r, repeats, bench::totalMs(encodeMs) + bench::totalMs(decodeMs), budgetMs); ++r) {
+        auto t0 = Clock::now();
+        format::SsvdagScene scene;
+        scene.grids.push_back(pipeline::encodeGrid(source, options));
+        const std::vector<uint8_t> bytes = format::writeScene(scene);
+        encodeMs.push_back(msSince(t0));
+        t0 = Clock::now();
+        const format::SsvdagScene back = format::readScene(bytes, "bench");
+        pipeline::decodeGrid(back.grids.front());
+        decodeMs.push_back(msSince(t0));
+        out.fileBytes = bytes.size();
+        out.grid = std::move(scene.grids.front());
+    }
+    out.encode = bench::summarise(encodeMs);
+    out.decode = bench::summarise(decodeMs);
+    return out;
+}
+
 } // namespace
 
 void addBenchCommand(CLI::App& app, int& exitCode) {
@@ -143,13 +172,13 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
             wide.options.compactPointers = false;
             settings.push_back(wide);
             std::vector<double> absTolerances;
-            std::map<std::string, double> absBoundOf;  // setting name -> its absolute bound
+            std::map<double, std::string> absSettingOf;  // the sweep's absolute bounds -> their setting names
             if (scalar && largest > 0) {
                 for (double f : sweep.absFractions) {
                     const double tolerance = std::stod(roundTolerance(largest * f));
                     absTolerances.push_back(tolerance);
                     Setting s{fmt::format("abs {}", roundTolerance(tolerance)), "vdbdag abs", {}, 0};
-                    absBoundOf[s.name] = tolerance;
+                    absSettingOf[tolerance] = s.name;
                     s.options.tolerance = {attributes::ScalarTolerance::Mode::Absolute, tolerance};
                     settings.push_back(s);
                 }
@@ -214,23 +243,11 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                     encoded = *losslessGrid;
                     p.note = "the lossless encoding, traced with an LOD cut-off";
                 } else {
-                    const GridRecord& source = setting.options.normalBits ? *withNormals : grid;
-                    std::vector<double> encodeMs, decodeMs;
-                    for (int r = 0; bench::repeatAgain(r, run.repeats, bench::totalMs(encodeMs) + bench::totalMs(decodeMs), budgetMs); ++r) {
-                        auto t0 = Clock::now();
-                        format::SsvdagScene scene;
-                        scene.grids.push_back(pipeline::encodeGrid(source, setting.options));
-                        const std::vector<uint8_t> bytes = format::writeScene(scene);
-                        encodeMs.push_back(msSince(t0));
-                        t0 = Clock::now();
-                        const format::SsvdagScene back = format::readScene(bytes, "bench");
-                        const GridRecord decoded = pipeline::decodeGrid(back.grids.front());
-                        decodeMs.push_back(msSince(t0));
-                        p.bytes = bytes.size();
-                        encoded = std::move(scene.grids.front());
-                    }
-                    p.encode = bench::summarise(encodeMs);
-                    p.decode = bench::summarise(decodeMs);
+                    TimedEncoding timed = timedEncode(setting.options.normalBits ? *withNormals : grid, setting.options, run.repeats, budgetMs);
+                    p.bytes = timed.fileBytes;
+                    p.encode = timed.encode;
+                    p.decode = timed.decode;
+                    encoded = std::move(timed.grid);
                     p.traceableBytes = encoded->dag.byteSize() + encoded->values.byteSize();
                     const auto& lossy = encoded->lossy;
                     p.exact = lossy.changed == 0;
@@ -317,9 +334,11 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                 p.rawBytes = voxels * valueSize(grid.valueType);
                 p.note = "matched to " + peer.tool + " " + peer.setting;
                 // The sweep already encoded this bound (FpN usually reaches its tolerance exactly): the same point again.
-                const auto same = std::find_if(run.points.begin(), run.points.end(), [&](const bench::BenchPoint& q) {
-                    return q.grid == gridName && q.family == "vdbdag abs" && absBoundOf.count(q.setting) && absBoundOf.at(q.setting) == peer.maxError;
-                });
+                const auto bound = absSettingOf.find(peer.maxError);
+                const auto same = bound == absSettingOf.end() ? run.points.end()
+                                                              : std::find_if(run.points.begin(), run.points.end(), [&](const bench::BenchPoint& q) {
+                                                                    return q.grid == gridName && q.setting == bound->second;
+                                                                });
                 if (same != run.points.end()) {
                     bench::BenchPoint copy = *same;
                     copy.setting = p.setting;
@@ -330,25 +349,14 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                     run.points.push_back(copy);
                     continue;
                 }
-                std::vector<double> encodeMs, decodeMs;
-                for (int r = 0; bench::repeatAgain(r, run.repeats, bench::totalMs(encodeMs) + bench::totalMs(decodeMs), budgetMs); ++r) {
-                    auto t0 = Clock::now();
-                    format::SsvdagScene scene;
-                    scene.grids.push_back(pipeline::encodeGrid(grid, options));
-                    const std::vector<uint8_t> bytes = format::writeScene(scene);
-                    encodeMs.push_back(msSince(t0));
-                    t0 = Clock::now();
-                    const format::SsvdagScene back = format::readScene(bytes, "bench");
-                    pipeline::decodeGrid(back.grids.front());
-                    decodeMs.push_back(msSince(t0));
-                    p.bytes = bytes.size();
-                    p.traceableBytes = scene.grids.front().dag.byteSize() + scene.grids.front().values.byteSize();
-                    p.exact = scene.grids.front().lossy.changed == 0;
-                    p.maxError = scene.grids.front().lossy.maxAbsError;
-                    p.rmsError = scene.grids.front().lossy.rmsError;
-                }
-                p.encode = bench::summarise(encodeMs);
-                p.decode = bench::summarise(decodeMs);
+                const TimedEncoding timed = timedEncode(grid, options, run.repeats, budgetMs);
+                p.bytes = timed.fileBytes;
+                p.encode = timed.encode;
+                p.decode = timed.decode;
+                p.traceableBytes = timed.grid.dag.byteSize() + timed.grid.values.byteSize();
+                p.exact = timed.grid.lossy.changed == 0;
+                p.maxError = timed.grid.lossy.maxAbsError;
+                p.rmsError = timed.grid.lossy.rmsError;
                 run.points.push_back(p);
             }
         }

@@ -1,21 +1,9 @@
 // Uploads a palette channel's sections; see DevicePaletteChannel.h.
 #include "gpu/DevicePaletteChannel.h"
 
+#include "gpu/ByteSpan.h"
+
 namespace vdbdag::gpu {
-namespace {
-
-template <class T>
-std::span<const uint8_t> bytesOf(const std::vector<T>& v) {
-    return {reinterpret_cast<const uint8_t*>(v.data()), v.size() * sizeof(T)};
-}
-
-// Empty sections still get a (zero) array so every address is valid.
-std::span<const uint8_t> orZeros(std::span<const uint8_t> bytes) {
-    static const uint8_t zeros[16] = {};
-    return bytes.empty() ? std::span<const uint8_t>(zeros, 16) : bytes;
-}
-
-} // namespace
 
 DevicePaletteChannel::DevicePaletteChannel(VulkanContext& context, const attributes::PaletteChannel* channel, const std::string& label,
                                            DeviceArrayOptions options) {

@@ -11,6 +11,7 @@
 
 #include <fmt/core.h>
 
+#include "gpu/ByteSpan.h"
 #include "gpu/ComputePipeline.h"
 #include "gpu/DeviceArray.h"
 #include "gpu/DeviceBuffer.h"
@@ -49,16 +50,6 @@ struct TracePush {
 };
 static_assert(sizeof(TracePush) == 40);
 
-template <class T>
-std::span<const uint8_t> bytesOf(const std::vector<T>& v) {
-    return {reinterpret_cast<const uint8_t*>(v.data()), v.size() * sizeof(T)};
-}
-
-// Empty sections still get a (zero) array so every address is valid.
-std::span<const uint8_t> orZeros(std::span<const uint8_t> bytes) {
-    static const uint8_t zeros[16] = {};
-    return bytes.empty() ? std::span<const uint8_t>(zeros, 16) : bytes;
-}
 
 enum class Mode : uint32_t { Hits = 0, Render = 1, Primary = 2 };
 

@@ -24,7 +24,7 @@ struct PaletteChannel {
     uint pad;
 };
 
-// PaletteChannel.cpp getBits.
+// PaletteChannel.h readPackedBits.
 uint64_t paletteBits(DeviceArray indexBits, uint64_t bitOffset, uint bits) {
     if (bits == 0u) return 0ul;
     const uint64_t word = bitOffset >> 6;

@@ -19,15 +19,15 @@ struct Timing {
 };
 Timing summarise(std::vector<double> samplesMs);
 
-// Whether to time run number `done` (0-based) of a measurement: at most
-// `repeats` runs, and after the first only while the runs so far took less
-// than `budgetMs` in all (a 20M-voxel grid's encode then runs once; small
-// grids get every repeat). Timing::runs reports what was done.
 inline double totalMs(const std::vector<double>& samplesMs) {
     double sum = 0;
     for (double ms : samplesMs) sum += ms;
     return sum;
 }
+// Whether to time run number `done` (0-based) of a measurement: at most
+// `repeats` runs, and after the first only while the runs so far took less
+// than `budgetMs` in all (a 20M-voxel grid's encode then runs once; small
+// grids get every repeat). Timing::runs reports what was done.
 inline bool repeatAgain(int done, int repeats, double spentMs, double budgetMs) {
     return done < repeats && (done == 0 || spentMs < budgetMs);
 }
