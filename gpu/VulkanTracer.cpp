@@ -39,10 +39,11 @@ struct TraceParamsGpu {
     double halfWidth, halfHeight;
     double eyeCell[3], inverse[9], normalMatrix[9], light[3], lightCell[3], background[3];
     double shadowBias, fogScale;
+    uint64_t offsetWordsPacked[2];
     uint32_t offsetWords[kMaxInnerLevels];
     uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, pad;
 };
-static_assert(sizeof(TraceParamsGpu) == 1320, "must match trace_params.glsl");
+static_assert(sizeof(TraceParamsGpu) == 1336, "must match trace_params.glsl");
 
 struct TracePush {
     uint64_t params, rays, results, counter;
@@ -153,6 +154,7 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid,
     for (size_t i = 0; i < dag.innerLevelCount(); ++i) {
         p.levelStart[i] = dag.levelStart[i];
         p.offsetWords[i] = dag.offsetWords[i];
+        p.offsetWordsPacked[i / 21] |= uint64_t(dag.offsetWords[i] & 7u) << (3 * (i % 21));
     }
     p.valueMin = grid.valueMin;
     p.valueMax = grid.valueMax;

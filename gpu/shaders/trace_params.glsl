@@ -35,6 +35,7 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Tra
     double background[3];
     double shadowBias;      // level sets: boxes entered before this are ignored by shadow rays
     double fogScale;        // densityScale / (valueMax * voxelSize)
+    uint64_t offsetWordsPacked[2];  // offsetWords again, 3 bits per level: levels 0-20, then 21-39
     uint offsetWords[kMaxInnerLevels];
     uint log2Size;
     uint rootReflection;

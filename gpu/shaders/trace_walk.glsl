@@ -21,6 +21,7 @@ i64vec3 gRootOrigin, gBoxLo, gBoxHi;
 uint gLog2Size, gRootReflection, gInnerLevels, gMaxSteps;
 uint64_t gInnerAddress, gLeavesAddress;  // chunk 0 of the DAG arrays
 DeviceArray gInner, gLeaves;
+uint64_t gOffsetWordsPacked[2];  // offsetWords, 3 bits per level (offsetWordsAt)
 
 void loadTraceParams() {
     gRootOrigin = i64vec3(P.origin[0], P.origin[1], P.origin[2]);
@@ -34,6 +35,15 @@ void loadTraceParams() {
     gLeaves = P.leaves;
     gInnerAddress = gInner.firstChunk;
     gLeavesAddress = gLeaves.firstChunk;
+    gOffsetWordsPacked[0] = P.offsetWordsPacked[0];
+    gOffsetWordsPacked[1] = P.offsetWordsPacked[1];
+}
+
+// P.offsetWords[depth] without a load: the walk's depth differs between the
+// invocations of a subgroup, so an indexed read of the parameter block is a
+// gather on every descent.
+uint offsetWordsAt(uint depth) {
+    return depth < 21u ? uint(gOffsetWordsPacked[0] >> (3u * depth)) & 7u : uint(gOffsetWordsPacked[1] >> (3u * (depth - 21u))) & 7u;
 }
 
 // The DAG's words; ONE_CHUNK_DAG (specialisation constant: both arrays fit
@@ -259,13 +269,17 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
     double tNext[3];
     for (int a = 0; a < 3; ++a) tNext[a] = gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? v[a] + 1l : v[a]);
 
-    uint64_t stackPos[kMaxInnerLevels];
+    // The stack of stored nodes containing v, a node's word position and
+    // mirror mask packed in one word (pos | mirror << 61), and the node at
+    // `depth` also in registers (node*): the stack is private memory, whose
+    // every access is a gather or a scatter, so it is read only on a pop.
+    uint64_t stackPosMirror[kMaxInnerLevels];
     uint64_t stackBase[kMaxInnerLevels];
-    uint stackMirror[kMaxInnerLevels];
     uint depth = 0u;
-    stackPos[0] = 0ul;
+    uint64_t nodePos = 0ul, nodeBase = 0ul;
+    uint nodeMirror = gRootReflection;
+    stackPosMirror[0] = uint64_t(gRootReflection) << 61;
     stackBase[0] = 0ul;
-    stackMirror[0] = gRootReflection;
     const uint innerLevels = gInnerLevels;
     uint steps = 0u;
     bool inLeaf = false;
@@ -277,12 +291,10 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         uint skip = 0u;
         bool occupied = false;
         while (!inLeaf) {
-            const uint64_t nodePos = stackPos[depth];
-            const uint nodeMirror = stackMirror[depth];
             const uint s = L - depth;
             const uint header = innerWord(nodePos);
             if (header == 0u) {
-                result = makeHit(v, crossed, t, stackBase[depth], s, steps);
+                result = makeHit(v, crossed, t, nodeBase, s, steps);
                 occupied = true;
                 skip = s;
                 break;
@@ -293,9 +305,9 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             if (((header >> (2u * j)) & 3u) == 0u) { skip = halfLog2; break; }
             uint64_t offset, attributeOffset;
             uint reflection;
-            readChildPointer(nodePos, header, j, P.offsetWords[depth], offset, reflection, attributeOffset);
+            readChildPointer(nodePos, header, j, offsetWordsAt(depth), offset, reflection, attributeOffset);
             const uint mirror = nodeMirror ^ reflection;
-            const uint64_t base = stackBase[depth] + attributeOffset;
+            const uint64_t base = nodeBase + attributeOffset;
             if (depth + 1u == innerLevels) {
                 leafStored = leafMask(offset);
                 // A leaf with no inside voxel is empty space to the zero crossing (DagWalk.h keepLeaf).
@@ -312,10 +324,12 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 skip = halfLog2;
                 break;
             }
-            stackPos[depth + 1u] = P.levelStart[depth + 1u] + offset;
-            stackBase[depth + 1u] = base;
-            stackMirror[depth + 1u] = mirror;
+            nodePos = P.levelStart[depth + 1u] + offset;
+            nodeBase = base;
+            nodeMirror = mirror;
             ++depth;
+            stackPosMirror[depth] = nodePos | (uint64_t(mirror) << 61);
+            stackBase[depth] = base;
         }
         if (inLeaf && !occupied && skip == 0u) {
             const uint x = uint(v[0] & 3l), y = uint(v[1] & 3l), z = uint(v[2] & 3l);
@@ -369,7 +383,13 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         const uint64_t changed = uint64_t(next[0] ^ v[0]) | uint64_t(next[1] ^ v[1]) | uint64_t(next[2] ^ v[2]);
         const uint keepLog2 = bitWidth64(changed);
         if (keepLog2 > 2u) inLeaf = false;
-        if (L - depth < keepLog2) depth = L - keepLog2;
+        if (L - depth < keepLog2) {
+            depth = L - keepLog2;
+            const uint64_t pm = stackPosMirror[depth];
+            nodePos = pm & ((uint64_t(1) << 61) - 1ul);
+            nodeMirror = uint(pm >> 61);
+            nodeBase = stackBase[depth];
+        }
         v = next;
         t = tNew;
     }
@@ -397,7 +417,7 @@ bool findVoxel(i64vec3 voxel, out uint64_t entry) {
         if (((header >> (2u * j)) & 3u) == 0u) return false;
         uint64_t offset, attributeOffset;
         uint reflection;
-        readChildPointer(pos, header, j, P.offsetWords[depth], offset, reflection, attributeOffset);
+        readChildPointer(pos, header, j, offsetWordsAt(depth), offset, reflection, attributeOffset);
         mirror ^= reflection;
         base += attributeOffset;
         if (depth + 1u == gInnerLevels) {
