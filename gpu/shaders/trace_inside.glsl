@@ -24,14 +24,17 @@ bool insideAt(uint64_t entry) {
     return ((deviceArrayU64(gInside, entry >> 6) >> uint(entry & 63ul)) & 1ul) != 0ul;
 }
 
-// InsideBits::anyInside: any of the `count` (<= 64) entries from `first`.
-bool anyInside(uint64_t first, uint count) {
-    if (count == 0u || first >= gInsideEntries) return false;
+// The inside bits of the `count` (<= 64) entries from `first` (bit k: entry
+// first + k), 0 past the entries; InsideBits::anyInside is whether any is
+// set. The walk keeps a leaf's word in a register, so the zero-crossing test
+// of its voxels reads no memory.
+uint64_t insideWord(uint64_t first, uint count) {
+    if (count == 0u || first >= gInsideEntries) return 0ul;
     const uint64_t word = first >> 6;
     const uint shift = uint(first & 63ul);
     uint64_t bits = deviceArrayU64(gInside, word) >> shift;
     if (shift + count > 64u && ((word + 1ul) << 6) < gInsideEntries) bits |= deviceArrayU64(gInside, word + 1ul) << (64u - shift);
-    return (count == 64u ? bits : bits & ((uint64_t(1) << count) - 1ul)) != 0ul;
+    return count == 64u ? bits : bits & ((uint64_t(1) << count) - 1ul);
 }
 
 #endif

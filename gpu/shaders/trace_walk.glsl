@@ -194,10 +194,11 @@ double expDouble(double x) {
 }
 
 // The visitor of the segment walks; true stops the walk.
-bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore, inout Hit found) {
+// `knownInside`: the walk has tested the box's inside bit already.
+bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore, inout Hit found, bool knownInside) {
     if (visitKind == kVisitZeroCrossing) {
         if (box.t < ignoreBefore) return false;
-        if (gHasInside ? !insideAt(box.entry) : !(valueAsDoubles(box.entry).x <= 0.0lf)) return false;
+        if (!knownInside && (gHasInside ? !insideAt(box.entry) : !(valueAsDoubles(box.entry).x <= 0.0lf))) return false;
         found = box;
         return true;
     }
@@ -285,7 +286,11 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
     bool inLeaf = false;
     uint64_t leafStored = 0ul, leafSpatial = 0ul, leafBase = 0ul;
     uint leafMirror = 0u;
-    bool pending = false;
+    // Zero crossing with inside bits: the leaf's bits (insideWord); its
+    // voxels that are outside are passed as empty, the others as inside.
+    const bool insideTest = visitKind == kVisitZeroCrossing && gHasInside;
+    uint64_t leafInside = 0ul;
+    bool pending = false, pendingInside = false;
 
     while (true) {
         uint skip = 0u;
@@ -311,7 +316,10 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             if (depth + 1u == innerLevels) {
                 leafStored = leafMask(offset);
                 // A leaf with no inside voxel is empty space to the zero crossing (DagWalk.h keepLeaf).
-                if (visitKind == kVisitZeroCrossing && gHasInside && !anyInside(base, popcount64(leafStored))) { skip = halfLog2; break; }
+                if (insideTest) {
+                    leafInside = insideWord(base, popcount64(leafStored));
+                    if (leafInside == 0ul) { skip = halfLog2; break; }
+                }
                 leafSpatial = reflectBrick(leafStored, mirror);
                 leafMirror = mirror;
                 leafBase = base;
@@ -331,12 +339,18 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             stackPosMirror[depth] = nodePos | (uint64_t(mirror) << 61);
             stackBase[depth] = base;
         }
+        bool occupiedInside = false;
         if (inLeaf && !occupied && skip == 0u) {
             const uint x = uint(v[0] & 3l), y = uint(v[1] & 3l), z = uint(v[2] & 3l);
             if (((leafSpatial >> (x + 4u * y + 16u * z)) & 1ul) != 0ul) {
                 const uint bit = storedBit(x, y, z, leafMirror);
-                result = makeHit(v, crossed, t, leafBase + uint64_t(popcount64(leafStored & ((uint64_t(1) << bit) - 1ul))), 0u, steps);
-                occupied = true;
+                const uint rank = popcount64(leafStored & ((uint64_t(1) << bit) - 1ul));
+                // An outside voxel would be rejected by the visitor: not passed at all.
+                if (!insideTest || ((leafInside >> rank) & 1ul) != 0ul) {
+                    result = makeHit(v, crossed, t, leafBase + uint64_t(rank), 0u, steps);
+                    occupied = true;
+                    occupiedInside = insideTest;
+                }
             } else {
                 const uint corner = (x & 2u) + 4u * (y & 2u) + 16u * (z & 2u);
                 if ((leafSpatial & (uint64_t(0x330033) << corner)) == 0ul) skip = 1u;
@@ -344,6 +358,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         }
         if (firstOnly && occupied) return result;
         pending = occupied;
+        pendingInside = occupiedInside;
 
         if (++steps > gMaxSteps) return firstOnly ? noHit() : found;
         const int64_t cube = int64_t(1) << skip;
@@ -360,7 +375,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         }
         if (!firstOnly && pending) {
             pending = false;
-            if (visitBox(visitKind, result, tExit < tNew ? tExit : tNew, ignoreBefore, found)) return found;
+            if (visitBox(visitKind, result, tExit < tNew ? tExit : tNew, ignoreBefore, found, pendingInside)) return found;
         }
         if (!(tNew < tExit)) return firstOnly ? noHit() : found;
         i64vec3 next;
