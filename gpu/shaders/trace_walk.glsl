@@ -216,7 +216,9 @@ bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore,
 Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, uint steps) {
     int faceAxis = -1;
     const int64_t within = (int64_t(1) << lodLevel) - 1l;
-    for (int a = 0; a < 3 && faceAxis < 0; ++a)
+    // The lowest crossed axis whose face is also the box's (straight-line:
+    // on lavapipe a loop's body runs at least once, whatever its condition).
+    for (int a = 2; a >= 0; --a)
         if (((crossed >> a) & 1u) != 0u && (v[a] & within) == (gD[a] > 0.0lf ? 0l : within)) faceAxis = a;
     Hit h;
     h.hit = true;
@@ -295,11 +297,16 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
     while (true) {
         uint skip = 0u;
         bool occupied = false;
+        // The occupied box found (a tile, an LOD node or a leaf voxel): one
+        // makeHit below for all three, as lavapipe runs every copy of it.
+        uint64_t hitEntry = 0ul;
+        uint hitLevel = 0u;
         while (!inLeaf) {
             const uint s = L - depth;
             const uint header = innerWord(nodePos);
             if (header == 0u) {
-                result = makeHit(v, crossed, t, nodeBase, s, steps);
+                hitEntry = nodeBase;
+                hitLevel = s;
                 occupied = true;
                 skip = s;
                 break;
@@ -327,7 +334,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 break;
             }
             if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * t) {
-                result = makeHit(v, crossed, t, base, halfLog2, steps);
+                hitEntry = base;
+                hitLevel = halfLog2;
                 occupied = true;
                 skip = halfLog2;
                 break;
@@ -347,7 +355,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 const uint rank = popcount64(leafStored & ((uint64_t(1) << bit) - 1ul));
                 // An outside voxel would be rejected by the visitor: not passed at all.
                 if (!insideTest || ((leafInside >> rank) & 1ul) != 0ul) {
-                    result = makeHit(v, crossed, t, leafBase + uint64_t(rank), 0u, steps);
+                    hitEntry = leafBase + uint64_t(rank);
+                    hitLevel = 0u;
                     occupied = true;
                     occupiedInside = insideTest;
                 }
@@ -356,6 +365,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 if ((leafSpatial & (uint64_t(0x330033) << corner)) == 0ul) skip = 1u;
             }
         }
+        if (occupied) result = makeHit(v, crossed, t, hitEntry, hitLevel, steps);
         if (firstOnly && occupied) return result;
         pending = occupied;
         pendingInside = occupiedInside;
