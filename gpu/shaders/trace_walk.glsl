@@ -269,7 +269,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         for (int a = 0; a < 3; ++a)
             if (gD[a] != 0.0lf && crossing(a, gD[a] > 0.0lf ? v[a] : v[a] + 1l) == t) crossed |= 1u << a;
 
-    double tNext[3];
+    dvec3 tNext;  // a vector, not an array: indexed by a varying axis below
     for (int a = 0; a < 3; ++a) tNext[a] = gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? v[a] + 1l : v[a]);
 
     // The stack of stored nodes containing v, a node's word position and
@@ -373,7 +373,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         if (++steps > gMaxSteps) return firstOnly ? noHit() : found;
         const int64_t cube = int64_t(1) << skip;
         i64vec3 lo, hi;
-        double tc[3];
+        dvec3 tc;
         double tNew = infinity();
         for (int a = 0; a < 3; ++a) {
             lo[a] = v[a] & ~(cube - 1l);
@@ -388,22 +388,30 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             if (visitBox(visitKind, result, tExit < tNew ? tExit : tNew, ignoreBefore, found, pendingInside)) return found;
         }
         if (!(tNew < tExit)) return firstOnly ? noHit() : found;
-        i64vec3 next;
+        i64vec3 next = v;
         crossed = 0u;
+        uint unknown = 0u;  // axes whose voxel at tNew voxelAt must find
         for (int a = 0; a < 3; ++a) {
             if (tc[a] == tNew) {
                 next[a] = gD[a] > 0.0lf ? hi[a] + 1l : lo[a] - 1l;
                 if (next[a] < gBoxLo[a] || next[a] >= gBoxHi[a]) return firstOnly ? noHit() : found;
                 tNext[a] = crossing(a, gD[a] > 0.0lf ? next[a] + 1l : next[a]);
                 crossed |= 1u << a;
-            } else if (tNext[a] > tNew) {
-                next[a] = v[a];
-            } else {
-                double tIn, tOut;
-                next[a] = gD[a] > 0.0lf ? voxelAt(a, tNew, v[a], hi[a], tIn, tOut) : voxelAt(a, tNew, lo[a], v[a], tIn, tOut);
-                tNext[a] = tOut;
-                if (next[a] != v[a] && tIn == tNew) crossed |= 1u << a;
+            } else if (!(tNext[a] > tNew)) {
+                unknown |= 1u << a;
             }
+        }
+        // At most two axes (one at least is crossed), through one copy of
+        // voxelAt with the axis as a variable: lavapipe runs every copy of
+        // code in the loop for every subgroup, and voxelAt is the costliest.
+        while (unknown != 0u) {
+            const int a = findLSB(unknown);
+            unknown &= unknown - 1u;
+            double tIn, tOut;
+            const int64_t c = gD[a] > 0.0lf ? voxelAt(a, tNew, v[a], hi[a], tIn, tOut) : voxelAt(a, tNew, lo[a], v[a], tIn, tOut);
+            next[a] = c;
+            tNext[a] = tOut;
+            if (c != v[a] && tIn == tNew) crossed |= 1u << a;
         }
         const uint64_t changed = uint64_t(next[0] ^ v[0]) | uint64_t(next[1] ^ v[1]) | uint64_t(next[2] ^ v[2]);
         const uint keepLog2 = bitWidth64(changed);
