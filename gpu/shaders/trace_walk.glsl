@@ -81,23 +81,38 @@ double crossing(int a, int64_t boundary) { return (double(boundary) - gO[a]) / g
 
 int64_t clamp64(int64_t c, int64_t lo, int64_t hi) { return c < lo ? lo : (hi < c ? hi : c); }
 
+// DagWalk.h voxelAt: the one voxel of [lo, hi] whose [tIn, tOut) holds t
+// (or the end of the range), found from the guess floor(o + t d) by one
+// boundary per turn in either direction. The CPU corrects the guess in two
+// loops per sign instead; the voxel, being unique, is the same, and so are
+// its crossing times. Here a branch on the sign would run both sides, and
+// every loop at least once: one loop, the sign a variable.
 int64_t voxelAt(int a, double t, int64_t lo, int64_t hi, out double tIn, out double tOut) {
+    const bool up = gD[a] > 0.0lf;
     precise double p = gO[a] + t * gD[a];
     int64_t c;
     if (!(p > double(lo) - 1.0lf)) c = lo;  // also NaN
     else if (!(p < double(hi) + 2.0lf)) c = hi;
-    else c = gD[a] > 0.0lf ? int64_t(floor(p)) : int64_t(ceil(p)) - 1l;
+    else c = up ? int64_t(floor(p)) : int64_t(ceil(p)) - 1l;
     c = clamp64(c, lo, hi);
-    if (gD[a] > 0.0lf) {
-        tOut = crossing(a, c + 1l);
-        while (c < hi && tOut <= t) { ++c; tOut = crossing(a, c + 1l); }
-        tIn = crossing(a, c);
-        while (c > lo && tIn > t) { --c; tOut = tIn; tIn = crossing(a, c); }
-    } else {
-        tOut = crossing(a, c);
-        while (c > lo && tOut <= t) { --c; tOut = crossing(a, c); }
-        tIn = crossing(a, c + 1l);
-        while (c < hi && tIn > t) { ++c; tOut = tIn; tIn = crossing(a, c + 1l); }
+    const int64_t forwardStep = up ? 1l : -1l;
+    const int64_t first = up ? lo : hi, last = up ? hi : lo;
+    const int64_t exitOffset = up ? 1l : 0l;  // voxel c is left through boundary c + exitOffset, entered through c + 1 - exitOffset
+    tIn = crossing(a, c + 1l - exitOffset);
+    tOut = crossing(a, c + exitOffset);
+    while (true) {
+        const bool forward = c != last && tOut <= t;
+        const bool back = !forward && c != first && tIn > t;
+        if (!forward && !back) break;
+        c += forward ? forwardStep : -forwardStep;
+        const double crossed = crossing(a, forward ? c + exitOffset : c + 1l - exitOffset);
+        if (forward) {
+            tIn = tOut;
+            tOut = crossed;
+        } else {
+            tOut = tIn;
+            tIn = crossed;
+        }
     }
     return c;
 }
@@ -378,9 +393,12 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         for (int a = 0; a < 3; ++a) {
             lo[a] = v[a] & ~(cube - 1l);
             hi[a] = lo[a] + cube - 1l;
-            if (gD[a] == 0.0lf) tc[a] = infinity();
-            else if (gD[a] > 0.0lf) tc[a] = v[a] == hi[a] ? tNext[a] : crossing(a, hi[a] + 1l);
-            else tc[a] = v[a] == lo[a] ? tNext[a] : crossing(a, lo[a]);
+            // The cube's far face on this axis (one crossing whatever the
+            // sign: both sides of a branch run here); the voxel's own exit
+            // when v is the cube's last voxel that way.
+            const bool up = gD[a] > 0.0lf;
+            const double tFar = crossing(a, up ? hi[a] + 1l : lo[a]);
+            tc[a] = gD[a] == 0.0lf ? infinity() : (v[a] == (up ? hi[a] : lo[a]) ? tNext[a] : tFar);
             tNew = tc[a] < tNew ? tc[a] : tNew;
         }
         if (!firstOnly && pending) {
