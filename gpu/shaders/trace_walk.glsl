@@ -426,7 +426,9 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             const int a = findLSB(unknown);
             unknown &= unknown - 1u;
             double tIn, tOut;
-            const int64_t c = gD[a] > 0.0lf ? voxelAt(a, tNew, v[a], hi[a], tIn, tOut) : voxelAt(a, tNew, lo[a], v[a], tIn, tOut);
+            // From v forwards to the cube's far end: one call, the range chosen first.
+            const bool up = gD[a] > 0.0lf;
+            const int64_t c = voxelAt(a, tNew, up ? v[a] : lo[a], up ? hi[a] : v[a], tIn, tOut);
             next[a] = c;
             tNext[a] = tOut;
             if (c != v[a] && tIn == tNew) crossed |= 1u << a;
