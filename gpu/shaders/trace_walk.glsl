@@ -316,6 +316,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         // makeHit below for all three, as lavapipe runs every copy of it.
         uint64_t hitEntry = 0ul;
         uint hitLevel = 0u;
+        bool enterLeaf = false;  // the descent reached a 4^3 leaf (at leafOffset, leafMirror, leafBase)
+        uint64_t leafOffset = 0ul;
         while (!inLeaf) {
             const uint s = L - depth;
             const uint header = innerWord(nodePos);
@@ -335,17 +337,11 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             readChildPointer(nodePos, header, j, offsetWordsAt(depth), offset, reflection, attributeOffset);
             const uint mirror = nodeMirror ^ reflection;
             const uint64_t base = nodeBase + attributeOffset;
-            if (depth + 1u == innerLevels) {
-                leafStored = leafMask(offset);
-                // A leaf with no inside voxel is empty space to the zero crossing (DagWalk.h keepLeaf).
-                if (insideTest) {
-                    leafInside = insideWord(base, popcount64(leafStored));
-                    if (leafInside == 0ul) { skip = halfLog2; break; }
-                }
-                leafSpatial = reflectBrick(leafStored, mirror);
+            if (depth + 1u == innerLevels) {  // the child is a 4^3 leaf: entered below, once per step
+                enterLeaf = true;
+                leafOffset = offset;
                 leafMirror = mirror;
                 leafBase = base;
-                inLeaf = true;
                 break;
             }
             if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * t) {
@@ -361,6 +357,19 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             ++depth;
             stackPosMirror[depth] = nodePos | (uint64_t(mirror) << 61);
             stackBase[depth] = base;
+        }
+        if (enterLeaf) {
+            // Outside the descent loop, which lavapipe runs at least once per
+            // step for the whole subgroup: this then runs once, not per level.
+            leafStored = leafMask(leafOffset);
+            // A leaf with no inside voxel is empty space to the zero crossing (DagWalk.h keepLeaf).
+            if (insideTest) leafInside = insideWord(leafBase, popcount64(leafStored));
+            if (insideTest && leafInside == 0ul) {
+                skip = L - depth - 1u;
+            } else {
+                leafSpatial = reflectBrick(leafStored, leafMirror);
+                inLeaf = true;
+            }
         }
         bool occupiedInside = false;
         if (inLeaf && !occupied && skip == 0u) {
