@@ -371,6 +371,31 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 inLeaf = true;
             }
         }
+        // Inside a leaf, past voxels the walk does not stop at (empty, or
+        // outside for the zero crossing) one voxel step per turn of a small
+        // loop, the axis a variable, until a voxel to stop at, a tie between
+        // axes, the leaf's or the box's end, or tExit: the same voxels, t and
+        // faces as the steps of the main loop, whose every turn costs the
+        // whole walk on lavapipe.
+        while (inLeaf && !occupied && skip == 0u) {
+            const uint x = uint(v[0] & 3l), y = uint(v[1] & 3l), z = uint(v[2] & 3l);
+            if (((leafSpatial >> (x + 4u * y + 16u * z)) & 1ul) != 0ul) {
+                if (!insideTest) break;
+                const uint rank = popcount64(leafStored & ((uint64_t(1) << storedBit(x, y, z, leafMirror)) - 1ul));
+                if (((leafInside >> rank) & 1ul) != 0ul) break;
+            }
+            const double tNew = min(tNext[0], min(tNext[1], tNext[2]));
+            if (!(tNew < tExit)) break;
+            const int a = tNext[0] == tNew ? 0 : (tNext[1] == tNew ? 1 : 2);
+            if ((a < 1 && tNext[1] == tNew) || (a < 2 && tNext[2] == tNew)) break;  // a tie: the main loop's step
+            const int64_t nx = gD[a] > 0.0lf ? v[a] + 1l : v[a] - 1l;
+            if ((nx >> 2) != (v[a] >> 2) || nx < gBoxLo[a] || nx >= gBoxHi[a]) break;
+            if (++steps > gMaxSteps) break;
+            tNext[a] = crossing(a, gD[a] > 0.0lf ? nx + 1l : nx);
+            v[a] = nx;
+            crossed = 1u << a;
+            t = tNew;
+        }
         bool occupiedInside = false;
         if (inLeaf && !occupied && skip == 0u) {
             const uint x = uint(v[0] & 3l), y = uint(v[1] & 3l), z = uint(v[2] & 3l);
