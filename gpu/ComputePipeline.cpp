@@ -26,7 +26,7 @@ SpecConstants& SpecConstants::setFloat(uint32_t id, float value) { return setUin
 SpecConstants& SpecConstants::setBool(uint32_t id, bool value) { return setUint(id, value ? VK_TRUE : VK_FALSE); }
 
 ComputePipeline::ComputePipeline(VulkanContext& context, std::span<const uint32_t> spirv, const SpecConstants& constants,
-                                 uint32_t pushConstantBytes, uint32_t workgroupSize, std::string name)
+                                 uint32_t pushConstantBytes, uint32_t workgroupSize, std::string name, bool uniformBuffer)
     : context_(context), name_(std::move(name)), pushConstantBytes_(pushConstantBytes), workgroupSize_(workgroupSize) {
     const DeviceInfo& info = context.deviceInfo();
     if (spirv.size() < 5 || spirv[0] != 0x07230203u) throw Error(fmt::format("{}: not a SPIR-V module", name_));
@@ -47,6 +47,11 @@ ComputePipeline::ComputePipeline(VulkanContext& context, std::span<const uint32_
         VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
         layoutInfo.pushConstantRangeCount = pushConstantBytes_ ? 1 : 0;
         layoutInfo.pPushConstantRanges = &range;
+        if (uniformBuffer) {
+            setLayout_ = uniformBufferSetLayout(device);
+            layoutInfo.setLayoutCount = 1;
+            layoutInfo.pSetLayouts = &setLayout_;
+        }
         checkVk(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout_), "vkCreatePipelineLayout");
 
         // Constant 0 = workgroup size, then the caller's, in id order.
@@ -91,6 +96,8 @@ void ComputePipeline::release() {
     if (timestamps_ != VK_NULL_HANDLE) vkDestroyQueryPool(device, timestamps_, nullptr);
     if (pipeline_ != VK_NULL_HANDLE) vkDestroyPipeline(device, pipeline_, nullptr);
     if (layout_ != VK_NULL_HANDLE) vkDestroyPipelineLayout(device, layout_, nullptr);
+    if (setLayout_ != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device, setLayout_, nullptr);
+    setLayout_ = VK_NULL_HANDLE;
     if (module_ != VK_NULL_HANDLE) vkDestroyShaderModule(device, module_, nullptr);
     timestamps_ = VK_NULL_HANDLE;
     pipeline_ = VK_NULL_HANDLE;
@@ -98,7 +105,25 @@ void ComputePipeline::release() {
     module_ = VK_NULL_HANDLE;
 }
 
-void ComputePipeline::record(VkCommandBuffer cmd, uint64_t itemCount, std::span<const uint8_t> pushConstants, DispatchTiming* grid) {
+VkDescriptorSetLayout ComputePipeline::uniformBufferSetLayout(VkDevice device) {
+    VkDescriptorSetLayoutBinding binding{};
+    binding.binding = 0;
+    binding.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    binding.descriptorCount = 1;
+    binding.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    VkDescriptorSetLayoutCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    info.bindingCount = 1;
+    info.pBindings = &binding;
+    VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+    checkVk(vkCreateDescriptorSetLayout(device, &info, nullptr, &layout), "vkCreateDescriptorSetLayout");
+    return layout;
+}
+
+void ComputePipeline::record(VkCommandBuffer cmd, uint64_t itemCount, std::span<const uint8_t> pushConstants, DispatchTiming* grid,
+                             VkDescriptorSet uniforms) {
+    if ((setLayout_ != VK_NULL_HANDLE) != (uniforms != VK_NULL_HANDLE))
+        throw Error(fmt::format("{}: {} uniform buffer set given, the pipeline was made {} one", name_, uniforms ? "a" : "no",
+                                setLayout_ ? "with" : "without"));
     if (pushConstants.size() != pushConstantBytes_)
         throw Error(fmt::format("{}: {} bytes of push constants given, the pipeline was made for {}", name_, pushConstants.size(),
                                 pushConstantBytes_));
@@ -119,10 +144,11 @@ void ComputePipeline::record(VkCommandBuffer cmd, uint64_t itemCount, std::span<
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
     if (pushConstantBytes_)
         vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes_, pushConstants.data());
+    if (uniforms != VK_NULL_HANDLE) vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &uniforms, 0, nullptr);
     vkCmdDispatch(cmd, x, static_cast<uint32_t>(y), 1);
 }
 
-DispatchTiming ComputePipeline::dispatch(uint64_t itemCount, std::span<const uint8_t> pushConstants) {
+DispatchTiming ComputePipeline::dispatch(uint64_t itemCount, std::span<const uint8_t> pushConstants, VkDescriptorSet uniforms) {
     DispatchTiming timing;
     const auto start = std::chrono::steady_clock::now();
     context_.submitAndWait([&](VkCommandBuffer cmd) {
@@ -130,7 +156,7 @@ DispatchTiming ComputePipeline::dispatch(uint64_t itemCount, std::span<const uin
             vkCmdResetQueryPool(cmd, timestamps_, 0, 2);
             vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps_, 0);
         }
-        record(cmd, itemCount, pushConstants, &timing);
+        record(cmd, itemCount, pushConstants, &timing, uniforms);
         if (timestamps_) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, 1);
         // Shader writes -> host reads, transfers and later dispatches.
         VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};

@@ -58,8 +58,11 @@ public:
     // at most the device's maxPushConstantsSize, >= 128 everywhere).
     // `workgroupSize`: 1..min(maxComputeWorkGroupInvocations, maxComputeWorkGroupSize[0]).
     // `name` appears in error messages.
+    // `uniformBuffer`: the shader reads one uniform buffer at set 0, binding
+    // 0 (a descriptor set made with uniformBufferSetLayout's definition,
+    // passed to dispatch).
     ComputePipeline(VulkanContext& context, std::span<const uint32_t> spirv, const SpecConstants& constants,
-                    uint32_t pushConstantBytes, uint32_t workgroupSize = 64, std::string name = "compute shader");
+                    uint32_t pushConstantBytes, uint32_t workgroupSize = 64, std::string name = "compute shader", bool uniformBuffer = false);
     ~ComputePipeline();
     ComputePipeline(const ComputePipeline&) = delete;
     ComputePipeline& operator=(const ComputePipeline&) = delete;
@@ -67,16 +70,23 @@ public:
     // Runs the shader over `itemCount` items with `pushConstants` (exactly
     // pushConstantBytes long) and waits for it. Writes by the shader are
     // visible to the host (mapped buffers, DeviceBuffer::download) afterwards.
-    DispatchTiming dispatch(uint64_t itemCount, std::span<const uint8_t> pushConstants);
+    DispatchTiming dispatch(uint64_t itemCount, std::span<const uint8_t> pushConstants, VkDescriptorSet uniforms = VK_NULL_HANDLE);
     template <class T>
-    DispatchTiming dispatch(uint64_t itemCount, const T& pushConstants) {
+    DispatchTiming dispatch(uint64_t itemCount, const T& pushConstants, VkDescriptorSet uniforms = VK_NULL_HANDLE) {
         static_assert(std::is_trivially_copyable_v<T>);
-        return dispatch(itemCount, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(&pushConstants), sizeof(T)));
+        return dispatch(itemCount, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(&pushConstants), sizeof(T)), uniforms);
     }
 
     // Records the dispatch (push constants + vkCmdDispatch) into `cmd`, for
     // callers that batch several dispatches into one submission. Add barriers yourself.
-    void record(VkCommandBuffer cmd, uint64_t itemCount, std::span<const uint8_t> pushConstants, DispatchTiming* grid = nullptr);
+    void record(VkCommandBuffer cmd, uint64_t itemCount, std::span<const uint8_t> pushConstants, DispatchTiming* grid = nullptr,
+                VkDescriptorSet uniforms = VK_NULL_HANDLE);
+
+    // The layout of a set holding one uniform buffer at binding 0 (the
+    // caller destroys it). On lavapipe a uniform-buffer read at an offset
+    // all invocations share is one load; a buffer-device-address read is a
+    // loop over the subgroup's lanes (~220 instructions per 8 lanes).
+    static VkDescriptorSetLayout uniformBufferSetLayout(VkDevice device);
 
     uint32_t workgroupSize() const { return workgroupSize_; }
     VkPipeline pipeline() const { return pipeline_; }
@@ -89,6 +99,7 @@ private:
     uint32_t workgroupSize_ = 0;
     VkShaderModule module_ = VK_NULL_HANDLE;
     VkPipelineLayout layout_ = VK_NULL_HANDLE;
+    VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;  // uniformBuffer pipelines
     VkPipeline pipeline_ = VK_NULL_HANDLE;
     VkQueryPool timestamps_ = VK_NULL_HANDLE;
 

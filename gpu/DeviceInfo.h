@@ -30,6 +30,7 @@ struct DeviceInfo {
     // Features vdbdag uses.
     bool bufferDeviceAddress = false;  // required: all data is reached through 64-bit addresses
     bool shaderInt64 = false;          // required: addresses and leaf masks are 64-bit
+    bool uniformBufferStandardLayout = false;  // required: the tracer's parameters are a std430 uniform block
     bool shaderInt16 = false;
     bool storageBuffer16BitAccess = false;
     bool shaderFloat64 = false;

@@ -207,6 +207,7 @@ DeviceInfo describe(VkPhysicalDevice device, uint32_t index) {
     vkGetPhysicalDeviceFeatures2(device, &features);
     info.bufferDeviceAddress = f12.bufferDeviceAddress;
     info.shaderInt64 = features.features.shaderInt64;
+    info.uniformBufferStandardLayout = f12.uniformBufferStandardLayout;
     info.shaderInt16 = features.features.shaderInt16;
     info.shaderFloat64 = features.features.shaderFloat64;
     info.storageBuffer16BitAccess = f11.storageBuffer16BitAccess;
@@ -214,6 +215,7 @@ DeviceInfo describe(VkPhysicalDevice device, uint32_t index) {
     if (family < 0) info.unusableReason = "has no compute queue";
     else if (!info.bufferDeviceAddress) info.unusableReason = "lacks the bufferDeviceAddress feature";
     else if (!info.shaderInt64) info.unusableReason = "lacks the shaderInt64 feature";
+    else if (!info.uniformBufferStandardLayout) info.unusableReason = "lacks the uniformBufferStandardLayout feature";
     info.usable = info.unusableReason.empty();
     return info;
 }
@@ -308,6 +310,7 @@ VulkanContext::VulkanContext(const ContextOptions& options) {
         want12.shaderInt8 = have12.shaderInt8;
         want12.storageBuffer8BitAccess = have12.storageBuffer8BitAccess;
         want12.scalarBlockLayout = have12.scalarBlockLayout;
+        want12.uniformBufferStandardLayout = have12.uniformBufferStandardLayout;
         want12.hostQueryReset = have12.hostQueryReset;
         VkPhysicalDeviceVulkan11Features want11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
         want11.pNext = &want12;

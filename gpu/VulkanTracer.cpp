@@ -65,8 +65,48 @@ struct VulkanTracer::Impl {
     TraceParamsGpu host{};
     std::map<uint32_t, ComputePipeline*> pipelines;
 
+    // The parameters reach the shader as a uniform buffer (set 0, binding 0).
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VkDescriptorSet paramsSet = VK_NULL_HANDLE;
+
     Impl(VulkanContext& c) : context(c), params(c, sizeof(TraceParamsGpu), MemoryKind::HostVisible, "trace parameters"),
-                             counter(c, 16, MemoryKind::HostVisible, "shadow ray counter") {}
+                             counter(c, 16, MemoryKind::HostVisible, "shadow ray counter") {
+        const VkDevice device = c.device();
+        setLayout = ComputePipeline::uniformBufferSetLayout(device);
+        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1};
+        VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+        poolInfo.maxSets = 1;
+        poolInfo.poolSizeCount = 1;
+        poolInfo.pPoolSizes = &size;
+        if (vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool) != VK_SUCCESS) {
+            vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
+            throw Error("Vulkan tracer: vkCreateDescriptorPool failed");
+        }
+        VkDescriptorSetAllocateInfo allocInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+        allocInfo.descriptorPool = pool;
+        allocInfo.descriptorSetCount = 1;
+        allocInfo.pSetLayouts = &setLayout;
+        if (vkAllocateDescriptorSets(device, &allocInfo, &paramsSet) != VK_SUCCESS) {
+            vkDestroyDescriptorPool(device, pool, nullptr);
+            vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
+            throw Error("Vulkan tracer: vkAllocateDescriptorSets failed");
+        }
+        VkDescriptorBufferInfo bufferInfo{params.buffer(), 0, sizeof(TraceParamsGpu)};
+        VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+        write.dstSet = paramsSet;
+        write.dstBinding = 0;
+        write.descriptorCount = 1;
+        write.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+        write.pBufferInfo = &bufferInfo;
+        vkUpdateDescriptorSets(device, 1, &write, 0, nullptr);
+    }
+    ~Impl() {
+        vkDestroyDescriptorPool(context.device(), pool, nullptr);  // frees the set
+        vkDestroyDescriptorSetLayout(context.device(), setLayout, nullptr);
+    }
+    Impl(const Impl&) = delete;
+    Impl& operator=(const Impl&) = delete;
 
     ComputePipeline& pipeline(const trace::RenderGrid& grid, Mode mode, bool levelSet, bool shadows) {
         // Only what this pipeline reads is specialised, so grids share
@@ -95,7 +135,7 @@ struct VulkanTracer::Impl {
                 constants.setBool(7, oneChunk);
                 constants.setBool(8, normals);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
-                                                           "trace.comp");
+                                                           "trace.comp", true);
             }
             slot = static_cast<ComputePipeline*>(shared.get());
         }
@@ -214,7 +254,7 @@ std::vector<trace::RayHit> VulkanTracer::traceHits(std::span<const trace::Ray> r
             r[8 * i + 7] = ray.tMax;
         }
         TracePush push{impl.params.address(), rayBuffer.address(), hitBuffer.address(), impl.counter.address(), uint32_t(n), 0};
-        lastDeviceMs_ += pipe.dispatch(n, push).deviceMs;
+        lastDeviceMs_ += pipe.dispatch(n, push, impl.paramsSet).deviceMs;
         unpackHits(hitBuffer.mappedData(), std::span<trace::RayHit>(hits).subspan(first, n));
     }
     return hits;
@@ -269,7 +309,7 @@ const std::vector<trace::RayHit>& VulkanTracer::tracePrimary(const trace::Camera
         primaryHits_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 48, MemoryKind::HostVisible, "primary ray hits", false);
     const uint64_t items = uint64_t(impl.host.tilesX) * ((impl.host.height + 7) / 8) * kWorkgroup;
     TracePush push{impl.params.address(), 0, primaryHits_->address(), impl.counter.address(), uint32_t(items), 0};
-    lastDeviceMs_ = pipe.dispatch(items, push).deviceMs;
+    lastDeviceMs_ = pipe.dispatch(items, push, impl.paramsSet).deviceMs;
     primaryHitsHost_.resize(pixels);
     unpackHits(primaryHits_->mappedData(), primaryHitsHost_);
     return primaryHitsHost_;
@@ -296,7 +336,7 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     DeviceBuffer& out = *renderedPixels_;
     const uint64_t items = uint64_t(p.tilesX) * tilesY * kWorkgroup;
     TracePush push{impl.params.address(), 0, out.address(), impl.counter.address(), uint32_t(items), 0};
-    lastDeviceMs_ = pipe.dispatch(items, push).deviceMs;
+    lastDeviceMs_ = pipe.dispatch(items, push, impl.paramsSet).deviceMs;
 
     trace::Image image;
     image.resize(camera.width, camera.height);

@@ -39,7 +39,7 @@ layout(constant_id = 8) const bool HAS_NORMALS = false;    // render: shade with
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
 layout(push_constant, std430) uniform Push {
-    uint64_t params;  // TraceParams
+    uint64_t params;  // unused: TraceParams is the uniform buffer (trace_params.glsl)
     uint64_t rays;    // hits: F64Array, 8 per ray
     uint64_t results; // hits: U64Array, 6 per ray; render: F32Array, 8 per pixel
     uint64_t counter; // render: U32Array[1], shadow rays cast
@@ -47,7 +47,6 @@ layout(push_constant, std430) uniform Push {
     uint pad;
 } pc;
 
-TraceParams P;
 
 #include "trace_values.glsl"
 #include "trace_normals.glsl"
@@ -272,7 +271,6 @@ void renderPixel(uint i) {
 void main() {
     const uint i = vdbdagItemIndex();
     if (i >= pc.itemCount) return;
-    P = TraceParams(pc.params);
     loadTraceParams();
     loadValueParams();
     loadInsideParams();

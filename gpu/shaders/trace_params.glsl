@@ -12,7 +12,11 @@
 
 const uint kMaxInnerLevels = 40u;  // encoder limit: log2Size <= 40
 
-layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer TraceParams {
+// A uniform buffer (set 0, binding 0), std430 (uniformBufferStandardLayout):
+// every invocation reads the same words, which lavapipe then loads once per
+// subgroup, where a buffer-device-address read is a loop over the lanes.
+#extension GL_EXT_scalar_block_layout : require
+layout(set = 0, binding = 0, std430) uniform TraceParams {
     DeviceArray inner;      // uint16 words, all inner levels
     DeviceArray leaves;     // uint64 4^3 bricks
     PaletteChannel values;  // entryCount 0 when the grid stores none
@@ -44,6 +48,6 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Tra
     uint width, height, tilesX;
     uint normalBits;        // k of the ONV codes
     uint normalsOriented;   // 1: gradient-sourced normals (outward: not flipped towards the viewer)
-};
+} P;
 
 #endif
