@@ -1,7 +1,8 @@
 // CPU reference tracer: rays straight through the compact SSVDAG, without
 // decompressing it (SSVDAG paper §5, Listing 1; attributes as Dado et al.
-// §4.1). The Vulkan shader (gpu/shaders/trace.comp) is a line-by-line port,
-// and the two must return the same voxels.
+// §4.1). The Vulkan shader (gpu/shaders/trace.comp, trace_walk.glsl) walks
+// the same boxes with the same arithmetic, arranged for SIMD lanes instead
+// of branches, and the two must return the same voxels.
 //
 // Traversal state is integer: the voxel the ray is in, and a stack of the
 // stored nodes containing it with their accumulated mirror masks and

@@ -6,9 +6,9 @@
 //
 // The walk is compiled once per octant of the ray direction (the signs of
 // its three components, -0.0 and 0 counting as positive), so the direction
-// of every step and every boundary choice is a constant, and once more for
-// the voxel-by-voxel walk through a 4^3 leaf (the narrow band of a level
-// set), which needs no cube arithmetic. The shader (gpu/shaders/
+// of every step and every boundary choice is a constant; it crosses a 4^3
+// leaf (the narrow band of a level set) voxel by voxel in a loop of its
+// own, without the cube arithmetic of the general step. The shader (gpu/shaders/
 // trace_walk.glsl) walks the same boxes with the signs as variables; every
 // crossing time is the same expression of the same integer boundary in both,
 // so they agree bit for bit.
