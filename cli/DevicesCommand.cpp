@@ -40,6 +40,7 @@ nlohmann::json toJson(const gpu::DeviceInfo& d, bool isChosen) {
             {"subgroup_size", d.subgroupSize},
             {"buffer_device_address", d.bufferDeviceAddress},
             {"shader_int64", d.shaderInt64},
+            {"uniform_buffer_standard_layout", d.uniformBufferStandardLayout},
             {"shader_int16", d.shaderInt16},
             {"storage_buffer_16bit_access", d.storageBuffer16BitAccess},
             {"shader_float64", d.shaderFloat64},
@@ -85,8 +86,9 @@ void addDevicesCommand(CLI::App& app, int& exitCode) {
                 fmt::print("   maxComputeWorkGroupInvocations {}, maxComputeWorkGroupCount {}x{}x{}, subgroup size {}, push constants {} bytes\n",
                            d.maxComputeWorkGroupInvocations, d.maxComputeWorkGroupCount[0], d.maxComputeWorkGroupCount[1],
                            d.maxComputeWorkGroupCount[2], d.subgroupSize, d.maxPushConstantsSize);
-                fmt::print("   bufferDeviceAddress {}, int64 {}, int16 {}, 16-bit storage {}, float64 {}, timestamps {}\n",
-                           yesNo(d.bufferDeviceAddress), yesNo(d.shaderInt64), yesNo(d.shaderInt16), yesNo(d.storageBuffer16BitAccess),
+                fmt::print("   bufferDeviceAddress {}, int64 {}, std430 uniforms {}, int16 {}, 16-bit storage {}, float64 {}, timestamps {}\n",
+                           yesNo(d.bufferDeviceAddress), yesNo(d.shaderInt64), yesNo(d.uniformBufferStandardLayout), yesNo(d.shaderInt16),
+                           yesNo(d.storageBuffer16BitAccess),
                            yesNo(d.shaderFloat64), d.timestamps ? fmt::format("yes ({} ns/tick)", d.timestampPeriodNs) : "no");
                 if (!d.usable) fmt::print("   not usable: {}\n", d.unusableReason);
             }

@@ -40,16 +40,15 @@ struct TraceParamsGpu {
     double eyeCell[3], inverse[9], normalMatrix[9], light[3], lightCell[3], background[3];
     double shadowBias, fogScale;
     uint64_t offsetWordsPacked[2];
-    uint32_t offsetWords[kMaxInnerLevels];
     uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, pad;
 };
-static_assert(sizeof(TraceParamsGpu) == 1336, "must match trace_params.glsl");
+static_assert(sizeof(TraceParamsGpu) == 1176, "must match trace_params.glsl");
 
 struct TracePush {
-    uint64_t params, rays, results, counter;
+    uint64_t rays, results, counter;
     uint32_t itemCount, pad;
 };
-static_assert(sizeof(TracePush) == 40);
+static_assert(sizeof(TracePush) == 32);
 
 
 enum class Mode : uint32_t { Hits = 0, Render = 1, Primary = 2 };
@@ -193,7 +192,6 @@ void VulkanTracer::upload(VulkanContext& context, const trace::RenderGrid& grid,
     }
     for (size_t i = 0; i < dag.innerLevelCount(); ++i) {
         p.levelStart[i] = dag.levelStart[i];
-        p.offsetWords[i] = dag.offsetWords[i];
         p.offsetWordsPacked[i / 21] |= uint64_t(dag.offsetWords[i] & 7u) << (3 * (i % 21));
     }
     p.valueMin = grid.valueMin;
@@ -253,7 +251,7 @@ std::vector<trace::RayHit> VulkanTracer::traceHits(std::span<const trace::Ray> r
             r[8 * i + 6] = ray.tMin;
             r[8 * i + 7] = ray.tMax;
         }
-        TracePush push{impl.params.address(), rayBuffer.address(), hitBuffer.address(), impl.counter.address(), uint32_t(n), 0};
+        TracePush push{rayBuffer.address(), hitBuffer.address(), impl.counter.address(), uint32_t(n), 0};
         lastDeviceMs_ += pipe.dispatch(n, push, impl.paramsSet).deviceMs;
         unpackHits(hitBuffer.mappedData(), std::span<trace::RayHit>(hits).subspan(first, n));
     }
@@ -308,7 +306,7 @@ const std::vector<trace::RayHit>& VulkanTracer::tracePrimary(const trace::Camera
     if (!primaryHits_ || primaryHits_->size() < pixels * 48)
         primaryHits_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 48, MemoryKind::HostVisible, "primary ray hits", false);
     const uint64_t items = uint64_t(impl.host.tilesX) * ((impl.host.height + 7) / 8) * kWorkgroup;
-    TracePush push{impl.params.address(), 0, primaryHits_->address(), impl.counter.address(), uint32_t(items), 0};
+    TracePush push{0, primaryHits_->address(), impl.counter.address(), uint32_t(items), 0};
     lastDeviceMs_ = pipe.dispatch(items, push, impl.paramsSet).deviceMs;
     primaryHitsHost_.resize(pixels);
     unpackHits(primaryHits_->mappedData(), primaryHitsHost_);
@@ -335,7 +333,7 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
         renderedPixels_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 32, MemoryKind::HostVisible, "rendered pixels", false);
     DeviceBuffer& out = *renderedPixels_;
     const uint64_t items = uint64_t(p.tilesX) * tilesY * kWorkgroup;
-    TracePush push{impl.params.address(), 0, out.address(), impl.counter.address(), uint32_t(items), 0};
+    TracePush push{0, out.address(), impl.counter.address(), uint32_t(items), 0};
     lastDeviceMs_ = pipe.dispatch(items, push, impl.paramsSet).deviceMs;
 
     trace::Image image;

@@ -39,14 +39,12 @@ layout(constant_id = 8) const bool HAS_NORMALS = false;    // render: shade with
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
 layout(push_constant, std430) uniform Push {
-    uint64_t params;  // unused: TraceParams is the uniform buffer (trace_params.glsl)
     uint64_t rays;    // hits: F64Array, 8 per ray
     uint64_t results; // hits: U64Array, 6 per ray; render: F32Array, 8 per pixel
     uint64_t counter; // render: U32Array[1], shadow rays cast
     uint itemCount;
     uint pad;
 } pc;
-
 
 #include "trace_values.glsl"
 #include "trace_normals.glsl"

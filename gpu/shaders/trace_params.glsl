@@ -39,8 +39,7 @@ layout(set = 0, binding = 0, std430) uniform TraceParams {
     double background[3];
     double shadowBias;      // level sets: boxes entered before this are ignored by shadow rays
     double fogScale;        // densityScale / (valueMax * voxelSize)
-    uint64_t offsetWordsPacked[2];  // offsetWords again, 3 bits per level: levels 0-20, then 21-39
-    uint offsetWords[kMaxInnerLevels];
+    uint64_t offsetWordsPacked[2];  // offsetWords of each level (<= 4), 3 bits per level: levels 0-20, then 21-39
     uint log2Size;
     uint rootReflection;
     uint innerLevels;

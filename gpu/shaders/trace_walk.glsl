@@ -28,9 +28,9 @@
 #ifndef VDBDAG_TRACE_WALK_GLSL
 #define VDBDAG_TRACE_WALK_GLSL
 
-// Private copies of what the walk reads at every step (a load through `P`
-// is a memory access each time: the compiler cannot know the buffer does not
-// change), made once per invocation by loadTraceParams().
+// Private copies of what the walk reads at every step, made once per
+// invocation by loadTraceParams() (P is a uniform buffer: cheap to read,
+// but a register is cheaper still).
 i64vec3 gRootOrigin, gBoxLo, gBoxHi;
 uint gLog2Size, gRootReflection, gInnerLevels, gMaxSteps;
 uint64_t gInnerAddress, gLeavesAddress;  // chunk 0 of the DAG arrays

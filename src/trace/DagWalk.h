@@ -49,9 +49,8 @@ template <unsigned kNegative>
 struct OctantRay {
     double o[3], d[3];
     static constexpr bool negative(int a) { return (kNegative >> a) & 1u; }
-    // The boundary through which the ray leaves (enters) voxel c on axis a.
+    // The boundary through which the ray leaves voxel c on axis a.
     static constexpr int64_t exitOf(int a, int64_t c) { return negative(a) ? c : c + 1; }
-    static constexpr int64_t entryOf(int a, int64_t c) { return negative(a) ? c + 1 : c; }
     // Time at which the ray crosses the plane `boundary` on axis a.
     double crossing(int a, int64_t boundary) const { return (double(boundary) - o[a]) / d[a]; }
     // Voxel coordinate on axis a at time t, by the crossing times themselves
