@@ -58,3 +58,14 @@ std::string thresholdText(const bridge::ThresholdReport& r) {
 }
 
 } // namespace vdbdag::cli
+
+namespace vdbdag::cli {
+
+std::vector<std::string> denseInputFiles(const std::string& input, const DenseInputOptions& options) {
+    const bridge::DenseFormat format = bridge::denseFormatOf(input);
+    if (format == bridge::DenseFormat::None || format == bridge::DenseFormat::Raw) return {input};
+    const bridge::DenseVolume header = bridge::describeDense(input, options.resolve(input).raw);
+    return {input, header.dataPath};
+}
+
+} // namespace vdbdag::cli

@@ -27,6 +27,10 @@ struct DenseInputOptions {
     bridge::DenseImportOptions resolve(const std::string& path) const;
 };
 
+// The files a command reads for `input`: the input itself and, for a dense
+// header (.nhdr, .mhd), the data file it names (an output must be neither).
+std::vector<std::string> denseInputFiles(const std::string& input, const DenseInputOptions& options);
+
 nlohmann::json thresholdJson(const bridge::ThresholdReport& report);
 std::string thresholdText(const bridge::ThresholdReport& report);
 

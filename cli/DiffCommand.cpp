@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/RunContext.h"
+#include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/VtkDiff.h"
 
@@ -25,7 +27,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string a, b, output, compressor = "zlib";
         std::vector<std::string> grids;
-        bool onlyDifferences = false, json = false;
+        bool onlyDifferences = false, json = false, force = false;
         uint64_t maxCells = 20'000'000;
     };
     auto opt = std::make_shared<Options>();
@@ -37,9 +39,12 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--only-differences", opt->onlyDifferences, "write only cells whose status is not 'same'");
     cmd->add_option("--max-cells", opt->maxCells, "stop if a written block would exceed this many cells")->capture_default_str();
     cmd->add_option("--compressor", opt->compressor, "zlib or lz4")->capture_default_str();
+    cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");
     cmd->callback([opt, &exitCode] {
+        setActivity(opt->a, "comparing");
         if (opt->json) setQuiet(true);
+        if (!opt->output.empty()) checkOutputPath(opt->output, {opt->a, opt->b}, {{".vtu", ".vtm"}, "diff", opt->force});
         bridge::DiffOptions options;
         options.grids = opt->grids;
         options.onlyDifferences = opt->onlyDifferences;

@@ -10,12 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "cli/DenseInputOptions.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
 #include "src/util/AtomicFile.h"
-#include "src/util/Error.h"
+#include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/VdbImport.h"
@@ -26,7 +27,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string input, output;
         std::vector<std::string> grids;
-        bool noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
+        bool force = false, noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
         int placementTrials = 1;
         double absError = 0, relError = 0;
         unsigned colourBits = 0, normalBits = 0;
@@ -38,6 +39,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha scan) into an .ssvdag file");
     cmd->add_option("input", opt->input, "input .vdb file or dense scan")->required();
     cmd->add_option("-o,--output", opt->output, "output .ssvdag file")->required();
+    cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_option("--grid", opt->grids, "encode only grids with this name (repeatable)");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "plain SVDAG: merge identical subtrees only");
     cmd->add_flag("--no-compress", opt->noCompress, "store sections without zstd");
@@ -58,6 +60,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
     cmd->callback([opt, &exitCode] {
+        setActivity(opt->input, "encoding");
         const auto start = std::chrono::steady_clock::now();
         bridge::ImportOptions importOptions;
         importOptions.onlyGrids = opt->grids;
@@ -66,9 +69,11 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         importOptions.normals = opt->normalBits != 0;
         importOptions.normalGrid = opt->normalGrid;
         if (opt->colourBits && opt->topologyOnly) throw Error("--colour-bits and --topology-only exclude each other: a topology-only file has no colours");
+        const bool dense = bridge::denseFormatOf(opt->input) != bridge::DenseFormat::None;
+        checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".ssvdag"}, "encode", opt->force});
         bridge::ImportResult imported;
         bridge::ThresholdReport threshold;
-        if (bridge::denseFormatOf(opt->input) != bridge::DenseFormat::None) {
+        if (dense) {
             if (!opt->grids.empty()) throw Error(opt->input + ": --grid applies to .vdb inputs only (a dense scan has one grid)");
             bridge::DenseImportResult dense = bridge::importDense(opt->input, opt->dense.resolve(opt->input));
             threshold = dense.threshold;
@@ -87,6 +92,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             imported = bridge::importVdb(opt->input, importOptions);
         }
         for (const auto& w : imported.warnings) fmt::print(stderr, "vdbdag: warning: {}\n", w);
+        if (imported.volume.grids.empty())
+            throw Error(opt->input + ": " + (imported.warnings.empty() ? "has no grids" : "has no grid vdbdag converts") + "; nothing to write to " + opt->output);
         for (const std::string& name : opt->colourGrids) {
             const auto& grids = imported.volume.grids;
             const auto it = std::find_if(grids.begin(), grids.end(), [&](const GridRecord& g) { return g.name == name; });

@@ -5,7 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/RunContext.h"
 #include "src/util/Error.h"
+#include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/VtkExport.h"
 #include "vdb_bridge/VtkStructure.h"
@@ -39,7 +41,7 @@ void addExportCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string input, output, bbox, compressor = "zlib";
         std::vector<std::string> grids;
-        bool structure = false, uniqueNodes = false, json = false;
+        bool structure = false, uniqueNodes = false, json = false, force = false;
         uint64_t maxCells = 20'000'000, maxBytes = uint64_t(256) << 20, maxInstances = 4'000'000;
     };
     auto opt = std::make_shared<Options>();
@@ -55,9 +57,12 @@ void addExportCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--structure", opt->structure, "write the DAG's structure: a block per level, a cell per node instance");
     cmd->add_option("--max-instances", opt->maxInstances, "--structure: past this many instances, write one cell per unique node")->capture_default_str();
     cmd->add_flag("--unique-nodes", opt->uniqueNodes, "--structure: one cell per unique node (at its first instance) with its instance count");
+    cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     cmd->callback([opt, &exitCode] {
+        setActivity(opt->input, "exporting");
         if (opt->json) setQuiet(true);
+        checkOutputPath(opt->output, {opt->input}, {opt->structure ? std::vector<std::string>{".vtm"} : std::vector<std::string>{".vtu", ".vti", ".vtm"}, "export", opt->force});
         nlohmann::json report{{"input", opt->input}, {"output", opt->output}};
         if (opt->structure) {
             if (!opt->bbox.empty()) throw Error("--bbox does not apply to --structure");

@@ -7,8 +7,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/RunContext.h"
 #include "cli/DenseInputOptions.h"
 #include "src/util/Error.h"
+#include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/VdbExport.h"
@@ -18,19 +20,22 @@ namespace vdbdag::cli {
 void addImportCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string input, output;
-        bool json = false;
+        bool json = false, force = false;
         DenseInputOptions dense;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("import", "Convert a dense scan (.raw, .nrrd, .nhdr, .mhd, .mha) into a .vdb grid");
     cmd->add_option("input", opt->input, "input volume")->required();
     cmd->add_option("-o,--output", opt->output, "output .vdb file")->required();
+    cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
     cmd->callback([opt, &exitCode] {
+        setActivity(opt->input, "importing");
         const auto start = std::chrono::steady_clock::now();
         if (bridge::denseFormatOf(opt->input) == bridge::DenseFormat::None)
             throw Error(opt->input + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
+        checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".vdb"}, "import", opt->force});
         const bridge::DenseImportResult imported = bridge::importDense(opt->input, opt->dense.resolve(opt->input));
         {
             Progress progress("import: writing " + opt->output, 1);

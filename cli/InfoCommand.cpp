@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include "cli/Commands.h"
+#include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "src/pipeline/GridCodec.h"
 #include "vdb_bridge/VdbImport.h"
@@ -25,6 +26,7 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--json", opt->json, "print JSON");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "for .vdb input: report the plain SVDAG encoding");
     cmd->callback([opt, &exitCode] {
+        setActivity(opt->input, "reading");
         std::vector<uint8_t> bytes = format::readFileBytes(opt->input);
         format::SsvdagScene scene;
         if (!isVdbFile(bytes)) {

@@ -9,11 +9,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/RunContext.h"
 #include "cli/RenderBackend.h"
 #include "src/format/SsvdagFile.h"
 #include "src/trace/Camera.h"
 #include "src/trace/RenderGrid.h"
 #include "src/util/Error.h"
+#include "src/util/OutputPath.h"
 #include "vdb_bridge/ImageWriter.h"
 
 namespace vdbdag::cli {
@@ -44,7 +46,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         std::string input, output, grid, camera, backend = "auto";
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
-        bool shadows = false, json = false;
+        bool shadows = false, json = false, force = false;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("render", "Trace an .ssvdag file without decompressing it and write an image");
@@ -61,8 +63,11 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--shadows", opt->shadows, "cast a shadow ray towards the light");
     cmd->add_option("--density-scale", opt->densityScale, "fog: extinction per voxel length at the largest density")->check(CLI::Range(0.0, 1e6));
     cmd->add_option("--frames", opt->frames, "render this many frames and report the median time")->check(CLI::Range(1, 1000));
+    cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");
     cmd->callback([opt, &exitCode] {
+        setActivity(opt->input, "rendering");
+        checkOutputPath(opt->output, {opt->input}, {{".png", ".exr"}, "render", opt->force});
         const format::SsvdagScene scene = format::readSceneFile(opt->input);
         const format::EncodedGrid* chosen = nullptr;
         for (const format::EncodedGrid& g : scene.grids)

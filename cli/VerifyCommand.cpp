@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/RunContext.h"
 #include "src/pipeline/GridCodec.h"
 #include "vdb_bridge/VdbCompare.h"
 #include "vdb_bridge/VdbImport.h"
@@ -21,6 +22,7 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--topology-only", opt->topologyOnly, "verify the geometry-only encoding (topology and headers)");
     cmd->add_flag("--json", opt->json, "print JSON");
     cmd->callback([opt, &exitCode] {
+        setActivity(opt->input, "verifying");
         bridge::ImportOptions importOptions;
         importOptions.topologyOnly = opt->topologyOnly;
         const bridge::ImportResult imported = bridge::importVdb(opt->input, importOptions);

@@ -6,9 +6,11 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
+#include "cli/RunContext.h"
 #include "src/util/Error.h"
 
 int main(int argc, char** argv) {
+    vdbdag::cli::installFailureHandlers();
     CLI::App app{"vdbdag: compress OpenVDB volumes into symmetry-aware sparse voxel DAGs (.ssvdag) and back"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "vdbdag 0.1.0");
@@ -32,7 +34,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "vdbdag: %s\n", e.what());
         return 1;
     } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "vdbdag: out of memory\n");
+        std::fprintf(stderr, "vdbdag: %s\n", vdbdag::cli::outOfMemoryMessage().c_str());
         return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "vdbdag: %s\n", e.what());

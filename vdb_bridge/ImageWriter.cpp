@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <random>
 
 #include <OpenImageIO/imageio.h>
 
+#include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::bridge {
@@ -30,15 +30,12 @@ void writeImage(const std::string& path, const trace::Image& image) {
     namespace fs = std::filesystem;
     const std::string ext = lowerExtension(path);
     if (ext.empty()) throw Error(path + ": no file extension (use .png or .exr)");
-    // A temporary name with the same extension, so OpenImageIO picks the format.
-    const fs::path target(path);
-    const fs::path temp = target.parent_path() / (target.stem().string() + ".tmp" + std::to_string(std::random_device{}()) + ext);
     const size_t pixels = size_t(image.width) * size_t(image.height);
-    bool ok = false;
-    std::string error;
-    {
-        auto out = OIIO::ImageOutput::create(temp.string());
+    // The temporary keeps the extension, so OpenImageIO picks the format.
+    writeViaTemporary(path, [&](const std::string& temp) {
+        auto out = OIIO::ImageOutput::create(temp);
         if (!out) throw Error(path + ": OpenImageIO cannot write '" + ext + "' files: " + OIIO::geterror());
+        bool ok = false;
         if (ext == ".exr") {
             OIIO::ImageSpec spec(image.width, image.height, 8, OIIO::TypeDesc::FLOAT);
             spec.channelnames = {"R", "G", "B", "A", "Z", "N.x", "N.y", "N.z"};
@@ -53,27 +50,19 @@ void writeImage(const std::string& path, const trace::Image& image) {
                 p[4] = image.depth[i];
                 for (int c = 0; c < 3; ++c) p[5 + c] = image.normal[3 * i + c];
             }
-            ok = out->open(temp.string(), spec) && out->write_image(OIIO::TypeDesc::FLOAT, data.data()) && out->close();
+            ok = out->open(temp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, data.data()) && out->close();
         } else {
             OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
             spec.attribute("oiio:ColorSpace", "sRGB");
             std::vector<uint8_t> data(pixels * 3);
             for (size_t i = 0; i < pixels * 3; ++i) data[i] = uint8_t(std::lround(linearToSrgb(image.rgb[i]) * 255.f));
-            ok = out->open(temp.string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, data.data()) && out->close();
+            ok = out->open(temp, spec) && out->write_image(OIIO::TypeDesc::UINT8, data.data()) && out->close();
         }
-        if (!ok) error = out->geterror();
-    }
-    if (!ok) {
-        std::error_code ec;
-        fs::remove(temp, ec);
-        throw Error(path + ": cannot write the image: " + (error.empty() ? std::string("unknown error") : error));
-    }
-    std::error_code ec;
-    fs::rename(temp, target, ec);
-    if (ec) {
-        fs::remove(temp, ec);
-        throw Error(path + ": cannot rename the finished image into place: " + ec.message());
-    }
+        if (!ok) {
+            const std::string error = out->geterror();
+            throw Error(path + ": cannot write the image: " + (error.empty() ? std::string("unknown error") : error));
+        }
+    }, ext);
 }
 
 } // namespace vdbdag::bridge

@@ -10,6 +10,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
+#include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::bridge {
@@ -110,11 +111,9 @@ void writeScatterPlot(const std::string& path, const std::vector<PlotSeries>& se
     OIIO::ImageBufAlgo::render_box(image, right + 13, ly - 7, right + 27, ly + 7, black);
     text(image, right + 32, ly + 5, "Pareto front", 14);
 
-    const std::string temp = path + ".tmp.png";
-    if (!image.write(temp)) throw Error(path + ": cannot write the plot: " + image.geterror());
-    std::error_code ec;
-    std::filesystem::rename(temp, path, ec);
-    if (ec) throw Error(path + ": cannot move the plot into place: " + ec.message());
+    writeViaTemporary(path, [&](const std::string& temp) {
+        if (!image.write(temp)) throw Error(path + ": cannot write the plot: " + image.geterror());
+    }, ".png");
 }
 
 } // namespace vdbdag::bridge

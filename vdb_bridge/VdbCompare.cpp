@@ -12,6 +12,7 @@
 #include "src/util/Error.h"
 #include "vdb_bridge/detail/GridBuilder.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
+#include "vdb_bridge/detail/VdbFile.h"
 
 namespace vdbdag::bridge {
 namespace {
@@ -177,31 +178,42 @@ CompareResult compareGridLists(const openvdb::GridPtrVec& a, const openvdb::Grid
     return result;
 }
 
-openvdb::GridPtrVec readAll(const std::string& path) {
-    detail::initializeOpenVdb();
-    try {
-        openvdb::io::File file(path);
-        file.open(false);
-        openvdb::GridPtrVecPtr grids = file.getGrids();
-        file.close();
-        return *grids;
-    } catch (const std::exception& e) {
-        throw Error(path + ": cannot be read as a .vdb file (" + detail::oneLine(e.what()) + ")");
+// File-level metadata, entry by entry.
+void compareFileMetadata(const openvdb::MetaMap& a, const openvdb::MetaMap& b, std::vector<std::string>& out) {
+    std::set<std::string> names;
+    for (auto it = a.beginMeta(); it != a.endMeta(); ++it) names.insert(it->first);
+    for (auto it = b.beginMeta(); it != b.endMeta(); ++it) names.insert(it->first);
+    for (const std::string& name : names) {
+        const auto ma = a[name], mb = b[name];
+        if (!ma || !mb) out.push_back("file metadata '" + name + "' only in " + (ma ? "the first" : "the second"));
+        else if (ma->typeName() != mb->typeName() || !(*ma == *mb))
+            out.push_back("file metadata '" + name + "' differs (" + ma->str() + " vs " + mb->str() + ")");
     }
+}
+
+void finish(CompareResult& result) {
+    result.identical = result.headerDifferences.empty() && result.topology.empty() && result.values.empty();
 }
 
 } // namespace
 
 CompareResult compareWithFile(const std::string& originalPath, const Volume& decoded, bool values) {
-    const openvdb::GridPtrVec original = readAll(originalPath);
+    const detail::VdbFileContents original = detail::readVdbFile(originalPath);
     openvdb::GridPtrVec rebuilt;
     for (size_t g = 0; g < decoded.grids.size(); ++g)
         rebuilt.push_back(detail::buildGrid(decoded.grids[g], originalPath + " (decoded grid " + std::to_string(g) + ")"));
-    return compareGridLists(original, rebuilt, values);
+    CompareResult result = compareGridLists(original.grids, rebuilt, values);
+    compareFileMetadata(*original.metadata, *detail::parseMetadata(decoded.fileMetadata, originalPath + " (decoded)"), result.headerDifferences);
+    finish(result);
+    return result;
 }
 
 CompareResult compareFiles(const std::string& pathA, const std::string& pathB, bool values) {
-    return compareGridLists(readAll(pathA), readAll(pathB), values);
+    const detail::VdbFileContents a = detail::readVdbFile(pathA), b = detail::readVdbFile(pathB);
+    CompareResult result = compareGridLists(a.grids, b.grids, values);
+    compareFileMetadata(*a.metadata, *b.metadata, result.headerDifferences);
+    finish(result);
+    return result;
 }
 
 } // namespace vdbdag::bridge

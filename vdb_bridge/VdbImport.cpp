@@ -17,6 +17,7 @@
 #include "src/util/Error.h"
 #include "vdb_bridge/detail/NormalEstimation.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
+#include "vdb_bridge/detail/VdbFile.h"
 
 namespace vdbdag::bridge {
 namespace {
@@ -128,24 +129,9 @@ void addNormals(const GridT& grid, GridRecord& record, const std::string& normal
 } // namespace
 
 ImportResult importVdb(const std::string& path, const ImportOptions& options) {
-    detail::initializeOpenVdb();
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
-    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a .vdb file");
-    openvdb::GridPtrVecPtr grids;
-    try {
-        // Delayed loading: topology (node masks) is read now, leaf value
-        // buffers only when touched, so a geometry-only import never
-        // decompresses the values.
-        openvdb::io::File file(path);
-        file.open(true);
-        grids = file.getGrids();
-        file.close();
-    } catch (const openvdb::Exception& e) {
-        throw Error(path + ": cannot be read as a .vdb file (" + detail::oneLine(e.what()) + ")");
-    } catch (const std::exception& e) {
-        throw Error(path + ": cannot be read as a .vdb file (" + detail::oneLine(e.what()) + ")");
-    }
+    // Checked and read whole, in file order (detail/VdbFile.h).
+    detail::VdbFileContents contents = detail::readVdbFile(path);
+    const openvdb::GridPtrVec* grids = &contents.grids;
 
     if (!options.onlyGrids.empty()) {
         for (const std::string& wanted : options.onlyGrids) {
@@ -159,6 +145,7 @@ ImportResult importVdb(const std::string& path, const ImportOptions& options) {
     }
 
     ImportResult result;
+    result.volume.fileMetadata = detail::serializeMetadata(*contents.metadata);
     for (size_t index = 0; index < grids->size(); ++index) {
         const openvdb::GridBase::Ptr& base = (*grids)[index];
         if (!options.onlyGrids.empty() &&

@@ -235,39 +235,57 @@ DiffReport diffVolumes(const std::string& pathA, const std::string& pathB, const
     const std::vector<LoadedGrid> gridsA = detail::loadGrids(pathA, options.grids);
     const std::vector<LoadedGrid> gridsB = detail::loadGrids(pathB, options.grids);
     DiffReport report;
-    if (gridsA.size() != gridsB.size())
-        report.headerDifferences.push_back(fmt::format("A has {} grid(s), B has {}; the first {} are compared", gridsA.size(), gridsB.size(),
-                                                       std::min(gridsA.size(), gridsB.size())));
-    const size_t pairs = std::min(gridsA.size(), gridsB.size());
+    // Grids are paired by name, and among grids of the same name by their
+    // rank (the second 'density' of A with the second 'density' of B).
+    std::vector<std::pair<size_t, size_t>> pairing;
+    std::vector<bool> usedB(gridsB.size(), false);
+    for (size_t i = 0; i < gridsA.size(); ++i) {
+        const std::string& name = gridsA[i].grid->getName();
+        size_t rank = 0;
+        for (size_t k = 0; k < i; ++k) rank += gridsA[k].grid->getName() == name;
+        size_t seen = 0, match = gridsB.size();
+        for (size_t j = 0; j < gridsB.size() && match == gridsB.size(); ++j)
+            if (gridsB[j].grid->getName() == name && seen++ == rank) match = j;
+        if (match == gridsB.size()) {
+            report.headerDifferences.push_back(fmt::format("grid {} of {} has no namesake in {}", detail::gridLabel(gridsA[i]), pathA, pathB));
+            continue;
+        }
+        usedB[match] = true;
+        pairing.emplace_back(i, match);
+    }
+    for (size_t j = 0; j < gridsB.size(); ++j)
+        if (!usedB[j]) report.headerDifferences.push_back(fmt::format("grid {} of {} has no namesake in {}", detail::gridLabel(gridsB[j]), pathB, pathA));
+    const size_t pairs = pairing.size();
     if (ext == ".vtu" && pairs > 1)
         throw Error(fmt::format("{}: {} grid pairs to compare but a .vtu holds one: pick one with --grid NAME or write a .vtm", output, pairs));
     uint64_t leaves = 0;
-    for (size_t i = 0; i < pairs; ++i) {
-        const auto& a = *gridsA[i].grid;
-        const auto& b = *gridsB[i].grid;
+    for (const auto& [ia, ib] : pairing) {
+        const auto& a = *gridsA[ia].grid;
+        const auto& b = *gridsB[ib].grid;
         if (a.type() != b.type())
-            throw Error(fmt::format("grid {} of {} is {} but grid {} of {} is {}: only grids of the same type are compared", detail::gridLabel(gridsA[i]),
-                                    pathA, a.valueType(), detail::gridLabel(gridsB[i]), pathB, b.valueType()));
+            throw Error(fmt::format("grid {} of {} is {} but grid {} of {} is {}: only grids of the same type are compared", detail::gridLabel(gridsA[ia]),
+                                    pathA, a.valueType(), detail::gridLabel(gridsB[ib]), pathB, b.valueType()));
         if (a.transform() != b.transform())
-            report.headerDifferences.push_back(fmt::format("grid {}: the transforms differ; cells are placed with A's", detail::gridLabel(gridsA[i])));
+            report.headerDifferences.push_back(fmt::format("grid {}: the transforms differ; cells are placed with A's", detail::gridLabel(gridsA[ia])));
         leaves += a.baseTree().leafCount();
     }
     vtkNew<vtkMultiBlockDataSet> blocks;
     vtkSmartPointer<vtkDataObject> single;
     Progress progress("diff", leaves);
-    for (size_t i = 0; i < pairs; ++i) {
+    for (size_t p = 0; p < pairs; ++p) {
+        const size_t i = pairing[p].first, ib = pairing[p].second;
         GridDiff d;
         d.name = gridsA[i].grid->getName();
         d.indexA = gridsA[i].fileIndex;
-        d.indexB = gridsB[i].fileIndex;
+        d.indexB = gridsB[ib].fileIndex;
         d.valueType = gridsA[i].grid->valueType();
         vtkSmartPointer<vtkUnstructuredGrid> cells;
         detail::dispatchGridType(*gridsA[i].grid, [&](const auto& a, ValueType) {
             using GridT = std::decay_t<decltype(a)>;
-            const auto& b = static_cast<const GridT&>(*gridsB[i].grid);
+            const auto& b = static_cast<const GridT&>(*gridsB[ib].grid);
             cells = diffGrids(a, b, !output.empty(), options, pathA + " vs " + pathB + ": grid " + detail::gridLabel(gridsA[i]), progress, d);
         });
-        if (ext == ".vtm") detail::setBlock(blocks, unsigned(i), cells, d.name.empty() ? "grid_" + std::to_string(d.indexA) : d.name);
+        if (ext == ".vtm") detail::setBlock(blocks, unsigned(p), cells, d.name.empty() ? "grid_" + std::to_string(d.indexA) : d.name);
         else single = cells;
         if (d.differs()) report.identical = false;
         report.grids.push_back(d);

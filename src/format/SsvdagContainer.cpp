@@ -229,6 +229,7 @@ bool compressSection(std::span<const uint8_t> data, const ContainerOptions& opti
 const char* sectionKindName(SectionKind kind) {
     switch (kind) {
         case SectionKind::FileInfo: return "FileInfo";
+        case SectionKind::FileMetadata: return "FileMetadata";
         case SectionKind::GridInfo: return "GridInfo";
         case SectionKind::VdbDescriptor: return "VdbDescriptor";
         case SectionKind::DagLevels: return "DagLevels";

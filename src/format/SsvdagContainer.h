@@ -34,6 +34,7 @@ enum class SectionKind : uint32_t {
     // 14-19: reserved for another branch.
     PredictedValues = 20,          // per grid: integer active values predicted in attribute order (instead of Values)
     InactivePredictedValues = 21,  // the same for the inactive layer (instead of InactiveValues)
+    FileMetadata = 22,  // file-level: the .vdb file's own metadata (opaque, vdb_bridge); absent when it has none
 };
 const char* sectionKindName(SectionKind kind);
 

@@ -1,5 +1,7 @@
 // Mapping between SsvdagScene and container sections. Section payloads:
 //   FileInfo      u32 grid count, string writer
+//   FileMetadata  opaque bytes (vdb_bridge: the .vdb file's MetaMap); absent
+//                 when the file has no metadata
 //   GridInfo      string name, string class, u8 value type, u8 symmetry,
 //                 f64[16] index-to-world, u64 active voxels,
 //                 string background (raw value bytes), u64 inactive voxels
@@ -90,6 +92,7 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
         w.putString(kWriter);
         sections.push_back({SectionKind::FileInfo, 0, w.take()});
     }
+    if (!scene.fileMetadata.empty()) sections.push_back({SectionKind::FileMetadata, 0, scene.fileMetadata});
     for (uint32_t g = 0; g < scene.grids.size(); ++g) {
         const EncodedGrid& grid = scene.grids[g];
         ByteWriter info;
@@ -148,11 +151,18 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
 
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options) {
     const Section* fileInfo = nullptr;
+    Section* fileMetadata = nullptr;
     std::map<std::pair<uint32_t, SectionKind>, Section*> byGrid;
     for (Section& s : sections) {
         if (s.kind == SectionKind::FileInfo) {
             if (fileInfo) throw Error(sourceName + ": two FileInfo sections");
             fileInfo = &s;
+            continue;
+        }
+        if (s.kind == SectionKind::FileMetadata) {
+            if (fileMetadata) throw Error(sourceName + ": two FileMetadata sections");
+            if (s.grid != 0) throw Error(sourceName + ": a FileMetadata section belongs to the file, not to grid " + std::to_string(s.grid));
+            fileMetadata = &s;
             continue;
         }
         if (!byGrid.emplace(std::make_pair(s.grid, s.kind), &s).second)
@@ -174,6 +184,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     };
 
     SsvdagScene scene;
+    if (fileMetadata) scene.fileMetadata = std::move(fileMetadata->data);
     scene.grids.resize(gridCount);
     for (uint32_t g = 0; g < gridCount; ++g) {
         EncodedGrid& grid = scene.grids[g];

@@ -54,6 +54,7 @@ struct EncodedGrid {
 
 struct SsvdagScene {
     std::vector<EncodedGrid> grids;
+    std::vector<uint8_t> fileMetadata;  // Volume::fileMetadata (opaque)
 };
 
 std::vector<Section> sceneToSections(const SsvdagScene& scene);

@@ -204,6 +204,7 @@ GridRecord decodeGrid(const format::EncodedGrid& grid) {
 
 format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& options, const GridProgress& onGrid) {
     format::SsvdagScene scene;
+    scene.fileMetadata = volume.fileMetadata;
     for (size_t g = 0; g < volume.grids.size(); ++g) {
         if (onGrid) onGrid(g, volume.grids.size());
         scene.grids.push_back(encodeGrid(volume.grids[g], options));
@@ -213,6 +214,7 @@ format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& opti
 
 format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options, const GridProgress& onGrid) {
     format::SsvdagScene scene;
+    scene.fileMetadata = volume.fileMetadata;
     for (size_t g = 0; g < volume.grids.size(); ++g) {
         if (onGrid) onGrid(g, volume.grids.size());
         scene.grids.push_back(encodeGridImpl(volume.grids[g], options, &volume.grids[g]));
@@ -222,6 +224,7 @@ format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& o
 
 Volume decodeScene(const format::SsvdagScene& scene, const GridProgress& onGrid) {
     Volume volume;
+    volume.fileMetadata = scene.fileMetadata;
     for (size_t g = 0; g < scene.grids.size(); ++g) {
         if (onGrid) onGrid(g, scene.grids.size());
         volume.grids.push_back(decodeGrid(scene.grids[g]));

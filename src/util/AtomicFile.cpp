@@ -10,13 +10,17 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <random>
+#include <optional>
+#include <ostream>
+#include <streambuf>
+#include <vector>
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "src/util/Error.h"
+#include "src/util/TemporaryFiles.h"
 
 namespace vdbdag {
 namespace {
@@ -28,23 +32,21 @@ std::string folderOf(const std::string& path) {
     return parent.empty() ? std::string(".") : parent.string();
 }
 
-std::string temporaryNameFor(const std::string& path) {
-    static thread_local std::mt19937_64 rng{std::random_device{}() ^ (uint64_t(getpid()) << 32)};
-    const fs::path p(path);
-    std::string name = ".";  // built by appending: GCC 12 warns (-Wrestrict) about "." + string
-    name += p.filename().string();
-    name += ".tmp.";
-    name += std::to_string(getpid());
-    name += '.';
-    name += std::to_string(rng() & 0xFFFFFFFFFFFFull);
-    return (p.parent_path() / name).string();
-}
-
 [[noreturn]] void fail(const std::string& path, const std::string& what, int err) {
     throw Error(path + ": " + what + " (" + std::strerror(err) + ")");
 }
 
-// Clear errors before any temporary exists.
+std::string describeNonRegular(mode_t mode) {
+    if (S_ISDIR(mode)) return "is a directory";
+    if (S_ISLNK(mode)) return "is a symbolic link (give the path it points to)";
+    if (S_ISFIFO(mode)) return "is a FIFO";
+    if (S_ISCHR(mode) || S_ISBLK(mode)) return "is a device";
+    if (S_ISSOCK(mode)) return "is a socket";
+    return "is not a regular file";
+}
+
+// Clear errors before any temporary exists; also removes what a killed
+// earlier write of the same output left behind.
 void checkDestination(const std::string& path) {
     const fs::path p(path);
     if (path.empty() || p.filename().empty() || p.filename() == "." || p.filename() == "..") throw Error(path + ": not a file name");
@@ -55,7 +57,8 @@ void checkDestination(const std::string& path) {
         fail(path, "cannot access the folder " + dir, errno);
     }
     if (!S_ISDIR(st.st_mode)) throw Error(path + ": " + dir + " is not a folder");
-    if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw Error(path + ": is a directory");
+    if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) throw Error(path + ": " + describeNonRegular(st.st_mode) + "; vdbdag replaces only regular files");
+    removeStaleTemporaries(path);
 }
 
 void removeQuietly(const std::string& tmp) {
@@ -81,38 +84,100 @@ void renameOver(const std::string& tmp, const std::string& path) {
     syncFolder(path);
 }
 
-// Creates a fresh temporary (O_EXCL, a few names tried) and returns its fd.
-int createTemporary(const std::string& path, std::string& tmp) {
+// Creates a fresh temporary (O_EXCL, a few names tried), registered for
+// removal on interrupt before it exists, and returns its fd.
+int createTemporary(const std::string& path, std::string& tmp, std::optional<TemporaryGuard>& guard) {
     for (int attempt = 0;; ++attempt) {
         tmp = temporaryNameFor(path);
+        guard.emplace(tmp);
         const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         if (fd >= 0) return fd;
-        if (errno != EEXIST || attempt == 8) fail(path, "cannot create a file in " + folderOf(path), errno);
+        const int err = errno;
+        guard.reset();
+        if (err != EEXIST || attempt == 8) fail(path, "cannot create a file in " + folderOf(path), err);
     }
 }
 
-} // namespace
-
-void writeFileAtomically(const std::string& path, std::span<const uint8_t> bytes) {
-    checkDestination(path);
-    std::string tmp;
-    const int fd = createTemporary(path, tmp);
-    auto failAndClean = [&](const char* what, int err) {
-        ::close(fd);
-        removeQuietly(tmp);
-        fail(path, what, err);
-    };
+// Writes all of `bytes` to `fd`; returns 0 or the errno of the failure.
+int writeAll(int fd, const uint8_t* data, size_t size) {
     size_t done = 0;
-    while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    while (done < size) {
+        const ssize_t n = ::write(fd, data + done, size - done);
         if (n < 0) {
             if (errno == EINTR) continue;
-            failAndClean("write failed", errno);
+            return errno;
         }
-        if (n == 0) failAndClean("write failed", ENOSPC);
+        if (n == 0) return ENOSPC;
         done += size_t(n);
     }
-    if (::fsync(fd) != 0) failAndClean("fsync failed", errno);
+    return 0;
+}
+
+// A buffered std::streambuf over a file descriptor that remembers the first
+// write error (std::ofstream keeps only a failbit, and OpenVDB's writer never
+// looks at it).
+class FdStreamBuf : public std::streambuf {
+public:
+    explicit FdStreamBuf(int fd) : fd_(fd), buffer_(1 << 20) { setp(buffer_.data(), buffer_.data() + buffer_.size()); }
+    int error() const { return error_; }
+    bool flushAll() { return flushBuffer(); }
+
+protected:
+    int_type overflow(int_type c) override {
+        if (!flushBuffer()) return traits_type::eof();
+        if (!traits_type::eq_int_type(c, traits_type::eof())) {
+            *pptr() = traits_type::to_char_type(c);
+            pbump(1);
+        }
+        return traits_type::not_eof(c);
+    }
+    std::streamsize xsputn(const char* s, std::streamsize n) override {
+        if (n >= std::streamsize(buffer_.size())) {
+            if (!flushBuffer()) return 0;
+            if (const int err = writeAll(fd_, reinterpret_cast<const uint8_t*>(s), size_t(n))) {
+                error_ = err;
+                return 0;
+            }
+            return n;
+        }
+        return std::streambuf::xsputn(s, n);
+    }
+    int sync() override { return flushBuffer() ? 0 : -1; }
+    // OpenVDB's archive goes back to fill in each grid's offsets.
+    pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
+        if (!flushBuffer()) return pos_type(off_type(-1));
+        const int whence = dir == std::ios_base::beg ? SEEK_SET : dir == std::ios_base::cur ? SEEK_CUR : SEEK_END;
+        const off_t at = ::lseek(fd_, off_t(off), whence);
+        if (at < 0) {
+            error_ = errno;
+            return pos_type(off_type(-1));
+        }
+        return pos_type(off_type(at));
+    }
+    pos_type seekpos(pos_type pos, std::ios_base::openmode mode) override { return seekoff(off_type(pos), std::ios_base::beg, mode); }
+
+private:
+    bool flushBuffer() {
+        if (error_) return false;
+        const size_t n = size_t(pptr() - pbase());
+        if (n) error_ = writeAll(fd_, reinterpret_cast<const uint8_t*>(pbase()), n);
+        setp(buffer_.data(), buffer_.data() + buffer_.size());
+        return error_ == 0;
+    }
+    int fd_;
+    int error_ = 0;
+    std::vector<char> buffer_;
+};
+
+// fsync + close the temporary, then rename it over `path`; on failure the
+// temporary is removed and Error thrown.
+void finishTemporary(const std::string& path, const std::string& tmp, int fd) {
+    if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {  // (EINVAL: a file system without fsync)
+        const int err = errno;
+        ::close(fd);
+        removeQuietly(tmp);
+        fail(path, "fsync failed", err);
+    }
     if (::close(fd) != 0) {
         const int err = errno;
         removeQuietly(tmp);
@@ -121,13 +186,58 @@ void writeFileAtomically(const std::string& path, std::span<const uint8_t> bytes
     renameOver(tmp, path);
 }
 
-void writeViaTemporary(const std::string& path, const std::function<void(const std::string& temporaryPath)>& writeTo) {
+} // namespace
+
+void writeFileAtomically(const std::string& path, std::span<const uint8_t> bytes) {
     checkDestination(path);
-    const std::string tmp = temporaryNameFor(path);
+    std::string tmp;
+    std::optional<TemporaryGuard> guard;
+    const int fd = createTemporary(path, tmp, guard);
+    if (const int err = writeAll(fd, bytes.data(), bytes.size())) {
+        ::close(fd);
+        removeQuietly(tmp);
+        fail(path, "write failed", err);
+    }
+    finishTemporary(path, tmp, fd);
+}
+
+void writeStreamAtomically(const std::string& path, const std::function<void(std::ostream& out)>& writeTo) {
+    checkDestination(path);
+    std::string tmp;
+    std::optional<TemporaryGuard> guard;
+    const int fd = createTemporary(path, tmp, guard);
+    int err = 0;
+    try {
+        FdStreamBuf buffer(fd);
+        std::ostream out(&buffer);
+        writeTo(out);
+        out.flush();
+        buffer.flushAll();
+        err = buffer.error();
+        if (!err && !out) err = EIO;
+    } catch (...) {
+        ::close(fd);
+        removeQuietly(tmp);
+        throw;
+    }
+    if (err) {
+        ::close(fd);
+        removeQuietly(tmp);
+        fail(path, "write failed", err);
+    }
+    finishTemporary(path, tmp, fd);
+}
+
+void writeViaTemporary(const std::string& path, const std::function<void(const std::string& temporaryPath)>& writeTo, const std::string& suffix,
+                       bool folder) {
+    checkDestination(path);
+    const std::string tmp = temporaryNameFor(path, suffix);
+    TemporaryGuard guard(tmp, folder);
     try {
         writeTo(tmp);
     } catch (...) {
-        removeQuietly(tmp);
+        std::error_code ec;
+        fs::remove_all(tmp, ec);
         throw;
     }
     struct stat st{};
@@ -139,14 +249,12 @@ void writeViaTemporary(const std::string& path, const std::function<void(const s
     }
     // The writer closed its file; flush it to disk before the rename.
     const int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0 || ::fsync(fd) != 0) {
+    if (fd < 0) {
         const int err = errno;
-        if (fd >= 0) ::close(fd);
         removeQuietly(tmp);
-        fail(path, "fsync failed", err);
+        fail(path, "cannot reopen the written file", err);
     }
-    ::close(fd);
-    renameOver(tmp, path);
+    finishTemporary(path, tmp, fd);
 }
 
 } // namespace vdbdag

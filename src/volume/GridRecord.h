@@ -71,9 +71,12 @@ struct GridRecord {
     std::optional<Normals> normals;
 };
 
-// A whole .vdb file, in file order.
+// A whole .vdb file: its grids in file order and its file-level metadata
+// (OpenVDB's own MetaMap serialisation, opaque like vdbDescriptor; empty
+// when the file has none).
 struct Volume {
     std::vector<GridRecord> grids;
+    std::vector<uint8_t> fileMetadata;
 };
 
 } // namespace vdbdag

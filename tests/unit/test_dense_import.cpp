@@ -251,7 +251,7 @@ TEST(DenseSharedData, HeaderTransformsAndLosslessSizeBeatZstd) {
                       {-0.016005020190061219, -0.95093665139041228, -0.30897139733494045},
                       {-0.11188725988575336, -0.30536684015686016, 0.94563858529983524}}},
                     {124, 160, 140}, "FLAIR");
-    r = runCli("import " + (denseDir() / "headsq_64x64x93_int16le.mhd").string() + " -o " + vdb.string());
+    r = runCli("import " + (denseDir() / "headsq_64x64x93_int16le.mhd").string() + " -o " + vdb.string() + " --force");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     expectTransform(*readOnlyGrid(vdb), {0, 0, 0}, {{{3.2, 0, 0}, {0, 3.2, 0}, {0, 0, 1.5}}}, {64, 64, 93}, "headsq");
 }
@@ -381,8 +381,8 @@ TEST(DenseErrors, MalformedInputsGiveOneLineErrorsAndNoOutput) {
     };
     for (const Case& c : cases) {
         std::ofstream(d / c.name) << c.text;
-        const fs::path out = d / (c.name + ".vdb");
         for (const std::string verb : {"import", "encode"}) {
+            const fs::path out = d / (c.name + (verb == "import" ? ".vdb" : ".ssvdag"));
             const auto r = runCli(verb + " " + (d / c.name).string() + " -o " + out.string());
             EXPECT_NE(r.exitCode, 0) << c.name;
             EXPECT_NE(r.err.find(c.name), std::string::npos) << c.name << ": " << r.err;

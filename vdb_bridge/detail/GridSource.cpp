@@ -3,13 +3,13 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
 #include "vdb_bridge/detail/GridBuilder.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
+#include "vdb_bridge/detail/VdbFile.h"
 
 namespace vdbdag::bridge::detail {
 
@@ -54,21 +54,8 @@ std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std
         }
         return out;
     }
-    openvdb::GridPtrVecPtr grids;
-    try {
-        // Read as a stream, whole (no delayed loading), so that a file cut
-        // short shows up as a failed stream: OpenVDB itself does not check
-        // and fills missing leaf buffers silently.
-        std::ifstream in(path, std::ios::binary);
-        if (!in) throw Error(path + ": cannot be opened");
-        openvdb::io::Stream stream(in, false);
-        grids = stream.getGrids();
-        if (!grids || in.fail()) throw Error(path + ": truncated or corrupted (the file ends inside its grids)");
-    } catch (const Error&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
-    }
+    const VdbFileContents contents = readVdbFile(path);
+    const openvdb::GridPtrVec* grids = &contents.grids;
     std::vector<std::string> names;
     for (const auto& g : *grids) names.push_back(g->getName());
     checkNames(path, names, onlyGrids);
@@ -78,12 +65,6 @@ std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std
         if (!dispatchGridType(*g, [](const auto&, ValueType) {}))
             throw Error(path + ": grid " + std::to_string(i) + " '" + g->getName() + "' has type '" + g->type() + "'" + typeHint(*g) +
                         ", which vdbdag does not convert (pick other grids with --grid NAME)");
-        // OpenVDB reads a truncated file without complaint (missing nodes
-        // are simply absent); its writer's own voxel count gives it away.
-        if (const auto count = g->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
-            if (uint64_t(count->value()) != g->activeVoxelCount())
-                throw Error(path + ": grid " + std::to_string(i) + " '" + g->getName() + "' is truncated or corrupted: it reads as " +
-                            std::to_string(g->activeVoxelCount()) + " active voxels but the file says " + std::to_string(count->value()));
         out.push_back({i, g});
     }
     return out;

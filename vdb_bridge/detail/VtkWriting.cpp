@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <random>
 
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
+#include "src/util/TemporaryFiles.h"
 
 namespace vdbdag::bridge::detail {
 namespace fs = std::filesystem;
@@ -79,11 +79,6 @@ struct QuietVtk {
     ~QuietVtk() { vtkObject::SetGlobalWarningDisplay(previous); }
 };
 
-std::string uniqueSuffix() {
-    static thread_local std::mt19937_64 rng{std::random_device{}()};
-    return std::to_string(getpid()) + "." + std::to_string(rng() & 0xFFFFFFFFFFull);
-}
-
 void writeMultiBlock(vtkMultiBlockDataSet* blocks, const std::string& path, Compressor compressor) {
     const fs::path dest(path);
     const fs::path folder = dest.parent_path().empty() ? fs::path(".") : dest.parent_path();
@@ -96,7 +91,9 @@ void writeMultiBlock(vtkMultiBlockDataSet* blocks, const std::string& path, Comp
             if (entry.path().filename().string().rfind(stem + "_", 0) != 0)
                 throw Error(path + ": folder " + pieces.string() + " holds other files than an earlier export's pieces; not overwriting it");
     }
-    const fs::path temporary = folder / ("." + stem + ".vtm.tmp." + uniqueSuffix());
+    removeStaleTemporaries(path);
+    const fs::path temporary = temporaryNameFor(path);
+    TemporaryGuard guard(temporary.string(), /*folder=*/true);
     if (!fs::create_directory(temporary, ec)) throw Error(path + ": cannot create a temporary folder in " + folder.string() + " (" + ec.message() + ")");
     try {
         vtkNew<vtkXMLMultiBlockDataWriter> writer;

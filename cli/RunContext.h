@@ -1,0 +1,21 @@
+// What the running command is doing, for the one message that cannot come
+// from an exception: running out of memory. OpenVDB's and TBB's destructors
+// may allocate while an earlier std::bad_alloc unwinds, which would end in
+// std::terminate; so the new-handler itself removes the temporaries
+// (TemporaryFiles.h), prints "vdbdag: PATH: out of memory while ACTIVITY"
+// and ends the process with exit status 1.
+#pragma once
+#include <string>
+
+namespace vdbdag::cli {
+
+// E.g. setActivity(opt->input, "encoding"); the first call of a command.
+void setActivity(const std::string& path, const std::string& activity);
+
+// The message for an out-of-memory ending ("PATH: out of memory while ...").
+std::string outOfMemoryMessage();
+
+// Installs the new-handler and the interrupt cleanup (once, from main).
+void installFailureHandlers();
+
+} // namespace vdbdag::cli

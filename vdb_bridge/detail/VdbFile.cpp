@@ -1,0 +1,98 @@
+// See VdbFile.h.
+#include "vdb_bridge/detail/VdbFile.h"
+
+#include <fstream>
+#include <sstream>
+
+#include <openvdb/io/Archive.h>
+#include <openvdb/io/Stream.h>
+
+#include "src/util/AtomicFile.h"
+#include "src/util/Error.h"
+#include "vdb_bridge/detail/OpenVdbSupport.h"
+#include "vdb_bridge/detail/VdbFileLayout.h"
+
+namespace vdbdag::bridge::detail {
+namespace {
+
+// OpenVDB's archive writer, given a stream of ours: io::File writes through
+// an std::ofstream whose failures it never checks.
+class StreamArchive : public openvdb::io::Archive {
+public:
+    void writeTo(std::ostream& out, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& metadata) const {
+        Archive::write(out, grids, /*seekable=*/true, metadata);
+    }
+};
+
+} // namespace
+
+VdbFileContents readVdbFile(const std::string& path) {
+    initializeOpenVdb();
+    const VdbFileLayout layout = checkVdbFileLayout(path);
+    VdbFileContents contents;
+    try {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw Error(path + ": cannot be opened");
+        openvdb::io::Stream stream(in, /*delayLoad=*/false);
+        contents.metadata = stream.getMetadata();
+        openvdb::GridPtrVecPtr grids = stream.getGrids();
+        if (!grids || in.fail()) throw Error(path + ": truncated or corrupted (the file ends inside its grids)");
+        contents.grids = *grids;
+    } catch (const Error&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
+    }
+    if (!contents.metadata) contents.metadata = std::make_shared<openvdb::MetaMap>();
+    if (contents.grids.size() != size_t(layout.gridCount))
+        throw Error(path + ": corrupted: the file lists " + std::to_string(layout.gridCount) + " grids but " + std::to_string(contents.grids.size()) +
+                    " could be read");
+    for (size_t i = 0; i < contents.grids.size(); ++i) {
+        const auto& g = contents.grids[i];
+        // OpenVDB reads a file cut short without complaint (missing nodes are
+        // simply absent); its writer's own voxel count gives it away.
+        if (const auto count = g->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
+            if (uint64_t(count->value()) != g->activeVoxelCount())
+                throw Error(path + ": grid " + std::to_string(i) + " '" + g->getName() + "' is truncated or corrupted: it reads as " +
+                            std::to_string(g->activeVoxelCount()) + " active voxels but the file says " + std::to_string(count->value()));
+    }
+    return contents;
+}
+
+void writeVdbFile(const std::string& path, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& metadata) {
+    initializeOpenVdb();
+    writeStreamAtomically(path, [&](std::ostream& out) {
+        try {
+            StreamArchive().writeTo(out, grids, metadata);
+        } catch (const openvdb::Exception& e) {
+            throw Error(path + ": OpenVDB could not write the file (" + oneLine(e.what()) + ")");
+        }
+    });
+}
+
+std::vector<uint8_t> serializeMetadata(const openvdb::MetaMap& metadata) {
+    if (metadata.metaCount() == 0) return {};
+    std::ostringstream out(std::ios::binary);
+    metadata.writeMeta(out);
+    const std::string s = out.str();
+    return std::vector<uint8_t>(s.begin(), s.end());
+}
+
+openvdb::MetaMap::Ptr parseMetadata(const std::vector<uint8_t>& bytes, const std::string& what) {
+    initializeOpenVdb();
+    auto meta = std::make_shared<openvdb::MetaMap>();
+    if (bytes.empty()) return meta;
+    checkMetadataBlock(bytes.data(), bytes.size(), what + ": file metadata");
+    try {
+        std::istringstream in(std::string(bytes.begin(), bytes.end()), std::ios::binary);
+        meta->readMeta(in);
+        if (in.fail()) throw Error(what + ": file metadata is corrupted");
+    } catch (const openvdb::Exception& e) {
+        throw Error(what + ": file metadata is corrupted (" + oneLine(e.what()) + ")");
+    }
+    return meta;
+}
+
+} // namespace vdbdag::bridge::detail
