@@ -28,14 +28,14 @@ for entry in "${inputs[@]}"; do
   r=$(stat -c %s "$raw")
   z=$(zstd -19 -T2 -q -c "$raw" | wc -c)
   x=$(xz -9e -T2 -c "$raw" | wc -c)
-  build/vdbdag import "$header" -o "$OUT/$name.import.vdb" > /dev/null
+  build/vdbdag import "$header" -o "$OUT/$name.import.vdb" -f > /dev/null
   vdb_tool -read "$OUT/$name.import.vdb" -write codec=blosc "$OUT/$name.blosc.vdb" > /dev/null 2>&1
   b=$(stat -c %s "$OUT/$name.blosc.vdb")
   start=$(date +%s.%N)
-  build/vdbdag encode "$header" -o "$OUT/$name.ssvdag" > /dev/null
+  build/vdbdag encode "$header" -o "$OUT/$name.ssvdag" -f > /dev/null
   end=$(date +%s.%N)
   s=$(stat -c %s "$OUT/$name.ssvdag")
-  build/vdbdag encode "$header" --no-predict -o "$OUT/$name.palette.ssvdag" > /dev/null
+  build/vdbdag encode "$header" --no-predict -o "$OUT/$name.palette.ssvdag" -f > /dev/null
   p=$(stat -c %s "$OUT/$name.palette.ssvdag")
   python3 -c "print(f'| $name | {$r:,} | {$z:,} ({$z/$r:.3f}x) | {$x:,} ({$x/$r:.3f}x) | {$b:,} ({$b/$r:.3f}x) | {$s:,} | {$p:,} ({$p/$r:.3f}x) | {$s/$r:.3f} | {$s/$z:.3f} | {$s/$x:.3f} | {$s/$b:.3f} | {$end-$start:.2f} |')"
 done
@@ -46,7 +46,7 @@ for entry in "${inputs[@]}"; do
   IFS='|' read -r header raw threshold <<< "$entry"
   name=$(basename "$header" .nhdr)
   r=$(stat -c %s "$raw")
-  build/vdbdag encode "$header" --background-below "$threshold" --json -o "$OUT/$name.air.ssvdag" > "$OUT/$name.air.json"
+  build/vdbdag encode "$header" --background-below "$threshold" --json -o "$OUT/$name.air.ssvdag" -f > "$OUT/$name.air.json"
   python3 - "$OUT/$name.air.json" "$r" "$name" "$threshold" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1])); raw = int(sys.argv[2]); t = j["threshold"]

@@ -20,10 +20,10 @@ printf "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n"
 for f in "${inputs[@]}"; do
   name=$(basename "$f" .vdb)
   start=$(date +%s.%N)
-  build/vdbdag encode "$f" -o "$OUT/$name.ssvdag" --topology-only --json > "$OUT/$name.json"
+  build/vdbdag encode "$f" -o "$OUT/$name.ssvdag" -f --topology-only --json > "$OUT/$name.json"
   end=$(date +%s.%N)
-  build/vdbdag encode "$f" -o "$OUT/$name.svdag.ssvdag" --no-symmetry --topology-only >/dev/null
-  build/vdbdag decode "$OUT/$name.ssvdag" -o "$OUT/${name}_mask.vdb"
+  build/vdbdag encode "$f" -o "$OUT/$name.svdag.ssvdag" -f --no-symmetry --topology-only >/dev/null
+  build/vdbdag decode "$OUT/$name.ssvdag" -o "$OUT/${name}_mask.vdb" -f
   voxels=$(python3 -c "import json;print(json.load(open('$OUT/$name.json'))['active_voxels'])")
   s=$(stat -c %s "$OUT/$name.ssvdag"); p=$(stat -c %s "$OUT/$name.svdag.ssvdag"); m=$(stat -c %s "$OUT/${name}_mask.vdb")
   python3 -c "print(f'| $name | {$voxels:,} | {$s:,} | {$p:,} | {$s/$p:.3f} | {$m:,} | {$s/$m:.4f} (1/{$m/$s:.1f}) | {8*$s/$voxels:.3f} | {$end-$start:.2f} |')"
@@ -35,7 +35,7 @@ for f in "${inputs[@]}"; do
   name=$(basename "$f" .vdb)
   nanovdb_convert -f "$f" "$OUT/$name.nvdb" >/dev/null
   start=$(date +%s.%N)
-  build/vdbdag encode "$f" -o "$OUT/$name.values.ssvdag" >/dev/null
+  build/vdbdag encode "$f" -o "$OUT/$name.values.ssvdag" -f >/dev/null
   end=$(date +%s.%N)
   build/vdbdag info "$OUT/$name.values.ssvdag" --json > "$OUT/$name.values.json"
   v=$(stat -c %s "$f"); n=$(stat -c %s "$OUT/$name.nvdb"); s=$(stat -c %s "$OUT/$name.values.ssvdag")
