@@ -5,6 +5,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/FiniteNumber.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::cli {
@@ -15,8 +16,12 @@ void DenseInputOptions::addTo(CLI::App& cmd) {
     cmd.add_option("--endian", endian, "raw input: little (default) or big")->check(CLI::IsMember({"little", "big"}));
     cmd.add_option("--spacing", spacing, "raw input: voxel spacing sx sy sz (default 1 1 1)")->expected(3);
     cmd.add_option("--origin", origin, "raw input: world position of sample (0,0,0) (default 0 0 0)")->expected(3);
-    belowOption = cmd.add_option("--background-below", below, "dense input: samples below V become inactive background (lossy; the cost is reported)");
-    aboveOption = cmd.add_option("--background-above", above, "dense input: samples above V become inactive background (lossy; the cost is reported)");
+    belowOption = cmd.add_option("--background-below", below, "dense input: samples below V become inactive background (lossy; the cost is reported)")
+                      ->check(finiteNumber());
+    aboveOption = cmd.add_option("--background-above", above, "dense input: samples above V become inactive background (lossy; the cost is reported)")
+                      ->check(finiteNumber());
+    cmd.add_flag("--allow-external-data", allowExternalData,
+                 "dense header: read a data file outside the header's folder (an absolute path, '..', or a link leading out)");
 }
 
 bridge::DenseImportOptions DenseInputOptions::resolve(const std::string& path) const {
@@ -31,6 +36,7 @@ bridge::DenseImportOptions DenseInputOptions::resolve(const std::string& path) c
     if (!origin.empty()) o.raw.origin = {origin[0], origin[1], origin[2]};
     if (belowOption && belowOption->count()) o.backgroundBelow = below;
     if (aboveOption && aboveOption->count()) o.backgroundAbove = above;
+    o.allowExternalData = allowExternalData;
     return o;
 }
 
@@ -64,7 +70,8 @@ namespace vdbdag::cli {
 std::vector<std::string> denseInputFiles(const std::string& input, const DenseInputOptions& options) {
     const bridge::DenseFormat format = bridge::denseFormatOf(input);
     if (format == bridge::DenseFormat::None || format == bridge::DenseFormat::Raw) return {input};
-    const bridge::DenseVolume header = bridge::describeDense(input, options.resolve(input).raw);
+    const bridge::DenseImportOptions resolved = options.resolve(input);
+    const bridge::DenseVolume header = bridge::describeDense(input, resolved.raw, resolved.allowExternalData);
     return {input, header.dataPath};
 }
 

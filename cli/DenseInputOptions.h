@@ -19,6 +19,7 @@ struct DenseInputOptions {
     std::string type, endian;
     std::vector<double> spacing, origin;
     double below = 0, above = 0;
+    bool allowExternalData = false;
     CLI::Option* belowOption = nullptr;
     CLI::Option* aboveOption = nullptr;
 

@@ -13,6 +13,7 @@
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "cli/DenseInputOptions.h"
+#include "cli/FiniteNumber.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
 #include "src/util/AtomicFile.h"
@@ -47,8 +48,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the smallest (1-64)")->check(CLI::Range(1, 64));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
-    auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error")->check(CLI::PositiveNumber);
-    cmd->add_option("--rel-error", opt->relError, "lossy: every float/double active value within this relative error")->check(CLI::Range(1e-12, 0.5))->excludes(abs);
+    auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error")->check(finiteNumber())->check(CLI::PositiveNumber);
+    cmd->add_option("--rel-error", opt->relError, "lossy: every float/double active value within this relative error")->check(finiteNumber())->check(CLI::Range(1e-12, 0.5))->excludes(abs);
     auto* colourBits = cmd->add_option("--colour-bits,--color-bits", opt->colourBits,
                                        "lossy colours: at most 2^K colours per colour grid, clustered in CIELAB (K = 10, 12, 14; 1..16)")
                            ->check(CLI::Range(1, 16));

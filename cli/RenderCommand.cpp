@@ -10,6 +10,7 @@
 
 #include "cli/Commands.h"
 #include "cli/RunContext.h"
+#include "cli/FiniteNumber.h"
 #include "cli/RenderBackend.h"
 #include "src/format/SsvdagFile.h"
 #include "src/trace/Camera.h"
@@ -56,12 +57,12 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--width", opt->width, "image width")->check(CLI::Range(1, 16384));
     cmd->add_option("--height", opt->height, "image height")->check(CLI::Range(1, 16384));
     cmd->add_option("--camera", opt->camera, "EYE,TARGET,UP as 9 comma-separated world coordinates (default: frame the grid)");
-    cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(CLI::Range(1.0, 170.0));
+    cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(finiteNumber())->check(CLI::Range(1.0, 170.0));
     cmd->add_option("--backend", opt->backend, "vulkan, cpu, or auto (Vulkan when a device exists)")->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
     cmd->add_option("--device", opt->device, "Vulkan device index (see `vdbdag devices`)");
-    cmd->add_option("--lod-pixels", opt->lodPixels, "stop descending where a node projects smaller than this many pixels (0: off)")->check(CLI::Range(0.0, 1e6));
+    cmd->add_option("--lod-pixels", opt->lodPixels, "stop descending where a node projects smaller than this many pixels (0: off)")->check(finiteNumber())->check(CLI::Range(0.0, 1e6));
     cmd->add_flag("--shadows", opt->shadows, "cast a shadow ray towards the light");
-    cmd->add_option("--density-scale", opt->densityScale, "fog: extinction per voxel length at the largest density")->check(CLI::Range(0.0, 1e6));
+    cmd->add_option("--density-scale", opt->densityScale, "fog: extinction per voxel length at the largest density")->check(finiteNumber())->check(CLI::Range(0.0, 1e6));
     cmd->add_option("--frames", opt->frames, "render this many frames and report the median time")->check(CLI::Range(1, 1000));
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");

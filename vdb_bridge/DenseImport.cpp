@@ -62,6 +62,7 @@ void forEachSlab(const DenseVolume& v, Progress* progress, const std::function<v
 
 template <typename S, typename V>
 DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueType valueType, bool showProgress) {
+    { DenseSampleStream check(v); }  // the data file's size against the header, before anything is reserved
     const int64_t nx = v.dims[0], ny = v.dims[1];
     const int64_t slabs = (v.dims[2] + kSlab - 1) / kSlab;
     const int64_t rows = (ny + 3) / 4, cols = (nx + 3) / 4;
@@ -187,18 +188,42 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
 
 } // namespace
 
-DenseVolume describeDense(const std::string& path, const RawLayout& raw) {
+namespace {
+
+// A detached data file stays inside the header's folder tree: its name in
+// the header is relative and never climbs out, and no link leads it out.
+void checkDataFileLocation(const DenseVolume& v, const std::string& nameInHeader) {
+    namespace fs = std::filesystem;
+    const std::string refuse = v.headerPath + ": its data file '" + nameInHeader + "' ";
+    const std::string hint = " (pass --allow-external-data if that is intended)";
+    const fs::path name(nameInHeader);
+    if (name.is_absolute()) throw Error(refuse + "is an absolute path, outside the header's folder" + hint);
+    const fs::path normal = name.lexically_normal();
+    if (!normal.empty() && *normal.begin() == "..") throw Error(refuse + "climbs out of the header's folder" + hint);
+    std::error_code ec;
+    const fs::path folder = fs::weakly_canonical(fs::absolute(fs::path(v.headerPath).parent_path().empty() ? fs::path(".") : fs::path(v.headerPath).parent_path()), ec);
+    const fs::path data = fs::weakly_canonical(fs::absolute(v.dataPath), ec);
+    if (ec) return;  // a missing data file is reported when it is opened
+    const fs::path rel = data.lexically_relative(folder);
+    if (rel.empty() || *rel.begin() == "..") throw Error(refuse + "leads out of the header's folder through a link" + hint);
+}
+
+} // namespace
+
+DenseVolume describeDense(const std::string& path, const RawLayout& raw, bool allowExternalData) {
+    DenseVolume v;
     switch (denseFormatOf(path)) {
         case DenseFormat::Raw: return describeRaw(path, raw);
-        case DenseFormat::Nrrd: return readNrrdHeader(path);
-        case DenseFormat::MetaImage: return readMetaImageHeader(path);
-        case DenseFormat::None: break;
+        case DenseFormat::Nrrd: v = readNrrdHeader(path); break;
+        case DenseFormat::MetaImage: v = readMetaImageHeader(path); break;
+        case DenseFormat::None: throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
     }
-    throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
+    if (!allowExternalData && v.dataPath != v.headerPath) checkDataFileLocation(v, v.dataNameInHeader);
+    return v;
 }
 
 DenseImportResult importDense(const std::string& path, const DenseImportOptions& options) {
-    const DenseVolume v = describeDense(path, options.raw);
+    const DenseVolume v = describeDense(path, options.raw, options.allowExternalData);
     Thresholds th;
     for (auto [set, value, flag] : {std::tuple{&th.below, &th.belowValue, options.backgroundBelow},
                                     std::tuple{&th.above, &th.aboveValue, options.backgroundAbove}}) {

@@ -28,6 +28,10 @@ namespace vdbdag::bridge {
 
 struct DenseImportOptions {
     RawLayout raw;  // layout of .raw inputs (ignored for NRRD / MetaImage)
+    // A header's detached data file must lie in the header's own folder
+    // tree (no absolute path, no '..' out of it, no link that leads out)
+    // unless this is set (`--allow-external-data`).
+    bool allowExternalData = false;
     std::optional<double> backgroundBelow, backgroundAbove;
     bool showProgress = true;  // a Progress line on a terminal
 };
@@ -49,8 +53,9 @@ struct DenseImportResult {
     ThresholdReport threshold;
 };
 
-// The header of `path`, by extension (see DenseVolume.h's denseFormatOf).
-DenseVolume describeDense(const std::string& path, const RawLayout& raw);
+// The header of `path`, by extension (see DenseVolume.h's denseFormatOf),
+// its data file checked as DenseImportOptions::allowExternalData says.
+DenseVolume describeDense(const std::string& path, const RawLayout& raw, bool allowExternalData = false);
 
 // Throws vdbdag::Error naming the file on any malformed header, missing or
 // short data, unsupported type or bad threshold.

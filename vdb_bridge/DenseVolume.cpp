@@ -91,7 +91,8 @@ DenseSampleStream::DenseSampleStream(const DenseVolume& volume) : volume_(volume
     std::error_code ec;
     if (!std::filesystem::exists(data, ec))
         throw Error(volume_.headerPath + ": data file " + data + " does not exist");
-    if (std::filesystem::is_directory(data, ec)) throw Error(volume_.headerPath + ": data file " + data + " is a directory");
+    if (!std::filesystem::is_regular_file(data, ec))
+        throw Error(volume_.headerPath + ": data file " + data + " is not a regular file (a directory, device or FIFO is never read)");
     const uint64_t fileSize = std::filesystem::file_size(data, ec);
     if (ec) throw Error(where() + ": cannot read the file size (" + ec.message() + ")");
     const uint64_t need = volume_.sampleCount() * sampleBytes(volume_.type);
@@ -121,6 +122,11 @@ DenseSampleStream::DenseSampleStream(const DenseVolume& volume) : volume_(volume
     } else {
         if (offset < 0 || uint64_t(offset) > fileSize) throw Error(where() + ": compressed data offset is beyond the end of the file");
         if (std::fseek(file_, long(offset), SEEK_SET) != 0) throw Error(where() + ": cannot seek to byte " + std::to_string(offset));
+        // zlib's deflate expands at most about 1032:1: a header that claims
+        // more samples than that is refused before anything is allocated.
+        if (need / 1032 > fileSize - uint64_t(offset))
+            throw Error(where() + ": " + std::to_string(fileSize - uint64_t(offset)) + " compressed bytes cannot hold the " + std::to_string(need) +
+                        " bytes of samples the header describes");
         inflater_ = std::make_unique<Inflater>();
         if (inflateInit2(&inflater_->z, 15 + 32) != Z_OK) throw Error(where() + ": cannot start zlib");
         skipDecoded(uint64_t(volume_.decodedSkip));

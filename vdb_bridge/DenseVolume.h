@@ -26,6 +26,7 @@ enum class DataEncoding : uint8_t { Raw, Zlib };  // Zlib: gzip or zlib stream (
 struct DenseVolume {
     std::string headerPath;  // the file the user named (for messages)
     std::string dataPath;    // where the samples are (may equal headerPath)
+    std::string dataNameInHeader;  // the data file as the header names it (empty when attached)
     std::array<int64_t, 3> dims{0, 0, 0};
     SampleType type = SampleType::U8;
     bool bigEndian = false;

@@ -10,6 +10,7 @@
 #include <map>
 
 #include "src/util/Error.h"
+#include "src/util/InputPath.h"
 #include "vdb_bridge/detail/HeaderText.h"
 
 namespace vdbdag::bridge {
@@ -27,19 +28,15 @@ bool parseBool(const std::string& value, const std::string& what) {
 } // namespace
 
 DenseVolume readMetaImageHeader(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
-    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a MetaImage file");
+    checkInputFile(path, "a MetaImage file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open");
 
     std::map<std::string, std::string> fields;  // lower-case keys
     std::string line;
-    size_t headerBytes = 0;
+    size_t budget = kMaxHeaderBytes;
     bool sawDataFile = false;
-    while (std::getline(in, line)) {
-        headerBytes += line.size() + 1;
-        if (headerBytes > kMaxHeaderBytes) throw Error(path + ": MetaImage header longer than 1 MiB (no ElementDataFile line?)");
+    while (detail::getBoundedLine(in, line, budget, path + ": MetaImage header longer than 1 MiB (no ElementDataFile line?)")) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (detail::trim(line).empty() || detail::trim(line)[0] == '#') continue;
         const size_t eq = line.find('=');
@@ -130,6 +127,7 @@ DenseVolume readMetaImageHeader(const std::string& path) {
         std::filesystem::path p(dataFile);
         if (p.is_relative()) p = std::filesystem::path(path).parent_path() / p;
         v.dataPath = p.string();
+        v.dataNameInHeader = dataFile;
         if (headerSize == -1) v.dataOffset = DenseVolume::kSkipToEnd;
         else if (compressed) v.dataOffset = headerSize;
         else v.decodedSkip = headerSize;

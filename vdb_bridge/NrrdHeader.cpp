@@ -8,6 +8,7 @@
 #include <map>
 
 #include "src/util/Error.h"
+#include "src/util/InputPath.h"
 #include "vdb_bridge/detail/HeaderText.h"
 
 namespace vdbdag::bridge {
@@ -65,21 +66,21 @@ std::vector<std::vector<double>> parseVectors(const std::string& s, const std::s
 } // namespace
 
 DenseVolume readNrrdHeader(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
-    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a NRRD file");
+    checkInputFile(path, "a NRRD file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open");
     std::string line;
-    if (!std::getline(in, line) || line.rfind("NRRD000", 0) != 0)
+    size_t budget = kMaxHeaderBytes;
+    const std::string tooLong = path + ": NRRD header longer than 1 MiB (no blank line ends it?)";
+    char magic[7] = {};
+    in.read(magic, sizeof magic);
+    if (in.gcount() != 7 || std::string(magic, 7) != "NRRD000")
         throw Error(path + ": not a NRRD file (it does not start with the magic 'NRRD000X')");
+    detail::getBoundedLine(in, line, budget, tooLong);
 
     std::map<std::string, std::string> fields;
     bool blankLineSeen = false;
-    size_t headerBytes = line.size() + 1;
-    while (std::getline(in, line)) {
-        headerBytes += line.size() + 1;
-        if (headerBytes > kMaxHeaderBytes) throw Error(path + ": NRRD header longer than 1 MiB (no blank line ends it?)");
+    while (detail::getBoundedLine(in, line, budget, tooLong)) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (line.empty()) { blankLineSeen = true; break; }
         if (line[0] == '#') continue;
@@ -172,6 +173,7 @@ DenseVolume readNrrdHeader(const std::string& path) {
         std::filesystem::path p(name);
         if (p.is_relative()) p = std::filesystem::path(path).parent_path() / p;
         v.dataPath = p.string();
+        v.dataNameInHeader = name;
         v.dataOffset = 0;
     } else {
         if (attachedOffset < 0) throw Error(path + ": NRRD header has neither a 'data file' field nor a blank line before attached data");

@@ -6,13 +6,14 @@
 #include <regex>
 
 #include "src/util/Error.h"
+#include "src/util/InputPath.h"
+#include "vdb_bridge/detail/HeaderText.h"
 
 namespace vdbdag::bridge {
 
 DenseVolume describeRaw(const std::string& path, const RawLayout& layout) {
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
-    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a raw volume");
+    checkInputFile(path, "a raw volume");
     DenseVolume v;
     v.headerPath = path;
     v.dataPath = path;
@@ -23,7 +24,7 @@ DenseVolume describeRaw(const std::string& path, const RawLayout& layout) {
     if (layout.dims) {
         v.dims = *layout.dims;
     } else if (named) {
-        for (int a = 0; a < 3; ++a) v.dims[size_t(a)] = std::stoll(m[a + 1].str());
+        for (int a = 0; a < 3; ++a) v.dims[size_t(a)] = detail::parseInteger(m[a + 1].str(), path + ": the size in the file name");
     } else {
         throw Error(path + ": a raw file needs its layout: pass --dims X Y Z --type T (or name it NAME_XxYxZ_TYPE.raw)");
     }

@@ -310,7 +310,8 @@ std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::st
 
 std::vector<uint8_t> readFileBytes(const std::string& path) {
     auto fail = [&](const std::string& why, int err) { throw Error(path + ": " + why + " (" + std::strerror(err) + ")"); };
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    // O_NONBLOCK: opening a FIFO must not block (it is refused below).
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) {
         const int err = errno;
         if (err == ENOENT || err == ENOTDIR) throw Error(path + ": no such file");
@@ -322,30 +323,20 @@ std::vector<uint8_t> readFileBytes(const std::string& path) {
     } closer{fd};
     struct stat st{};
     if (::fstat(fd, &st) != 0) fail("cannot be read", errno);
-    if (S_ISDIR(st.st_mode)) throw Error(path + ": is a directory, not a file");
-    // Regular files: their size up front, then read on until the end in case
-    // the file grew; pipes and devices: chunks until the end.
-    std::vector<uint8_t> bytes(S_ISREG(st.st_mode) ? size_t(st.st_size) : 0);
+    if (!S_ISREG(st.st_mode)) {
+        const char* kind = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a FIFO" : S_ISSOCK(st.st_mode) ? "a socket" : "a device";
+        throw Error(path + ": is " + kind + ", not an .ssvdag file");  // a device could be read forever, a FIFO block
+    }
+    // The size the file has now; a file that shrinks while it is read ends early.
+    std::vector<uint8_t> bytes(size_t(st.st_size));
     size_t done = 0;
-    for (;;) {
-        if (done == bytes.size()) {
-            uint8_t probe[1 << 12];
-            const ssize_t n = ::read(fd, probe, sizeof(probe));
-            if (n < 0) {
-                if (errno == EINTR) continue;
-                fail("read error", errno);
-            }
-            if (n == 0) break;
-            bytes.insert(bytes.end(), probe, probe + n);
-            done += size_t(n);
-            continue;
-        }
+    while (done < bytes.size()) {
         const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
         if (n < 0) {
             if (errno == EINTR) continue;
             fail("read error", errno);
         }
-        if (n == 0) break;  // shrank while reading
+        if (n == 0) break;
         done += size_t(n);
     }
     bytes.resize(done);

@@ -478,7 +478,21 @@ TEST(ReadFileBytes, ReadsFilesAndNamesTheProblem) {
         fs::permissions(dir / "f.bin", fs::perms::none);
         EXPECT_THROW(format::readFileBytes((dir / "f.bin").string()), Error);
     }
-    EXPECT_TRUE(format::readFileBytes("/dev/null").empty());
+    // Devices and FIFOs are refused before they are read (a device could be
+    // read forever, a FIFO without a writer would block).
+    try {
+        format::readFileBytes("/dev/zero");
+        ADD_FAILURE() << "no error for a device";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("is a device"), std::string::npos) << e.what();
+    }
+    ASSERT_EQ(::mkfifo((dir / "fifo.ssvdag").c_str(), 0600), 0);
+    try {
+        format::readFileBytes((dir / "fifo.ssvdag").string());
+        ADD_FAILURE() << "no error for a FIFO";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("is a FIFO"), std::string::npos) << e.what();
+    }
     fs::remove_all(dir);
 }
 

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,28 @@ inline int64_t parseInteger(const std::string& token, const std::string& what) {
     const long long v = std::strtoll(begin, &end, 10);
     if (token.empty() || end != begin + token.size() || errno == ERANGE) throw Error(what + ": '" + token + "' is not an integer");
     return int64_t(v);
+}
+
+// std::getline with a budget: reads at most `budget` bytes (counting the
+// newline) and throws `tooLong` past it, so a header "line" of gigabytes is
+// never held in memory. Returns false at the end of the stream.
+inline bool getBoundedLine(std::istream& in, std::string& line, size_t& budget, const std::string& tooLong) {
+    line.clear();
+    std::streambuf* buffer = in.rdbuf();
+    bool any = false;
+    for (;;) {
+        const int c = buffer->sbumpc();
+        if (c == std::char_traits<char>::eof()) {
+            if (!any) in.setstate(std::ios::eofbit | std::ios::failbit);
+            else in.setstate(std::ios::eofbit);
+            return any;
+        }
+        any = true;
+        if (budget == 0) throw Error(tooLong);
+        --budget;
+        if (c == '\n') return true;
+        line.push_back(char(c));
+    }
 }
 
 inline std::vector<double> parseNumbers(const std::string& s, size_t count, const std::string& what) {

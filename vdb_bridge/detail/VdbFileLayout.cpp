@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "src/util/Error.h"
+#include "src/util/InputPath.h"
 
 namespace vdbdag::bridge::detail {
 namespace {
@@ -97,7 +98,8 @@ void checkMetadataBlock(const uint8_t* data, uint64_t size, const std::string& w
 }
 
 VdbFileLayout checkVdbFileLayout(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    checkInputFile(path, "a .vdb file");  // before open: opening a FIFO blocks
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) {
         const int err = errno;
         if (err == ENOENT) throw Error(path + ": no such file");
