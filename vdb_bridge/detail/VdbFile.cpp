@@ -5,6 +5,8 @@
 #include <sstream>
 
 #include <openvdb/io/Archive.h>
+#include <openvdb/io/File.h>
+#include <openvdb/io/GridDescriptor.h>
 #include <openvdb/io/Stream.h>
 
 #include "src/util/AtomicFile.h"
@@ -31,13 +33,26 @@ VdbFileContents readVdbFile(const std::string& path) {
     const VdbFileLayout layout = checkVdbFileLayout(path);
     VdbFileContents contents;
     try {
-        std::ifstream in(path, std::ios::binary);
-        if (!in) throw Error(path + ": cannot be opened");
-        openvdb::io::Stream stream(in, /*delayLoad=*/false);
-        contents.metadata = stream.getMetadata();
-        openvdb::GridPtrVecPtr grids = stream.getGrids();
-        if (!grids || in.fail()) throw Error(path + ": truncated or corrupted (the file ends inside its grids)");
-        contents.grids = *grids;
+        if (layout.hasGridOffsets) {
+            // io::File without delayed loading is OpenVDB's strictest reader
+            // (it checks every compressed block's size); grids are read one
+            // by one by their unique names, in file order.
+            openvdb::io::File file(path);
+            file.open(/*delayLoad=*/false);
+            contents.metadata = file.getMetadata();
+            for (const VdbGridEntry& entry : layout.grids)
+                contents.grids.push_back(file.readGrid(openvdb::io::GridDescriptor::nameAsString(entry.uniqueName)));
+            file.close();
+        } else {
+            // A stream (no offsets): read in order, whole.
+            std::ifstream in(path, std::ios::binary);
+            if (!in) throw Error(path + ": cannot be opened");
+            openvdb::io::Stream stream(in, /*delayLoad=*/false);
+            contents.metadata = stream.getMetadata();
+            openvdb::GridPtrVecPtr grids = stream.getGrids();
+            if (!grids || in.fail()) throw Error(path + ": truncated or corrupted (the file ends inside its grids)");
+            contents.grids = *grids;
+        }
     } catch (const Error&) {
         throw;
     } catch (const std::bad_alloc&) {
@@ -53,10 +68,23 @@ VdbFileContents readVdbFile(const std::string& path) {
         const auto& g = contents.grids[i];
         // OpenVDB reads a file cut short without complaint (missing nodes are
         // simply absent); its writer's own voxel count gives it away.
+        const std::string which = path + ": grid " + std::to_string(i) + " '" + g->getName() + "'";
+        if (!g || !g->baseTreePtr()) throw Error(which + " could not be read");
+        const uint64_t voxels = g->activeVoxelCount();
         if (const auto count = g->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
-            if (uint64_t(count->value()) != g->activeVoxelCount())
-                throw Error(path + ": grid " + std::to_string(i) + " '" + g->getName() + "' is truncated or corrupted: it reads as " +
-                            std::to_string(g->activeVoxelCount()) + " active voxels but the file says " + std::to_string(count->value()));
+            if (uint64_t(count->value()) != voxels)
+                throw Error(which + " is truncated or corrupted: it reads as " + std::to_string(voxels) + " active voxels but the file says " +
+                            std::to_string(count->value()));
+        // The writer's bounding box too: OpenVDB recomputes it on every write,
+        // so a corrupted one could not come back.
+        const auto lo = g->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+        const auto hi = g->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+        if (voxels > 0 && lo && hi) {
+            const openvdb::CoordBBox box = g->evalActiveVoxelBoundingBox();
+            if (openvdb::Vec3i(box.min().asVec3i()) != lo->value() || openvdb::Vec3i(box.max().asVec3i()) != hi->value())
+                throw Error(which + " is corrupted: its active voxels span " + openvdb::Vec3IMetadata(box.min().asVec3i()).str() + ".." + openvdb::Vec3IMetadata(box.max().asVec3i()).str() + " but the file says " +
+                            lo->str() + ".." + hi->str());
+        }
     }
     return contents;
 }
