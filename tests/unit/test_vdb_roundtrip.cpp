@@ -326,3 +326,28 @@ TEST(VdbRoundTrip, ComparisonDetectsAChangedActiveAndInactiveValue) {
     EXPECT_TRUE(bridge::compareFiles(a.string(), a.string()).identical);
     EXPECT_GT(valueMismatchesAny(*readGrids(a)[0], *readGrids(b)[0]), 0u);
 }
+
+// `verify` compares what a decode must keep: a decoded volume that lost the
+// file's metadata, or whose grids came back in another order, is reported.
+// The reference is the original file as OpenVDB reads it.
+TEST(VerifyNotices, LostFileMetadataAndGridOrder) {
+    const fs::path file = fs::path(VDBDAG_SHARED_DATA) / "vdb" / "constant_grids.vdb";
+    if (!fs::exists(file)) GTEST_SKIP() << "needs ../shared/data";
+    const bridge::ImportResult imported = bridge::importVdb(file.string(), {});
+    ASSERT_GE(imported.volume.grids.size(), 2u);
+    ASSERT_FALSE(imported.volume.fileMetadata.empty());
+    const Volume decoded = pipeline::decodeScene(format::readScene(format::writeScene(pipeline::encodeVolume(imported.volume)), "memory"));
+    EXPECT_TRUE(bridge::compareWithFile(file.string(), decoded).identical);
+
+    Volume lost = decoded;
+    lost.fileMetadata.clear();
+    const bridge::CompareResult noMeta = bridge::compareWithFile(file.string(), lost);
+    EXPECT_FALSE(noMeta.identical);
+    bool named = false;
+    for (const std::string& d : noMeta.headerDifferences) named |= d.find("file metadata 'kNeighbors'") != std::string::npos;
+    EXPECT_TRUE(named) << "the lost entry is not named";
+
+    Volume swapped = decoded;
+    std::swap(swapped.grids[0], swapped.grids[1]);
+    EXPECT_FALSE(bridge::compareWithFile(file.string(), swapped).identical);
+}
