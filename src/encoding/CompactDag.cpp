@@ -208,6 +208,12 @@ void validateCompact(const CompactDag& dag, const std::string& what) {
     }
     if (dag.log2Size < 3 || dag.log2Size > kMaxLog2Size) fail("root size 2^" + std::to_string(dag.log2Size) + " out of range");
     if (dag.rootReflection > 7) fail("bad root reflection");
+    // The root's origin is an index of OpenVDB's int32 range; with at most
+    // 2^40 voxels per side no coordinate arithmetic of the walkers overflows
+    // (each voxel's own index is checked where it is decoded).
+    for (int64_t o : dag.origin)
+        if (o < int64_t(std::numeric_limits<int32_t>::min()) || o > int64_t(std::numeric_limits<int32_t>::max()))
+            fail("the root's origin " + std::to_string(o) + " is outside OpenVDB's int32 index range");
     const size_t levels = dag.innerLevelCount();
     if (levels != size_t(dag.log2Size) - 2) fail("level table has " + std::to_string(levels) + " levels, expected " + std::to_string(dag.log2Size - 2));
     if (dag.offsetWords.size() != levels) fail("offset width table has " + std::to_string(dag.offsetWords.size()) + " entries");

@@ -598,3 +598,35 @@ TEST(AtomicFile, WriteViaTemporary) {
     EXPECT_EQ(slurp(target).size(), 7u);
     fs::remove_all(dir);
 }
+
+// A forged root origin (checksums recomputed, as a hostile writer would) is
+// refused when the file is read, before any coordinate arithmetic: the
+// fuzzers found 9223372036854775801 + 8 overflowing in the DAG walk.
+TEST(Container, ForgedRootOriginOutsideInt32IsRejected) {
+    const auto bytes = smallSceneBytes(false);
+    std::vector<Section> sections = format::readContainer(bytes, "small");
+    for (const int64_t forged : {int64_t(9223372036854775801), int64_t(1) << 31, -(int64_t(1) << 31) - 1}) {
+        std::vector<Section> copy = sections;
+        bool changed = false;
+        for (Section& s : copy)
+            if (s.kind == SectionKind::DagLevels) {
+                std::memcpy(s.data.data(), &forged, sizeof forged);  // i64 origin x comes first
+                changed = true;
+            }
+        ASSERT_TRUE(changed);
+        const auto forgedBytes = format::writeContainer(copy, format::ContainerOptions{false});
+        try {
+            format::readScene(forgedBytes, "forged");
+            ADD_FAILURE() << "origin " << forged << " accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("int32 index range"), std::string::npos) << e.what();
+        }
+    }
+    // The extremes of the range itself are valid origins.
+    for (const int64_t edge : {-(int64_t(1) << 31), (int64_t(1) << 31) - 1}) {
+        std::vector<Section> copy = sections;
+        for (Section& s : copy)
+            if (s.kind == SectionKind::DagLevels) std::memcpy(s.data.data(), &edge, sizeof edge);
+        EXPECT_NO_THROW(format::readScene(format::writeContainer(copy, format::ContainerOptions{false}), "edge")) << edge;
+    }
+}
