@@ -296,13 +296,19 @@ std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, c
     return out;
 }
 
-std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName) {
+std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName, bool unknownKinds) {
     const std::vector<Entry> entries = parseTable(bytes, sourceName);
     std::vector<Section> sections;
     sections.reserve(entries.size());
     for (size_t i = 0; i < entries.size(); ++i) {
         const Entry& e = entries[i];
         const std::string what = sourceName + ": " + describe(i, e.kind, e.grid);
+        if (!unknownKinds && std::strcmp(sectionKindName(SectionKind(e.kind)), "unknown") == 0) {
+            // Checked (its stored bytes), never inflated: a reader that does
+            // not know the kind has no use for it, whatever it claims to hold.
+            if (XXH3_64bits(bytes.data() + e.offset, e.stored) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
+            continue;
+        }
         sections.push_back({SectionKind(e.kind), e.grid, restore(e, bytes.subspan(e.offset, e.stored), what)});
     }
     return sections;

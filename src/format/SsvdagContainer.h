@@ -63,8 +63,10 @@ std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const 
 
 // Parses and validates container bytes; throws vdbdag::Error with a one-line
 // message starting with `sourceName` on any truncation, corruption, checksum
-// mismatch or implausible size.
-std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName);
+// mismatch or implausible size. With `unknownKinds` false, sections of kinds
+// this reader does not know are checksum-checked and dropped, never inflated
+// (what the scene readers do: such a section may claim gigabytes).
+std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName, bool unknownKinds = true);
 
 // Validates the header and table only (no payload decompression) and returns
 // the section summaries.

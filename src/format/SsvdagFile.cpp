@@ -319,7 +319,7 @@ std::vector<uint8_t> writeScene(const SsvdagScene& scene, const ContainerOptions
 }
 
 SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName) {
-    return sectionsToScene(readContainer(bytes, sourceName), sourceName);
+    return sectionsToScene(readContainer(bytes, sourceName, /*unknownKinds=*/false), sourceName);
 }
 
 SsvdagScene readSceneFile(const std::string& path) { return readSceneFile(path, ReadOptions{}); }
@@ -328,7 +328,7 @@ SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
     std::vector<Section> sections;
     {
         const std::vector<uint8_t> bytes = readFileBytes(path);  // released before the sections are parsed
-        sections = readContainer(bytes, path);
+        sections = readContainer(bytes, path, /*unknownKinds=*/false);
     }
     return sectionsToScene(std::move(sections), path, options);
 }
