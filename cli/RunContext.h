@@ -15,6 +15,10 @@ void setActivity(const std::string& path, const std::string& activity);
 // The message for an out-of-memory ending ("PATH: out of memory while ...").
 std::string outOfMemoryMessage();
 
+// Removes the temporaries, prints the out-of-memory line and ends the
+// process (exit status 1); async-signal-safe.
+[[noreturn]] void endOutOfMemory();
+
 // Installs the new-handler and the interrupt cleanup (once, from main).
 void installFailureHandlers();
 

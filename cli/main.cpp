@@ -1,6 +1,7 @@
 // Entry point of the `vdbdag` command: OpenVDB volumes <-> SSVDAG files.
 // Errors are printed as one line "vdbdag: <message>" with a non-zero exit.
 #include <cstdio>
+#include <cstring>
 #include <exception>
 
 #include <CLI/CLI.hpp>
@@ -37,7 +38,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "vdbdag: %s\n", vdbdag::cli::outOfMemoryMessage().c_str());
         return 1;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "vdbdag: %s\n", e.what());
+        // TBB reports a thread whose stack could not be mapped this way.
+        if (std::strstr(e.what(), "pthread_create has failed") != nullptr)
+            std::fprintf(stderr, "vdbdag: %s (no memory for a thread's stack)\n", vdbdag::cli::outOfMemoryMessage().c_str());
+        else
+            std::fprintf(stderr, "vdbdag: %s\n", e.what());
         return 1;
     }
     return exitCode;

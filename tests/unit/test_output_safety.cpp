@@ -5,7 +5,9 @@
 // bytes written by the test.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <ostream>
@@ -220,4 +222,45 @@ TEST(TemporaryFiles, StaleTemporariesOfDeadProcessesAreRemovedOnly) {
     EXPECT_FALSE(fs::exists(t / (".out.vdb.tmp." + std::to_string(dead) + ".9")));
     EXPECT_TRUE(fs::exists(live));
     EXPECT_TRUE(fs::exists(other));
+}
+
+// Out of memory is one line naming the file, exit 1, and no temporary left:
+// never "terminate called" (OpenVDB's destructors allocate while a bad_alloc
+// unwinds) and never a crash (c-blosc goes on with a null buffer when its
+// posix_memalign fails). The address-space cap that makes a run fail depends
+// on the machine, so caps are tried from small to large, every 20 MB, from
+// the first at which the program starts at all (below it the libraries'
+// own start-up fails) until one run succeeds; every run must end either
+// well or with that one line.
+TEST(OutOfMemory, IsOneLineNamingTheFileAndLeavesNothing) {
+    const fs::path input = fs::path(VDBDAG_SHARED_DATA) / "levelsets" / "bunny_d512_ls.vdb";
+    if (!fs::exists(input)) GTEST_SKIP() << "needs ../shared/data";
+    TempFolder t;
+    const std::string out = t / "out.ssvdag";
+    bool sawOutOfMemory = false;
+    int startMb = 300;
+    while (startMb <= 1600 && std::system(("ulimit -v " + std::to_string(startMb * 1024) + "; exec " + std::string(VDBDAG_BINARY) +
+                                           " --version > /dev/null 2>&1").c_str()) != 0)
+        startMb += 20;
+    // A margin above that: right at it, the libraries' start-up (280 shared
+    // libraries) can still fail in their own static initialisers.
+    for (int capMb = startMb + 40; capMb <= 1600; capMb += 20) {
+        const std::string errFile = t / "err.txt";
+        const int status = std::system(("ulimit -v " + std::to_string(capMb * 1024) + "; exec " + std::string(VDBDAG_BINARY) + " encode " +
+                                        input.string() + " -o " + out + " -f > /dev/null 2> " + errFile)
+                                           .c_str());
+        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        const std::string err = readText(errFile);
+        fs::remove(errFile);
+        if (code == 127) continue;  // the dynamic loader itself did not fit
+        EXPECT_EQ(err.find("terminate called"), std::string::npos) << capMb << " MB: " << err;
+        if (code == 0) break;  // fits: larger caps will too
+        EXPECT_EQ(code, 1) << capMb << " MB: " << err;
+        EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << capMb << " MB: " << err;
+        EXPECT_NE(err.find(input.string() + ": out of memory while encoding"), std::string::npos) << capMb << " MB: " << err;
+        sawOutOfMemory = true;
+        EXPECT_FALSE(fs::exists(out)) << capMb << " MB";
+        EXPECT_EQ(entries(t.path), 0u) << "a temporary was left behind";
+    }
+    if (!sawOutOfMemory) GTEST_SKIP() << "no cap up to 1.6 GB made the encode run out of memory here";
 }
