@@ -59,6 +59,7 @@
 
 #include "src/format/ByteIO.h"
 #include "src/util/Error.h"
+#include "src/util/InputPath.h"
 
 namespace vdbdag::format {
 namespace {
@@ -330,8 +331,7 @@ std::vector<uint8_t> readFileBytes(const std::string& path) {
     struct stat st{};
     if (::fstat(fd, &st) != 0) fail("cannot be read", errno);
     if (!S_ISREG(st.st_mode)) {
-        const char* kind = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a FIFO" : S_ISSOCK(st.st_mode) ? "a socket" : "a device";
-        throw Error(path + ": is " + kind + ", not an .ssvdag file");  // a device could be read forever, a FIFO block
+        throw Error(path + ": is " + fileKindName(st.st_mode) + ", not an .ssvdag file");  // a device could be read forever, a FIFO block
     }
     // The size the file has now; a file that shrinks while it is read ends early.
     std::vector<uint8_t> bytes(size_t(st.st_size));

@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "src/util/Error.h"
+#include "src/util/InputPath.h"
 #include "src/util/TemporaryFiles.h"
 
 namespace vdbdag {
@@ -37,12 +38,8 @@ std::string folderOf(const std::string& path) {
 }
 
 std::string describeNonRegular(mode_t mode) {
-    if (S_ISDIR(mode)) return "is a directory";
     if (S_ISLNK(mode)) return "is a symbolic link (give the path it points to)";
-    if (S_ISFIFO(mode)) return "is a FIFO";
-    if (S_ISCHR(mode) || S_ISBLK(mode)) return "is a device";
-    if (S_ISSOCK(mode)) return "is a socket";
-    return "is not a regular file";
+    return std::string("is ") + fileKindName(mode);
 }
 
 // Clear errors before any temporary exists; also removes what a killed

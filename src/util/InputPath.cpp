@@ -10,6 +10,15 @@
 
 namespace vdbdag {
 
+const char* fileKindName(unsigned mode) {
+    if (S_ISDIR(mode)) return "a directory";
+    if (S_ISLNK(mode)) return "a symbolic link";
+    if (S_ISFIFO(mode)) return "a FIFO";
+    if (S_ISSOCK(mode)) return "a socket";
+    if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+    return "a special file";
+}
+
 void checkInputFile(const std::string& path, const std::string& what) {
     struct stat st{};
     if (::stat(path.c_str(), &st) != 0) {
@@ -17,9 +26,7 @@ void checkInputFile(const std::string& path, const std::string& what) {
         throw Error(path + ": cannot be read (" + std::strerror(errno) + ")");
     }
     if (S_ISREG(st.st_mode)) return;
-    const char* kind = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a FIFO" : S_ISSOCK(st.st_mode) ? "a socket"
-                     : (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) ? "a device" : "not a regular file";
-    throw Error(path + ": is " + kind + ", not " + what);
+    throw Error(path + ": is " + fileKindName(st.st_mode) + ", not " + what);
 }
 
 } // namespace vdbdag

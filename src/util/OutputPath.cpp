@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "src/util/Error.h"
+#include "src/util/InputPath.h"
 
 namespace vdbdag {
 
@@ -44,9 +45,7 @@ void checkOutputPath(const std::string& output, const std::vector<std::string>& 
     }
     if (S_ISLNK(out.st_mode)) throw Error(output + ": is a symbolic link; not writing through it (give the path it points to)");
     if (S_ISDIR(out.st_mode)) throw Error(output + ": is a directory");
-    if (S_ISFIFO(out.st_mode)) throw Error(output + ": is a FIFO; " + rules.command + " writes only regular files");
-    if (S_ISCHR(out.st_mode) || S_ISBLK(out.st_mode)) throw Error(output + ": is a device; " + rules.command + " writes only regular files");
-    if (!S_ISREG(out.st_mode)) throw Error(output + ": is not a regular file; " + rules.command + " writes only regular files");
+    if (!S_ISREG(out.st_mode)) throw Error(output + ": is " + fileKindName(out.st_mode) + "; " + rules.command + " writes only regular files");
     if ((out.st_mode & 0222) == 0) throw Error(output + ": exists and is read-only; not replacing it");
     if (!rules.force) throw Error(output + ": already exists (use -f or --force to replace it)");
 }
