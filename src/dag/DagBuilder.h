@@ -18,6 +18,10 @@ struct BuildOptions {
     // not above the box's minimum. Placement decides which reflective
     // symmetries exist (DESIGN.md invariant 1).
     std::optional<std::array<int64_t, 3>> origin;
+    // Root size (log2 of its width); must cover the active box from the
+    // origin. Unset: the smallest that does. Sub-DAGs of a split build
+    // (SubDagMerge.h) are all built at the split's cube size.
+    std::optional<unsigned> log2Size;
 };
 
 // Builds and reduces; unreferenced nodes are dropped, refcounts are exact.
@@ -33,5 +37,14 @@ struct ActiveBounds {
     std::array<int64_t, 3> min, max;
 };
 ActiveBounds activeBounds(const GridTopology& topology);
+
+// Where the root cube goes for a box and an alignment under `options`
+// (origin and log2Size as in BuildOptions). Throws vdbdag::Error if an
+// explicit origin or size does not fit.
+struct RootPlacement {
+    std::array<int64_t, 3> origin;
+    unsigned log2Size;
+};
+RootPlacement placeRoot(const ActiveBounds& box, int64_t alignment, const BuildOptions& options);
 
 } // namespace vdbdag::dag
