@@ -325,43 +325,78 @@ DecodedSize decodedSize(const CompactDag& dag) {
 
 uint64_t BrickInstance::spatialMask() const { return dag::reflectBrick(storedMask, mirror); }
 
-void visitInAttributeOrder(const CompactDag& dag, const BrickInstanceVisitor& brick, const SolidVisitor& solid) {
-    if (dag.empty()) return;
-    const auto facts = computeFacts(dag);
-    if (saturatingAdd(facts[0].bricks[0], facts[0].tiles[0]) > kMaxEmittedPieces)
-        throw Error("decoding would create more than 2^31 bricks and tiles: the grid is implausibly large to decode here");
+namespace {
 
-    struct Walker {
-        const CompactDag& dag;
-        const std::vector<NodeFacts>& facts;
-        const BrickInstanceVisitor& brick;
-        const SolidVisitor& solid;
-        uint64_t entry = 0;
+// The depth-first walk of DESIGN.md invariant 2. With a cut size, nodes of
+// that size (and solid nodes above it) are reported to `cut` and skipped.
+struct Walker {
+    const CompactDag& dag;
+    const std::vector<NodeFacts>& facts;
+    const BrickInstanceVisitor* brick;
+    const SolidVisitor* solid;
+    unsigned cutLog2 = 0;
+    std::vector<SubtreeInstance>* cut = nullptr;
+    uint64_t entry = 0;
 
-        void visit(size_t i, uint64_t offset, unsigned mirror, int64_t x, int64_t y, int64_t z) {
-            const unsigned log2Size = dag.log2Size - unsigned(i);
-            const uint64_t pos = dag.levelStart[i] + offset;
-            const uint16_t header = dag.inner[pos];
-            if (header == 0) { solid(x, y, z, log2Size, entry++); return; }
-            const int64_t half = int64_t(1) << (log2Size - 1);
-            const bool toLeaves = i + 1 == dag.innerLevelCount();
-            for (unsigned j = 0; j < 8; ++j) {  // stored slot order = attribute order
-                if (((header >> (2 * j)) & 3u) == 0) continue;
-                const unsigned p = j ^ mirror;   // spatial slot
-                const ChildPointer ptr = readChild(dag.inner, pos, j, dag.offsetWords[i]);
-                const unsigned childMirror = mirror ^ ptr.reflection;
-                const int64_t cx = x + ((p & 1u) ? half : 0), cy = y + ((p & 2u) ? half : 0), cz = z + ((p & 4u) ? half : 0);
-                if (toLeaves) {
-                    const uint64_t stored = dag.leaves[ptr.offset];
-                    brick(BrickInstance{cx, cy, cz, childMirror, stored, entry});
-                    entry += uint64_t(std::popcount(stored));
-                } else {
-                    visit(i + 1, ptr.offset, childMirror, cx, cy, cz);
-                }
+    void visit(size_t i, uint64_t offset, unsigned mirror, int64_t x, int64_t y, int64_t z) {
+        const unsigned log2Size = dag.log2Size - unsigned(i);
+        const uint64_t pos = dag.levelStart[i] + offset;
+        const uint16_t header = dag.inner[pos];
+        if (cut && (log2Size == cutLog2 || header == 0)) {
+            cut->push_back({unsigned(i), offset, mirror, x, y, z, log2Size, entry, header == 0});
+            entry += facts[i].entries[offset];
+            return;
+        }
+        if (header == 0) { (*solid)(x, y, z, log2Size, entry++); return; }
+        const int64_t half = int64_t(1) << (log2Size - 1);
+        const bool toLeaves = i + 1 == dag.innerLevelCount();
+        for (unsigned j = 0; j < 8; ++j) {  // stored slot order = attribute order
+            if (((header >> (2 * j)) & 3u) == 0) continue;
+            const unsigned p = j ^ mirror;   // spatial slot
+            const ChildPointer ptr = readChild(dag.inner, pos, j, dag.offsetWords[i]);
+            const unsigned childMirror = mirror ^ ptr.reflection;
+            const int64_t cx = x + ((p & 1u) ? half : 0), cy = y + ((p & 2u) ? half : 0), cz = z + ((p & 4u) ? half : 0);
+            if (toLeaves) {
+                const uint64_t stored = dag.leaves[ptr.offset];
+                if (brick) (*brick)(BrickInstance{cx, cy, cz, childMirror, stored, entry});
+                entry += uint64_t(std::popcount(stored));
+            } else {
+                visit(i + 1, ptr.offset, childMirror, cx, cy, cz);
             }
         }
-    };
-    Walker{dag, facts, brick, solid}.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
+    }
+};
+
+std::vector<NodeFacts> checkedFacts(const CompactDag& dag) {
+    auto facts = computeFacts(dag);
+    if (saturatingAdd(facts[0].bricks[0], facts[0].tiles[0]) > kMaxEmittedPieces)
+        throw Error("decoding would create more than 2^31 bricks and tiles: the grid is implausibly large to decode here");
+    return facts;
+}
+
+} // namespace
+
+void visitInAttributeOrder(const CompactDag& dag, const BrickInstanceVisitor& brick, const SolidVisitor& solid) {
+    if (dag.empty()) return;
+    const auto facts = checkedFacts(dag);
+    Walker{dag, facts, &brick, &solid}.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
+}
+
+std::vector<SubtreeInstance> subtreesInAttributeOrder(const CompactDag& dag, unsigned log2Size) {
+    std::vector<SubtreeInstance> out;
+    if (dag.empty()) return out;
+    if (log2Size < 3 || log2Size > dag.log2Size) throw Error("internal error: subtree size out of range");
+    const auto facts = computeFacts(dag);
+    Walker walker{dag, facts, nullptr, nullptr, log2Size, &out};
+    walker.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
+    return out;
+}
+
+void visitSubtreeInAttributeOrder(const CompactDag& dag, const SubtreeInstance& root, const BrickInstanceVisitor& brick, const SolidVisitor& solid) {
+    const std::vector<NodeFacts> none;  // an uncut walk reads no facts
+    Walker walker{dag, none, &brick, &solid};
+    walker.entry = root.firstEntry;
+    walker.visit(root.level, root.offset, root.mirror, root.x, root.y, root.z);
 }
 
 void visitInstances(const CompactDag& dag, const BrickVisitor& brick, const TileVisitor& tile) {

@@ -76,6 +76,25 @@ using BrickInstanceVisitor = std::function<void(const BrickInstance&)>;
 using SolidVisitor = std::function<void(int64_t x, int64_t y, int64_t z, unsigned log2Size, uint64_t entry)>;
 void visitInAttributeOrder(const CompactDag& dag, const BrickInstanceVisitor& brick, const SolidVisitor& solid);
 
+// The same walk cut into subtrees (for encoders that gather values one cube
+// at a time): the instances of nodes of 2^log2Size voxels, and of solid
+// nodes at or above that size, in attribute order. A subtree's entries are
+// contiguous, starting at firstEntry.
+struct SubtreeInstance {
+    unsigned level;        // inner level index (0 = root level)
+    uint64_t offset;       // word offset of the node within its level
+    unsigned mirror;       // accumulated reflection
+    int64_t x, y, z;       // minimum corner (index space)
+    unsigned log2Size;
+    uint64_t firstEntry;
+    bool solid;            // a solid node (tile): one entry
+};
+std::vector<SubtreeInstance> subtreesInAttributeOrder(const CompactDag& dag, unsigned log2Size);
+// visitInAttributeOrder restricted to one such subtree (entries numbered
+// from its firstEntry).
+void visitSubtreeInAttributeOrder(const CompactDag& dag, const SubtreeInstance& root, const BrickInstanceVisitor& brick,
+                                  const SolidVisitor& solid);
+
 // Geometry-only convenience over visitInAttributeOrder.
 using BrickVisitor = std::function<void(int64_t x, int64_t y, int64_t z, uint64_t mask)>;
 using TileVisitor = std::function<void(int64_t x, int64_t y, int64_t z, unsigned log2Size)>;

@@ -42,42 +42,72 @@ inline unsigned rankBelow(uint64_t mask, unsigned bit) { return unsigned(std::po
 
 } // namespace
 
+namespace {
+
+// Input position of every brick's first value and of every tile, and the
+// copy of one instance's values into attribute order.
+class InputValues {
+public:
+    InputValues(const GridTopology& topology, const LayerValues& values, unsigned valueSize) : values_(values), vs_(valueSize) {
+        bricks_.reserve(topology.bricks.size());
+        uint64_t next = 0;
+        for (const Brick& b : topology.bricks) {
+            bricks_.emplace(CoordKey{b.x, b.y, b.z}, std::make_pair(next, b.mask));
+            next += uint64_t(std::popcount(b.mask));
+        }
+        if (values.bricks.size() != next * valueSize || values.tiles.size() != topology.tiles.size() * valueSize)
+            throw Error("internal error: value count does not match the topology");
+        for (size_t t = 0; t < topology.tiles.size(); ++t) tiles_.emplace(CoordKey{topology.tiles[t].x, topology.tiles[t].y, topology.tiles[t].z}, t);
+    }
+
+    void brick(const encoding::BrickInstance& b, uint8_t* out) const {
+        const auto it = bricks_.find(CoordKey{b.x, b.y, b.z});
+        if (it == bricks_.end()) throw Error("internal error: DAG brick missing from the input");
+        const auto [first, inputMask] = it->second;
+        uint64_t entry = b.firstEntry;
+        for (uint64_t bits = b.storedMask; bits; bits &= bits - 1, ++entry) {
+            const unsigned spatial = kReflected.bit[b.mirror][std::countr_zero(bits)];
+            std::memcpy(out + entry * vs_, &values_.bricks[(first + rankBelow(inputMask, spatial)) * vs_], vs_);
+        }
+    }
+
+    void solid(int64_t x, int64_t y, int64_t z, uint64_t entry, uint8_t* out) const {
+        const auto it = tiles_.find(CoordKey{x, y, z});
+        if (it == tiles_.end()) throw Error("internal error: DAG solid node missing from the input tiles");
+        std::memcpy(out + entry * vs_, &values_.tiles[it->second * vs_], vs_);
+    }
+
+private:
+    const LayerValues& values_;
+    unsigned vs_;
+    std::unordered_map<CoordKey, std::pair<uint64_t, uint64_t>, CoordHash> bricks_;  // -> (first value, mask)
+    std::unordered_map<CoordKey, uint64_t, CoordHash> tiles_;
+};
+
+} // namespace
+
 std::vector<uint8_t> gatherAttributes(const encoding::CompactDag& dag, const GridTopology& topology, const LayerValues& values,
                                       unsigned valueSize) {
     if (valueSize == 0) return {};
-    // Input position of every brick's first value, and of every tile.
-    std::unordered_map<CoordKey, std::pair<uint64_t, uint64_t>, CoordHash> bricks;  // -> (first value, mask)
-    bricks.reserve(topology.bricks.size());
-    uint64_t next = 0;
-    for (const Brick& b : topology.bricks) {
-        bricks.emplace(CoordKey{b.x, b.y, b.z}, std::make_pair(next, b.mask));
-        next += uint64_t(std::popcount(b.mask));
-    }
-    if (values.bricks.size() != next * valueSize || values.tiles.size() != topology.tiles.size() * valueSize)
-        throw Error("internal error: value count does not match the topology");
-    std::unordered_map<CoordKey, uint64_t, CoordHash> tiles;
-    for (size_t t = 0; t < topology.tiles.size(); ++t) tiles.emplace(CoordKey{topology.tiles[t].x, topology.tiles[t].y, topology.tiles[t].z}, t);
-
-    const encoding::DecodedSize size = encoding::decodedSize(dag);
-    std::vector<uint8_t> out(size.attributeEntries * valueSize);
+    const InputValues input(topology, values, valueSize);
+    std::vector<uint8_t> out(encoding::decodedSize(dag).attributeEntries * valueSize);
     encoding::visitInAttributeOrder(
-        dag,
-        [&](const encoding::BrickInstance& b) {
-            const auto it = bricks.find(CoordKey{b.x, b.y, b.z});
-            if (it == bricks.end()) throw Error("internal error: DAG brick missing from the input");
-            const auto [first, inputMask] = it->second;
-            uint64_t entry = b.firstEntry;
-            for (uint64_t bits = b.storedMask; bits; bits &= bits - 1, ++entry) {
-                const unsigned spatial = kReflected.bit[b.mirror][std::countr_zero(bits)];
-                std::memcpy(&out[entry * valueSize], &values.bricks[(first + rankBelow(inputMask, spatial)) * valueSize], valueSize);
-            }
-        },
-        [&](int64_t x, int64_t y, int64_t z, unsigned, uint64_t entry) {
-            const auto it = tiles.find(CoordKey{x, y, z});
-            if (it == tiles.end()) throw Error("internal error: DAG solid node missing from the input tiles");
-            std::memcpy(&out[entry * valueSize], &values.tiles[it->second * valueSize], valueSize);
-        });
+        dag, [&](const encoding::BrickInstance& b) { input.brick(b, out.data()); },
+        [&](int64_t x, int64_t y, int64_t z, unsigned, uint64_t entry) { input.solid(x, y, z, entry, out.data()); });
     return out;
+}
+
+void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInstance& subtree, const GridTopology& topology,
+                   const LayerValues& values, unsigned valueSize, uint8_t* attributes) {
+    if (valueSize == 0) return;
+    const InputValues input(topology, values, valueSize);
+    if (subtree.solid) {
+        input.solid(subtree.x, subtree.y, subtree.z, subtree.firstEntry, attributes);
+        return;
+    }
+    encoding::visitSubtreeInAttributeOrder(
+        dag, subtree, [&](const encoding::BrickInstance& b) { input.brick(b, attributes); },
+        [&](int64_t x, int64_t y, int64_t z, unsigned, uint64_t entry) { input.solid(x, y, z, entry, attributes); });
 }
 
 void scatterAttributes(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, unsigned valueSize,

@@ -17,6 +17,12 @@ namespace vdbdag::pipeline {
 std::vector<uint8_t> gatherAttributes(const encoding::CompactDag& dag, const GridTopology& topology, const LayerValues& values,
                                       unsigned valueSize);
 
+// The same for one subtree (encoding::subtreesInAttributeOrder) and the
+// part of the input inside it: writes the subtree's entries of the whole
+// attribute array `attributes`.
+void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInstance& subtree, const GridTopology& topology,
+                   const LayerValues& values, unsigned valueSize, uint8_t* attributes);
+
 // Attribute-order values -> the decoded topology and its values in input order.
 void scatterAttributes(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, unsigned valueSize,
                        GridTopology& topology, LayerValues& values);

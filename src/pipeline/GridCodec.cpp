@@ -11,9 +11,9 @@
 #include "src/dag/DagBuilder.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/pipeline/AttributeOrder.h"
+#include "src/pipeline/GridCodecParts.h"
 
 namespace vdbdag::pipeline {
-namespace {
 
 format::DagStats statsOf(const dag::ReducedDag& reduced) {
     format::DagStats stats;
@@ -22,7 +22,9 @@ format::DagStats statsOf(const dag::ReducedDag& reduced) {
     return stats;
 }
 
+namespace {
 int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+} // namespace
 
 // Candidate root origins, best guesses first (DESIGN.md invariant 1: node
 // reflections mirror about planes between voxels through node centres, so
@@ -32,9 +34,7 @@ int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) 
 //     shape symmetric about its own centre is symmetric about the root's;
 //  3+. the aligned minimum shifted down by one or more alignment steps along
 //     combinations of axes.
-std::vector<std::array<int64_t, 3>> placementCandidates(const GridTopology& topology, int trials) {
-    const int64_t a = dag::placementAlignment(topology);
-    const dag::ActiveBounds box = dag::activeBounds(topology);
+std::vector<std::array<int64_t, 3>> placementCandidates(const dag::ActiveBounds& box, int64_t a, int trials) {
     std::array<int64_t, 3> base{}, mid{};
     for (int i = 0; i < 3; ++i) {
         base[i] = floorDiv(box.min[i], a) * a;
@@ -56,6 +56,8 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const GridTopology& topo
     }
     return candidates;
 }
+
+namespace {
 
 // Bytes after a fast zstd pass: the yardstick for choosing a channel coding
 // (the container compresses harder, by about the same factor for both).
@@ -100,7 +102,7 @@ encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptio
     bool first = true;
     std::array<int64_t, 3> keptOrigin{0, 0, 0};
     encoding::CompactDag kept;
-    for (const auto& origin : placementCandidates(topology, std::max(1, options.placementTrials))) {
+    for (const auto& origin : placementCandidates(dag::activeBounds(topology), dag::placementAlignment(topology), std::max(1, options.placementTrials))) {
         build.origin = origin;
         const dag::ReducedDag reduced = dag::buildDag(topology, build);
         encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
@@ -127,6 +129,34 @@ encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptio
 
 } // namespace
 
+format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options) {
+    format::EncodedGrid out;
+    // The header only: copying the voxels first would double peak memory.
+    out.record.name = grid.name;
+    out.record.gridClass = grid.gridClass;
+    out.record.valueType = grid.valueType;
+    out.record.indexToWorld = grid.indexToWorld;
+    out.record.vdbDescriptor = grid.vdbDescriptor;
+    out.record.background = grid.background;
+    out.symmetry = options.symmetry;
+    return out;
+}
+
+void codeActiveValues(format::EncodedGrid& out, const EncodeOptions& options) {
+    const ValueType type = out.record.valueType;
+    out.lossy = attributes::applyScalarTolerance(out.attributes, type, options.tolerance);
+    if (isColourGrid(out.record, options))
+        out.colour = attributes::quantiseColours(out.attributes, type, options.colourBits, "grid '" + out.record.name + "'");
+    out.values = attributes::compressPalette(out.attributes, valueSize(type));
+    out.predictedValues = predictedIfSmaller(out.dag, out.attributes, out.values, type, options);
+}
+
+void codeInactiveValues(format::EncodedGrid& out, const EncodeOptions& options) {
+    const ValueType type = out.record.valueType;
+    out.inactiveValues = attributes::compressPalette(out.inactiveAttributes, valueSize(type));
+    out.inactivePredictedValues = predictedIfSmaller(out.inactiveDag, out.inactiveAttributes, out.inactiveValues, type, options);
+}
+
 bool isColourGrid(const GridRecord& grid, const EncodeOptions& options) {
     if (!options.colourBits || !attributes::isVec3Type(grid.valueType)) return false;
     if (options.colourGrids.empty()) return attributes::hasColourGridName(grid.name);
@@ -138,15 +168,7 @@ namespace {
 // `release`: the same grid, non-const, whose voxels may be dropped once
 // they are in attribute order (nullptr: keep them).
 format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& options, GridRecord* release) {
-    format::EncodedGrid out;
-    // The header only: copying the voxels first would double peak memory.
-    out.record.name = grid.name;
-    out.record.gridClass = grid.gridClass;
-    out.record.valueType = grid.valueType;
-    out.record.indexToWorld = grid.indexToWorld;
-    out.record.vdbDescriptor = grid.vdbDescriptor;
-    out.record.background = grid.background;
-    out.symmetry = options.symmetry;
+    format::EncodedGrid out = encodedHeader(grid, options);
     const unsigned vs = valueSize(grid.valueType);
     auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };
     out.activeVoxels = grid.topology.activeVoxelCount();
@@ -160,9 +182,6 @@ format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& 
             std::vector<uint8_t>().swap(release->values.bricks);
             std::vector<uint8_t>().swap(release->values.tiles);
         }
-        out.lossy = attributes::applyScalarTolerance(out.attributes, grid.valueType, options.tolerance);
-        if (isColourGrid(grid, options))
-            out.colour = attributes::quantiseColours(out.attributes, grid.valueType, options.colourBits, "grid '" + grid.name + "'");
     }
     if (withNormals) {
         const std::vector<uint8_t> raw = gatherAttributes(out.dag, grid.topology, grid.normals->vectors, sizeof(std::array<float, 3>));
@@ -174,17 +193,13 @@ format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& 
                                                 grid.normals->oneSided);
     }
     step("palette compression");
-    if (!grid.topology.empty()) {
-        out.values = attributes::compressPalette(out.attributes, vs);
-        out.predictedValues = predictedIfSmaller(out.dag, out.attributes, out.values, grid.valueType, options);
-    }
+    if (!grid.topology.empty()) codeActiveValues(out, options);
     out.inactiveVoxels = grid.inactiveTopology.activeVoxelCount();
     step("inactive values");
     if (!grid.inactiveTopology.empty()) {
         out.inactiveDag = encodeLayer(grid.inactiveTopology, options, vs > 0, nullptr);
         out.inactiveAttributes = gatherAttributes(out.inactiveDag, grid.inactiveTopology, grid.inactiveValues, vs);
-        out.inactiveValues = attributes::compressPalette(out.inactiveAttributes, vs);
-        out.inactivePredictedValues = predictedIfSmaller(out.inactiveDag, out.inactiveAttributes, out.inactiveValues, grid.valueType, options);
+        codeInactiveValues(out, options);
     }
     if (release) *release = GridRecord{};  // everything the scene needs is copied
     return out;

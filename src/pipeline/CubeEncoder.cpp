@@ -1,0 +1,218 @@
+// See CubeEncoder.h.
+#include "src/pipeline/CubeEncoder.h"
+
+#include <algorithm>
+
+#include <tbb/info.h>
+#include <tbb/parallel_pipeline.h>
+
+#include "src/dag/SubDagMerge.h"
+#include "src/encoding/CompactDag.h"
+#include "src/pipeline/AttributeOrder.h"
+#include "src/pipeline/GridCodecParts.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::pipeline {
+namespace {
+
+struct LayerPlan {
+    dag::RootPlacement placement;
+    unsigned cubeLog2;
+    std::vector<CubeLoad> cubes;  // Morton order
+};
+
+dag::ActiveBounds boxOf(const LayerSummary& summary) { return {summary.min, summary.max}; }
+
+unsigned workersOf(const CubeBudget& budget) {
+    return budget.workers ? budget.workers : unsigned(std::max(1, tbb::info::default_concurrency()));
+}
+
+// The largest cube size whose busiest cube fits a worker's share of the budget.
+LayerPlan planLayer(CubeSource& source, Layer layer, const dag::RootPlacement& placement, const CubeBudget& budget, unsigned valueSize) {
+    const uint64_t share = std::max<uint64_t>(1, budget.bytes / workersOf(budget));
+    const unsigned smallest = std::min(placement.log2Size, 3u);
+    unsigned log2 = budget.cubeLog2 ? std::clamp(*budget.cubeLog2, smallest, placement.log2Size) : placement.log2Size;
+    for (;;) {
+        std::vector<CubeLoad> cubes = source.cubes(layer, placement.origin, log2);
+        uint64_t busiest = 0;
+        for (const CubeLoad& c : cubes) busiest = std::max(busiest, c.bricks);
+        if (budget.cubeLog2 || log2 <= smallest || busiest * cubeBytesPerBrick(valueSize) <= share) {
+            std::sort(cubes.begin(), cubes.end(), [](const CubeLoad& a, const CubeLoad& b) {
+                return dag::mortonLess({a.cell.x, a.cell.y, a.cell.z}, {b.cell.x, b.cell.y, b.cell.z});
+            });
+            return {placement, log2, std::move(cubes)};
+        }
+        --log2;
+    }
+}
+
+std::array<int64_t, 3> cornerOf(const LayerPlan& plan, const CubeCell& cell) {
+    const auto& o = plan.placement.origin;
+    return {o[0] + (int64_t(cell.x) << plan.cubeLog2), o[1] + (int64_t(cell.y) << plan.cubeLog2), o[2] + (int64_t(cell.z) << plan.cubeLog2)};
+}
+
+// Builds the layer's DAG from its cubes (geometry only).
+dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& plan, bool symmetry, const CubeBudget& budget) {
+    dag::BuildOptions local;
+    local.symmetry = symmetry;
+    local.log2Size = plan.cubeLog2;
+    source.beginPass(layer, plan.placement.origin, plan.cubeLog2, false);
+    if (plan.cubeLog2 >= plan.placement.log2Size) {  // one cube: the whole layer
+        GridTopology topology;
+        LayerValues none;
+        source.read({0, 0, 0}, topology, none);
+        source.endPass();
+        local.origin = plan.placement.origin;
+        return dag::buildDag(topology, local);
+    }
+    dag::SubDagMerger merger(plan.placement, plan.cubeLog2, symmetry);
+    struct Piece {
+        size_t index;
+        GridTopology topology;
+        dag::ReducedDag sub;
+    };
+    size_t next = 0;
+    tbb::parallel_pipeline(
+        workersOf(budget),
+        tbb::make_filter<void, std::shared_ptr<Piece>>(tbb::filter_mode::serial_in_order,
+                                                       [&](tbb::flow_control& fc) -> std::shared_ptr<Piece> {
+                                                           if (next == plan.cubes.size()) { fc.stop(); return nullptr; }
+                                                           auto piece = std::make_shared<Piece>();
+                                                           piece->index = next++;
+                                                           LayerValues none;
+                                                           source.read(plan.cubes[piece->index].cell, piece->topology, none);
+                                                           return piece;
+                                                       }) &
+            tbb::make_filter<std::shared_ptr<Piece>, std::shared_ptr<Piece>>(tbb::filter_mode::parallel,
+                                                                             [&](std::shared_ptr<Piece> piece) {
+                                                                                 dag::BuildOptions options = local;
+                                                                                 options.origin = cornerOf(plan, plan.cubes[piece->index].cell);
+                                                                                 piece->sub = dag::buildDag(piece->topology, options);
+                                                                                 piece->topology = {};
+                                                                                 return piece;
+                                                                             }) &
+            tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Piece> piece) {
+                const CubeCell& c = plan.cubes[piece->index].cell;
+                merger.add({c.x, c.y, c.z}, piece->sub);
+            }));
+    source.endPass();
+    GridTopology large;
+    LayerValues none;
+    source.largeTiles(layer, plan.cubeLog2, large, none);
+    std::vector<std::pair<dag::CellCoord, unsigned>> largeTiles;
+    for (const Tile& t : large.tiles) {
+        const auto& o = plan.placement.origin;
+        largeTiles.push_back({{uint32_t(uint64_t(t.x - o[0]) >> t.log2Size), uint32_t(uint64_t(t.y - o[1]) >> t.log2Size),
+                               uint32_t(uint64_t(t.z - o[2]) >> t.log2Size)},
+                              t.log2Size});
+    }
+    return merger.finish(largeTiles);
+}
+
+// The layer's values in attribute order, cube by cube.
+std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPlan& plan, const encoding::CompactDag& dag, unsigned vs,
+                                 const CubeBudget& budget) {
+    if (vs == 0 || dag.empty()) return {};
+    std::vector<uint8_t> attributes(encoding::decodedSize(dag).attributeEntries * vs);
+    const unsigned cut = std::min<unsigned>(plan.cubeLog2, dag.log2Size);
+    const std::vector<encoding::SubtreeInstance> subtrees = encoding::subtreesInAttributeOrder(dag, cut);
+    GridTopology largeTopology;
+    LayerValues largeValues;
+    source.largeTiles(layer, plan.cubeLog2, largeTopology, largeValues);
+    source.beginPass(layer, plan.placement.origin, plan.cubeLog2, true);
+    struct Piece {
+        size_t index;
+        GridTopology topology;
+        LayerValues values;
+    };
+    size_t next = 0;
+    tbb::parallel_pipeline(
+        workersOf(budget),
+        tbb::make_filter<void, std::shared_ptr<Piece>>(tbb::filter_mode::serial_in_order,
+                                                       [&](tbb::flow_control& fc) -> std::shared_ptr<Piece> {
+                                                           if (next == subtrees.size()) { fc.stop(); return nullptr; }
+                                                           auto piece = std::make_shared<Piece>();
+                                                           piece->index = next++;
+                                                           const encoding::SubtreeInstance& s = subtrees[piece->index];
+                                                           if (s.log2Size <= plan.cubeLog2) {
+                                                               const auto& o = plan.placement.origin;
+                                                               source.read({uint32_t(uint64_t(s.x - o[0]) >> plan.cubeLog2),
+                                                                            uint32_t(uint64_t(s.y - o[1]) >> plan.cubeLog2),
+                                                                            uint32_t(uint64_t(s.z - o[2]) >> plan.cubeLog2)},
+                                                                           piece->topology, piece->values);
+                                                           }
+                                                           return piece;
+                                                       }) &
+            tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::parallel, [&](std::shared_ptr<Piece> piece) {
+                const encoding::SubtreeInstance& s = subtrees[piece->index];
+                if (s.log2Size <= plan.cubeLog2) gatherSubtree(dag, s, piece->topology, piece->values, vs, attributes.data());
+                else gatherSubtree(dag, s, largeTopology, largeValues, vs, attributes.data());
+            }));
+    source.endPass();
+    return attributes;
+}
+
+// Tries the placements like encodeLayer (GridCodec.cpp) and keeps the smallest.
+encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const EncodeOptions& options, const CubeBudget& budget, bool withOffsets,
+                                        format::DagStats* stats, LayerPlan& keptPlan) {
+    const LayerSummary summary = source.summary(layer);
+    const int64_t alignment = int64_t(1) << std::max(2u, summary.largestTileLog2);
+    const unsigned vs = valueSize(source.header().valueType);
+    encoding::CompactDag kept;
+    bool first = true;
+    for (const auto& origin : placementCandidates(boxOf(summary), alignment, std::max(1, options.placementTrials))) {
+        dag::BuildOptions build;
+        build.origin = origin;
+        const LayerPlan plan = planLayer(source, layer, dag::placeRoot(boxOf(summary), alignment, build), budget, vs);
+        const dag::ReducedDag reduced = buildLayer(source, layer, plan, options.symmetry, budget);
+        encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
+        if (first || compact.byteSize() < kept.byteSize()) {
+            kept = std::move(compact);
+            if (stats) *stats = statsOf(reduced);
+            keptPlan = plan;
+        }
+        first = false;
+    }
+    if (stats && options.computeSvdagStats) {
+        if (!options.symmetry) {
+            stats->svdagNodes = stats->storedNodes;
+        } else {
+            const dag::ReducedDag plain = buildLayer(source, layer, keptPlan, false, budget);
+            for (unsigned s = 2; s <= plain.log2Size; ++s) stats->svdagNodes.push_back(plain.uniqueNodeCount(s));
+        }
+        stats->hasSvdag = true;
+    }
+    return kept;
+}
+
+} // namespace
+
+uint64_t cubeBytesPerBrick(unsigned valueSize) { return 160 + 64ull * valueSize; }
+
+format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget) {
+    if (options.normalBits) throw Error("--normals needs the whole grid in memory (the gradient reads across cubes): use it without --memory-limit");
+    format::EncodedGrid out = encodedHeader(source.header(), options);
+    const unsigned vs = valueSize(source.header().valueType);
+    auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };
+    const LayerSummary active = source.summary(Layer::Active);
+    out.activeVoxels = active.voxels;
+    step("reducing the DAG");
+    LayerPlan plan;
+    if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan);
+    step("ordering values");
+    if (!active.empty()) out.attributes = gatherLayer(source, Layer::Active, plan, out.dag, vs, budget);
+    step("palette compression");
+    if (!active.empty()) codeActiveValues(out, options);
+    const LayerSummary inactive = source.summary(Layer::Inactive);
+    out.inactiveVoxels = inactive.voxels;
+    step("inactive values");
+    if (!inactive.empty()) {
+        LayerPlan inactivePlan;
+        out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, inactivePlan);
+        out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget);
+        codeInactiveValues(out, options);
+    }
+    return out;
+}
+
+} // namespace vdbdag::pipeline

@@ -1,0 +1,34 @@
+// The out-of-core encoder (SSVDAG paper §4.2): one grid read cube by cube
+// from a CubeSource. Per layer: the cubes' sub-DAGs are built several at a
+// time (TBB) and merged in Morton order (dag/SubDagMerge.h); the values are
+// then gathered cube by cube in the final DAG's attribute order. The result
+// is the EncodedGrid encodeGrid gives for the whole grid in memory, so the
+// file is byte-identical whatever the cube size, the budget and the thread
+// count.
+//
+// Bounded: the cubes in flight (at most `workers`, each within its share of
+// the budget) and the reduced DAG. Not yet bounded: the attribute array of
+// each layer (entries x value size) and its palettes, which are built whole.
+#pragma once
+#include <cstdint>
+#include <optional>
+
+#include "src/pipeline/GridCodec.h"
+#include "src/volume/CubeSource.h"
+
+namespace vdbdag::pipeline {
+
+struct CubeBudget {
+    uint64_t bytes = 256ull << 20;  // working memory of the cubes in flight, all workers together
+    unsigned workers = 0;           // cubes in flight; 0 = TBB's concurrency
+    std::optional<unsigned> cubeLog2;  // force the cube size (tests); else the largest that fits
+};
+
+// Rough working bytes per brick of a cube being reduced or gathered.
+uint64_t cubeBytesPerBrick(unsigned valueSize);
+
+// Throws vdbdag::Error for --normals (which needs the whole grid: the
+// gradient reads neighbours across cubes).
+format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget);
+
+} // namespace vdbdag::pipeline

@@ -1,0 +1,27 @@
+// The steps of encodeGrid that the cube-by-cube encoder (CubeEncoder.h)
+// shares, so both give the same bytes: root placement candidates, DAG
+// statistics, the grid header and the coding of gathered values.
+#pragma once
+#include <array>
+#include <vector>
+
+#include "src/dag/DagBuilder.h"
+#include "src/pipeline/GridCodec.h"
+
+namespace vdbdag::pipeline {
+
+// Root origins to try for a layer with this box and tile alignment
+// (placementAlignment), best guesses first; `trials` of them at most.
+std::vector<std::array<int64_t, 3>> placementCandidates(const dag::ActiveBounds& box, int64_t alignment, int trials);
+
+format::DagStats statsOf(const dag::ReducedDag& reduced);
+
+// An EncodedGrid with `grid`'s header and nothing else.
+format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options);
+
+// From out.attributes / out.inactiveAttributes (attribute order): the lossy
+// settings, then palettes and, for integers, predicted values when smaller.
+void codeActiveValues(format::EncodedGrid& out, const EncodeOptions& options);
+void codeInactiveValues(format::EncodedGrid& out, const EncodeOptions& options);
+
+} // namespace vdbdag::pipeline

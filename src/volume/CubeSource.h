@@ -1,0 +1,66 @@
+// A grid read one aligned cube at a time: the input of the out-of-core
+// encoder (pipeline/CubeEncoder.h), which never holds the whole grid. An
+// implementation reads its file region by region (vdb_bridge's .vdb reader
+// through OpenVDB's delayed loading) or slices a grid already in memory
+// (RecordCubes, below). No OpenVDB here.
+//
+// A grid has two layers, each encoded as its own DAG: the active voxels and
+// tiles, and the inactive ones whose value differs from the background
+// (GridRecord). Cubes are 2^log2 voxels wide, placed from an origin that is
+// a multiple of 4, so every 4^3 brick lies in exactly one cube.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "src/volume/GridRecord.h"
+
+namespace vdbdag {
+
+enum class Layer : uint8_t { Active, Inactive };
+
+struct LayerSummary {
+    uint64_t voxels = 0;  // tiles counted as their voxels (saturating)
+    uint64_t bricks = 0;  // 4^3 bricks
+    uint64_t tiles = 0;
+    std::array<int64_t, 3> min{0, 0, 0}, max{0, 0, 0};  // inclusive box; meaningless when empty()
+    unsigned largestTileLog2 = 2;                     // 2: no tiles
+    bool empty() const { return bricks == 0 && tiles == 0; }
+};
+
+// One cube of a layer, in units of the cube size from the origin.
+struct CubeCell {
+    uint32_t x, y, z;
+    bool operator==(const CubeCell&) const = default;
+};
+struct CubeLoad {
+    CubeCell cell;
+    uint64_t bricks = 0;  // bricks in the cube (tiles no larger than the cube count as one brick)
+};
+
+class CubeSource {
+public:
+    virtual ~CubeSource() = default;
+    // Name, class, type, transform, descriptor, background; no voxels.
+    virtual const GridRecord& header() const = 0;
+    virtual LayerSummary summary(Layer layer) = 0;
+    // The non-empty cubes of 2^log2 from `origin` (any order) and the tiles
+    // larger than a cube (with their values, input order).
+    virtual std::vector<CubeLoad> cubes(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2) = 0;
+    virtual void largeTiles(Layer layer, unsigned log2, GridTopology& tiles, LayerValues& values) = 0;
+    // A pass reads each cube of `cubes` once, in any order; between
+    // beginPass and endPass a source may free what a read cube used.
+    virtual void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) = 0;
+    // The bricks and the tiles no larger than the cube inside cube `cell`,
+    // with their values (input order, GridRecord's LayerValues convention)
+    // unless the pass is without values.
+    virtual void read(const CubeCell& cell, GridTopology& topology, LayerValues& values) = 0;
+    virtual void endPass() = 0;
+};
+
+// A CubeSource over a grid in memory (for dense scans, tests and the
+// in-core path). Keeps a reference: `grid` must outlive it.
+std::unique_ptr<CubeSource> recordCubes(const GridRecord& grid);
+
+} // namespace vdbdag

@@ -1,0 +1,135 @@
+// RecordCubes (CubeSource.h): a grid in memory, sliced into cubes.
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "src/util/Error.h"
+#include "src/volume/CubeSource.h"
+
+namespace vdbdag {
+namespace {
+
+struct CellLess {
+    bool operator()(const CubeCell& a, const CubeCell& b) const { return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x); }
+};
+
+class RecordCubes final : public CubeSource {
+public:
+    explicit RecordCubes(const GridRecord& grid) : grid_(grid) {
+        header_.name = grid.name;
+        header_.gridClass = grid.gridClass;
+        header_.valueType = grid.valueType;
+        header_.indexToWorld = grid.indexToWorld;
+        header_.vdbDescriptor = grid.vdbDescriptor;
+        header_.background = grid.background;
+    }
+    const GridRecord& header() const override { return header_; }
+
+    LayerSummary summary(Layer layer) override {
+        const GridTopology& t = topology(layer);
+        LayerSummary s;
+        s.bricks = t.bricks.size();
+        s.tiles = t.tiles.size();
+        s.voxels = t.activeVoxelCount();
+        s.min.fill(std::numeric_limits<int64_t>::max());
+        s.max.fill(std::numeric_limits<int64_t>::min());
+        auto extend = [&](int64_t x, int64_t y, int64_t z, int64_t size) {
+            const int64_t c[3] = {x, y, z};
+            for (int a = 0; a < 3; ++a) { s.min[a] = std::min(s.min[a], c[a]); s.max[a] = std::max(s.max[a], c[a] + size - 1); }
+        };
+        for (const Brick& b : t.bricks) extend(b.x, b.y, b.z, 4);
+        for (const Tile& tile : t.tiles) {
+            extend(tile.x, tile.y, tile.z, int64_t(1) << tile.log2Size);
+            s.largestTileLog2 = std::max<unsigned>(s.largestTileLog2, tile.log2Size);
+        }
+        return s;
+    }
+
+    std::vector<CubeLoad> cubes(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2) override {
+        std::map<CubeCell, uint64_t, CellLess> counts;
+        const GridTopology& t = topology(layer);
+        for (const Brick& b : t.bricks) ++counts[cellOf(origin, log2, b.x, b.y, b.z)];
+        for (const Tile& tile : t.tiles)
+            if (tile.log2Size <= log2) ++counts[cellOf(origin, log2, tile.x, tile.y, tile.z)];
+        std::vector<CubeLoad> out;
+        for (const auto& [cell, n] : counts) out.push_back({cell, n});
+        return out;
+    }
+
+    void largeTiles(Layer layer, unsigned log2, GridTopology& tiles, LayerValues& values) override {
+        const GridTopology& t = topology(layer);
+        const LayerValues& v = layerValues(layer);
+        const unsigned vs = valueSize(grid_.valueType);
+        tiles = {};
+        values = {};
+        for (size_t i = 0; i < t.tiles.size(); ++i) {
+            if (t.tiles[i].log2Size <= log2) continue;
+            tiles.tiles.push_back(t.tiles[i]);
+            if (vs) values.tiles.insert(values.tiles.end(), v.tiles.begin() + long(i * vs), v.tiles.begin() + long((i + 1) * vs));
+        }
+    }
+
+    void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {
+        layer_ = layer;
+        withValues_ = withValues;
+        const GridTopology& t = topology(layer);
+        index_.clear();
+        uint64_t value = 0;
+        for (size_t i = 0; i < t.bricks.size(); ++i) {
+            const Brick& b = t.bricks[i];
+            index_[cellOf(origin, log2, b.x, b.y, b.z)].bricks.push_back({i, value});
+            value += uint64_t(std::popcount(b.mask));
+        }
+        for (size_t i = 0; i < t.tiles.size(); ++i)
+            if (t.tiles[i].log2Size <= log2) index_[cellOf(origin, log2, t.tiles[i].x, t.tiles[i].y, t.tiles[i].z)].tiles.push_back(i);
+    }
+
+    void read(const CubeCell& cell, GridTopology& topology, LayerValues& values) override {
+        topology = {};
+        values = {};
+        const auto it = index_.find(cell);
+        if (it == index_.end()) return;
+        const GridTopology& t = this->topology(layer_);
+        const LayerValues& v = layerValues(layer_);
+        const unsigned vs = withValues_ ? valueSize(grid_.valueType) : 0;
+        for (const auto& [brick, firstValue] : it->second.bricks) {
+            topology.bricks.push_back(t.bricks[brick]);
+            if (vs) {
+                const size_t n = size_t(std::popcount(t.bricks[brick].mask)) * vs;
+                values.bricks.insert(values.bricks.end(), v.bricks.begin() + long(firstValue * vs), v.bricks.begin() + long(firstValue * vs + n));
+            }
+        }
+        for (size_t tile : it->second.tiles) {
+            topology.tiles.push_back(t.tiles[tile]);
+            if (vs) values.tiles.insert(values.tiles.end(), v.tiles.begin() + long(tile * vs), v.tiles.begin() + long((tile + 1) * vs));
+        }
+    }
+
+    void endPass() override { index_.clear(); }
+
+private:
+    static CubeCell cellOf(const std::array<int64_t, 3>& origin, unsigned log2, int64_t x, int64_t y, int64_t z) {
+        return {uint32_t(uint64_t(x - origin[0]) >> log2), uint32_t(uint64_t(y - origin[1]) >> log2), uint32_t(uint64_t(z - origin[2]) >> log2)};
+    }
+    const GridTopology& topology(Layer layer) const { return layer == Layer::Active ? grid_.topology : grid_.inactiveTopology; }
+    const LayerValues& layerValues(Layer layer) const { return layer == Layer::Active ? grid_.values : grid_.inactiveValues; }
+
+    struct CubeIndex {
+        std::vector<std::pair<size_t, uint64_t>> bricks;  // (brick, its first value)
+        std::vector<size_t> tiles;
+    };
+    const GridRecord& grid_;
+    GridRecord header_;
+    Layer layer_ = Layer::Active;
+    bool withValues_ = false;
+    std::map<CubeCell, CubeIndex, CellLess> index_;
+};
+
+} // namespace
+
+std::unique_ptr<CubeSource> recordCubes(const GridRecord& grid) { return std::make_unique<RecordCubes>(grid); }
+
+} // namespace vdbdag
