@@ -5,6 +5,9 @@
 // Dense scans (.raw, .nrrd, .nhdr, .mhd, .mha, by extension) are read by
 // vdb_bridge/DenseImport.h instead, with the raw layout and threshold options.
 #include <chrono>
+#include <optional>
+
+#include <tbb/global_control.h>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -14,12 +17,14 @@
 #include "cli/SceneReport.h"
 #include "cli/DenseInputOptions.h"
 #include "cli/FiniteNumber.h"
+#include "src/pipeline/CubeEncoder.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
 #include "src/util/AtomicFile.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/DenseImport.h"
+#include "vdb_bridge/VdbCubes.h"
 #include "vdb_bridge/VdbImport.h"
 
 namespace vdbdag::cli {
@@ -30,6 +35,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         std::vector<std::string> grids;
         bool force = false, noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
         int placementTrials = 1;
+        uint64_t memoryLimit = 0;
+        unsigned threads = 0;
         double absError = 0, relError = 0;
         unsigned colourBits = 0, normalBits = 0;
         std::vector<std::string> colourGrids;
@@ -58,11 +65,19 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     auto* normals = cmd->add_option("--normals", opt->normalBits, "store K-bit octahedral normals (K = 10, 12, 16, 24, 32) from the level-set gradient")
                         ->check(CLI::IsMember({10u, 12u, 16u, 24u, 32u}));
     cmd->add_option("--normal-grid", opt->normalGrid, "take the normals from this vec3 grid (stored on its geometry) instead of a gradient")->needs(normals);
+    cmd->add_option("--memory-limit", opt->memoryLimit,
+                    "encode cube by cube within about this much working memory, e.g. 512M or 4G (a .vdb is then read region by region); "
+                    "the output is the same bytes")
+        ->transform(CLI::AsSizeValue(false))
+        ->excludes(normals);
+    cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "encoding");
         const auto start = std::chrono::steady_clock::now();
+        std::optional<tbb::global_control> threads;
+        if (opt->threads) threads.emplace(tbb::global_control::max_allowed_parallelism, opt->threads);
         bridge::ImportOptions importOptions;
         importOptions.onlyGrids = opt->grids;
         importOptions.skipUnsupported = opt->skipUnsupported;
@@ -73,6 +88,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         const bool dense = bridge::denseFormatOf(opt->input) != bridge::DenseFormat::None;
         checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".ssvdag"}, "encode", opt->force});
         bridge::ImportResult imported;
+        std::optional<bridge::VdbCubeInput> cubeInput;  // --memory-limit on a .vdb: read region by region
         bridge::ThresholdReport threshold;
         if (dense) {
             if (!opt->grids.empty()) throw Error(opt->input + ": --grid applies to .vdb inputs only (a dense scan has one grid)");
@@ -90,7 +106,13 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
                 throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
                                          "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
-            imported = bridge::importVdb(opt->input, importOptions);
+            if (opt->memoryLimit && bridge::canReadVdbByCubes(opt->input)) {
+                cubeInput = bridge::openVdbCubes(opt->input, importOptions);
+                imported.warnings = cubeInput->warnings;
+                for (const auto& g : cubeInput->grids) imported.volume.grids.push_back(g->header());  // headers only, for the checks
+            } else {
+                imported = bridge::importVdb(opt->input, importOptions);
+            }
         }
         for (const auto& w : imported.warnings) fmt::print(stderr, "vdbdag: warning: {}\n", w);
         if (imported.volume.grids.empty())
@@ -122,8 +144,22 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         std::vector<std::string> gridNames;
         for (const auto& g : imported.volume.grids) gridNames.push_back(g.name);
         format::SsvdagScene scene;
+        const auto onGrid = [&](size_t i, size_t) { gridName = gridNames[i]; };
         try {
-            scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, [&](size_t i, size_t) { gridName = gridNames[i]; });
+            if (opt->memoryLimit) {
+                pipeline::CubeBudget budget;
+                budget.bytes = std::max<uint64_t>(opt->memoryLimit / 2, 1);
+                std::vector<std::unique_ptr<CubeSource>> sources;
+                if (cubeInput) {
+                    sources = std::move(cubeInput->grids);
+                    imported.volume.fileMetadata = cubeInput->fileMetadata;
+                } else {  // a dense scan or an OpenVDB stream: in memory, encoded cube by cube
+                    for (const GridRecord& g : imported.volume.grids) sources.push_back(recordCubes(g));
+                }
+                scene = pipeline::encodeSourcesByCubes(std::move(sources), imported.volume.fileMetadata, encodeOptions, budget, onGrid);
+            } else {
+                scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, onGrid);
+            }
         } catch (const Error& e) {
             throw Error(opt->input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
         }

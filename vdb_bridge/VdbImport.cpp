@@ -15,29 +15,13 @@
 #include <tbb/parallel_for.h>
 
 #include "src/util/Error.h"
+#include "vdb_bridge/detail/LeafBricks.h"
 #include "vdb_bridge/detail/NormalEstimation.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/VdbFile.h"
 
 namespace vdbdag::bridge {
 namespace {
-
-// Raw bytes of a value (bool as one byte), so values round-trip bit-exactly.
-template <typename T>
-void appendValue(std::vector<uint8_t>& out, const T& value) {
-    if constexpr (std::is_same_v<T, bool>) {
-        out.push_back(value ? 1 : 0);
-    } else {
-        const auto* p = reinterpret_cast<const uint8_t*>(&value);
-        out.insert(out.end(), p, p + sizeof(T));
-    }
-}
-
-template <typename T>
-bool sameBits(const T& a, const T& b) {
-    if constexpr (std::is_same_v<T, bool>) return a == b;
-    else return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
 
 // Per leaf: its 4^3 bricks of active voxels and of inactive voxels whose
 // value is not (bitwise) the background, each with its values.
@@ -50,6 +34,7 @@ template <typename GridT, bool hasValues = !std::is_same_v<typename GridT::TreeT
 void collectLayers(const GridT& grid, GridRecord& record) {
     using TreeT = typename GridT::TreeType;
     using ValueT = typename GridT::ValueType;
+    using LeafT = typename TreeT::LeafNodeType;
     const TreeT& tree = grid.tree();
     const ValueT background = tree.background();
     std::vector<const typename TreeT::LeafNodeType*> leaves;
@@ -61,25 +46,12 @@ void collectLayers(const GridT& grid, GridRecord& record) {
             const auto& leaf = *leaves[i];
             const openvdb::Coord origin = leaf.origin();
             LeafLayers& out = perLeaf[i];
-            for (int b = 0; b < 8; ++b) {
-                const int bx = (b & 1) * 4, by = ((b >> 1) & 1) * 4, bz = ((b >> 2) & 1) * 4;
-                uint64_t activeMask = 0, inactiveMask = 0;
-                for (int bit = 0; bit < 64; ++bit) {
-                    const int x = bx + (bit & 3), y = by + ((bit >> 2) & 3), z = bz + (bit >> 4);
-                    const openvdb::Index n = openvdb::Index((x << 6) | (y << 3) | z);
-                    if (leaf.isValueOn(n)) {
-                        activeMask |= uint64_t(1) << bit;
-                        if constexpr (hasValues) appendValue(out.activeValues, leaf.getValue(n));
-                    } else if constexpr (hasValues) {
-                        if (!sameBits(leaf.getValue(n), background)) {
-                            inactiveMask |= uint64_t(1) << bit;
-                            appendValue(out.inactiveValues, leaf.getValue(n));
-                        }
-                    }
-                }
-                const int32_t cx = origin.x() + bx, cy = origin.y() + by, cz = origin.z() + bz;
-                if (activeMask) out.active.push_back({cx, cy, cz, activeMask});
-                if (inactiveMask) out.inactive.push_back({cx, cy, cz, inactiveMask});
+            for (unsigned b = 0; b < 8; ++b) {
+                const openvdb::Coord c = detail::brickCorner(origin, b);
+                const uint64_t activeMask = detail::leafBrick<LeafT, hasValues>(leaf, b, Layer::Active, background, &out.activeValues);
+                const uint64_t inactiveMask = detail::leafBrick<LeafT, hasValues>(leaf, b, Layer::Inactive, background, &out.inactiveValues);
+                if (activeMask) out.active.push_back({c.x(), c.y(), c.z(), activeMask});
+                if (inactiveMask) out.inactive.push_back({c.x(), c.y(), c.z(), inactiveMask});
             }
         }
     });
@@ -99,15 +71,15 @@ void collectLayers(const GridT& grid, GridRecord& record) {
         const Tile tile{box.min().x(), box.min().y(), box.min().z(), uint8_t(std::countr_zero(unsigned(box.dim().x())))};
         if (it.isValueOn()) {
             record.topology.tiles.push_back(tile);
-            if constexpr (hasValues) appendValue(record.values.tiles, *it);
+            if constexpr (hasValues) detail::appendValue(record.values.tiles, *it);
         } else if constexpr (hasValues) {
-            if (!sameBits(ValueT(*it), background)) {
+            if (!detail::sameBits(ValueT(*it), background)) {
                 record.inactiveTopology.tiles.push_back(tile);
-                appendValue(record.inactiveValues.tiles, *it);
+                detail::appendValue(record.inactiveValues.tiles, *it);
             }
         }
     }
-    if constexpr (hasValues) appendValue(record.background, background);
+    if constexpr (hasValues) detail::appendValue(record.background, background);
 }
 
 // Exact normals for `--normals` (NormalEstimation.h): the gradient of float

@@ -215,4 +215,18 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     return out;
 }
 
+format::SsvdagScene encodeSourcesByCubes(std::vector<std::unique_ptr<CubeSource>> grids, std::vector<uint8_t> fileMetadata,
+                                         const EncodeOptions& options, const CubeBudget& budget, const GridProgress& onGrid) {
+    format::SsvdagScene scene;
+    scene.fileMetadata = std::move(fileMetadata);
+    for (size_t g = 0; g < grids.size(); ++g) {
+        if (onGrid) onGrid(g, grids.size());
+        scene.grids.push_back(encodeGridByCubes(*grids[g], options, budget));
+        grids[g].reset();
+        std::vector<uint8_t>().swap(scene.grids.back().attributes);
+        std::vector<uint8_t>().swap(scene.grids.back().inactiveAttributes);
+    }
+    return scene;
+}
+
 } // namespace vdbdag::pipeline

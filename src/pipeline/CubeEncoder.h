@@ -31,4 +31,9 @@ uint64_t cubeBytesPerBrick(unsigned valueSize);
 // gradient reads neighbours across cubes).
 format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget);
 
+// Whole files: the grids in order, each released (source and attribute
+// arrays) as soon as it is coded; `onGrid(index, count)` before each grid.
+format::SsvdagScene encodeSourcesByCubes(std::vector<std::unique_ptr<CubeSource>> grids, std::vector<uint8_t> fileMetadata,
+                                         const EncodeOptions& options, const CubeBudget& budget, const GridProgress& onGrid = {});
+
 } // namespace vdbdag::pipeline

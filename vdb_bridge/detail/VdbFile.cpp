@@ -65,28 +65,72 @@ VdbFileContents readVdbFile(const std::string& path) {
         throw Error(path + ": corrupted: the file lists " + std::to_string(layout.gridCount) + " grids but " + std::to_string(contents.grids.size()) +
                     " could be read");
     for (size_t i = 0; i < contents.grids.size(); ++i) {
-        const auto& g = contents.grids[i];
-        // OpenVDB reads a file cut short without complaint (missing nodes are
-        // simply absent); its writer's own voxel count gives it away.
-        const std::string which = path + ": grid " + std::to_string(i) + " '" + g->getName() + "'";
-        if (!g || !g->baseTreePtr()) throw Error(which + " could not be read");
-        const uint64_t voxels = g->activeVoxelCount();
-        if (const auto count = g->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
-            if (uint64_t(count->value()) != voxels)
-                throw Error(which + " is truncated or corrupted: it reads as " + std::to_string(voxels) + " active voxels but the file says " +
-                            std::to_string(count->value()));
-        // The writer's bounding box too: OpenVDB recomputes it on every write,
-        // so a corrupted one could not come back.
-        const auto lo = g->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
-        const auto hi = g->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
-        if (voxels > 0 && lo && hi) {
-            const openvdb::CoordBBox box = g->evalActiveVoxelBoundingBox();
-            if (openvdb::Vec3i(box.min().asVec3i()) != lo->value() || openvdb::Vec3i(box.max().asVec3i()) != hi->value())
-                throw Error(which + " is corrupted: its active voxels span " + openvdb::Vec3IMetadata(box.min().asVec3i()).str() + ".." + openvdb::Vec3IMetadata(box.max().asVec3i()).str() + " but the file says " +
-                            lo->str() + ".." + hi->str());
-        }
+        if (!contents.grids[i]) throw Error(path + ": grid " + std::to_string(i) + " could not be read");
+        checkGridAgainstFile(path, i, *contents.grids[i]);
     }
     return contents;
+}
+
+void checkGridAgainstFile(const std::string& path, size_t index, const openvdb::GridBase& g) {
+    // OpenVDB reads a file cut short without complaint (missing nodes are
+    // simply absent); its writer's own voxel count gives it away.
+    const std::string which = path + ": grid " + std::to_string(index) + " '" + g.getName() + "'";
+    if (!g.baseTreePtr()) throw Error(which + " could not be read");
+    const uint64_t voxels = g.activeVoxelCount();
+    if (const auto count = g.getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
+        if (uint64_t(count->value()) != voxels)
+            throw Error(which + " is truncated or corrupted: it reads as " + std::to_string(voxels) + " active voxels but the file says " +
+                        std::to_string(count->value()));
+    // The writer's bounding box too: OpenVDB recomputes it on every write,
+    // so a corrupted one could not come back.
+    const auto lo = g.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+    const auto hi = g.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+    if (voxels > 0 && lo && hi) {
+        const openvdb::CoordBBox box = g.evalActiveVoxelBoundingBox();
+        if (openvdb::Vec3i(box.min().asVec3i()) != lo->value() || openvdb::Vec3i(box.max().asVec3i()) != hi->value())
+            throw Error(which + " is corrupted: its active voxels span " + openvdb::Vec3IMetadata(box.min().asVec3i()).str() + ".." +
+                        openvdb::Vec3IMetadata(box.max().asVec3i()).str() + " but the file says " + lo->str() + ".." + hi->str());
+    }
+}
+
+VdbFileIndex indexVdbFile(const std::string& path) {
+    initializeOpenVdb();
+    const VdbFileLayout layout = checkVdbFileLayout(path);
+    if (!layout.hasGridOffsets) throw Error(path + ": an OpenVDB stream without grid offsets cannot be read region by region");
+    VdbFileIndex index;
+    try {
+        openvdb::io::File file(path);
+        file.setCopyMaxBytes(0);  // never a private copy in the temporary directory
+        file.open(/*delayLoad=*/true);
+        index.metadata = file.getMetadata();
+        file.close();
+    } catch (const std::bad_alloc&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
+    }
+    if (!index.metadata) index.metadata = std::make_shared<openvdb::MetaMap>();
+    for (const VdbGridEntry& entry : layout.grids) index.uniqueNames.push_back(openvdb::io::GridDescriptor::nameAsString(entry.uniqueName));
+    return index;
+}
+
+openvdb::GridBase::Ptr readGridDelayed(const std::string& path, const std::string& uniqueName) {
+    initializeOpenVdb();
+    try {
+        openvdb::io::File file(path);
+        file.setCopyMaxBytes(0);
+        file.open(/*delayLoad=*/true);
+        openvdb::GridBase::Ptr grid = file.readGrid(uniqueName);
+        file.close();  // the leaves keep the file mapped
+        if (!grid) throw Error(path + ": grid '" + uniqueName + "' could not be read");
+        return grid;
+    } catch (const Error&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
+    }
 }
 
 void writeVdbFile(const std::string& path, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& metadata) {

@@ -29,6 +29,19 @@ struct VdbFileContents {
 // unreadable file.
 VdbFileContents readVdbFile(const std::string& path);
 
+// For the cube-by-cube reader (VdbCubes.h): the file checked like
+// readVdbFile, its metadata and its grids' unique names in file order; then
+// one grid at a time with OpenVDB's delayed loading (leaf buffers are read
+// from the file when first touched). Throws for a file without offsets.
+struct VdbFileIndex {
+    openvdb::MetaMap::Ptr metadata;
+    std::vector<std::string> uniqueNames;  // file order
+};
+VdbFileIndex indexVdbFile(const std::string& path);
+openvdb::GridBase::Ptr readGridDelayed(const std::string& path, const std::string& uniqueName);
+// readVdbFile's checks of grid `index` against what the writer recorded.
+void checkGridAgainstFile(const std::string& path, size_t index, const openvdb::GridBase& grid);
+
 // Writes `grids` (in this order) and the file metadata atomically.
 void writeVdbFile(const std::string& path, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& metadata);
 

@@ -1,0 +1,177 @@
+// The .vdb file read region by region (vdb_bridge/VdbCubes.h) and encoded
+// cube by cube must give the very bytes of the whole-file import encoded in
+// memory, for every shared data file, every grid type, tiles at every
+// level, inactive values, half floats and every codec; the decoded file is
+// compared with the input by OpenVDB's own accessors (compareWithFile). The
+// CLI's --memory-limit and --threads must not change the output either.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <openvdb/openvdb.h>
+
+#include "src/format/SsvdagFile.h"
+#include "src/pipeline/CubeEncoder.h"
+#include "src/pipeline/GridCodec.h"
+#include "src/util/Error.h"
+#include "tests/unit/CliRunner.h"
+#include "vdb_bridge/VdbCompare.h"
+#include "vdb_bridge/VdbCubes.h"
+#include "vdb_bridge/VdbImport.h"
+
+using namespace vdbdag;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path tempDir() {
+    static const fs::path dir = [] {
+        fs::path d = fs::temp_directory_path() / ("vdbdag_cubes_" + std::to_string(getpid()));
+        fs::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+std::vector<uint8_t> inMemoryFile(const fs::path& path, const bridge::ImportOptions& import = {}, const pipeline::EncodeOptions& options = {}) {
+    return format::writeScene(pipeline::encodeVolume(bridge::importVdb(path.string(), import).volume, options));
+}
+
+std::vector<uint8_t> byCubesFile(const fs::path& path, std::optional<unsigned> cubeLog2, const bridge::ImportOptions& import = {},
+                                 const pipeline::EncodeOptions& options = {}) {
+    bridge::VdbCubeInput input = bridge::openVdbCubes(path.string(), import);
+    pipeline::CubeBudget budget;
+    budget.cubeLog2 = cubeLog2;
+    return format::writeScene(pipeline::encodeSourcesByCubes(std::move(input.grids), input.fileMetadata, options, budget));
+}
+
+// Every supported type; tiles at all three levels; level-set-like inactive
+// values; saved with `codec` and half floats when asked.
+fs::path writeAllTypes(const std::string& name, uint32_t codec, bool half, int seed) {
+    openvdb::initialize();
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> small(-200, 200);
+    auto f = openvdb::FloatGrid::create(3.0f);
+    f->setName("density");
+    f->setGridClass(openvdb::GRID_LEVEL_SET);
+    auto acc = f->getAccessor();
+    for (int i = 0; i < 4000; ++i) {
+        const openvdb::Coord c(small(rng), small(rng), small(rng) / 4);
+        acc.setValueOn(c, float(rng() % 9) * 0.25f);
+        acc.setValueOff(c.offsetBy(1, 0, 0), -3.0f);  // inactive, not the background
+    }
+    f->tree().addTile(1, openvdb::Coord(1024, 0, 0), 1.5f, true);
+    f->tree().addTile(2, openvdb::Coord(-128 * 20, 128 * 3, 0), 2.5f, true);
+    f->tree().addTile(2, openvdb::Coord(128 * 20, 128 * 3, 0), -3.0f, false);  // inactive inside tile
+    f->tree().addTile(3, openvdb::Coord(4096 * 3, -4096 * 2, 4096), 4.0f, true);
+    f->setSaveFloatAsHalf(half);
+    auto d = openvdb::DoubleGrid::create(0.0);
+    d->setName("temperature");
+    auto i32 = openvdb::Int32Grid::create(0);
+    i32->setName("labels");
+    auto v = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+    v->setName("Cd");
+    auto b = openvdb::BoolGrid::create(false);
+    b->setName("flags");
+    auto m = openvdb::MaskGrid::create();
+    m->setName("mask");
+    for (int i = 0; i < 3000; ++i) {
+        const openvdb::Coord c(small(rng), small(rng) / 2, small(rng));
+        d->tree().setValueOn(c, double(small(rng)) * 1e-3);
+        i32->tree().setValueOn(c.offsetBy(3, 0, 0), c.x() / 16);
+        v->tree().setValueOn(c, openvdb::Vec3s(float(rng() % 4), 0.5f, float(c.z())));
+        b->tree().setValueOn(c, (rng() & 1) != 0);
+        m->tree().setValueOn(c.offsetBy(0, 0, 5));
+    }
+    i32->tree().addTile(1, openvdb::Coord(512, 512, 512), 7, true);
+    m->tree().addTile(2, openvdb::Coord(1024, 1024, 1024), true, true);
+    const fs::path path = tempDir() / (name + ".vdb");
+    openvdb::io::File file(path.string());
+    file.setCompression(codec | openvdb::io::COMPRESS_ACTIVE_MASK);
+    openvdb::MetaMap meta;
+    meta.insertMeta("creator", openvdb::StringMetadata("test_vdb_cubes"));
+    file.write({f, d, i32, v, b, m}, meta);
+    file.close();
+    return path;
+}
+
+std::vector<fs::path> sharedVdbFiles() {
+    std::vector<fs::path> files;
+    for (const char* sub : {"vdb", "levelsets"}) {
+        const fs::path dir = fs::path(VDBDAG_SHARED_DATA) / sub;
+        if (!fs::is_directory(dir)) continue;
+        for (const auto& e : fs::directory_iterator(dir))
+            if (e.path().extension() == ".vdb" && e.path().filename() != "points.vdb") files.push_back(e.path());
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+} // namespace
+
+TEST(VdbCubes, EveryTypeCodecAndCubeSizeGivesTheInMemoryBytes) {
+    const uint32_t codecs[3] = {openvdb::io::COMPRESS_BLOSC, openvdb::io::COMPRESS_ZIP, openvdb::io::COMPRESS_NONE};
+    for (int k = 0; k < 3; ++k) {
+        const fs::path path = writeAllTypes("all_types_" + std::to_string(k), codecs[k], k == 1, 10 + k);
+        SCOPED_TRACE(path.string());
+        const std::vector<uint8_t> whole = inMemoryFile(path);
+        for (unsigned cube : {3u, 5u, 8u, 13u}) EXPECT_EQ(byCubesFile(path, cube), whole) << "cubes of 2^" << cube;
+        EXPECT_EQ(byCubesFile(path, std::nullopt), whole) << "default budget";
+        // The decoded cube-by-cube file is the input, by OpenVDB's accessors.
+        const fs::path encoded = tempDir() / (path.stem().string() + ".ssvdag");
+        std::ofstream(encoded, std::ios::binary).write(reinterpret_cast<const char*>(whole.data()), std::streamsize(whole.size()));
+        const auto result = bridge::compareWithFile(path.string(), pipeline::decodeScene(format::readSceneFile(encoded.string())));
+        EXPECT_TRUE(result.identical) << result.headerDifferences.size() << " header, " << result.topology.size() << " topology, " << result.values.size() << " value differences";
+    }
+}
+
+TEST(VdbCubes, TopologyOnlyAndChosenGridsGiveTheInMemoryBytes) {
+    const fs::path path = writeAllTypes("all_types_topology", openvdb::io::COMPRESS_BLOSC, false, 3);
+    bridge::ImportOptions topology;
+    topology.topologyOnly = true;
+    EXPECT_EQ(byCubesFile(path, 4, topology), inMemoryFile(path, topology));
+    bridge::ImportOptions some;
+    some.onlyGrids = {"labels", "density"};
+    EXPECT_EQ(byCubesFile(path, 6, some), inMemoryFile(path, some));
+    bridge::ImportOptions unknown;
+    unknown.onlyGrids = {"nope"};
+    try {
+        bridge::openVdbCubes(path.string(), unknown);
+        ADD_FAILURE() << "an unknown grid name must be refused";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("no grid named 'nope'"), std::string::npos) << e.what();
+    }
+}
+
+TEST(VdbCubes, EverySharedDataFileGivesTheInMemoryBytes) {
+    const auto files = sharedVdbFiles();
+    if (files.empty()) GTEST_SKIP() << "../shared/data not present";
+    pipeline::EncodeOptions options;
+    options.computeSvdagStats = true;  // as the CLI encodes
+    for (const auto& f : files) {
+        SCOPED_TRACE(f.string());
+        const std::vector<uint8_t> whole = inMemoryFile(f, {}, options);
+        EXPECT_EQ(byCubesFile(f, 5, {}, options), whole);
+        EXPECT_EQ(byCubesFile(f, std::nullopt, {}, options), whole);
+    }
+}
+
+TEST(VdbCubes, CliMemoryLimitAndThreadsDoNotChangeTheBytes) {
+    const fs::path in = writeAllTypes("cli_input", openvdb::io::COMPRESS_BLOSC, false, 8);
+    const fs::path a = tempDir() / "cli_default.ssvdag", b = tempDir() / "cli_limited.ssvdag", c = tempDir() / "cli_one_thread.ssvdag";
+    ASSERT_EQ(vdbdag::testing::runCli("encode " + in.string() + " -o " + a.string() + " -f").exitCode, 0);
+    const auto limited = vdbdag::testing::runCli("encode " + in.string() + " -o " + b.string() + " -f --memory-limit 1M --threads 2");
+    ASSERT_EQ(limited.exitCode, 0) << limited.err;
+    ASSERT_EQ(vdbdag::testing::runCli("encode " + in.string() + " -o " + c.string() + " -f --memory-limit 64K --threads 1").exitCode, 0);
+    EXPECT_EQ(vdbdag::testing::runShell("cmp " + a.string() + " " + b.string()).exitCode, 0);
+    EXPECT_EQ(vdbdag::testing::runShell("cmp " + a.string() + " " + c.string()).exitCode, 0);
+    const auto bad = vdbdag::testing::runCli("encode " + in.string() + " -o " + b.string() + " -f --memory-limit lots");
+    EXPECT_NE(bad.exitCode, 0);
+    const auto normals = vdbdag::testing::runCli("encode " + in.string() + " -o " + b.string() + " -f --memory-limit 1G --normals 16");
+    EXPECT_NE(normals.exitCode, 0);
+    EXPECT_NE(normals.err.find("--memory-limit"), std::string::npos) << normals.err;
+}

@@ -1,0 +1,305 @@
+// See VdbCubes.h. Per grid, a summary pass records for every leaf which of
+// its 8 bricks hold voxels of each layer (the inactive layer needs the
+// values, so that pass loads every buffer, a chunk of leaves at a time,
+// dropping them as it goes); the active and inactive tiles are kept in
+// memory (they carry one value each). A cube pass then indexes the fresh
+// tree's leaves by cube and reads each cube's bricks on demand.
+#include "vdb_bridge/VdbCubes.h"
+
+#include <algorithm>
+#include <bit>
+#include <limits>
+#include <map>
+#include <tuple>
+
+#include <openvdb/openvdb.h>
+#include <tbb/parallel_for.h>
+
+#include "src/util/Error.h"
+#include "vdb_bridge/detail/LeafBricks.h"
+#include "vdb_bridge/detail/OpenVdbSupport.h"
+#include "vdb_bridge/detail/VdbFile.h"
+#include "vdb_bridge/detail/VdbFileLayout.h"
+
+namespace vdbdag::bridge {
+namespace {
+
+struct CellLess {
+    bool operator()(const CubeCell& a, const CubeCell& b) const { return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x); }
+};
+
+CubeCell cellOf(const std::array<int64_t, 3>& origin, unsigned log2, int64_t x, int64_t y, int64_t z) {
+    return {uint32_t(uint64_t(x - origin[0]) >> log2), uint32_t(uint64_t(y - origin[1]) >> log2), uint32_t(uint64_t(z - origin[2]) >> log2)};
+}
+
+constexpr size_t kLeafChunk = 8192;  // leaves loaded at once by the summary pass
+
+template <typename GridT, bool hasValues>
+class VdbGridCubes final : public CubeSource {
+    using TreeT = typename GridT::TreeType;
+    using LeafT = typename TreeT::LeafNodeType;
+    using ValueT = typename GridT::ValueType;
+
+public:
+    VdbGridCubes(std::string path, std::string uniqueName, GridRecord header, typename GridT::Ptr grid)
+        : path_(std::move(path)), uniqueName_(std::move(uniqueName)), header_(std::move(header)) {
+        summarise(*grid);
+    }
+
+    const GridRecord& header() const override { return header_; }
+    LayerSummary summary(Layer layer) override { return summary_[int(layer)]; }
+
+    std::vector<CubeLoad> cubes(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2) override {
+        std::map<CubeCell, uint64_t, CellLess> counts;
+        for (const LeafInfo& leaf : leaves_)
+            for (uint8_t bits = leaf.occupancy[int(layer)]; bits; bits &= uint8_t(bits - 1)) {
+                const openvdb::Coord c = detail::brickCorner(leaf.origin, unsigned(std::countr_zero(bits)));
+                ++counts[cellOf(origin, log2, c.x(), c.y(), c.z())];
+            }
+        for (const Tile& t : tiles_[int(layer)].tiles)
+            if (t.log2Size <= log2) ++counts[cellOf(origin, log2, t.x, t.y, t.z)];
+        std::vector<CubeLoad> out;
+        out.reserve(counts.size());
+        for (const auto& [cell, n] : counts) out.push_back({cell, n});
+        return out;
+    }
+
+    void largeTiles(Layer layer, unsigned log2, GridTopology& tiles, LayerValues& values) override {
+        tiles = {};
+        values = {};
+        const GridTopology& all = tiles_[int(layer)];
+        const LayerValues& v = tileValues_[int(layer)];
+        const unsigned vs = valueSize(header_.valueType);
+        for (size_t i = 0; i < all.tiles.size(); ++i) {
+            if (all.tiles[i].log2Size <= log2) continue;
+            tiles.tiles.push_back(all.tiles[i]);
+            if (vs) values.tiles.insert(values.tiles.end(), v.tiles.begin() + long(i * vs), v.tiles.begin() + long((i + 1) * vs));
+        }
+    }
+
+    void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {
+        layer_ = layer;
+        withValues_ = withValues && hasValues;
+        grid_ = openvdb::gridPtrCast<GridT>(detail::readGridDelayed(path_, uniqueName_));
+        if (!grid_) throw Error(path_ + ": grid '" + header_.name + "' changed type while being read");
+        leafPtrs_.clear();
+        for (auto it = grid_->tree().beginLeaf(); it; ++it) leafPtrs_.push_back(it.getLeaf());
+        if (leafPtrs_.size() != leaves_.size()) throw Error(path_ + ": the file changed while being read");
+        remaining_.assign(leaves_.size(), 0);
+        index_.clear();
+        for (size_t i = 0; i < leaves_.size(); ++i) {
+            if (leafPtrs_[i]->origin() != leaves_[i].origin) throw Error(path_ + ": the file changed while being read");
+            std::map<CubeCell, uint8_t, CellLess> cells;
+            for (uint8_t bits = leaves_[i].occupancy[int(layer)]; bits; bits &= uint8_t(bits - 1)) {
+                const unsigned b = unsigned(std::countr_zero(bits));
+                const openvdb::Coord c = detail::brickCorner(leaves_[i].origin, b);
+                cells[cellOf(origin, log2, c.x(), c.y(), c.z())] |= uint8_t(1u << b);
+            }
+            for (const auto& [cell, bricks] : cells) index_[cell].leaves.push_back({i, bricks});
+            remaining_[i] = uint8_t(cells.size());
+        }
+        const GridTopology& tiles = tiles_[int(layer)];
+        for (size_t t = 0; t < tiles.tiles.size(); ++t)
+            if (tiles.tiles[t].log2Size <= log2) index_[cellOf(origin, log2, tiles.tiles[t].x, tiles.tiles[t].y, tiles.tiles[t].z)].tiles.push_back(t);
+    }
+
+    void read(const CubeCell& cell, GridTopology& topology, LayerValues& values) override {
+        topology = {};
+        values = {};
+        const auto it = index_.find(cell);
+        if (it == index_.end()) return;
+        const ValueT background = grid_->tree().background();
+        std::vector<uint8_t>* out = withValues_ ? &values.bricks : nullptr;
+        for (const auto& [leafIndex, bricks] : it->second.leaves) {
+            const LeafT& leaf = *leafPtrs_[leafIndex];
+            for (uint8_t bits = bricks; bits; bits &= uint8_t(bits - 1)) {
+                const unsigned b = unsigned(std::countr_zero(bits));
+                const uint64_t mask = detail::leafBrick<LeafT, hasValues>(leaf, b, layer_, background, out);
+                if (!mask) throw Error(path_ + ": the file changed while being read");
+                const openvdb::Coord c = detail::brickCorner(leaf.origin(), b);
+                topology.bricks.push_back({c.x(), c.y(), c.z(), mask});
+            }
+            if (--remaining_[leafIndex] == 0) dropLeaf(leafIndex, background);
+        }
+        const GridTopology& tiles = tiles_[int(layer_)];
+        const LayerValues& tileValues = tileValues_[int(layer_)];
+        const unsigned vs = withValues_ ? valueSize(header_.valueType) : 0;
+        for (size_t t : it->second.tiles) {
+            topology.tiles.push_back(tiles.tiles[t]);
+            if (vs) values.tiles.insert(values.tiles.end(), tileValues.tiles.begin() + long(t * vs), tileValues.tiles.begin() + long((t + 1) * vs));
+        }
+        index_.erase(it);
+    }
+
+    void endPass() override {
+        index_.clear();
+        leafPtrs_.clear();
+        remaining_.clear();
+        grid_.reset();
+    }
+
+private:
+    struct LeafInfo {
+        openvdb::Coord origin;
+        uint8_t occupancy[2];  // per layer: bit b = brick b holds voxels
+    };
+    struct CubeIndex {
+        std::vector<std::pair<size_t, uint8_t>> leaves;  // (leaf, its bricks in this cube)
+        std::vector<size_t> tiles;
+    };
+
+    // Replaces a leaf that no cube of the pass needs any more by an inactive
+    // tile, freeing its buffer (OpenVDB has no way to unload one).
+    void dropLeaf(size_t leafIndex, const ValueT& background) {
+        grid_->tree().addTile(1, leaves_[leafIndex].origin, background, false);
+        leafPtrs_[leafIndex] = nullptr;
+    }
+
+    void summarise(GridT& grid) {
+        TreeT& tree = grid.tree();
+        const ValueT background = tree.background();
+        summary_[0].voxels = tree.activeVoxelCount();
+        // Tiles above the leaves: active ones, and inactive ones whose value
+        // is not the background.
+        typename TreeT::ValueAllCIter it = tree.cbeginValueAll();
+        it.setMaxDepth(TreeT::ValueAllCIter::LEAF_DEPTH - 1);
+        for (; it; ++it) {
+            if (!it.isTileValue()) continue;
+            const openvdb::CoordBBox box = it.getBoundingBox();
+            const unsigned log2 = unsigned(std::countr_zero(unsigned(box.dim().x())));
+            const Tile tile{box.min().x(), box.min().y(), box.min().z(), uint8_t(log2)};
+            if (it.isValueOn()) {
+                tiles_[0].tiles.push_back(tile);
+                if constexpr (hasValues) detail::appendValue(tileValues_[0].tiles, *it);
+            } else if constexpr (hasValues) {
+                if (!detail::sameBits(ValueT(*it), background)) {
+                    tiles_[1].tiles.push_back(tile);
+                    detail::appendValue(tileValues_[1].tiles, *it);
+                }
+            }
+        }
+        std::vector<LeafT*> leaves;
+        leaves.reserve(tree.leafCount());
+        for (auto it = tree.beginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
+        leaves_.resize(leaves.size());
+        std::vector<uint64_t> inactiveVoxels(leaves.size(), 0);
+        for (size_t begin = 0; begin < leaves.size(); begin += kLeafChunk) {
+            const size_t end = std::min(leaves.size(), begin + kLeafChunk);
+            tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 64), [&](const auto& r) {
+                for (size_t i = r.begin(); i != r.end(); ++i) {
+                    LeafInfo& info = leaves_[i];
+                    info.origin = leaves[i]->origin();
+                    info.occupancy[0] = info.occupancy[1] = 0;
+                    for (unsigned b = 0; b < 8; ++b) {
+                        if (detail::leafBrick<LeafT, hasValues>(*leaves[i], b, Layer::Active, background, nullptr)) info.occupancy[0] |= uint8_t(1u << b);
+                        if constexpr (hasValues) {
+                            const uint64_t inactive = detail::leafBrick<LeafT, hasValues>(*leaves[i], b, Layer::Inactive, background, nullptr);
+                            if (inactive) info.occupancy[1] |= uint8_t(1u << b);
+                            inactiveVoxels[i] += uint64_t(std::popcount(inactive));
+                        }
+                    }
+                }
+            });
+            if constexpr (hasValues)  // drop the loaded buffers
+                for (size_t i = begin; i < end; ++i) tree.addTile(1, leaves_[i].origin, background, false);
+        }
+        for (int l = 0; l < 2; ++l) {
+            LayerSummary& s = summary_[l];
+            s.min.fill(std::numeric_limits<int64_t>::max());
+            s.max.fill(std::numeric_limits<int64_t>::min());
+            auto extend = [&](int64_t x, int64_t y, int64_t z, int64_t size) {
+                const int64_t c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a) { s.min[a] = std::min(s.min[a], c[a]); s.max[a] = std::max(s.max[a], c[a] + size - 1); }
+            };
+            for (const LeafInfo& leaf : leaves_)
+                for (uint8_t bits = leaf.occupancy[l]; bits; bits &= uint8_t(bits - 1)) {
+                    const openvdb::Coord c = detail::brickCorner(leaf.origin, unsigned(std::countr_zero(bits)));
+                    extend(c.x(), c.y(), c.z(), 4);
+                    ++s.bricks;
+                }
+            for (const Tile& t : tiles_[l].tiles) {
+                extend(t.x, t.y, t.z, int64_t(1) << t.log2Size);
+                s.largestTileLog2 = std::max<unsigned>(s.largestTileLog2, t.log2Size);
+            }
+            s.tiles = tiles_[l].tiles.size();
+        }
+        // As GridTopology::activeVoxelCount counts them.
+        GridTopology inactive;
+        inactive.tiles = tiles_[1].tiles;
+        summary_[1].voxels = inactive.activeVoxelCount();
+        for (uint64_t n : inactiveVoxels) summary_[1].voxels += n;
+    }
+
+    std::string path_, uniqueName_;
+    GridRecord header_;
+    std::vector<LeafInfo> leaves_;
+    GridTopology tiles_[2];
+    LayerValues tileValues_[2];
+    LayerSummary summary_[2];
+    // The current pass.
+    typename GridT::Ptr grid_;
+    Layer layer_ = Layer::Active;
+    bool withValues_ = false;
+    std::vector<LeafT*> leafPtrs_;
+    std::vector<uint8_t> remaining_;
+    std::map<CubeCell, CubeIndex, CellLess> index_;
+};
+
+} // namespace
+
+bool canReadVdbByCubes(const std::string& path) {
+    try {
+        return detail::checkVdbFileLayout(path).hasGridOffsets;
+    } catch (const Error&) {
+        return false;
+    }
+}
+
+VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options) {
+    if (options.normals) throw Error(path + ": --normals needs the whole grid in memory; use it without --memory-limit");
+    const detail::VdbFileIndex index = detail::indexVdbFile(path);
+    VdbCubeInput input;
+    input.fileMetadata = detail::serializeMetadata(*index.metadata);
+    std::vector<std::string> found;
+    for (size_t i = 0; i < index.uniqueNames.size(); ++i) {
+        openvdb::GridBase::Ptr base = detail::readGridDelayed(path, index.uniqueNames[i]);
+        detail::checkGridAgainstFile(path, i, *base);
+        found.push_back(base->getName());
+        if (!options.onlyGrids.empty() && std::find(options.onlyGrids.begin(), options.onlyGrids.end(), base->getName()) == options.onlyGrids.end())
+            continue;
+        GridRecord header;
+        header.name = base->getName();
+        header.gridClass = openvdb::GridBase::gridClassToString(base->getGridClass());
+        header.indexToWorld = detail::indexToWorldOf(*base);
+        header.vdbDescriptor = detail::descriptorOf(*base);
+        const bool supported = detail::dispatchGridType(*base, [&](const auto& typed, ValueType type) {
+            using GridT = std::decay_t<decltype(typed)>;
+            constexpr bool typeHasValues = !std::is_same_v<typename GridT::TreeType::LeafNodeType::BuildType, openvdb::ValueMask>;
+            typename GridT::Ptr grid = openvdb::gridPtrCast<GridT>(base);
+            base.reset();
+            if (options.topologyOnly || !typeHasValues) {
+                header.valueType = ValueType::Mask;
+                input.grids.push_back(std::make_unique<VdbGridCubes<GridT, false>>(path, index.uniqueNames[i], std::move(header), std::move(grid)));
+            } else {
+                header.valueType = type;
+                detail::appendValue(header.background, grid->tree().background());
+                input.grids.push_back(std::make_unique<VdbGridCubes<GridT, typeHasValues>>(path, index.uniqueNames[i], std::move(header), std::move(grid)));
+            }
+        });
+        if (!supported) {
+            const std::string message = "grid " + std::to_string(i) + " '" + base->getName() + "' has type '" + base->type() + "'" +
+                                        detail::typeHint(*base) + ", which vdbdag does not convert";
+            if (!options.skipUnsupported) throw Error(path + ": " + message + " (use --skip-unsupported to convert the other grids)");
+            input.warnings.push_back(path + ": skipped " + message);
+        }
+    }
+    for (const std::string& wanted : options.onlyGrids)
+        if (std::find(found.begin(), found.end(), wanted) == found.end()) {
+            std::string names;
+            for (const auto& n : found) names += (names.empty() ? "'" : ", '") + n + "'";
+            throw Error(path + ": no grid named '" + wanted + "' (the file has " + (names.empty() ? "no grids" : names) + ")");
+        }
+    return input;
+}
+
+} // namespace vdbdag::bridge
