@@ -12,10 +12,13 @@
 #include <map>
 #include <tuple>
 
+#include <malloc.h>
+
 #include <openvdb/openvdb.h>
 #include <tbb/parallel_for.h>
 
 #include "src/util/Error.h"
+#include "src/util/MappedPages.h"
 #include "vdb_bridge/detail/LeafBricks.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/VdbFile.h"
@@ -32,6 +35,14 @@ CubeCell cellOf(const std::array<int64_t, 3>& origin, unsigned log2, int64_t x, 
     return {uint32_t(uint64_t(x - origin[0]) >> log2), uint32_t(uint64_t(y - origin[1]) >> log2), uint32_t(uint64_t(z - origin[2]) >> log2)};
 }
 
+// Hands the heap's free pages back to the system after a pass (glibc keeps
+// them otherwise, and the resident size is what a memory limit is held to).
+void releaseFreedMemory() {
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
+}
+
 constexpr size_t kLeafChunk = 8192;  // leaves loaded at once by the summary pass
 
 template <typename GridT, bool hasValues>
@@ -44,6 +55,8 @@ public:
     VdbGridCubes(std::string path, std::string uniqueName, GridRecord header, typename GridT::Ptr grid)
         : path_(std::move(path)), uniqueName_(std::move(uniqueName)), header_(std::move(header)) {
         summarise(*grid);
+        grid.reset();
+        releaseFreedMemory();
     }
 
     const GridRecord& header() const override { return header_; }
@@ -82,6 +95,7 @@ public:
         withValues_ = withValues && hasValues;
         grid_ = openvdb::gridPtrCast<GridT>(detail::readGridDelayed(path_, uniqueName_));
         if (!grid_) throw Error(path_ + ": grid '" + header_.name + "' changed type while being read");
+        mapped_ = MappedPages(path_);
         leafPtrs_.clear();
         for (auto it = grid_->tree().beginLeaf(); it; ++it) leafPtrs_.push_back(it.getLeaf());
         if (leafPtrs_.size() != leaves_.size()) throw Error(path_ + ": the file changed while being read");
@@ -121,6 +135,7 @@ public:
             }
             if (--remaining_[leafIndex] == 0) dropLeaf(leafIndex, background);
         }
+        if (withValues_ || layer_ == Layer::Inactive) mapped_.release();  // the file pages this cube's buffers were read from
         const GridTopology& tiles = tiles_[int(layer_)];
         const LayerValues& tileValues = tileValues_[int(layer_)];
         const unsigned vs = withValues_ ? valueSize(header_.valueType) : 0;
@@ -136,6 +151,8 @@ public:
         leafPtrs_.clear();
         remaining_.clear();
         grid_.reset();
+        mapped_ = {};
+        releaseFreedMemory();
     }
 
 private:
@@ -183,6 +200,7 @@ private:
         for (auto it = tree.beginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
         leaves_.resize(leaves.size());
         std::vector<uint64_t> inactiveVoxels(leaves.size(), 0);
+        const MappedPages mapped(path_);
         for (size_t begin = 0; begin < leaves.size(); begin += kLeafChunk) {
             const size_t end = std::min(leaves.size(), begin + kLeafChunk);
             tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 64), [&](const auto& r) {
@@ -200,8 +218,10 @@ private:
                     }
                 }
             });
-            if constexpr (hasValues)  // drop the loaded buffers
+            if constexpr (hasValues) {  // drop the loaded buffers and the file pages they were read from
                 for (size_t i = begin; i < end; ++i) tree.addTile(1, leaves_[i].origin, background, false);
+                mapped.release();
+            }
         }
         for (int l = 0; l < 2; ++l) {
             LayerSummary& s = summary_[l];
@@ -243,6 +263,7 @@ private:
     std::vector<LeafT*> leafPtrs_;
     std::vector<uint8_t> remaining_;
     std::map<CubeCell, CubeIndex, CellLess> index_;
+    MappedPages mapped_;
 };
 
 } // namespace

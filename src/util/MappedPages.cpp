@@ -1,0 +1,35 @@
+// See MappedPages.h.
+#include "src/util/MappedPages.h"
+
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+
+#include <cinttypes>
+#include <cstdio>
+
+namespace vdbdag {
+
+MappedPages::MappedPages(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return;
+    FILE* maps = std::fopen("/proc/self/maps", "r");
+    if (!maps) return;
+    char line[4096];
+    while (std::fgets(line, sizeof line, maps)) {
+        uintptr_t begin = 0, end = 0;
+        char perms[8] = {};
+        unsigned long long offset = 0, inode = 0;
+        unsigned devMajor = 0, devMinor = 0;
+        if (std::sscanf(line, "%" SCNxPTR "-%" SCNxPTR " %7s %llx %x:%x %llu", &begin, &end, perms, &offset, &devMajor, &devMinor, &inode) != 7) continue;
+        if (inode != st.st_ino || makedev(devMajor, devMinor) != st.st_dev || perms[1] == 'w') continue;
+        ranges_.push_back({reinterpret_cast<void*>(begin), size_t(end - begin)});
+    }
+    std::fclose(maps);
+}
+
+void MappedPages::release() const {
+    for (const auto& [address, length] : ranges_) ::madvise(address, length, MADV_DONTNEED);
+}
+
+} // namespace vdbdag
