@@ -106,7 +106,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
                 throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
                                          "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
-            if (opt->memoryLimit && bridge::canReadVdbByCubes(opt->input)) {
+            if ((opt->memoryLimit || cubeTeam().size() > 1) && bridge::canReadVdbByCubes(opt->input)) {
                 cubeInput = bridge::openVdbCubes(opt->input, importOptions);
                 imported.warnings = cubeInput->warnings;
                 for (const auto& g : cubeInput->grids) imported.volume.grids.push_back(g->header());  // headers only, for the checks
@@ -143,12 +143,13 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         };
         std::vector<std::string> gridNames;
         for (const auto& g : imported.volume.grids) gridNames.push_back(g.name);
+        pipeline::CubeTeam& team = cubeTeam();
         format::SsvdagScene scene;
         const auto onGrid = [&](size_t i, size_t) { gridName = gridNames[i]; };
         try {
-            if (opt->memoryLimit) {
+            if (opt->memoryLimit || team.size() > 1) {
                 pipeline::CubeBudget budget;
-                budget.bytes = std::max<uint64_t>(opt->memoryLimit / 2, 1);
+                if (opt->memoryLimit) budget.bytes = std::max<uint64_t>(opt->memoryLimit / 2, 1);
                 std::vector<std::unique_ptr<CubeSource>> sources;
                 if (cubeInput) {
                     sources = std::move(cubeInput->grids);
@@ -156,7 +157,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 } else {  // a dense scan or an OpenVDB stream: in memory, encoded cube by cube
                     for (const GridRecord& g : imported.volume.grids) sources.push_back(recordCubes(g));
                 }
-                scene = pipeline::encodeSourcesByCubes(std::move(sources), imported.volume.fileMetadata, encodeOptions, budget, onGrid);
+                scene = pipeline::encodeSourcesByCubes(std::move(sources), imported.volume.fileMetadata, encodeOptions, budget, onGrid, team);
             } else {
                 scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, onGrid);
             }
@@ -170,6 +171,10 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         for (auto& g : scene.grids) {
             std::vector<uint8_t>().swap(g.attributes);
             std::vector<uint8_t>().swap(g.inactiveAttributes);
+        }
+        if (!team.isRoot()) {  // process 0 writes and reports
+            exitCode = 0;
+            return;
         }
         progress.setLabel("encode: writing " + opt->output);
         format::ContainerOptions containerOptions;

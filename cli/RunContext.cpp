@@ -83,6 +83,13 @@ extern "C" int posix_memalign(void** out, size_t alignment, size_t size) {
 
 namespace vdbdag::cli {
 
+namespace {
+pipeline::CubeTeam* currentTeam = nullptr;
+}
+
+void setCubeTeam(pipeline::CubeTeam& team) { currentTeam = &team; }
+pipeline::CubeTeam& cubeTeam() { return currentTeam ? *currentTeam : pipeline::soloTeam(); }
+
 void setActivity(const std::string& path, const std::string& activity) {
     const std::string text = "vdbdag: " + outOfMemoryMessageFor(path, activity) + "\n";
     const size_t n = std::min(text.size(), sizeof g_message - 1);

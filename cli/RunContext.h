@@ -4,10 +4,18 @@
 // std::terminate; so the new-handler itself removes the temporaries
 // (TemporaryFiles.h), prints "vdbdag: PATH: out of memory while ACTIVITY"
 // and ends the process with exit status 1.
+//
+// It also holds the processes the command runs on (CubeTeam.h): one, or
+// those of an `mpirun` for vdbdag-mpi.
 #pragma once
 #include <string>
 
+#include "src/pipeline/CubeTeam.h"
+
 namespace vdbdag::cli {
+
+void setCubeTeam(pipeline::CubeTeam& team);
+pipeline::CubeTeam& cubeTeam();
 
 // E.g. setActivity(opt->input, "encoding"); the first call of a command.
 void setActivity(const std::string& path, const std::string& activity);

@@ -98,15 +98,20 @@ std::vector<uint8_t> gatherAttributes(const encoding::CompactDag& dag, const Gri
 }
 
 void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInstance& subtree, const GridTopology& topology,
-                   const LayerValues& values, unsigned valueSize, uint8_t* attributes) {
+                   const LayerValues& values, unsigned valueSize, uint8_t* buffer, uint64_t bufferFirstEntry) {
     if (valueSize == 0) return;
+    if (subtree.firstEntry < bufferFirstEntry) throw Error("internal error: a subtree's values start before the buffer");
+    // Entry e goes to buffer + (e - bufferFirstEntry) * valueSize.
+    encoding::SubtreeInstance shifted = subtree;
+    shifted.firstEntry -= bufferFirstEntry;
+    uint8_t* const attributes = buffer;
     const InputValues input(topology, values, valueSize);
-    if (subtree.solid) {
-        input.solid(subtree.x, subtree.y, subtree.z, subtree.firstEntry, attributes);
+    if (shifted.solid) {
+        input.solid(shifted.x, shifted.y, shifted.z, shifted.firstEntry, attributes);
         return;
     }
     encoding::visitSubtreeInAttributeOrder(
-        dag, subtree, [&](const encoding::BrickInstance& b) { input.brick(b, attributes); },
+        dag, shifted, [&](const encoding::BrickInstance& b) { input.brick(b, attributes); },
         [&](int64_t x, int64_t y, int64_t z, unsigned, uint64_t entry) { input.solid(x, y, z, entry, attributes); });
 }
 

@@ -18,10 +18,10 @@ std::vector<uint8_t> gatherAttributes(const encoding::CompactDag& dag, const Gri
                                       unsigned valueSize);
 
 // The same for one subtree (encoding::subtreesInAttributeOrder) and the
-// part of the input inside it: writes the subtree's entries of the whole
-// attribute array `attributes`.
+// part of the input inside it: writes the subtree's entries into `buffer`,
+// which holds the attribute array's entries from `bufferFirstEntry` on.
 void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInstance& subtree, const GridTopology& topology,
-                   const LayerValues& values, unsigned valueSize, uint8_t* attributes);
+                   const LayerValues& values, unsigned valueSize, uint8_t* buffer, uint64_t bufferFirstEntry = 0);
 
 // Attribute-order values -> the decoded topology and its values in input order.
 void scatterAttributes(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, unsigned valueSize,

@@ -2,10 +2,13 @@
 #include "src/pipeline/CubeEncoder.h"
 
 #include <algorithm>
+#include <functional>
+#include <optional>
 
 #include <tbb/info.h>
 #include <tbb/parallel_pipeline.h>
 
+#include "src/dag/ReducedDagBytes.h"
 #include "src/dag/SubDagMerge.h"
 #include "src/encoding/CompactDag.h"
 #include "src/pipeline/AttributeOrder.h"
@@ -51,32 +54,21 @@ std::array<int64_t, 3> cornerOf(const LayerPlan& plan, const CubeCell& cell) {
     return {o[0] + (int64_t(cell.x) << plan.cubeLog2), o[1] + (int64_t(cell.y) << plan.cubeLog2), o[2] + (int64_t(cell.z) << plan.cubeLog2)};
 }
 
-// Builds the layer's DAG from its cubes (geometry only).
-dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& plan, bool symmetry, const CubeBudget& budget) {
-    dag::BuildOptions local;
-    local.symmetry = symmetry;
-    local.log2Size = plan.cubeLog2;
-    source.beginPass(layer, plan.placement.origin, plan.cubeLog2, false);
-    if (plan.cubeLog2 >= plan.placement.log2Size) {  // one cube: the whole layer
-        GridTopology topology;
-        LayerValues none;
-        source.read({0, 0, 0}, topology, none);
-        source.endPass();
-        local.origin = plan.placement.origin;
-        return dag::buildDag(topology, local);
-    }
-    dag::SubDagMerger merger(plan.placement, plan.cubeLog2, symmetry);
+// Sub-DAGs of cubes [begin, end) of the plan, built several at a time;
+// `onSub(index, sub)` runs in cube order.
+void buildSubDags(CubeSource& source, const LayerPlan& plan, bool symmetry, const CubeBudget& budget, size_t begin, size_t end,
+                  const std::function<void(size_t, dag::ReducedDag&)>& onSub) {
     struct Piece {
         size_t index;
         GridTopology topology;
         dag::ReducedDag sub;
     };
-    size_t next = 0;
+    size_t next = begin;
     tbb::parallel_pipeline(
         workersOf(budget),
         tbb::make_filter<void, std::shared_ptr<Piece>>(tbb::filter_mode::serial_in_order,
                                                        [&](tbb::flow_control& fc) -> std::shared_ptr<Piece> {
-                                                           if (next == plan.cubes.size()) { fc.stop(); return nullptr; }
+                                                           if (next == end) { fc.stop(); return nullptr; }
                                                            auto piece = std::make_shared<Piece>();
                                                            piece->index = next++;
                                                            LayerValues none;
@@ -85,37 +77,106 @@ dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& pla
                                                        }) &
             tbb::make_filter<std::shared_ptr<Piece>, std::shared_ptr<Piece>>(tbb::filter_mode::parallel,
                                                                              [&](std::shared_ptr<Piece> piece) {
-                                                                                 dag::BuildOptions options = local;
+                                                                                 dag::BuildOptions options;
+                                                                                 options.symmetry = symmetry;
+                                                                                 options.log2Size = plan.cubeLog2;
                                                                                  options.origin = cornerOf(plan, plan.cubes[piece->index].cell);
                                                                                  piece->sub = dag::buildDag(piece->topology, options);
                                                                                  piece->topology = {};
                                                                                  return piece;
                                                                              }) &
-            tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Piece> piece) {
-                const CubeCell& c = plan.cubes[piece->index].cell;
-                merger.add({c.x, c.y, c.z}, piece->sub);
-            }));
-    source.endPass();
-    GridTopology large;
-    LayerValues none;
-    source.largeTiles(layer, plan.cubeLog2, large, none);
-    std::vector<std::pair<dag::CellCoord, unsigned>> largeTiles;
-    for (const Tile& t : large.tiles) {
-        const auto& o = plan.placement.origin;
-        largeTiles.push_back({{uint32_t(uint64_t(t.x - o[0]) >> t.log2Size), uint32_t(uint64_t(t.y - o[1]) >> t.log2Size),
-                               uint32_t(uint64_t(t.z - o[2]) >> t.log2Size)},
-                              t.log2Size});
-    }
-    return merger.finish(largeTiles);
+            tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::serial_in_order,
+                                                           [&](std::shared_ptr<Piece> piece) { onSub(piece->index, piece->sub); }));
 }
 
-// The layer's values in attribute order, cube by cube.
+// Builds the layer's DAG from its cubes (geometry only). With several
+// processes each builds the sub-DAGs of its share of the cubes and process
+// 0 merges them; every process gets the merged DAG.
+dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& plan, bool symmetry, const CubeBudget& budget, CubeTeam& team) {
+    if (plan.cubeLog2 >= plan.placement.log2Size) {  // one cube: the whole layer, on process 0
+        std::vector<uint8_t> bytes;
+        if (team.isRoot()) {
+            dag::BuildOptions whole;
+            whole.symmetry = symmetry;
+            whole.origin = plan.placement.origin;
+            whole.log2Size = plan.cubeLog2;
+            GridTopology topology;
+            LayerValues none;
+            source.beginPass(layer, plan.placement.origin, plan.cubeLog2, false);
+            source.read({0, 0, 0}, topology, none);
+            source.endPass();
+            const dag::ReducedDag dag = dag::buildDag(topology, whole);
+            if (team.size() == 1) return dag;
+            dag::appendReducedDag(dag, bytes);
+        }
+        bytes = team.broadcast(bytes);
+        size_t pos = 0;
+        return dag::readReducedDag(bytes, pos);
+    }
+    std::vector<uint64_t> weights;
+    for (const CubeLoad& c : plan.cubes) weights.push_back(c.bricks);
+    const std::vector<size_t> shares = splitByWeight(weights, team.size());
+    std::optional<dag::SubDagMerger> merger;
+    if (team.isRoot()) merger.emplace(plan.placement, plan.cubeLog2, symmetry);
+    auto addToMerger = [&](size_t index, const dag::ReducedDag& sub) {
+        const CubeCell& c = plan.cubes[index].cell;
+        merger->add({c.x, c.y, c.z}, sub);
+    };
+    source.beginPass(layer, plan.placement.origin, plan.cubeLog2, false);
+    std::vector<uint8_t> mine;
+    buildSubDags(source, plan, symmetry, budget, shares[team.rank()], shares[team.rank() + 1], [&](size_t index, dag::ReducedDag& sub) {
+        if (team.size() == 1) addToMerger(index, sub);
+        else dag::appendReducedDag(sub, mine);
+    });
+    source.endPass();
+    if (team.size() > 1) {
+        const std::vector<std::vector<uint8_t>> all = team.gather(mine);
+        std::vector<uint8_t>().swap(mine);
+        if (team.isRoot())
+            for (unsigned r = 0; r < team.size(); ++r) {
+                size_t pos = 0;
+                for (size_t index = shares[r]; index < shares[r + 1]; ++index) addToMerger(index, dag::readReducedDag(all[r], pos));
+            }
+    }
+    std::vector<uint8_t> bytes;
+    if (team.isRoot()) {
+        GridTopology large;
+        LayerValues none;
+        source.largeTiles(layer, plan.cubeLog2, large, none);
+        std::vector<std::pair<dag::CellCoord, unsigned>> largeTiles;
+        for (const Tile& t : large.tiles) {
+            const auto& o = plan.placement.origin;
+            largeTiles.push_back({{uint32_t(uint64_t(t.x - o[0]) >> t.log2Size), uint32_t(uint64_t(t.y - o[1]) >> t.log2Size),
+                                   uint32_t(uint64_t(t.z - o[2]) >> t.log2Size)},
+                                  t.log2Size});
+        }
+        dag::ReducedDag merged = merger->finish(largeTiles);
+        if (team.size() == 1) return merged;
+        dag::appendReducedDag(merged, bytes);
+    }
+    bytes = team.broadcast(bytes);
+    size_t pos = 0;
+    return dag::readReducedDag(bytes, pos);
+}
+
+// The layer's values in attribute order, cube by cube. With several
+// processes each gathers a contiguous share of the subtrees and process 0
+// receives them; elsewhere the result is empty.
 std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPlan& plan, const encoding::CompactDag& dag, unsigned vs,
-                                 const CubeBudget& budget) {
+                                 const CubeBudget& budget, CubeTeam& team) {
     if (vs == 0 || dag.empty()) return {};
-    std::vector<uint8_t> attributes(encoding::decodedSize(dag).attributeEntries * vs);
+    const uint64_t entries = encoding::decodedSize(dag).attributeEntries;
     const unsigned cut = std::min<unsigned>(plan.cubeLog2, dag.log2Size);
     const std::vector<encoding::SubtreeInstance> subtrees = encoding::subtreesInAttributeOrder(dag, cut);
+    std::vector<uint64_t> weights;
+    for (size_t i = 0; i < subtrees.size(); ++i) weights.push_back((i + 1 < subtrees.size() ? subtrees[i + 1].firstEntry : entries) - subtrees[i].firstEntry);
+    const std::vector<size_t> shares = splitByWeight(weights, team.size());
+    const size_t begin = shares[team.rank()], end = shares[team.rank() + 1];
+    const uint64_t firstEntry = begin < subtrees.size() ? subtrees[begin].firstEntry : entries;
+    const uint64_t endEntry = end < subtrees.size() ? subtrees[end].firstEntry : entries;
+    // This process's entries, [firstEntry, endEntry); process 0 of a solo
+    // team fills the whole array directly.
+    std::vector<uint8_t> attributes((endEntry - firstEntry) * vs);
     GridTopology largeTopology;
     LayerValues largeValues;
     source.largeTiles(layer, plan.cubeLog2, largeTopology, largeValues);
@@ -125,12 +186,12 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         GridTopology topology;
         LayerValues values;
     };
-    size_t next = 0;
+    size_t next = begin;
     tbb::parallel_pipeline(
         workersOf(budget),
         tbb::make_filter<void, std::shared_ptr<Piece>>(tbb::filter_mode::serial_in_order,
                                                        [&](tbb::flow_control& fc) -> std::shared_ptr<Piece> {
-                                                           if (next == subtrees.size()) { fc.stop(); return nullptr; }
+                                                           if (next == end) { fc.stop(); return nullptr; }
                                                            auto piece = std::make_shared<Piece>();
                                                            piece->index = next++;
                                                            const encoding::SubtreeInstance& s = subtrees[piece->index];
@@ -145,16 +206,23 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
                                                        }) &
             tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::parallel, [&](std::shared_ptr<Piece> piece) {
                 const encoding::SubtreeInstance& s = subtrees[piece->index];
-                if (s.log2Size <= plan.cubeLog2) gatherSubtree(dag, s, piece->topology, piece->values, vs, attributes.data());
-                else gatherSubtree(dag, s, largeTopology, largeValues, vs, attributes.data());
+                if (s.log2Size <= plan.cubeLog2) gatherSubtree(dag, s, piece->topology, piece->values, vs, attributes.data(), firstEntry);
+                else gatherSubtree(dag, s, largeTopology, largeValues, vs, attributes.data(), firstEntry);
             }));
     source.endPass();
-    return attributes;
+    if (team.size() == 1) return attributes;
+    const std::vector<std::vector<uint8_t>> all = team.gather(attributes);
+    if (!team.isRoot()) return {};
+    std::vector<uint8_t> whole;
+    whole.reserve(entries * vs);
+    for (const auto& part : all) whole.insert(whole.end(), part.begin(), part.end());
+    if (whole.size() != entries * vs) throw Error("internal error: the processes' values do not add up to the DAG's entries");
+    return whole;
 }
 
 // Tries the placements like encodeLayer (GridCodec.cpp) and keeps the smallest.
 encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const EncodeOptions& options, const CubeBudget& budget, bool withOffsets,
-                                        format::DagStats* stats, LayerPlan& keptPlan) {
+                                        format::DagStats* stats, LayerPlan& keptPlan, CubeTeam& team) {
     const LayerSummary summary = source.summary(layer);
     const int64_t alignment = int64_t(1) << std::max(2u, summary.largestTileLog2);
     const unsigned vs = valueSize(source.header().valueType);
@@ -164,7 +232,7 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
         dag::BuildOptions build;
         build.origin = origin;
         const LayerPlan plan = planLayer(source, layer, dag::placeRoot(boxOf(summary), alignment, build), budget, vs);
-        const dag::ReducedDag reduced = buildLayer(source, layer, plan, options.symmetry, budget);
+        const dag::ReducedDag reduced = buildLayer(source, layer, plan, options.symmetry, budget, team);
         encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
         if (first || compact.byteSize() < kept.byteSize()) {
             kept = std::move(compact);
@@ -177,7 +245,7 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
         if (!options.symmetry) {
             stats->svdagNodes = stats->storedNodes;
         } else {
-            const dag::ReducedDag plain = buildLayer(source, layer, keptPlan, false, budget);
+            const dag::ReducedDag plain = buildLayer(source, layer, keptPlan, false, budget, team);
             for (unsigned s = 2; s <= plain.log2Size; ++s) stats->svdagNodes.push_back(plain.uniqueNodeCount(s));
         }
         stats->hasSvdag = true;
@@ -189,7 +257,7 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
 
 uint64_t cubeBytesPerBrick(unsigned valueSize) { return 160 + 64ull * valueSize; }
 
-format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget) {
+format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget, CubeTeam& team) {
     if (options.normalBits) throw Error("--normals needs the whole grid in memory (the gradient reads across cubes): use it without --memory-limit");
     format::EncodedGrid out = encodedHeader(source.header(), options);
     const unsigned vs = valueSize(source.header().valueType);
@@ -198,30 +266,30 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     out.activeVoxels = active.voxels;
     step("reducing the DAG");
     LayerPlan plan;
-    if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan);
+    if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan, team);
     step("ordering values");
-    if (!active.empty()) out.attributes = gatherLayer(source, Layer::Active, plan, out.dag, vs, budget);
+    if (!active.empty()) out.attributes = gatherLayer(source, Layer::Active, plan, out.dag, vs, budget, team);
     step("palette compression");
-    if (!active.empty()) codeActiveValues(out, options);
+    if (!active.empty() && team.isRoot()) codeActiveValues(out, options);
     const LayerSummary inactive = source.summary(Layer::Inactive);
     out.inactiveVoxels = inactive.voxels;
     step("inactive values");
     if (!inactive.empty()) {
         LayerPlan inactivePlan;
-        out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, inactivePlan);
-        out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget);
-        codeInactiveValues(out, options);
+        out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, inactivePlan, team);
+        out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team);
+        if (team.isRoot()) codeInactiveValues(out, options);
     }
     return out;
 }
 
 format::SsvdagScene encodeSourcesByCubes(std::vector<std::unique_ptr<CubeSource>> grids, std::vector<uint8_t> fileMetadata,
-                                         const EncodeOptions& options, const CubeBudget& budget, const GridProgress& onGrid) {
+                                         const EncodeOptions& options, const CubeBudget& budget, const GridProgress& onGrid, CubeTeam& team) {
     format::SsvdagScene scene;
     scene.fileMetadata = std::move(fileMetadata);
     for (size_t g = 0; g < grids.size(); ++g) {
         if (onGrid) onGrid(g, grids.size());
-        scene.grids.push_back(encodeGridByCubes(*grids[g], options, budget));
+        scene.grids.push_back(encodeGridByCubes(*grids[g], options, budget, team));
         grids[g].reset();
         std::vector<uint8_t>().swap(scene.grids.back().attributes);
         std::vector<uint8_t>().swap(scene.grids.back().inactiveAttributes);

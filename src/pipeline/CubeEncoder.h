@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "src/pipeline/CubeTeam.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/volume/CubeSource.h"
 
@@ -29,11 +30,15 @@ uint64_t cubeBytesPerBrick(unsigned valueSize);
 
 // Throws vdbdag::Error for --normals (which needs the whole grid: the
 // gradient reads neighbours across cubes).
-format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget);
+// With a team of several processes (CubeTeam.h), every process must call
+// this with the same input and options; only process 0's result holds the
+// coded values (the others' are headers and DAGs).
+format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget, CubeTeam& team = soloTeam());
 
 // Whole files: the grids in order, each released (source and attribute
 // arrays) as soon as it is coded; `onGrid(index, count)` before each grid.
 format::SsvdagScene encodeSourcesByCubes(std::vector<std::unique_ptr<CubeSource>> grids, std::vector<uint8_t> fileMetadata,
-                                         const EncodeOptions& options, const CubeBudget& budget, const GridProgress& onGrid = {});
+                                         const EncodeOptions& options, const CubeBudget& budget, const GridProgress& onGrid = {},
+                                         CubeTeam& team = soloTeam());
 
 } // namespace vdbdag::pipeline

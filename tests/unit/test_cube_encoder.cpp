@@ -11,6 +11,7 @@
 
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/CubeEncoder.h"
+#include "src/pipeline/CubeTeam.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/selftest/SyntheticGrid.h"
 #include "src/util/Error.h"
@@ -130,4 +131,15 @@ TEST(CubeEncoder, RefusesNormals) {
     pipeline::EncodeOptions options;
     options.normalBits = 12;
     EXPECT_THROW(pipeline::encodeGridByCubes(*recordCubes(grid), options, {}), Error);
+}
+
+TEST(CubeTeam, SplitByWeightGivesContiguousBalancedShares) {
+    using pipeline::splitByWeight;
+    EXPECT_EQ(splitByWeight({1, 1, 1, 1}, 2), (std::vector<size_t>{0, 2, 4}));
+    EXPECT_EQ(splitByWeight({1, 1, 1, 1, 1, 1}, 3), (std::vector<size_t>{0, 2, 4, 6}));
+    EXPECT_EQ(splitByWeight({9, 1, 1, 1}, 2), (std::vector<size_t>{0, 1, 4}));  // the heavy item alone
+    EXPECT_EQ(splitByWeight({}, 3), (std::vector<size_t>{0, 0, 0, 0}));
+    EXPECT_EQ(splitByWeight({5}, 3).back(), 1u);
+    const auto one = splitByWeight({3, 4}, 1);
+    EXPECT_EQ(one, (std::vector<size_t>{0, 2}));
 }

@@ -175,3 +175,32 @@ TEST(VdbCubes, CliMemoryLimitAndThreadsDoNotChangeTheBytes) {
     EXPECT_NE(normals.exitCode, 0);
     EXPECT_NE(normals.err.find("--memory-limit"), std::string::npos) << normals.err;
 }
+
+// mpirun -np 2 and -np 3 of vdbdag-mpi: the same bytes as one process, on a
+// generated file and on a shared level set with tiles (bunny fog).
+TEST(VdbCubes, MpirunGivesTheSingleProcessBytes) {
+#if !defined(VDBDAG_MPI_BINARY)
+    GTEST_SKIP() << "vdbdag-mpi not built (no MPI found)";
+#else
+    std::vector<fs::path> inputs{writeAllTypes("mpi_input", openvdb::io::COMPRESS_BLOSC, false, 21)};
+    const fs::path fog = fs::path(VDBDAG_SHARED_DATA) / "levelsets" / "bunny_d512_fog.vdb";
+    if (fs::exists(fog)) inputs.push_back(fog);
+    for (const fs::path& in : inputs) {
+        SCOPED_TRACE(in.string());
+        const fs::path single = tempDir() / (in.stem().string() + "_single.ssvdag");
+        ASSERT_EQ(vdbdag::testing::runCli("encode " + in.string() + " -o " + single.string() + " -f").exitCode, 0);
+        for (int ranks : {2, 3}) {
+            const fs::path out = tempDir() / (in.stem().string() + "_np" + std::to_string(ranks) + ".ssvdag");
+            const std::string command = std::string(VDBDAG_MPIRUN) + " --oversubscribe --allow-run-as-root -np " + std::to_string(ranks) + " " +
+                                        VDBDAG_MPI_BINARY + " encode " + in.string() + " -o " + out.string() + " -f --memory-limit 8M";
+            const auto run = vdbdag::testing::runShell(command);
+            ASSERT_EQ(run.exitCode, 0) << command << "\n" << run.err;
+            EXPECT_EQ(vdbdag::testing::runShell("cmp " + single.string() + " " + out.string()).exitCode, 0) << ranks << " processes";
+        }
+    }
+    // A failing run (an output that is the input) ends every process with an error.
+    const auto bad = vdbdag::testing::runShell(std::string(VDBDAG_MPIRUN) + " --oversubscribe --allow-run-as-root -np 2 " + VDBDAG_MPI_BINARY +
+                                               " encode " + inputs[0].string() + " -o " + inputs[0].string() + " -f");
+    EXPECT_NE(bad.exitCode, 0);
+#endif
+}

@@ -1,0 +1,60 @@
+// The `vdbdag` command line as a function, for the plain binary (main.cpp)
+// and the MPI one (distributed/main.cpp). Errors are printed as one line
+// "vdbdag: <message>" with a non-zero exit.
+#include "cli/Cli.h"
+
+#include <cstdio>
+#include <cstring>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/Commands.h"
+#include "cli/RunContext.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::cli {
+
+int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
+    setCubeTeam(team);
+    // Under mpirun every process runs the command line; only `encode` is
+    // shared among them, anything else runs on process 0 alone.
+    if (!team.isRoot() && (argc < 2 || std::strcmp(argv[1], "encode") != 0)) return 0;
+    installFailureHandlers();
+    CLI::App app{"vdbdag: compress OpenVDB volumes into symmetry-aware sparse voxel DAGs (.ssvdag) and back"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "vdbdag 0.1.0");
+    int exitCode = 0;
+    addEncodeCommand(app, exitCode);
+    addDecodeCommand(app, exitCode);
+    addInfoCommand(app, exitCode);
+    addVerifyCommand(app, exitCode);
+    addRenderCommand(app, exitCode);
+    addBenchCommand(app, exitCode);
+    addDevicesCommand(app, exitCode);
+    addExportCommand(app, exitCode);
+    addDiffCommand(app, exitCode);
+    addSelftestCommand(app, exitCode);
+    addImportCommand(app, exitCode);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const Error& e) {
+        std::fprintf(stderr, "vdbdag: %s\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "vdbdag: %s\n", outOfMemoryMessage().c_str());
+        return 1;
+    } catch (const std::exception& e) {
+        // TBB reports a thread whose stack could not be mapped this way.
+        if (std::strstr(e.what(), "pthread_create has failed") != nullptr)
+            std::fprintf(stderr, "vdbdag: %s (no memory for a thread's stack)\n", outOfMemoryMessage().c_str());
+        else
+            std::fprintf(stderr, "vdbdag: %s\n", e.what());
+        return 1;
+    }
+    return exitCode;
+}
+
+} // namespace vdbdag::cli
