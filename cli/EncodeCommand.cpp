@@ -4,6 +4,8 @@
 // `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]`
 // Dense scans (.raw, .nrrd, .nhdr, .mhd, .mha, by extension) are read by
 // vdb_bridge/DenseImport.h instead, with the raw layout and threshold options.
+#include <unistd.h>
+
 #include <chrono>
 #include <optional>
 
@@ -28,6 +30,15 @@
 #include "vdb_bridge/VdbImport.h"
 
 namespace vdbdag::cli {
+namespace {
+
+// Without --memory-limit: half of the physical memory.
+uint64_t defaultMemoryLimit() {
+    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) / 2 : uint64_t(4) << 30;
+}
+
+} // namespace
 
 void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
@@ -66,8 +77,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                         ->check(CLI::IsMember({10u, 12u, 16u, 24u, 32u}));
     cmd->add_option("--normal-grid", opt->normalGrid, "take the normals from this vec3 grid (stored on its geometry) instead of a gradient")->needs(normals);
     cmd->add_option("--memory-limit", opt->memoryLimit,
-                    "encode cube by cube within about this much working memory, e.g. 512M or 4G (a .vdb is then read region by region); "
-                    "the output is the same bytes")
+                    "working memory for the cubes being encoded, e.g. 512M or 4G (default: half the physical memory); "
+                    "a .vdb is read region by region, a dense scan whole; the output is the same bytes")
         ->transform(CLI::AsSizeValue(false))
         ->excludes(normals);
     cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));
@@ -106,7 +117,10 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
                 throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
                                          "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
-            if ((opt->memoryLimit || cubeTeam().size() > 1) && bridge::canReadVdbByCubes(opt->input)) {
+            // A .vdb with grid offsets is read region by region and encoded
+            // cube by cube (the same bytes as in memory, less memory, both
+            // cores busy); --normals needs the whole grid.
+            if (!importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
                 cubeInput = bridge::openVdbCubes(opt->input, importOptions);
                 imported.warnings = cubeInput->warnings;
                 for (const auto& g : cubeInput->grids) imported.volume.grids.push_back(g->header());  // headers only, for the checks
@@ -147,9 +161,9 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         format::SsvdagScene scene;
         const auto onGrid = [&](size_t i, size_t) { gridName = gridNames[i]; };
         try {
-            if (opt->memoryLimit || team.size() > 1) {
+            if (cubeInput || opt->memoryLimit || team.size() > 1) {
                 pipeline::CubeBudget budget;
-                if (opt->memoryLimit) budget.bytes = std::max<uint64_t>(opt->memoryLimit / 2, 1);
+                budget.bytes = std::max<uint64_t>((opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()) / 2, 1);
                 std::vector<std::unique_ptr<CubeSource>> sources;
                 if (cubeInput) {
                     sources = std::move(cubeInput->grids);

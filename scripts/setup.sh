@@ -13,6 +13,7 @@ PACKAGES=(
   libtbb-dev libblosc-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils
   libzfp-dev fonts-dejavu-core
+  libopenmpi-dev openmpi-bin
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils zlib1g-dev
   libzfp-dev
 )

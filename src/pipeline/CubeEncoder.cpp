@@ -32,7 +32,10 @@ unsigned workersOf(const CubeBudget& budget) {
 
 // The largest cube size whose busiest cube fits a worker's share of the budget.
 LayerPlan planLayer(CubeSource& source, Layer layer, const dag::RootPlacement& placement, const CubeBudget& budget, unsigned valueSize) {
-    const uint64_t share = std::max<uint64_t>(1, budget.bytes / workersOf(budget));
+    // Small cubes even with memory to spare: they keep the cores busy and
+    // the working set in cache-friendly pieces; the merge costs little.
+    constexpr uint64_t kLargestCube = uint64_t(64) << 20;
+    const uint64_t share = std::clamp<uint64_t>(budget.bytes / workersOf(budget), 1, kLargestCube);
     const unsigned smallest = std::min(placement.log2Size, 3u);
     unsigned log2 = budget.cubeLog2 ? std::clamp(*budget.cubeLog2, smallest, placement.log2Size) : placement.log2Size;
     for (;;) {

@@ -4,6 +4,7 @@
 // they round-trip bit-exactly. Shared by the whole-file import (VdbImport)
 // and the cube-by-cube reader (VdbCubes).
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <type_traits>
@@ -36,30 +37,76 @@ inline openvdb::Coord brickCorner(const openvdb::Coord& leafOrigin, unsigned b) 
     return leafOrigin.offsetBy(int(b & 1u) * 4, int((b >> 1) & 1u) * 4, int((b >> 2) & 1u) * 4);
 }
 
+// Spreads the 4 bits of a z-row nibble to brick bits 0, 16, 32, 48.
+inline constexpr uint64_t spreadZ(unsigned nibble) {
+    return uint64_t(nibble & 1u) | (uint64_t((nibble >> 1) & 1u) << 16) | (uint64_t((nibble >> 2) & 1u) << 32) | (uint64_t((nibble >> 3) & 1u) << 48);
+}
+
+// Brick b's voxels among the leaf mask's: leaf voxel n = x << 6 | y << 3 | z
+// is bit (y << 3 | z) of word x, brick bit x + 4y + 16z (brick-relative).
+inline uint64_t brickOfLeafMask(const uint64_t words[8], unsigned b) {
+    const unsigned bx = (b & 1u) * 4, by = ((b >> 1) & 1u) * 4, bz = ((b >> 2) & 1u) * 4;
+    uint64_t mask = 0;
+    for (unsigned xi = 0; xi < 4; ++xi) {
+        const uint64_t word = words[bx + xi];
+        if (!word) continue;
+        for (unsigned yi = 0; yi < 4; ++yi) mask |= spreadZ(unsigned(word >> (((by + yi) << 3) | bz)) & 0xFu) << (xi + 4 * yi);
+    }
+    return mask;
+}
+
+// Leaf voxel index of brick b's bit `bit`.
+inline openvdb::Index leafIndexOf(unsigned b, unsigned bit) {
+    const unsigned x = (b & 1u) * 4 + (bit & 3u), y = ((b >> 1) & 1u) * 4 + ((bit >> 2) & 3u), z = ((b >> 2) & 1u) * 4 + (bit >> 4);
+    return openvdb::Index((x << 6) | (y << 3) | z);
+}
+
 // The mask of brick b of `leaf` in `layer`; with `values`, appends the
 // values of its set bits in increasing bit order. Layer::Inactive reads
 // the leaf's values (loading a delayed buffer); Layer::Active without
 // values reads the value mask only.
 template <typename LeafT, bool hasValues>
 uint64_t leafBrick(const LeafT& leaf, unsigned b, Layer layer, const typename LeafT::ValueType& background, std::vector<uint8_t>* values) {
+    using ValueT = typename LeafT::ValueType;
     if constexpr (!hasValues) {
         if (layer == Layer::Inactive) return 0;
     }
-    const int bx = int(b & 1u) * 4, by = int((b >> 1) & 1u) * 4, bz = int((b >> 2) & 1u) * 4;
+    uint64_t words[8];
+    for (unsigned w = 0; w < 8; ++w) words[w] = leaf.getValueMask().template getWord<uint64_t>(w);
+    const uint64_t active = brickOfLeafMask(words, b);
+    if (layer == Layer::Active) {
+        if constexpr (hasValues) {
+            if (values && active) {
+                if constexpr (std::is_same_v<ValueT, bool>) {
+                    for (uint64_t bits = active; bits; bits &= bits - 1) appendValue(*values, leaf.getValue(leafIndexOf(b, unsigned(std::countr_zero(bits)))));
+                } else {
+                    const ValueT* data = leaf.buffer().data();
+                    const size_t at = values->size();
+                    values->resize(at + size_t(std::popcount(active)) * sizeof(ValueT));
+                    uint8_t* out = values->data() + at;
+                    for (uint64_t bits = active; bits; bits &= bits - 1, out += sizeof(ValueT))
+                        std::memcpy(out, &data[leafIndexOf(b, unsigned(std::countr_zero(bits)))], sizeof(ValueT));
+                }
+            }
+        }
+        return active;
+    }
     uint64_t mask = 0;
-    for (int bit = 0; bit < 64; ++bit) {
-        const int x = bx + (bit & 3), y = by + ((bit >> 2) & 3), z = bz + (bit >> 4);
-        const openvdb::Index n = openvdb::Index((x << 6) | (y << 3) | z);
-        const bool on = leaf.isValueOn(n);
-        if (layer == Layer::Active) {
-            if (!on) continue;
-            mask |= uint64_t(1) << bit;
-            if constexpr (hasValues)
-                if (values) appendValue(*values, leaf.getValue(n));
-        } else if constexpr (hasValues) {
-            if (on || sameBits(leaf.getValue(n), background)) continue;
-            mask |= uint64_t(1) << bit;
-            if (values) appendValue(*values, leaf.getValue(n));
+    if constexpr (hasValues) {
+        auto visit = [&](auto valueAt) {
+            for (uint64_t bits = ~active; bits; bits &= bits - 1) {
+                const unsigned bit = unsigned(std::countr_zero(bits));
+                const ValueT value = valueAt(leafIndexOf(b, bit));
+                if (sameBits(value, background)) continue;
+                mask |= uint64_t(1) << bit;
+                if (values) appendValue(*values, value);
+            }
+        };
+        if constexpr (std::is_same_v<ValueT, bool>) {
+            visit([&](openvdb::Index n) { return leaf.getValue(n); });
+        } else {
+            const ValueT* data = leaf.buffer().data();
+            visit([&](openvdb::Index n) { return data[n]; });
         }
     }
     return mask;
