@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <optional>
 
 #include <tbb/global_control.h>
@@ -78,7 +79,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--normal-grid", opt->normalGrid, "take the normals from this vec3 grid (stored on its geometry) instead of a gradient")->needs(normals);
     cmd->add_option("--memory-limit", opt->memoryLimit,
                     "working memory for the cubes being encoded, e.g. 512M or 4G (default: half the physical memory); "
-                    "a .vdb is read region by region, a dense scan whole; the output is the same bytes")
+                    "a .vdb is read region by region (a dense scan is read whole); the output is the same bytes")
         ->transform(CLI::AsSizeValue(false))
         ->excludes(normals);
     cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));
@@ -117,10 +118,15 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
                 throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
                                          "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
-            // A .vdb with grid offsets is read region by region and encoded
-            // cube by cube (the same bytes as in memory, less memory, both
-            // cores busy); --normals needs the whole grid.
-            if (!importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
+            // Cube by cube (region by region from the file) with
+            // --memory-limit, under mpirun, or when the whole grid would not
+            // fit in memory (about 10x the file, against half the physical
+            // memory); otherwise whole, through OpenVDB's strictest reader.
+            // The same bytes either way; --normals needs the whole grid.
+            std::error_code sizeError;
+            const uintmax_t fileBytes = std::filesystem::file_size(opt->input, sizeError);
+            const bool large = !sizeError && fileBytes > defaultMemoryLimit() / 10;
+            if ((opt->memoryLimit || cubeTeam().size() > 1 || large) && !importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
                 cubeInput = bridge::openVdbCubes(opt->input, importOptions);
                 imported.warnings = cubeInput->warnings;
                 for (const auto& g : cubeInput->grids) imported.volume.grids.push_back(g->header());  // headers only, for the checks
@@ -149,11 +155,17 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         encodeOptions.colourBits = opt->colourBits;
         encodeOptions.colourGrids = opt->colourGrids;
         encodeOptions.normalBits = opt->normalBits;
-        Progress progress("encode", imported.volume.grids.size() * pipeline::kEncodeSteps + 1);
+        // Each step is 1000 units, filled cube by cube where the encoder reports it.
+        constexpr uint64_t kUnits = 1000;
+        Progress progress("encode", (imported.volume.grids.size() * pipeline::kEncodeSteps + 1) * kUnits);
         std::string gridName;
+        uint64_t stepsStarted = 0;
         encodeOptions.onStep = [&](const char* step) {
             progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
-            progress.advance();
+            progress.set(stepsStarted++ * kUnits);
+        };
+        encodeOptions.onStepProgress = [&](uint64_t done, uint64_t total) {
+            if (stepsStarted && total) progress.set((stepsStarted - 1) * kUnits + std::min<uint64_t>(kUnits, done * kUnits / total));
         };
         std::vector<std::string> gridNames;
         for (const auto& g : imported.volume.grids) gridNames.push_back(g.name);
@@ -161,14 +173,17 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         format::SsvdagScene scene;
         const auto onGrid = [&](size_t i, size_t) { gridName = gridNames[i]; };
         try {
-            if (cubeInput || opt->memoryLimit || team.size() > 1) {
+            // A dense scan or an OpenVDB stream is already whole in memory:
+            // encoding it in memory costs least (the same bytes), except
+            // under mpirun, where the processes share its cubes.
+            if (cubeInput || team.size() > 1) {
                 pipeline::CubeBudget budget;
                 budget.bytes = std::max<uint64_t>((opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()) / 2, 1);
                 std::vector<std::unique_ptr<CubeSource>> sources;
                 if (cubeInput) {
                     sources = std::move(cubeInput->grids);
                     imported.volume.fileMetadata = cubeInput->fileMetadata;
-                } else {  // a dense scan or an OpenVDB stream: in memory, encoded cube by cube
+                } else {
                     for (const GridRecord& g : imported.volume.grids) sources.push_back(recordCubes(g));
                 }
                 scene = pipeline::encodeSourcesByCubes(std::move(sources), imported.volume.fileMetadata, encodeOptions, budget, onGrid, team);

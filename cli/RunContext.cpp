@@ -12,6 +12,7 @@
 #include <new>
 
 #include <dlfcn.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include "src/util/TemporaryFiles.h"
@@ -21,6 +22,32 @@ namespace {
 
 char g_message[4096] = "vdbdag: out of memory\n";
 size_t g_length = std::strlen(g_message);
+char g_crash[4096] = "vdbdag: crashed (a library failed on this input, which may be corrupted); nothing was written\n";
+size_t g_crashLength = std::strlen(g_crash);
+std::atomic_flag g_ending = ATOMIC_FLAG_INIT;
+
+// A crash inside a library (OpenVDB's delayed loading segfaults or asserts
+// on some corrupted files) ends like any bad input: one line, exit 1, and
+// no temporary left. The first thread to crash speaks.
+void onCrash(int) {
+    if (g_ending.test_and_set()) for (;;) ::pause();
+    removeAllTemporaries();
+    [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, g_crash, g_crashLength);
+    ::_exit(1);
+}
+
+void installCrashHandlers() {
+    static char altStack[64 * 1024];  // a stack overflow still gets its line
+    stack_t ss{};
+    ss.ss_sp = altStack;
+    ss.ss_size = sizeof altStack;
+    ::sigaltstack(&ss, nullptr);
+    struct sigaction sa {};
+    sa.sa_handler = onCrash;
+    sa.sa_flags = SA_ONSTACK;
+    sigemptyset(&sa.sa_mask);
+    for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) ::sigaction(sig, &sa, nullptr);
+}
 
 [[noreturn]] void onOutOfMemory() { endOutOfMemory(); }
 
@@ -50,8 +77,7 @@ size_t g_length = std::strlen(g_message);
 void endOutOfMemory() {
     // Several threads may run out at once: the first one speaks and ends the
     // process, the others wait for that.
-    static std::atomic_flag ending = ATOMIC_FLAG_INIT;
-    if (ending.test_and_set()) for (;;) ::pause();
+    if (g_ending.test_and_set()) for (;;) ::pause();
     removeAllTemporaries();
     [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, g_message, g_length);
     ::_exit(1);
@@ -81,6 +107,22 @@ extern "C" int posix_memalign(void** out, size_t alignment, size_t size) {
     return result;
 }
 
+// A failed assert() inside a library (Debian builds OpenVDB with them on)
+// is a crash like the others, with its place in the message.
+extern "C" [[noreturn]] void __assert_fail(const char* assertion, const char* file, unsigned line, const char* function) noexcept {
+    (void)assertion;
+    (void)function;
+    char text[sizeof vdbdag::cli::g_crash + 256];
+    size_t n = vdbdag::cli::g_crashLength;
+    std::memcpy(text, vdbdag::cli::g_crash, n);
+    if (n > 0 && text[n - 1] == '\n') --n;
+    n += size_t(std::snprintf(text + n, sizeof text - n, " [internal check at %s:%u]\n", file, line));
+    if (vdbdag::cli::g_ending.test_and_set()) for (;;) ::pause();
+    vdbdag::removeAllTemporaries();
+    [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, text, std::min(n, sizeof text - 1));
+    ::_exit(1);
+}
+
 namespace vdbdag::cli {
 
 namespace {
@@ -96,6 +138,12 @@ void setActivity(const std::string& path, const std::string& activity) {
     std::memcpy(g_message, text.data(), n);
     g_message[n - 1] = '\n';
     g_length = n;
+    const std::string crash = "vdbdag: " + (path.empty() ? std::string() : path + ": ") + "crashed while " + activity +
+                              " (a library failed on this input, which may be corrupted); nothing was written\n";
+    const size_t m = std::min(crash.size(), sizeof g_crash - 1);
+    std::memcpy(g_crash, crash.data(), m);
+    g_crash[m - 1] = '\n';
+    g_crashLength = m;
 }
 
 std::string outOfMemoryMessage() { return std::string(g_message + 8, g_length > 9 ? g_length - 9 : 0); }
@@ -104,6 +152,7 @@ void installFailureHandlers() {
     std::set_new_handler(onOutOfMemory);
     std::set_terminate(onTerminate);
     installInterruptCleanup();
+    installCrashHandlers();
 }
 
 } // namespace vdbdag::cli

@@ -2,6 +2,7 @@
 #include "src/pipeline/CubeEncoder.h"
 
 #include <algorithm>
+#include <atomic>
 #include <functional>
 #include <optional>
 
@@ -59,8 +60,10 @@ std::array<int64_t, 3> cornerOf(const LayerPlan& plan, const CubeCell& cell) {
 
 // Sub-DAGs of cubes [begin, end) of the plan, built several at a time;
 // `onSub(index, sub)` runs in cube order.
+using StepProgress = std::function<void(uint64_t done, uint64_t total)>;
+
 void buildSubDags(CubeSource& source, const LayerPlan& plan, bool symmetry, const CubeBudget& budget, size_t begin, size_t end,
-                  const std::function<void(size_t, dag::ReducedDag&)>& onSub) {
+                  const std::function<void(size_t, dag::ReducedDag&)>& onSub, const StepProgress& progress) {
     struct Piece {
         size_t index;
         GridTopology topology;
@@ -89,13 +92,17 @@ void buildSubDags(CubeSource& source, const LayerPlan& plan, bool symmetry, cons
                                                                                  return piece;
                                                                              }) &
             tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::serial_in_order,
-                                                           [&](std::shared_ptr<Piece> piece) { onSub(piece->index, piece->sub); }));
+                                                           [&](std::shared_ptr<Piece> piece) {
+                                                               onSub(piece->index, piece->sub);
+                                                               if (progress) progress(piece->index + 1 - begin, end - begin);
+                                                           }));
 }
 
 // Builds the layer's DAG from its cubes (geometry only). With several
 // processes each builds the sub-DAGs of its share of the cubes and process
 // 0 merges them; every process gets the merged DAG.
-dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& plan, bool symmetry, const CubeBudget& budget, CubeTeam& team) {
+dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& plan, bool symmetry, const CubeBudget& budget, CubeTeam& team,
+                           const StepProgress& progress) {
     if (plan.cubeLog2 >= plan.placement.log2Size) {  // one cube: the whole layer, on process 0
         std::vector<uint8_t> bytes;
         if (team.isRoot()) {
@@ -130,7 +137,7 @@ dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& pla
     buildSubDags(source, plan, symmetry, budget, shares[team.rank()], shares[team.rank() + 1], [&](size_t index, dag::ReducedDag& sub) {
         if (team.size() == 1) addToMerger(index, sub);
         else dag::appendReducedDag(sub, mine);
-    });
+    }, progress);
     source.endPass();
     if (team.size() > 1) {
         const std::vector<std::vector<uint8_t>> all = team.gather(mine);
@@ -166,7 +173,7 @@ dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& pla
 // processes each gathers a contiguous share of the subtrees and process 0
 // receives them; elsewhere the result is empty.
 std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPlan& plan, const encoding::CompactDag& dag, unsigned vs,
-                                 const CubeBudget& budget, CubeTeam& team) {
+                                 const CubeBudget& budget, CubeTeam& team, const StepProgress& progress) {
     if (vs == 0 || dag.empty()) return {};
     const uint64_t entries = encoding::decodedSize(dag).attributeEntries;
     const unsigned cut = std::min<unsigned>(plan.cubeLog2, dag.log2Size);
@@ -190,6 +197,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         LayerValues values;
     };
     size_t next = begin;
+    std::atomic<uint64_t> gathered{0};
     tbb::parallel_pipeline(
         workersOf(budget),
         tbb::make_filter<void, std::shared_ptr<Piece>>(tbb::filter_mode::serial_in_order,
@@ -211,6 +219,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
                 const encoding::SubtreeInstance& s = subtrees[piece->index];
                 if (s.log2Size <= plan.cubeLog2) gatherSubtree(dag, s, piece->topology, piece->values, vs, attributes.data(), firstEntry);
                 else gatherSubtree(dag, s, largeTopology, largeValues, vs, attributes.data(), firstEntry);
+                if (progress) progress(++gathered, end - begin);
             }));
     source.endPass();
     if (team.size() == 1) return attributes;
@@ -235,7 +244,7 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
         dag::BuildOptions build;
         build.origin = origin;
         const LayerPlan plan = planLayer(source, layer, dag::placeRoot(boxOf(summary), alignment, build), budget, vs);
-        const dag::ReducedDag reduced = buildLayer(source, layer, plan, options.symmetry, budget, team);
+        const dag::ReducedDag reduced = buildLayer(source, layer, plan, options.symmetry, budget, team, options.onStepProgress);
         encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
         if (first || compact.byteSize() < kept.byteSize()) {
             kept = std::move(compact);
@@ -248,7 +257,7 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
         if (!options.symmetry) {
             stats->svdagNodes = stats->storedNodes;
         } else {
-            const dag::ReducedDag plain = buildLayer(source, layer, keptPlan, false, budget, team);
+            const dag::ReducedDag plain = buildLayer(source, layer, keptPlan, false, budget, team, options.onStepProgress);
             for (unsigned s = 2; s <= plain.log2Size; ++s) stats->svdagNodes.push_back(plain.uniqueNodeCount(s));
         }
         stats->hasSvdag = true;
@@ -271,7 +280,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     LayerPlan plan;
     if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan, team);
     step("ordering values");
-    if (!active.empty()) out.attributes = gatherLayer(source, Layer::Active, plan, out.dag, vs, budget, team);
+    if (!active.empty()) out.attributes = gatherLayer(source, Layer::Active, plan, out.dag, vs, budget, team, options.onStepProgress);
     step("palette compression");
     if (!active.empty() && team.isRoot()) codeActiveValues(out, options);
     const LayerSummary inactive = source.summary(Layer::Inactive);
@@ -280,7 +289,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     if (!inactive.empty()) {
         LayerPlan inactivePlan;
         out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, inactivePlan, team);
-        out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team);
+        out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team, options.onStepProgress);
         if (team.isRoot()) codeInactiveValues(out, options);
     }
     return out;

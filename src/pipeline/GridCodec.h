@@ -35,6 +35,8 @@ struct EncodeOptions {
     bool predictIntegers = true;
     // Called as each step of a grid starts (kEncodeSteps per grid), for progress.
     std::function<void(const char* step)> onStep;
+    // Within a step of the cube-by-cube encoder: cubes done of the pass's total.
+    std::function<void(uint64_t done, uint64_t total)> onStepProgress;
 };
 inline constexpr int kEncodeSteps = 4;
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <string>
 #include <unistd.h>
 
 namespace vdbdag {
@@ -17,13 +18,23 @@ int64_t nowNs() {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// "42s", "3m07s", "2h05m".
+std::string duration(double seconds) {
+    char text[32];
+    const long s = long(seconds + 0.5);
+    if (s < 60) std::snprintf(text, sizeof text, "%lds", s);
+    else if (s < 3600) std::snprintf(text, sizeof text, "%ldm%02lds", s / 60, s % 60);
+    else std::snprintf(text, sizeof text, "%ldh%02ldm", s / 3600, (s % 3600) / 60);
+    return text;
+}
+
 } // namespace
 
 void Progress::setQuiet(bool quiet) { gQuiet = quiet; }
 void setQuiet(bool quiet) { Progress::setQuiet(quiet); }
 
 Progress::Progress(std::string label, uint64_t total)
-    : label_(std::move(label)), total_(total), enabled_(!gQuiet && isatty(STDERR_FILENO) == 1) {}
+    : label_(std::move(label)), total_(total), startNs_(nowNs()), enabled_(!gQuiet && isatty(STDERR_FILENO) == 1) {}
 
 Progress::~Progress() {
     if (!enabled_) return;
@@ -72,7 +83,15 @@ void Progress::drawLocked(bool force) {
     const int filled = percent * kBarWidth / 100;
     for (int i = 0; i < kBarWidth; ++i) bar[i] = i < filled ? '#' : '.';
     bar[kBarWidth] = 0;
-    std::fprintf(stderr, "\r\033[K%s %3d%% [%s]", label_.c_str(), percent, bar);
+    // Elapsed time, and once a little is done, the time left at this pace.
+    const double elapsed = double(now - startNs_) * 1e-9;
+    std::string timing;
+    if (elapsed >= 1.0) {
+        timing = " " + duration(elapsed);
+        if (done > 0 && done < total_ && double(done) >= 0.02 * double(total_))
+            timing += ", about " + duration(elapsed * double(total_ - done) / double(done)) + " left";
+    }
+    std::fprintf(stderr, "\r\033[K%s %3d%% [%s]%s", label_.c_str(), percent, bar, timing.c_str());
     std::fflush(stderr);
     drawn_ = true;
 }

@@ -1,5 +1,5 @@
 // A one-line progress display on stderr ("encode: building levels  42%
-// [########............]"), drawn only when stderr is a terminal and silent
+// [########............] 12s, about 16s left"), drawn only when stderr is a terminal and silent
 // when it is piped or redirected (or after setQuiet(true)); at most ~10
 // redraws per second; advance() and set() are thread-safe and cost one atomic
 // add plus a clock read when nothing is drawn.
@@ -31,6 +31,7 @@ private:
     void drawLocked(bool force);
     std::string label_;
     const uint64_t total_;
+    const int64_t startNs_;
     std::atomic<uint64_t> done_{0};
     std::atomic<int64_t> nextDrawNs_{0};
     const bool enabled_;
