@@ -48,6 +48,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         bool force = false, noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
         int placementTrials = 1;
         uint64_t memoryLimit = 0;
+        std::string scratch;
         unsigned threads = 0;
         double absError = 0, relError = 0;
         unsigned colourBits = 0, normalBits = 0;
@@ -82,6 +83,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                     "a .vdb is read region by region (a dense scan is read whole); the output is the same bytes")
         ->transform(CLI::AsSizeValue(false))
         ->excludes(normals);
+    cmd->add_option("--scratch", opt->scratch, "folder for the scratch file of a region-by-region read (default: the output's folder)")
+        ->check(CLI::ExistingDirectory);
     cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
@@ -127,7 +130,9 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             const uintmax_t fileBytes = std::filesystem::file_size(opt->input, sizeError);
             const bool large = !sizeError && fileBytes > defaultMemoryLimit() / 10;
             if ((opt->memoryLimit || cubeTeam().size() > 1 || large) && !importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
-                cubeInput = bridge::openVdbCubes(opt->input, importOptions);
+                const std::string scratchNear =
+                    opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
+                cubeInput = bridge::openVdbCubes(opt->input, importOptions, scratchNear);
                 imported.warnings = cubeInput->warnings;
                 for (const auto& g : cubeInput->grids) imported.volume.grids.push_back(g->header());  // headers only, for the checks
             } else {

@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <tuple>
@@ -19,6 +21,7 @@
 
 #include "src/util/Error.h"
 #include "src/util/MappedPages.h"
+#include "src/util/ScratchFile.h"
 #include "vdb_bridge/detail/LeafBricks.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/VdbFile.h"
@@ -52,8 +55,8 @@ class VdbGridCubes final : public CubeSource {
     using ValueT = typename GridT::ValueType;
 
 public:
-    VdbGridCubes(std::string path, std::string uniqueName, GridRecord header, typename GridT::Ptr grid)
-        : path_(std::move(path)), uniqueName_(std::move(uniqueName)), header_(std::move(header)) {
+    VdbGridCubes(std::string path, std::string uniqueName, GridRecord header, typename GridT::Ptr grid, std::shared_ptr<ScratchFile> scratch)
+        : path_(std::move(path)), uniqueName_(std::move(uniqueName)), header_(std::move(header)), scratch_(std::move(scratch)) {
         summarise(*grid);
         grid.reset();
         releaseFreedMemory();
@@ -93,16 +96,8 @@ public:
     void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {
         layer_ = layer;
         withValues_ = withValues && hasValues;
-        grid_ = openvdb::gridPtrCast<GridT>(detail::readGridDelayed(path_, uniqueName_));
-        if (!grid_) throw Error(path_ + ": grid '" + header_.name + "' changed type while being read");
-        mapped_ = MappedPages(path_);
-        leafPtrs_.clear();
-        for (auto it = grid_->tree().beginLeaf(); it; ++it) leafPtrs_.push_back(it.getLeaf());
-        if (leafPtrs_.size() != leaves_.size()) throw Error(path_ + ": the file changed while being read");
-        remaining_.assign(leaves_.size(), 0);
         index_.clear();
         for (size_t i = 0; i < leaves_.size(); ++i) {
-            if (leafPtrs_[i]->origin() != leaves_[i].origin) throw Error(path_ + ": the file changed while being read");
             std::map<CubeCell, uint8_t, CellLess> cells;
             for (uint8_t bits = leaves_[i].occupancy[int(layer)]; bits; bits &= uint8_t(bits - 1)) {
                 const unsigned b = unsigned(std::countr_zero(bits));
@@ -110,7 +105,6 @@ public:
                 cells[cellOf(origin, log2, c.x(), c.y(), c.z())] |= uint8_t(1u << b);
             }
             for (const auto& [cell, bricks] : cells) index_[cell].leaves.push_back({i, bricks});
-            remaining_[i] = uint8_t(cells.size());
         }
         const GridTopology& tiles = tiles_[int(layer)];
         for (size_t t = 0; t < tiles.tiles.size(); ++t)
@@ -122,23 +116,36 @@ public:
         values = {};
         const auto it = index_.find(cell);
         if (it == index_.end()) return;
-        const ValueT background = grid_->tree().background();
-        std::vector<uint8_t>* out = withValues_ ? &values.bricks : nullptr;
+        const unsigned vs = withValues_ ? valueSize(header_.valueType) : 0;
+        std::vector<uint8_t> record;
         for (const auto& [leafIndex, bricks] : it->second.leaves) {
-            const LeafT& leaf = *leafPtrs_[leafIndex];
-            for (uint8_t bits = bricks; bits; bits &= uint8_t(bits - 1)) {
-                const unsigned b = unsigned(std::countr_zero(bits));
-                const uint64_t mask = detail::leafBrick<LeafT, hasValues>(leaf, b, layer_, background, out);
-                if (!mask) throw Error(path_ + ": the file changed while being read");
-                const openvdb::Coord c = detail::brickCorner(leaf.origin(), b);
-                topology.bricks.push_back({c.x(), c.y(), c.z(), mask});
+            const LeafInfo& leaf = leaves_[leafIndex];
+            scratch_->read(leaf.recordOffset, leaf.recordSize, record);
+            // Record: the masks of the occupied active bricks, then of the
+            // inactive ones (brick order), then the active values, then the
+            // inactive values (LeafBricks.h order).
+            const uint8_t occupancy[2] = {leaf.occupancy[0], leaf.occupancy[1]};
+            const unsigned l = unsigned(layer_);
+            const size_t maskBase = l == 0 ? 0 : size_t(std::popcount(occupancy[0]));
+            const uint64_t* masks = reinterpret_cast<const uint64_t*>(record.data());
+            size_t valueCursor = size_t(std::popcount(occupancy[0]) + std::popcount(occupancy[1])) * 8;
+            if (l == 1)
+                for (int k = 0; k < std::popcount(occupancy[0]); ++k) valueCursor += size_t(std::popcount(mask(masks, size_t(k)))) * valueSize(header_.valueType);
+            unsigned rank = 0;
+            for (unsigned b = 0; b < 8; ++b) {
+                if (!((occupancy[l] >> b) & 1u)) continue;
+                const uint64_t m = mask(masks, maskBase + rank++);
+                const size_t n = size_t(std::popcount(m)) * valueSize(header_.valueType);
+                if ((bricks >> b) & 1u) {
+                    const openvdb::Coord c = detail::brickCorner(leaf.origin, b);
+                    topology.bricks.push_back({c.x(), c.y(), c.z(), m});
+                    if (vs) values.bricks.insert(values.bricks.end(), record.begin() + long(valueCursor), record.begin() + long(valueCursor + n));
+                }
+                valueCursor += n;
             }
-            if (--remaining_[leafIndex] == 0) dropLeaf(leafIndex, background);
         }
-        if (withValues_ || layer_ == Layer::Inactive) mapped_.release();  // the file pages this cube's buffers were read from
         const GridTopology& tiles = tiles_[int(layer_)];
         const LayerValues& tileValues = tileValues_[int(layer_)];
-        const unsigned vs = withValues_ ? valueSize(header_.valueType) : 0;
         for (size_t t : it->second.tiles) {
             topology.tiles.push_back(tiles.tiles[t]);
             if (vs) values.tiles.insert(values.tiles.end(), tileValues.tiles.begin() + long(t * vs), tileValues.tiles.begin() + long((t + 1) * vs));
@@ -148,10 +155,6 @@ public:
 
     void endPass() override {
         index_.clear();
-        leafPtrs_.clear();
-        remaining_.clear();
-        grid_.reset();
-        mapped_ = {};
         releaseFreedMemory();
     }
 
@@ -159,18 +162,18 @@ private:
     struct LeafInfo {
         openvdb::Coord origin;
         uint8_t occupancy[2];  // per layer: bit b = brick b holds voxels
+        uint32_t recordSize;   // the leaf's bricks in the scratch file
+        uint64_t recordOffset;
     };
+    static uint64_t mask(const uint64_t* masks, size_t k) {
+        uint64_t m;
+        std::memcpy(&m, masks + k, sizeof m);
+        return m;
+    }
     struct CubeIndex {
         std::vector<std::pair<size_t, uint8_t>> leaves;  // (leaf, its bricks in this cube)
         std::vector<size_t> tiles;
     };
-
-    // Replaces a leaf that no cube of the pass needs any more by an inactive
-    // tile, freeing its buffer (OpenVDB has no way to unload one).
-    void dropLeaf(size_t leafIndex, const ValueT& background) {
-        grid_->tree().addTile(1, leaves_[leafIndex].origin, background, false);
-        leafPtrs_[leafIndex] = nullptr;
-    }
 
     void summarise(GridT& grid) {
         TreeT& tree = grid.tree();
@@ -201,6 +204,10 @@ private:
         leaves_.resize(leaves.size());
         std::vector<uint64_t> inactiveVoxels(leaves.size(), 0);
         const MappedPages mapped(path_);
+        // Chunk by chunk: each leaf's bricks of both layers, with values,
+        // into the scratch file; then the chunk's leaves (and the file pages
+        // their buffers were read from) are dropped.
+        std::vector<std::vector<uint8_t>> records(std::min(leaves.size(), kLeafChunk));
         for (size_t begin = 0; begin < leaves.size(); begin += kLeafChunk) {
             const size_t end = std::min(leaves.size(), begin + kLeafChunk);
             tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 64), [&](const auto& r) {
@@ -208,20 +215,32 @@ private:
                     LeafInfo& info = leaves_[i];
                     info.origin = leaves[i]->origin();
                     info.occupancy[0] = info.occupancy[1] = 0;
-                    for (unsigned b = 0; b < 8; ++b) {
-                        if (detail::leafBrick<LeafT, hasValues>(*leaves[i], b, Layer::Active, background, nullptr)) info.occupancy[0] |= uint8_t(1u << b);
-                        if constexpr (hasValues) {
-                            const uint64_t inactive = detail::leafBrick<LeafT, hasValues>(*leaves[i], b, Layer::Inactive, background, nullptr);
-                            if (inactive) info.occupancy[1] |= uint8_t(1u << b);
-                            inactiveVoxels[i] += uint64_t(std::popcount(inactive));
+                    std::vector<uint8_t>& record = records[i - begin];
+                    record.clear();
+                    uint64_t masks[2][8];
+                    std::vector<uint8_t> valuesOf[2];
+                    int count[2] = {0, 0};
+                    for (unsigned b = 0; b < 8; ++b)
+                        for (unsigned l = 0; l < 2; ++l) {
+                            const uint64_t m = detail::leafBrick<LeafT, hasValues>(*leaves[i], b, Layer(l), background, &valuesOf[l]);
+                            if (!m) continue;
+                            info.occupancy[l] |= uint8_t(1u << b);
+                            masks[l][count[l]++] = m;
+                            if (l == 1) inactiveVoxels[i] += uint64_t(std::popcount(m));
                         }
+                    for (unsigned l = 0; l < 2; ++l) {
+                        const auto* p = reinterpret_cast<const uint8_t*>(masks[l]);
+                        record.insert(record.end(), p, p + size_t(count[l]) * sizeof(uint64_t));
                     }
+                    for (unsigned l = 0; l < 2; ++l) record.insert(record.end(), valuesOf[l].begin(), valuesOf[l].end());
                 }
             });
-            if constexpr (hasValues) {  // drop the loaded buffers and the file pages they were read from
-                for (size_t i = begin; i < end; ++i) tree.addTile(1, leaves_[i].origin, background, false);
-                mapped.release();
+            for (size_t i = begin; i < end; ++i) {
+                leaves_[i].recordSize = uint32_t(records[i - begin].size());
+                leaves_[i].recordOffset = scratch_->append(records[i - begin].data(), records[i - begin].size());
+                if constexpr (hasValues) tree.addTile(1, leaves_[i].origin, background, false);
             }
+            if constexpr (hasValues) mapped.release();
         }
         for (int l = 0; l < 2; ++l) {
             LayerSummary& s = summary_[l];
@@ -256,14 +275,11 @@ private:
     GridTopology tiles_[2];
     LayerValues tileValues_[2];
     LayerSummary summary_[2];
+    std::shared_ptr<ScratchFile> scratch_;  // shared by the file's grids
     // The current pass.
-    typename GridT::Ptr grid_;
     Layer layer_ = Layer::Active;
     bool withValues_ = false;
-    std::vector<LeafT*> leafPtrs_;
-    std::vector<uint8_t> remaining_;
     std::map<CubeCell, CubeIndex, CellLess> index_;
-    MappedPages mapped_;
 };
 
 } // namespace
@@ -276,9 +292,11 @@ bool canReadVdbByCubes(const std::string& path) {
     }
 }
 
-VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options) {
+VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options, const std::string& scratchNear) {
     if (options.normals) throw Error(path + ": --normals needs the whole grid in memory; use it without --memory-limit");
     const detail::VdbFileIndex index = detail::indexVdbFile(path);
+    const std::string near = scratchNear.empty() ? (std::filesystem::temp_directory_path() / "vdbdag").string() : scratchNear;
+    std::shared_ptr<ScratchFile> scratch;  // created with the first grid
     VdbCubeInput input;
     input.fileMetadata = detail::serializeMetadata(*index.metadata);
     std::vector<std::string> found;
@@ -294,17 +312,18 @@ VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options)
         header.indexToWorld = detail::indexToWorldOf(*base);
         header.vdbDescriptor = detail::descriptorOf(*base);
         const bool supported = detail::dispatchGridType(*base, [&](const auto& typed, ValueType type) {
+            if (!scratch) scratch = std::make_shared<ScratchFile>(near);
             using GridT = std::decay_t<decltype(typed)>;
             constexpr bool typeHasValues = !std::is_same_v<typename GridT::TreeType::LeafNodeType::BuildType, openvdb::ValueMask>;
             typename GridT::Ptr grid = openvdb::gridPtrCast<GridT>(base);
             base.reset();
             if (options.topologyOnly || !typeHasValues) {
                 header.valueType = ValueType::Mask;
-                input.grids.push_back(std::make_unique<VdbGridCubes<GridT, false>>(path, index.uniqueNames[i], std::move(header), std::move(grid)));
+                input.grids.push_back(std::make_unique<VdbGridCubes<GridT, false>>(path, index.uniqueNames[i], std::move(header), std::move(grid), scratch));
             } else {
                 header.valueType = type;
                 detail::appendValue(header.background, grid->tree().background());
-                input.grids.push_back(std::make_unique<VdbGridCubes<GridT, typeHasValues>>(path, index.uniqueNames[i], std::move(header), std::move(grid)));
+                input.grids.push_back(std::make_unique<VdbGridCubes<GridT, typeHasValues>>(path, index.uniqueNames[i], std::move(header), std::move(grid), scratch));
             }
         });
         if (!supported) {

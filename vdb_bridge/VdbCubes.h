@@ -1,8 +1,9 @@
-// The grids of a .vdb file as CubeSources (src/volume/CubeSource.h): read
-// region by region through OpenVDB's delayed loading, so the out-of-core
-// encoder never holds a whole grid. Each pass opens the file afresh (a
-// delayed-loading grid keeps every leaf it has loaded), and every leaf is
-// dropped from the tree as soon as the last cube that needs it is read.
+// The grids of a .vdb file as CubeSources (src/volume/CubeSource.h), so the
+// out-of-core encoder never holds a whole grid. One pass through OpenVDB's
+// delayed loading, a chunk of leaves at a time (each chunk dropped once
+// read), writes every leaf's bricks of both layers to a scratch file
+// (ScratchFile.h); the encoder's passes then read each cube's bricks back
+// from there, with no OpenVDB and no decompression.
 // A file without grid offsets (an OpenVDB stream) cannot be loaded lazily:
 // openVdbCubes refuses it and callers read it whole (importVdb).
 #pragma once
@@ -25,8 +26,10 @@ struct VdbCubeInput {
 bool canReadVdbByCubes(const std::string& path);
 
 // The file is checked like importVdb (layout, voxel counts, bounding
-// boxes) and each grid is summarised (one pass over its leaves) before
-// this returns. `options.normals` is not supported (Error).
-VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options = {});
+// boxes) and each grid is read once into the scratch file, created beside
+// `scratchNear` (a path in the folder to use; default: the system's
+// temporary folder), before this returns. The scratch
+// files go with the sources. `options.normals` is not supported (Error).
+VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options = {}, const std::string& scratchNear = "");
 
 } // namespace vdbdag::bridge
