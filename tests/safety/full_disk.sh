@@ -51,22 +51,25 @@ for f in small.vdb big.vdb small.nhdr big.nhdr small.ssvdag big.ssvdag; do
     fi
 done
 
-# command | output extension | small input | big input
+# command | output extension | small input | big input [| options]
+# (encode --memory-limit also writes its scratch file beside the output)
 CASES=(
     "decode|vdb|small.ssvdag|big.ssvdag"
     "import|vdb|small.nhdr|big.nhdr"
     "encode|ssvdag|small.vdb|big.vdb"
+    "encode|ssvdag|small.vdb|big.vdb|--memory-limit 1M"
     "export|vtu|small.vdb|big.vdb"
 )
 
 for c in "${CASES[@]}"; do
-    IFS='|' read -r cmd ext small big <<< "$c"
-    name="full disk: $cmd -> .$ext"
+    IFS='|' read -r cmd ext small big options <<< "$c"
+    name="full disk: $cmd${options:+ $options} -> .$ext"
     force=$(force_flag "$cmd")
     rm -rf "${REF:?}"/*
     # Undisturbed runs elsewhere: the sizes of the previous and the new output.
-    if ! "$VDBDAG" "$cmd" "$IN/$small" -o "$REF/prev.$ext" > /dev/null 2> "$WORK/err" ||
-        ! "$VDBDAG" "$cmd" "$IN/$big" -o "$REF/new.$ext" > /dev/null 2> "$WORK/err"; then
+    # shellcheck disable=SC2086  # options split into words on purpose
+    if ! "$VDBDAG" "$cmd" "$IN/$small" -o "$REF/prev.$ext" $options > /dev/null 2> "$WORK/err" ||
+        ! "$VDBDAG" "$cmd" "$IN/$big" -o "$REF/new.$ext" $options > /dev/null 2> "$WORK/err"; then
         fail "$name" "an undisturbed run failed: $(flat "$WORK/err")"
         continue
     fi
@@ -96,7 +99,8 @@ for c in "${CASES[@]}"; do
     fi
     before=$(listing "$MNT")
     prevSha=$(sha "$MNT/out.$ext")
-    timeout -k 5 300 "$VDBDAG" "$cmd" "$IN/$big" -o "$MNT/out.$ext" $force > "$WORK/out" 2> "$WORK/err"
+    # shellcheck disable=SC2086
+    timeout -k 5 300 "$VDBDAG" "$cmd" "$IN/$big" -o "$MNT/out.$ext" $force $options > "$WORK/out" 2> "$WORK/err"
     rc=$?
     after=$(listing "$MNT")
     why=""

@@ -34,6 +34,7 @@ using vdbdag::testing::runCli;
 inline fs::path workDir() {
     static const fs::path dir = [] {
         fs::path d = fs::temp_directory_path() / ("vdbdag_vtk_" + std::to_string(getpid()));
+        fs::remove_all(d);  // a finished process with the same PID may have left it
         fs::create_directories(d);
         return d;
     }();

@@ -49,6 +49,7 @@ TEST(Bench, PsnrAndSsimOfKnownImages) {
 TEST(Bench, CommandWritesTheReportAndHoldsItsBounds) {
     openvdb::initialize();
     const fs::path dir = fs::temp_directory_path() / ("vdbdag_bench_test_" + std::to_string(::getpid()));
+    fs::remove_all(dir);  // a finished process with the same PID may have left it
     fs::create_directories(dir);
     const fs::path input = dir / "sphere.vdb";
     {
@@ -113,6 +114,7 @@ TEST(Bench, ColourGridGetsColourRowsWithinTheirPaletteSize) {
     // 12-bit row keeps at most 4096 colours, with a positive ΔE94.
     openvdb::initialize();
     const fs::path dir = fs::temp_directory_path() / ("vdbdag_bench_colour_" + std::to_string(::getpid()));
+    fs::remove_all(dir);  // a finished process with the same PID may have left it
     fs::create_directories(dir);
     const fs::path input = dir / "cd.vdb";
     {

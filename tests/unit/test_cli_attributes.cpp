@@ -42,6 +42,7 @@ fs::path inputFile(const fs::path& dir) {
 
 TEST(CliAttributes, ColourAndNormalReportsInEncodeAndInfo) {
     const fs::path dir = fs::temp_directory_path() / ("vdbdag_cliattr_" + std::to_string(getpid()));
+    fs::remove_all(dir);  // a finished process with the same PID may have left it
     fs::create_directories(dir);
     const fs::path in = inputFile(dir), out = dir / "scene.ssvdag";
     CliRun r = run("encode " + in.string() + " -o " + out.string() + " --color-bits 10 --normals 16 --json");

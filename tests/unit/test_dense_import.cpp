@@ -38,6 +38,7 @@ using vdbdag::testing::runCli;
 fs::path workDir() {
     static const fs::path dir = [] {
         fs::path d = fs::temp_directory_path() / ("vdbdag_dense_" + std::to_string(getpid()));
+        fs::remove_all(d);  // a finished process with the same PID may have left it
         fs::create_directories(d);
         return d;
     }();

@@ -31,6 +31,7 @@ const openvdb::Vec3f kCentre(1.3f, -0.7f, 2.1f);
 fs::path tempDir() {
     static const fs::path dir = [] {
         fs::path d = fs::temp_directory_path() / ("vdbdag_normals_" + std::to_string(getpid()));
+        fs::remove_all(d);  // a finished process with the same PID may have left it
         fs::create_directories(d);
         return d;
     }();

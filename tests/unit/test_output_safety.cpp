@@ -30,6 +30,7 @@ struct TempFolder {
     fs::path path;
     TempFolder() {
         path = fs::temp_directory_path() / ("vdbdag_output_safety_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
+        fs::remove_all(path);  // a finished process with the same PID may have left it
         fs::create_directories(path);
     }
     ~TempFolder() {

@@ -88,6 +88,7 @@ TEST(ScalarTolerance, RelativeBoundHoldsFrom1e30Down) {
 TEST(ScalarTolerance, EndToEndEveryDecodedValueWithinTheBound) {
     openvdb::initialize();
     const fs::path dir = fs::temp_directory_path() / ("vdbdag_tol_" + std::to_string(getpid()));
+    fs::remove_all(dir);  // a finished process with the same PID may have left it
     fs::create_directories(dir);
     auto g = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(30.0f, openvdb::Vec3f(0.3f), 0.1f, 3.0f);
     g->setName("ls");

@@ -31,6 +31,7 @@ namespace {
 fs::path tempDir() {
     static const fs::path dir = [] {
         fs::path d = fs::temp_directory_path() / ("vdbdag_cubes_" + std::to_string(getpid()));
+        fs::remove_all(d);  // a finished process with the same PID may have left it
         fs::create_directories(d);
         return d;
     }();

@@ -91,7 +91,8 @@ TEST(VtkStructure, LevelsAreTheOctreeCellsWithConsistentRefcountsAndMirrors) {
     auto grid = structureGrid();
     const fs::path in = workDir() / "shape.vdb", enc = workDir() / "shape.ssvdag", out = workDir() / "shape_structure.vtm";
     writeGrids(in, {grid});
-    ASSERT_EQ(runCli("encode " + in.string() + " -o " + enc.string()).exitCode, 0);
+    const auto encoded = runCli("encode " + in.string() + " -o " + enc.string());
+    ASSERT_EQ(encoded.exitCode, 0) << encoded.err;
     auto r = runCli("export " + enc.string() + " --structure -o " + out.string());
     ASSERT_EQ(r.exitCode, 0) << r.err;
     auto blocks = readVtm(out);

@@ -343,6 +343,7 @@ TEST(VulkanTracer, AdversarialRaysRootsSpanning2To32AndTheUnitCubeAgreeWithTheEx
 TEST(VulkanTracer, AgreesWithTheCpuTracerOnTheGeneratedSamples) {
     VULKAN_OR_SKIP();
     const fs::path dir = fs::temp_directory_path() / ("vdbdag_vk_samples_" + std::to_string(::getpid()));
+    fs::remove_all(dir);  // a finished process with the same PID may have left it
     fs::create_directories(dir);
     ASSERT_EQ(std::system((std::string(VDBDAG_SAMPLES_TOOL) + " " + dir.string() + " > /dev/null").c_str()), 0);
     size_t total = 0, grids = 0, hits = 0, distinct = 0;
