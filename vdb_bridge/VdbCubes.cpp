@@ -81,16 +81,7 @@ public:
     }
 
     void largeTiles(Layer layer, unsigned log2, GridTopology& tiles, LayerValues& values) override {
-        tiles = {};
-        values = {};
-        const GridTopology& all = tiles_[int(layer)];
-        const LayerValues& v = tileValues_[int(layer)];
-        const unsigned vs = valueSize(header_.valueType);
-        for (size_t i = 0; i < all.tiles.size(); ++i) {
-            if (all.tiles[i].log2Size <= log2) continue;
-            tiles.tiles.push_back(all.tiles[i]);
-            if (vs) values.tiles.insert(values.tiles.end(), v.tiles.begin() + long(i * vs), v.tiles.begin() + long((i + 1) * vs));
-        }
+        selectLargeTiles(tiles_[int(layer)], tileValues_[int(layer)], valueSize(header_.valueType), log2, tiles, values);
     }
 
     void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {
@@ -244,20 +235,14 @@ private:
         }
         for (int l = 0; l < 2; ++l) {
             LayerSummary& s = summary_[l];
-            s.min.fill(std::numeric_limits<int64_t>::max());
-            s.max.fill(std::numeric_limits<int64_t>::min());
-            auto extend = [&](int64_t x, int64_t y, int64_t z, int64_t size) {
-                const int64_t c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a) { s.min[a] = std::min(s.min[a], c[a]); s.max[a] = std::max(s.max[a], c[a] + size - 1); }
-            };
             for (const LeafInfo& leaf : leaves_)
                 for (uint8_t bits = leaf.occupancy[l]; bits; bits &= uint8_t(bits - 1)) {
                     const openvdb::Coord c = detail::brickCorner(leaf.origin, unsigned(std::countr_zero(bits)));
-                    extend(c.x(), c.y(), c.z(), 4);
+                    s.extend(c.x(), c.y(), c.z(), 4);
                     ++s.bricks;
                 }
             for (const Tile& t : tiles_[l].tiles) {
-                extend(t.x, t.y, t.z, int64_t(1) << t.log2Size);
+                s.extend(t.x, t.y, t.z, int64_t(1) << t.log2Size);
                 s.largestTileLog2 = std::max<unsigned>(s.largestTileLog2, t.log2Size);
             }
             s.tiles = tiles_[l].tiles.size();

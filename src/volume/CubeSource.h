@@ -24,9 +24,18 @@ struct LayerSummary {
     uint64_t voxels = 0;  // tiles counted as their voxels (saturating)
     uint64_t bricks = 0;  // 4^3 bricks
     uint64_t tiles = 0;
-    std::array<int64_t, 3> min{0, 0, 0}, max{0, 0, 0};  // inclusive box; meaningless when empty()
+    // Inclusive box (meaningless when empty()); extend() grows it.
+    std::array<int64_t, 3> min{INT64_MAX, INT64_MAX, INT64_MAX}, max{INT64_MIN, INT64_MIN, INT64_MIN};
     unsigned largestTileLog2 = 2;                     // 2: no tiles
     bool empty() const { return bricks == 0 && tiles == 0; }
+    // The cube [x, x + size)^3 is in the layer.
+    void extend(int64_t x, int64_t y, int64_t z, int64_t size) {
+        const int64_t c[3] = {x, y, z};
+        for (int a = 0; a < 3; ++a) {
+            if (c[a] < min[a]) min[a] = c[a];
+            if (c[a] + size - 1 > max[a]) max[a] = c[a] + size - 1;
+        }
+    }
 };
 
 // One cube of a layer, in units of the cube size from the origin.
@@ -58,6 +67,11 @@ public:
     virtual void read(const CubeCell& cell, GridTopology& topology, LayerValues& values) = 0;
     virtual void endPass() = 0;
 };
+
+// For implementations: the tiles of `all` larger than 2^log2, with their
+// values (`valueSize` bytes each in `values`; none when 0).
+void selectLargeTiles(const GridTopology& all, const LayerValues& values, unsigned valueSize, unsigned log2, GridTopology& tiles,
+                      LayerValues& tileValues);
 
 // A CubeSource over a grid in memory (for dense scans, tests and the
 // in-core path). Keeps a reference: `grid` must outlive it.

@@ -34,15 +34,9 @@ public:
         s.bricks = t.bricks.size();
         s.tiles = t.tiles.size();
         s.voxels = t.activeVoxelCount();
-        s.min.fill(std::numeric_limits<int64_t>::max());
-        s.max.fill(std::numeric_limits<int64_t>::min());
-        auto extend = [&](int64_t x, int64_t y, int64_t z, int64_t size) {
-            const int64_t c[3] = {x, y, z};
-            for (int a = 0; a < 3; ++a) { s.min[a] = std::min(s.min[a], c[a]); s.max[a] = std::max(s.max[a], c[a] + size - 1); }
-        };
-        for (const Brick& b : t.bricks) extend(b.x, b.y, b.z, 4);
+        for (const Brick& b : t.bricks) s.extend(b.x, b.y, b.z, 4);
         for (const Tile& tile : t.tiles) {
-            extend(tile.x, tile.y, tile.z, int64_t(1) << tile.log2Size);
+            s.extend(tile.x, tile.y, tile.z, int64_t(1) << tile.log2Size);
             s.largestTileLog2 = std::max<unsigned>(s.largestTileLog2, tile.log2Size);
         }
         return s;
@@ -60,16 +54,7 @@ public:
     }
 
     void largeTiles(Layer layer, unsigned log2, GridTopology& tiles, LayerValues& values) override {
-        const GridTopology& t = topology(layer);
-        const LayerValues& v = layerValues(layer);
-        const unsigned vs = valueSize(grid_.valueType);
-        tiles = {};
-        values = {};
-        for (size_t i = 0; i < t.tiles.size(); ++i) {
-            if (t.tiles[i].log2Size <= log2) continue;
-            tiles.tiles.push_back(t.tiles[i]);
-            if (vs) values.tiles.insert(values.tiles.end(), v.tiles.begin() + long(i * vs), v.tiles.begin() + long((i + 1) * vs));
-        }
+        selectLargeTiles(topology(layer), layerValues(layer), valueSize(grid_.valueType), log2, tiles, values);
     }
 
     void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {

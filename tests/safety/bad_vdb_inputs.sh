@@ -18,6 +18,8 @@
 #   VDBDAG_FUZZ_TRUNCATIONS=N / VDBDAG_FUZZ_FLIPS=N   set them apart
 #   VDBDAG_FUZZ_SEED=S          (default 20240611)   VDBDAG_FUZZ_JOBS=J (default 2)
 #   VDBDAG_FUZZ_TIMEOUT=S       per run (default 60)
+#   VDBDAG_FUZZ_ENCODE_OPTIONS="..."  extra encode options, e.g. "--memory-limit 1M"
+#                               (the region-by-region reader)
 set -u
 source "$(dirname "$0")/common.sh"
 safety_init "${1:-}" bad_vdb_inputs
@@ -74,7 +76,8 @@ run_case() {
     fi
     capped "$d/ref.out" "$d/ref.err" "$PROBE" read "$f"
     refrc=$?
-    capped "$d/tool.out" "$d/tool.err" "$VDBDAG" encode "$f" -o "$d/out/out.ssvdag"
+    # shellcheck disable=SC2086  # the options split into words on purpose
+    capped "$d/tool.out" "$d/tool.err" "$VDBDAG" encode "$f" -o "$d/out/out.ssvdag" ${VDBDAG_FUZZ_ENCODE_OPTIONS:-}
     rc=$?
     if [ "$rc" -eq 124 ] || [ "$rc" -eq 137 ]; then
         why="timed out after $LIMIT_S s (exit $rc)"; cat="timeout"

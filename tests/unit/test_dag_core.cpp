@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "src/dag/DagBuilder.h"
+#include "tests/unit/TestInputs.h"
 #include "src/dag/Reflection.h"
 #include "src/encoding/CompactDag.h"
 #include "src/format/SsvdagFile.h"
@@ -20,7 +21,8 @@ using namespace vdbdag;
 
 namespace {
 
-using Voxel = std::tuple<int64_t, int64_t, int64_t>;
+using vdbdag::testing::Voxel;
+using vdbdag::testing::topologyFromVoxels;
 
 uint64_t bruteReflect(uint64_t mask, unsigned m) {
     uint64_t out = 0;
@@ -48,18 +50,6 @@ std::set<Voxel> voxelsOf(const GridTopology& topo) {
                 for (int64_t x = 0; x < n; ++x) voxels.insert({t.x + x, t.y + y, t.z + z});
     }
     return voxels;
-}
-
-GridTopology topologyFromVoxels(const std::set<Voxel>& voxels) {
-    std::map<Voxel, uint64_t> bricks;
-    auto floor4 = [](int64_t v) { return v >= 0 ? v / 4 * 4 : -((-v + 3) / 4) * 4; };
-    for (const auto& [x, y, z] : voxels) {
-        const int64_t bx = floor4(x), by = floor4(y), bz = floor4(z);
-        bricks[{bx, by, bz}] |= uint64_t(1) << brickBitIndex(int(x - bx), int(y - by), int(z - bz));
-    }
-    GridTopology topo;
-    for (const auto& [c, mask] : bricks) topo.bricks.push_back({int32_t(std::get<0>(c)), int32_t(std::get<1>(c)), int32_t(std::get<2>(c)), mask});
-    return topo;
 }
 
 encoding::CompactDag roundTripCompact(const GridTopology& topo, bool symmetry) {

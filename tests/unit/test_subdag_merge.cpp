@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "src/dag/DagBuilder.h"
+#include "tests/unit/TestInputs.h"
 #include "src/dag/SubDagMerge.h"
 #include "src/encoding/CompactDag.h"
 #include "src/util/Error.h"
@@ -20,19 +21,8 @@ using namespace vdbdag;
 
 namespace {
 
-using Voxel = std::tuple<int64_t, int64_t, int64_t>;
-
-GridTopology topologyFromVoxels(const std::set<Voxel>& voxels) {
-    std::map<Voxel, uint64_t> bricks;
-    auto floor4 = [](int64_t v) { return v >= 0 ? v / 4 * 4 : -((-v + 3) / 4) * 4; };
-    for (const auto& [x, y, z] : voxels) {
-        const int64_t bx = floor4(x), by = floor4(y), bz = floor4(z);
-        bricks[{bx, by, bz}] |= uint64_t(1) << brickBitIndex(int(x - bx), int(y - by), int(z - bz));
-    }
-    GridTopology topo;
-    for (const auto& [c, mask] : bricks) topo.bricks.push_back({int32_t(std::get<0>(c)), int32_t(std::get<1>(c)), int32_t(std::get<2>(c)), mask});
-    return topo;
-}
+using vdbdag::testing::Voxel;
+using vdbdag::testing::topologyFromVoxels;
 
 // A voxel set of a topology, bricks expanded, tiles kept as (corner, size).
 std::set<std::tuple<int64_t, int64_t, int64_t, int>> cellsOf(const GridTopology& topo) {

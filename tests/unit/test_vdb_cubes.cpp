@@ -15,6 +15,7 @@
 #include <openvdb/openvdb.h>
 
 #include "src/format/SsvdagFile.h"
+#include "tests/unit/TestInputs.h"
 #include "src/pipeline/CubeEncoder.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
@@ -100,18 +101,6 @@ fs::path writeAllTypes(const std::string& name, uint32_t codec, bool half, int s
     return path;
 }
 
-std::vector<fs::path> sharedVdbFiles() {
-    std::vector<fs::path> files;
-    for (const char* sub : {"vdb", "levelsets"}) {
-        const fs::path dir = fs::path(VDBDAG_SHARED_DATA) / sub;
-        if (!fs::is_directory(dir)) continue;
-        for (const auto& e : fs::directory_iterator(dir))
-            if (e.path().extension() == ".vdb" && e.path().filename() != "points.vdb") files.push_back(e.path());
-    }
-    std::sort(files.begin(), files.end());
-    return files;
-}
-
 } // namespace
 
 TEST(VdbCubes, EveryTypeCodecAndCubeSizeGivesTheInMemoryBytes) {
@@ -149,7 +138,7 @@ TEST(VdbCubes, TopologyOnlyAndChosenGridsGiveTheInMemoryBytes) {
 }
 
 TEST(VdbCubes, EverySharedDataFileGivesTheInMemoryBytes) {
-    const auto files = sharedVdbFiles();
+    const auto files = vdbdag::testing::sharedVdbFiles();
     if (files.empty()) GTEST_SKIP() << "../shared/data not present";
     pipeline::EncodeOptions options;
     options.computeSvdagStats = true;  // as the CLI encodes

@@ -13,6 +13,7 @@
 #include <tbb/global_control.h>
 
 #include "src/format/SsvdagFile.h"
+#include "tests/unit/TestInputs.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
@@ -128,22 +129,10 @@ fs::path roundTrip(const fs::path& input, bool symmetry = true) {
     return decoded;
 }
 
-std::vector<fs::path> sharedVdbFiles() {
-    std::vector<fs::path> files;
-    for (const char* sub : {"vdb", "levelsets"}) {
-        const fs::path dir = fs::path(VDBDAG_SHARED_DATA) / sub;
-        if (!fs::is_directory(dir)) continue;
-        for (const auto& e : fs::directory_iterator(dir))
-            if (e.path().extension() == ".vdb" && e.path().filename() != "points.vdb") files.push_back(e.path());
-    }
-    std::sort(files.begin(), files.end());
-    return files;
-}
-
 } // namespace
 
 TEST(VdbRoundTrip, EverySharedDataFileKeepsItsTopology) {
-    const auto files = sharedVdbFiles();
+    const auto files = vdbdag::testing::sharedVdbFiles();
     if (files.empty()) GTEST_SKIP() << "../shared/data not present";
     for (const auto& f : files) {
         SCOPED_TRACE(f.string());
