@@ -50,7 +50,7 @@ RANDOM=$SEED
     for ((i = 0; i < FLIPS; ++i)); do echo "flip $(((RANDOM * 32768 + RANDOM) % SIZE)) $((RANDOM % 8))"; done
 } > "$CASES"
 TOTAL=$(wc -l < "$CASES")
-echo "---- $TOTAL cases on $SRC ($SIZE bytes): lengths 0..200, $TRUNCS random truncations, $FLIPS bit flips; seed $SEED, $JOBS jobs, ${LIMIT_S} s and ${MEM_KB} KB per run"
+echo "---- $TOTAL cases on $SRC ($SIZE bytes): lengths 0..200, $TRUNCS random truncations, $FLIPS bit flips; seed $SEED, $JOBS jobs, ${LIMIT_S} s and ${MEM_KB} KB per run${VDBDAG_FUZZ_ENCODE_OPTIONS:+; encode $VDBDAG_FUZZ_ENCODE_OPTIONS}"
 
 capped() {  # capped OUT ERR CMD...: runs CMD under the memory cap and time limit
     local out=$1 err=$2
