@@ -2,7 +2,6 @@
 #include "src/pipeline/CubeEncoder.h"
 
 #include <algorithm>
-#include <atomic>
 #include <functional>
 #include <optional>
 
@@ -58,17 +57,17 @@ std::array<int64_t, 3> cornerOf(const LayerPlan& plan, const CubeCell& cell) {
     return {o[0] + (int64_t(cell.x) << plan.cubeLog2), o[1] + (int64_t(cell.y) << plan.cubeLog2), o[2] + (int64_t(cell.z) << plan.cubeLog2)};
 }
 
-// Sub-DAGs of cubes [begin, end) of the plan, built several at a time;
-// `onSub(index, sub)` runs in cube order.
-using StepProgress = std::function<void(uint64_t done, uint64_t total)>;
+// The cell of the cube whose minimum corner is (x, y, z).
+CubeCell cellAt(const LayerPlan& plan, int64_t x, int64_t y, int64_t z) {
+    const auto& o = plan.placement.origin;
+    return {uint32_t(uint64_t(x - o[0]) >> plan.cubeLog2), uint32_t(uint64_t(y - o[1]) >> plan.cubeLog2), uint32_t(uint64_t(z - o[2]) >> plan.cubeLog2)};
+}
 
-void buildSubDags(CubeSource& source, const LayerPlan& plan, bool symmetry, const CubeBudget& budget, size_t begin, size_t end,
-                  const std::function<void(size_t, dag::ReducedDag&)>& onSub, const StepProgress& progress) {
-    struct Piece {
-        size_t index;
-        GridTopology topology;
-        dag::ReducedDag sub;
-    };
+// Items [begin, end) through three stages, at most `workers` in flight:
+// read(piece) in order (a CubeSource is read by one thread at a time),
+// work(piece) on any worker, done(piece) in order.
+template <typename Piece, typename Read, typename Work, typename Done>
+void throughCubes(const CubeBudget& budget, size_t begin, size_t end, Read&& read, Work&& work, Done&& done) {
     size_t next = begin;
     tbb::parallel_pipeline(
         workersOf(budget),
@@ -77,25 +76,46 @@ void buildSubDags(CubeSource& source, const LayerPlan& plan, bool symmetry, cons
                                                            if (next == end) { fc.stop(); return nullptr; }
                                                            auto piece = std::make_shared<Piece>();
                                                            piece->index = next++;
-                                                           LayerValues none;
-                                                           source.read(plan.cubes[piece->index].cell, piece->topology, none);
+                                                           read(*piece);
                                                            return piece;
                                                        }) &
             tbb::make_filter<std::shared_ptr<Piece>, std::shared_ptr<Piece>>(tbb::filter_mode::parallel,
                                                                              [&](std::shared_ptr<Piece> piece) {
-                                                                                 dag::BuildOptions options;
-                                                                                 options.symmetry = symmetry;
-                                                                                 options.log2Size = plan.cubeLog2;
-                                                                                 options.origin = cornerOf(plan, plan.cubes[piece->index].cell);
-                                                                                 piece->sub = dag::buildDag(piece->topology, options);
-                                                                                 piece->topology = {};
+                                                                                 work(*piece);
                                                                                  return piece;
                                                                              }) &
-            tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::serial_in_order,
-                                                           [&](std::shared_ptr<Piece> piece) {
-                                                               onSub(piece->index, piece->sub);
-                                                               if (progress) progress(piece->index + 1 - begin, end - begin);
-                                                           }));
+            tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Piece> piece) { done(*piece); }));
+}
+
+using StepProgress = std::function<void(uint64_t done, uint64_t total)>;
+
+// Sub-DAGs of cubes [begin, end) of the plan, built several at a time;
+// `onSub(index, sub)` runs in cube order.
+void buildSubDags(CubeSource& source, const LayerPlan& plan, bool symmetry, const CubeBudget& budget, size_t begin, size_t end,
+                  const std::function<void(size_t, dag::ReducedDag&)>& onSub, const StepProgress& progress) {
+    struct Piece {
+        size_t index;
+        GridTopology topology;
+        dag::ReducedDag sub;
+    };
+    throughCubes<Piece>(
+        budget, begin, end,
+        [&](Piece& piece) {
+            LayerValues none;
+            source.read(plan.cubes[piece.index].cell, piece.topology, none);
+        },
+        [&](Piece& piece) {
+            dag::BuildOptions options;
+            options.symmetry = symmetry;
+            options.log2Size = plan.cubeLog2;
+            options.origin = cornerOf(plan, plan.cubes[piece.index].cell);
+            piece.sub = dag::buildDag(piece.topology, options);
+            piece.topology = {};
+        },
+        [&](Piece& piece) {
+            onSub(piece.index, piece.sub);
+            if (progress) progress(piece.index + 1 - begin, end - begin);
+        });
 }
 
 // Builds the layer's DAG from its cubes (geometry only). With several
@@ -196,31 +216,21 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         GridTopology topology;
         LayerValues values;
     };
-    size_t next = begin;
-    std::atomic<uint64_t> gathered{0};
-    tbb::parallel_pipeline(
-        workersOf(budget),
-        tbb::make_filter<void, std::shared_ptr<Piece>>(tbb::filter_mode::serial_in_order,
-                                                       [&](tbb::flow_control& fc) -> std::shared_ptr<Piece> {
-                                                           if (next == end) { fc.stop(); return nullptr; }
-                                                           auto piece = std::make_shared<Piece>();
-                                                           piece->index = next++;
-                                                           const encoding::SubtreeInstance& s = subtrees[piece->index];
-                                                           if (s.log2Size <= plan.cubeLog2) {
-                                                               const auto& o = plan.placement.origin;
-                                                               source.read({uint32_t(uint64_t(s.x - o[0]) >> plan.cubeLog2),
-                                                                            uint32_t(uint64_t(s.y - o[1]) >> plan.cubeLog2),
-                                                                            uint32_t(uint64_t(s.z - o[2]) >> plan.cubeLog2)},
-                                                                           piece->topology, piece->values);
-                                                           }
-                                                           return piece;
-                                                       }) &
-            tbb::make_filter<std::shared_ptr<Piece>, void>(tbb::filter_mode::parallel, [&](std::shared_ptr<Piece> piece) {
-                const encoding::SubtreeInstance& s = subtrees[piece->index];
-                if (s.log2Size <= plan.cubeLog2) gatherSubtree(dag, s, piece->topology, piece->values, vs, attributes.data(), firstEntry);
-                else gatherSubtree(dag, s, largeTopology, largeValues, vs, attributes.data(), firstEntry);
-                if (progress) progress(++gathered, end - begin);
-            }));
+    throughCubes<Piece>(
+        budget, begin, end,
+        [&](Piece& piece) {
+            const encoding::SubtreeInstance& s = subtrees[piece.index];
+            if (s.log2Size <= plan.cubeLog2) source.read(cellAt(plan, s.x, s.y, s.z), piece.topology, piece.values);
+        },
+        [&](Piece& piece) {
+            const encoding::SubtreeInstance& s = subtrees[piece.index];
+            const bool large = s.log2Size > plan.cubeLog2;
+            gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, attributes.data(), firstEntry);
+            piece = {piece.index, {}, {}};
+        },
+        [&](Piece& piece) {
+            if (progress) progress(piece.index + 1 - begin, end - begin);
+        });
     source.endPass();
     if (team.size() == 1) return attributes;
     const std::vector<std::vector<uint8_t>> all = team.gather(attributes);
@@ -238,31 +248,24 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
     const LayerSummary summary = source.summary(layer);
     const int64_t alignment = int64_t(1) << std::max(2u, summary.largestTileLog2);
     const unsigned vs = valueSize(source.header().valueType);
-    encoding::CompactDag kept;
-    bool first = true;
-    for (const auto& origin : placementCandidates(boxOf(summary), alignment, std::max(1, options.placementTrials))) {
-        dag::BuildOptions build;
-        build.origin = origin;
-        const LayerPlan plan = planLayer(source, layer, dag::placeRoot(boxOf(summary), alignment, build), budget, vs);
-        const dag::ReducedDag reduced = buildLayer(source, layer, plan, options.symmetry, budget, team, options.onStepProgress);
-        encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
-        if (first || compact.byteSize() < kept.byteSize()) {
-            kept = std::move(compact);
-            if (stats) *stats = statsOf(reduced);
-            keptPlan = plan;
+    std::optional<std::pair<std::array<int64_t, 3>, LayerPlan>> last;  // the SVDAG statistics rebuild the kept placement
+    auto planAt = [&](const std::array<int64_t, 3>& origin) -> const LayerPlan& {
+        if (!last || last->first != origin) {
+            dag::BuildOptions build;
+            build.origin = origin;
+            last.emplace(origin, planLayer(source, layer, dag::placeRoot(boxOf(summary), alignment, build), budget, vs));
         }
-        first = false;
-    }
-    if (stats && options.computeSvdagStats) {
-        if (!options.symmetry) {
-            stats->svdagNodes = stats->storedNodes;
-        } else {
-            const dag::ReducedDag plain = buildLayer(source, layer, keptPlan, false, budget, team, options.onStepProgress);
-            for (unsigned s = 2; s <= plain.log2Size; ++s) stats->svdagNodes.push_back(plain.uniqueNodeCount(s));
-        }
-        stats->hasSvdag = true;
-    }
-    return kept;
+        return last->second;
+    };
+    std::array<int64_t, 3> kept{};
+    encoding::CompactDag compact =
+        encodeAtBestPlacement(boxOf(summary), alignment, options, withOffsets, stats,
+                              [&](const std::array<int64_t, 3>& origin, bool symmetry) {
+                                  return buildLayer(source, layer, planAt(origin), symmetry, budget, team, options.onStepProgress);
+                              },
+                              &kept);
+    keptPlan = planAt(kept);
+    return compact;
 }
 
 } // namespace

@@ -97,19 +97,29 @@ namespace {
 
 // Builds and lays out one layer (active or inactive), trying the placements.
 encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptions& options, bool withOffsets, format::DagStats* stats) {
-    dag::BuildOptions build;
-    build.symmetry = options.symmetry;
+    return encodeAtBestPlacement(dag::activeBounds(topology), dag::placementAlignment(topology), options, withOffsets, stats,
+                                 [&](const std::array<int64_t, 3>& origin, bool symmetry) {
+                                     dag::BuildOptions build;
+                                     build.symmetry = symmetry;
+                                     build.origin = origin;
+                                     return dag::buildDag(topology, build);
+                                 });
+}
+
+} // namespace
+
+encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t alignment, const EncodeOptions& options, bool withOffsets,
+                                           format::DagStats* stats, const PlacedBuild& build, std::array<int64_t, 3>* keptOrigin) {
     bool first = true;
-    std::array<int64_t, 3> keptOrigin{0, 0, 0};
-    encoding::CompactDag kept;
-    for (const auto& origin : placementCandidates(dag::activeBounds(topology), dag::placementAlignment(topology), std::max(1, options.placementTrials))) {
-        build.origin = origin;
-        const dag::ReducedDag reduced = dag::buildDag(topology, build);
+    std::array<int64_t, 3> kept{0, 0, 0};
+    encoding::CompactDag best;
+    for (const auto& origin : placementCandidates(box, alignment, std::max(1, options.placementTrials))) {
+        const dag::ReducedDag reduced = build(origin, options.symmetry);
         encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
-        if (first || compact.byteSize() < kept.byteSize()) {
-            kept = std::move(compact);
+        if (first || compact.byteSize() < best.byteSize()) {
+            best = std::move(compact);
             if (stats) *stats = statsOf(reduced);
-            keptOrigin = origin;
+            kept = origin;
         }
         first = false;
     }
@@ -117,17 +127,14 @@ encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptio
         if (!options.symmetry) {
             stats->svdagNodes = stats->storedNodes;
         } else {
-            build.symmetry = false;
-            build.origin = keptOrigin;  // same placement, so the per-level counts compare
-            const dag::ReducedDag plain = dag::buildDag(topology, build);
+            const dag::ReducedDag plain = build(kept, false);  // same placement, so the per-level counts compare
             for (unsigned s = 2; s <= plain.log2Size; ++s) stats->svdagNodes.push_back(plain.uniqueNodeCount(s));
         }
         stats->hasSvdag = true;
     }
-    return kept;
+    if (keptOrigin) *keptOrigin = kept;
+    return best;
 }
-
-} // namespace
 
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options) {
     format::EncodedGrid out;

@@ -3,6 +3,7 @@
 // statistics, the grid header and the coding of gathered values.
 #pragma once
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "src/dag/DagBuilder.h"
@@ -15,6 +16,14 @@ namespace vdbdag::pipeline {
 std::vector<std::array<int64_t, 3>> placementCandidates(const dag::ActiveBounds& box, int64_t alignment, int trials);
 
 format::DagStats statsOf(const dag::ReducedDag& reduced);
+
+// Builds a layer at each placement candidate and keeps the smallest compact
+// encoding; with `stats`, also the plain SVDAG's node counts at the kept
+// placement when options.computeSvdagStats. `build(origin, symmetry)`
+// builds the layer's DAG with its root at `origin`.
+using PlacedBuild = std::function<dag::ReducedDag(const std::array<int64_t, 3>& origin, bool symmetry)>;
+encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t alignment, const EncodeOptions& options, bool withOffsets,
+                                           format::DagStats* stats, const PlacedBuild& build, std::array<int64_t, 3>* keptOrigin = nullptr);
 
 // An EncodedGrid with `grid`'s header and nothing else.
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options);

@@ -26,13 +26,28 @@ public:
     }
 };
 
+// Runs `read`, turning OpenVDB's exceptions into one vdbdag::Error naming
+// `path` (our own Errors and std::bad_alloc pass through).
+template <typename Read>
+auto reportingReadErrors(const std::string& path, Read&& read) {
+    try {
+        return read();
+    } catch (const Error&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
+    }
+}
+
 } // namespace
 
 VdbFileContents readVdbFile(const std::string& path) {
     initializeOpenVdb();
     const VdbFileLayout layout = checkVdbFileLayout(path);
     VdbFileContents contents;
-    try {
+    reportingReadErrors(path, [&] {
         if (layout.hasGridOffsets) {
             // io::File without delayed loading is OpenVDB's strictest reader
             // (it checks every compressed block's size); grids are read one
@@ -53,13 +68,7 @@ VdbFileContents readVdbFile(const std::string& path) {
             if (!grids || in.fail()) throw Error(path + ": truncated or corrupted (the file ends inside its grids)");
             contents.grids = *grids;
         }
-    } catch (const Error&) {
-        throw;
-    } catch (const std::bad_alloc&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
-    }
+    });
     if (!contents.metadata) contents.metadata = std::make_shared<openvdb::MetaMap>();
     if (contents.grids.size() != size_t(layout.gridCount))
         throw Error(path + ": corrupted: the file lists " + std::to_string(layout.gridCount) + " grids but " + std::to_string(contents.grids.size()) +
@@ -98,17 +107,13 @@ VdbFileIndex indexVdbFile(const std::string& path) {
     const VdbFileLayout layout = checkVdbFileLayout(path);
     if (!layout.hasGridOffsets) throw Error(path + ": an OpenVDB stream without grid offsets cannot be read region by region");
     VdbFileIndex index;
-    try {
+    reportingReadErrors(path, [&] {
         openvdb::io::File file(path);
         file.setCopyMaxBytes(0);  // never a private copy in the temporary directory
         file.open(/*delayLoad=*/true);
         index.metadata = file.getMetadata();
         file.close();
-    } catch (const std::bad_alloc&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
-    }
+    });
     if (!index.metadata) index.metadata = std::make_shared<openvdb::MetaMap>();
     for (const VdbGridEntry& entry : layout.grids) index.uniqueNames.push_back(openvdb::io::GridDescriptor::nameAsString(entry.uniqueName));
     return index;
@@ -116,7 +121,7 @@ VdbFileIndex indexVdbFile(const std::string& path) {
 
 openvdb::GridBase::Ptr readGridDelayed(const std::string& path, const std::string& uniqueName) {
     initializeOpenVdb();
-    try {
+    return reportingReadErrors(path, [&] {
         openvdb::io::File file(path);
         file.setCopyMaxBytes(0);
         file.open(/*delayLoad=*/true);
@@ -124,13 +129,7 @@ openvdb::GridBase::Ptr readGridDelayed(const std::string& path, const std::strin
         file.close();  // the leaves keep the file mapped
         if (!grid) throw Error(path + ": grid '" + uniqueName + "' could not be read");
         return grid;
-    } catch (const Error&) {
-        throw;
-    } catch (const std::bad_alloc&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw Error(path + ": cannot be read as a .vdb file (" + oneLine(e.what()) + ")");
-    }
+    });
 }
 
 void writeVdbFile(const std::string& path, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& metadata) {
