@@ -50,6 +50,7 @@
 #include <fcntl.h>
 #include <limits>
 #include <memory>
+#include <new>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -190,7 +191,10 @@ std::vector<uint8_t> restore(const Entry& e, std::span<const uint8_t> stored, co
         throw Error(what + ": the zstd frame declares " + num(declared) + " bytes but the table " + num(e.raw) + ", the file is corrupted");
     std::vector<uint8_t> data(e.raw);  // raw <= stored * 2^16 + 4096 (parseTable)
     const size_t n = ZSTD_decompress(data.data(), data.size(), stored.data(), stored.size());
-    if (ZSTD_isError(n)) throw Error(what + ": corrupted zstd data (" + ZSTD_getErrorName(n) + ")");
+    if (ZSTD_isError(n)) {
+        if (ZSTD_getErrorCode(n) == ZSTD_error_memory_allocation) throw std::bad_alloc();
+        throw Error(what + ": corrupted zstd data (" + ZSTD_getErrorName(n) + ")");
+    }
     if (n != e.raw) throw Error(what + ": zstd restored " + num(n) + " bytes instead of " + num(e.raw) + ", the file is corrupted");
     return data;
 }
@@ -202,11 +206,15 @@ bool compressSection(std::span<const uint8_t> data, const ContainerOptions& opti
         void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
     };
     std::unique_ptr<ZSTD_CCtx, CCtxDeleter> cctx(ZSTD_createCCtx());
-    if (!cctx) throw Error("zstd compression failed: out of memory");
+    if (!cctx) throw std::bad_alloc();
     const bool large = data.size() > kLargeSection;
     const int level = large ? std::min(options.zstdLevel, 3) : options.zstdLevel;
+    // zstd reports a failed allocation as an error code; it is the same out
+    // of memory as a failed `new`, and the command line says so in one line.
     auto check = [](size_t r) {
-        if (ZSTD_isError(r)) throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(r));
+        if (!ZSTD_isError(r)) return;
+        if (ZSTD_getErrorCode(r) == ZSTD_error_memory_allocation) throw std::bad_alloc();
+        throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(r));
     };
     check(ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, level));
     check(ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_contentSizeFlag, 1));  // the reader requires the frame content size

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cstring>
+#include <new>
 
 #include <zstd.h>
+#include <zstd_errors.h>
 
 #include "src/attributes/PredictedChannel.h"
 #include "src/dag/DagBuilder.h"
@@ -63,7 +65,10 @@ namespace {
 // (the container compresses harder, by about the same factor for both).
 // Streams through a 1 MiB buffer that is overwritten, so it costs no memory.
 size_t zstdEstimate(const std::vector<uint8_t>& bytes) {
+    // A failed allocation is out of memory, never a different estimate (the
+    // bytes written must not depend on how much memory is left).
     ZSTD_CCtx* cctx = ZSTD_createCCtx();
+    if (!cctx) throw std::bad_alloc();
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, 1);
     std::vector<uint8_t> buffer(1u << 20);
     ZSTD_inBuffer in{bytes.data(), bytes.size(), 0};
@@ -71,7 +76,11 @@ size_t zstdEstimate(const std::vector<uint8_t>& bytes) {
     for (;;) {
         ZSTD_outBuffer out{buffer.data(), buffer.size(), 0};
         const size_t left = ZSTD_compressStream2(cctx, &out, &in, ZSTD_e_end);
-        if (ZSTD_isError(left)) { total = bytes.size(); break; }
+        if (ZSTD_isError(left)) {
+            ZSTD_freeCCtx(cctx);
+            if (ZSTD_getErrorCode(left) == ZSTD_error_memory_allocation) throw std::bad_alloc();
+            return bytes.size();
+        }
         total += out.pos;
         if (left == 0) break;
     }
