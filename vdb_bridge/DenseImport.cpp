@@ -14,7 +14,9 @@
 
 #include "src/util/Error.h"
 #include "src/util/Progress.h"
+#include "vdb_bridge/DicomSeries.h"
 #include "vdb_bridge/MetaImageHeader.h"
+#include "vdb_bridge/NiftiHeader.h"
 #include "vdb_bridge/NrrdHeader.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 
@@ -50,11 +52,11 @@ struct PassStats {
 
 template <typename S>
 void forEachSlab(const DenseVolume& v, Progress* progress, const std::function<void(int64_t z0, int64_t nz, const S* samples)>& fn) {
-    DenseSampleStream stream(v);
+    const std::unique_ptr<SliceReader> stream = openSliceReader(v);
     std::vector<uint8_t> slab;
     for (int64_t z0 = 0; z0 < v.dims[2]; z0 += kSlab) {
         const int64_t nz = std::min(kSlab, v.dims[2] - z0);
-        stream.readSlices(nz, slab);
+        stream->readSlices(nz, slab);
         fn(z0, nz, reinterpret_cast<const S*>(slab.data()));
         if (progress) progress->advance();
     }
@@ -62,7 +64,16 @@ void forEachSlab(const DenseVolume& v, Progress* progress, const std::function<v
 
 template <typename S, typename V>
 DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueType valueType, bool showProgress) {
-    { DenseSampleStream check(v); }  // the data file's size against the header, before anything is reserved
+    { openSliceReader(v); }  // the data file's size against the header, before anything is reserved
+    // Stored sample -> grid value: the header's rescale (DICOM Rescale
+    // Slope/Intercept, NIfTI scl_slope/scl_inter), exact in integers when
+    // both are integral (importDense chose V so that the range fits).
+    const bool rescaled = v.rescaleSlope != 1 || v.rescaleIntercept != 0;
+    const auto convert = [&](S s) -> V {
+        if (!rescaled) return V(s);
+        if constexpr (std::is_integral_v<V>) return V(int64_t(s) * int64_t(v.rescaleSlope) + int64_t(v.rescaleIntercept));
+        else return V(double(s) * v.rescaleSlope + v.rescaleIntercept);
+    };
     const int64_t nx = v.dims[0], ny = v.dims[1];
     const int64_t slabs = (v.dims[2] + kSlab - 1) / kSlab;
     const int64_t rows = (ny + 3) / 4, cols = (nx + 3) / 4;
@@ -79,7 +90,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
             const uint64_t n = uint64_t(nz) * uint64_t(nx * ny);
             PassStats st;
             for (uint64_t i = 0; i < n; ++i) {
-                const double x = double(s[i]);
+                const double x = double(convert(s[i]));
                 if (std::isfinite(x)) { st.min = std::min(st.min, x); st.max = std::max(st.max, x); }
                 if (th.removes(x)) { ++st.removed; st.removedSum += x; }
             }
@@ -117,7 +128,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
                 for (int bit = 0; bit < 64; ++bit) {
                     const int64_t x = bx * 4 + (bit & 3), y = by * 4 + ((bit >> 2) & 3), z = bit >> 4;
                     if (x >= nx || y >= ny || z >= nz) continue;
-                    const S sample = s[(z * ny + y) * nx + x];
+                    const V sample = convert(s[(z * ny + y) * nx + x]);
                     const double d = double(sample);
                     if (th.any() && th.removes(d)) {
                         const double change = std::abs(d - double(background));
@@ -128,7 +139,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
                         continue;
                     }
                     mask |= uint64_t(1) << bit;
-                    row.values.push_back(V(sample));
+                    row.values.push_back(sample);
                 }
                 if (mask) row.bricks.push_back({int32_t(bx * 4), int32_t(by * 4), int32_t(z0), mask});
             }
@@ -174,6 +185,15 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
     grid->setTransform(openvdb::math::Transform::Ptr(new openvdb::math::Transform(openvdb::math::MapBase::Ptr(new openvdb::math::AffineMap(m)))));
     grid->insertMeta("source_file", openvdb::StringMetadata(name));
     grid->insertMeta("source_sample_type", openvdb::StringMetadata(sampleTypeName(v.type)));
+    // What `decode -o SCAN.nrrd|.nii.gz|...` needs to give the scan back as
+    // it came: its full extent (thresholds may leave the borders inactive),
+    // its stored samples (before any rescale) and its patient space.
+    grid->insertMeta("source_dims", openvdb::Vec3IMetadata(openvdb::Vec3i(int(v.dims[0]), int(v.dims[1]), int(v.dims[2]))));
+    if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) {
+        grid->insertMeta("source_rescale_slope", openvdb::DoubleMetadata(v.rescaleSlope));
+        grid->insertMeta("source_rescale_intercept", openvdb::DoubleMetadata(v.rescaleIntercept));
+    }
+    if (!v.space.empty()) grid->insertMeta("source_space", openvdb::StringMetadata(v.space));
     if (th.below) grid->insertMeta("background_below", openvdb::DoubleMetadata(th.belowValue));
     if (th.above) grid->insertMeta("background_above", openvdb::DoubleMetadata(th.aboveValue));
     record.name = grid->getName();
@@ -210,20 +230,70 @@ void checkDataFileLocation(const DenseVolume& v, const std::string& nameInHeader
 
 } // namespace
 
-DenseVolume describeDense(const std::string& path, const RawLayout& raw, bool allowExternalData) {
+DenseVolume describeDense(const std::string& path, const RawLayout& raw, bool allowExternalData, const std::string& series) {
     DenseVolume v;
     switch (denseFormatOf(path)) {
-        case DenseFormat::Raw: return describeRaw(path, raw);
+        case DenseFormat::Raw: v = describeRaw(path, raw); v.format = DenseFormat::Raw; return v;
         case DenseFormat::Nrrd: v = readNrrdHeader(path); break;
         case DenseFormat::MetaImage: v = readMetaImageHeader(path); break;
+        case DenseFormat::Nifti: v = readNiftiHeader(path); break;
+        case DenseFormat::Dicom: v = describeDicomSeries(path, series); v.format = DenseFormat::Dicom; return v;
         case DenseFormat::None: throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
     }
+    v.format = denseFormatOf(path);
     if (!allowExternalData && v.dataPath != v.headerPath) checkDataFileLocation(v, v.dataNameInHeader);
     return v;
 }
 
+namespace {
+
+// Samples with a rescale: an Int32 grid when slope and intercept are
+// integers and every stored value maps into int32 (CT in HU), else a Float
+// grid (a Double grid for 32-bit and f64 samples, whose values float cannot
+// hold).
+DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, bool p) {
+    const double a = v.rescaleSlope, b = v.rescaleIntercept;
+    if (!std::isfinite(a) || !std::isfinite(b) || a == 0)
+        throw Error(v.headerPath + ": the rescale slope " + std::to_string(a) + " / intercept " + std::to_string(b) + " is not usable");
+    double lo = 0, hi = 0;
+    switch (v.type) {
+        case SampleType::U8: hi = 255; break;
+        case SampleType::I8: lo = -128; hi = 127; break;
+        case SampleType::U16: hi = 65535; break;
+        case SampleType::I16: lo = -32768; hi = 32767; break;
+        case SampleType::U32: hi = 4294967295.0; break;
+        case SampleType::I32: lo = -2147483648.0; hi = 2147483647.0; break;
+        default: lo = hi = std::numeric_limits<double>::quiet_NaN();
+    }
+    const bool integral = isIntegerSample(v.type) && a == std::trunc(a) && b == std::trunc(b) && std::abs(a) < 2147483648.0 &&
+                          std::abs(b) < 2147483648.0;
+    const double r0 = a * lo + b, r1 = a * hi + b;
+    if (integral && std::min(r0, r1) >= -2147483648.0 && std::max(r0, r1) <= 2147483647.0) {
+        switch (v.type) {
+            case SampleType::U8: return importTyped<uint8_t, int32_t>(v, th, ValueType::Int32, p);
+            case SampleType::I8: return importTyped<int8_t, int32_t>(v, th, ValueType::Int32, p);
+            case SampleType::U16: return importTyped<uint16_t, int32_t>(v, th, ValueType::Int32, p);
+            case SampleType::I16: return importTyped<int16_t, int32_t>(v, th, ValueType::Int32, p);
+            default: break;  // 32-bit samples rescaled: as doubles
+        }
+    }
+    switch (v.type) {
+        case SampleType::U8: return importTyped<uint8_t, float>(v, th, ValueType::Float, p);
+        case SampleType::I8: return importTyped<int8_t, float>(v, th, ValueType::Float, p);
+        case SampleType::U16: return importTyped<uint16_t, float>(v, th, ValueType::Float, p);
+        case SampleType::I16: return importTyped<int16_t, float>(v, th, ValueType::Float, p);
+        case SampleType::F32: return importTyped<float, float>(v, th, ValueType::Float, p);
+        case SampleType::U32: return importTyped<uint32_t, double>(v, th, ValueType::Double, p);
+        case SampleType::I32: return importTyped<int32_t, double>(v, th, ValueType::Double, p);
+        case SampleType::F64: return importTyped<double, double>(v, th, ValueType::Double, p);
+    }
+    throw Error(v.headerPath + ": unsupported sample type");
+}
+
+} // namespace
+
 DenseImportResult importDense(const std::string& path, const DenseImportOptions& options) {
-    const DenseVolume v = describeDense(path, options.raw, options.allowExternalData);
+    const DenseVolume v = describeDense(path, options.raw, options.allowExternalData, options.series);
     Thresholds th;
     for (auto [set, value, flag] : {std::tuple{&th.below, &th.belowValue, options.backgroundBelow},
                                     std::tuple{&th.above, &th.aboveValue, options.backgroundAbove}}) {
@@ -235,6 +305,7 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
     if (th.below && th.above && th.aboveValue < th.belowValue)
         throw Error(path + ": --background-above is below --background-below: every sample would become background");
     const bool p = options.showProgress;
+    if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) return importRescaled(v, th, p);
     switch (v.type) {
         case SampleType::U8: return importTyped<uint8_t, int32_t>(v, th, ValueType::Int32, p);
         case SampleType::I8: return importTyped<int8_t, int32_t>(v, th, ValueType::Int32, p);

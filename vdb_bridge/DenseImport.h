@@ -34,6 +34,8 @@ struct DenseImportOptions {
     bool allowExternalData = false;
     std::optional<double> backgroundBelow, backgroundAbove;
     bool showProgress = true;  // a Progress line on a terminal
+    // DICOM: which series (`--series N|UID`); empty when the input holds one.
+    std::string series;
 };
 
 struct ThresholdReport {
@@ -55,7 +57,8 @@ struct DenseImportResult {
 
 // The header of `path`, by extension (see DenseVolume.h's denseFormatOf),
 // its data file checked as DenseImportOptions::allowExternalData says.
-DenseVolume describeDense(const std::string& path, const RawLayout& raw, bool allowExternalData = false);
+// A DICOM input: the series `series` names (DicomSeries.h).
+DenseVolume describeDense(const std::string& path, const RawLayout& raw, bool allowExternalData = false, const std::string& series = "");
 
 // Throws vdbdag::Error naming the file on any malformed header, missing or
 // short data, unsupported type or bad threshold.

@@ -2,6 +2,7 @@
 // gzip/zlib stream with zlib (inflateInit2 with window bits 15 + 32 detects
 // either header), in fixed 1 MiB input chunks, so memory stays at one slab.
 #include "vdb_bridge/DenseVolume.h"
+#include "vdb_bridge/DicomSeries.h"
 
 #include <algorithm>
 #include <cmath>
@@ -70,12 +71,38 @@ void DenseVolume::validate() const {
 }
 
 DenseFormat denseFormatOf(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    auto lower = [](std::string t) {
+        std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        return t;
+    };
+    const std::filesystem::path p(path);
+    const std::string ext = lower(p.extension().string());
+    const std::string name = lower(p.filename().string());
     if (ext == ".raw") return DenseFormat::Raw;
     if (ext == ".nrrd" || ext == ".nhdr") return DenseFormat::Nrrd;
     if (ext == ".mhd" || ext == ".mha") return DenseFormat::MetaImage;
+    if (ext == ".nii" || ext == ".hdr" || (name.size() > 7 && name.ends_with(".nii.gz"))) return DenseFormat::Nifti;
+    if (ext == ".dcm" || name == "dicomdir") return DenseFormat::Dicom;
+    std::error_code ec;
+    if (std::filesystem::is_directory(p, ec)) return DenseFormat::Dicom;
     return DenseFormat::None;
+}
+
+const char* denseFormatName(DenseFormat format) {
+    switch (format) {
+        case DenseFormat::None: return "none";
+        case DenseFormat::Raw: return "raw";
+        case DenseFormat::Nrrd: return "nrrd";
+        case DenseFormat::MetaImage: return "metaimage";
+        case DenseFormat::Nifti: return "nifti";
+        case DenseFormat::Dicom: return "dicom";
+    }
+    return "none";
+}
+
+std::unique_ptr<SliceReader> openSliceReader(const DenseVolume& volume) {
+    if (volume.format == DenseFormat::Dicom) return openDicomSlices(volume);
+    return std::make_unique<DenseSampleStream>(volume);
 }
 
 struct DenseSampleStream::Inflater {

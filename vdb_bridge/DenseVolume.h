@@ -1,5 +1,6 @@
-// The shared description of a dense scan (what the raw, NRRD and MetaImage
-// readers produce) and the sample stream that reads it slice by slice.
+// The shared description of a dense scan (what the raw, NRRD, MetaImage,
+// NIfTI and DICOM readers produce) and the readers that give its samples
+// slice by slice.
 // Sample (i, j, k), i fastest in the file, sits at index coordinate (i, j, k);
 // world = origin + i * axis[0] + j * axis[1] + k * axis[2], so each axis
 // vector carries its spacing (NRRD "space directions", MetaImage
@@ -23,7 +24,22 @@ SampleType parseSampleType(const std::string& name, const std::string& what);
 
 enum class DataEncoding : uint8_t { Raw, Zlib };  // Zlib: gzip or zlib stream (detected)
 
+// Which dense format a path names: by extension ".nrrd", ".nhdr", ".mhd",
+// ".mha", ".raw", ".nii", ".nii.gz", ".hdr" (case-insensitive); a folder, a
+// ".dcm" file or a DICOMDIR is DICOM; None for anything else (e.g. ".vdb").
+enum class DenseFormat { None, Raw, Nrrd, MetaImage, Nifti, Dicom };
+DenseFormat denseFormatOf(const std::string& path);
+const char* denseFormatName(DenseFormat format);  // "raw", "nrrd", "metaimage", "nifti", "dicom"
+
+// One slice of a DICOM series: a file, and the frame within it (0 for
+// single-frame files).
+struct DicomSlice {
+    std::string file;
+    uint32_t frame = 0;
+};
+
 struct DenseVolume {
+    DenseFormat format = DenseFormat::Raw;
     std::string headerPath;  // the file the user named (for messages)
     std::string dataPath;    // where the samples are (may equal headerPath)
     std::string dataNameInHeader;  // the data file as the header names it (empty when attached)
@@ -41,6 +57,15 @@ struct DenseVolume {
     int64_t lineSkip = 0;
     std::array<double, 3> origin{0, 0, 0};
     std::array<std::array<double, 3>, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+    // The patient space of origin and axes: "LPS" (DICOM, NRRD
+    // "left-posterior-superior", MetaImage by default), "RAS" (NIfTI), or
+    // empty when the header names none.
+    std::string space;
+    // value = stored sample * slope + intercept (DICOM Rescale Slope and
+    // Intercept, NIfTI scl_slope / scl_inter); identity by default.
+    double rescaleSlope = 1, rescaleIntercept = 0;
+    // DICOM: the slices in order along the slice normal (dims[2] of them).
+    std::vector<DicomSlice> slices;
 
     uint64_t sampleCount() const { return uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]); }
     uint64_t sliceSamples() const { return uint64_t(dims[0]) * uint64_t(dims[1]); }
@@ -49,20 +74,32 @@ struct DenseVolume {
     void validate() const;
 };
 
-// Reads whole z-slices in file order, converted to host byte order (raw
-// sample bytes, sampleBytes(type) each). Checks that the data file exists and
-// is long enough when opened; a short or corrupt stream is reported naming
-// the data file. Never reads more than it needs.
-class DenseSampleStream {
+// Gives a scan's stored samples (before any rescale) whole z-slices at a
+// time, in order, in host byte order (sampleBytes(type) each).
+class SliceReader {
+public:
+    virtual ~SliceReader() = default;
+    // Reads the next `slices` slices into `out` (resized to
+    // slices * sliceSamples * sampleBytes). Throws vdbdag::Error naming the file.
+    virtual void readSlices(int64_t slices, std::vector<uint8_t>& out) = 0;
+};
+
+// The reader for `volume`'s format (DICOM: DicomSeries.h; the others: a
+// DenseSampleStream). Checks what it can before the first slice (the data
+// file's size against the header).
+std::unique_ptr<SliceReader> openSliceReader(const DenseVolume& volume);
+
+// Reads one data file (raw, NRRD, MetaImage, NIfTI): checks that it exists
+// and is long enough when opened; a short or corrupt stream is reported
+// naming the data file. Never reads more than it needs.
+class DenseSampleStream : public SliceReader {
 public:
     explicit DenseSampleStream(const DenseVolume& volume);
-    ~DenseSampleStream();
+    ~DenseSampleStream() override;
     DenseSampleStream(const DenseSampleStream&) = delete;
     DenseSampleStream& operator=(const DenseSampleStream&) = delete;
 
-    // Reads the next `slices` slices into `out` (resized to
-    // slices * sliceSamples * sampleBytes). Throws vdbdag::Error.
-    void readSlices(int64_t slices, std::vector<uint8_t>& out);
+    void readSlices(int64_t slices, std::vector<uint8_t>& out) override;
 
 private:
     void readBytes(uint8_t* out, size_t n);
@@ -74,10 +111,5 @@ private:
     std::unique_ptr<Inflater> inflater_;
     int64_t slicesRead_ = 0;
 };
-
-// Which dense format a path names, by extension: ".nrrd", ".nhdr", ".mhd",
-// ".mha", ".raw" (case-insensitive); None for anything else (e.g. ".vdb").
-enum class DenseFormat { None, Raw, Nrrd, MetaImage };
-DenseFormat denseFormatOf(const std::string& path);
 
 } // namespace vdbdag::bridge

@@ -133,6 +133,16 @@ DenseVolume readNrrdHeader(const std::string& path) {
         if (detail::parseInteger(detail::trim(*sd), path + ": space dimension") != 3)
             throw Error(path + ": space dimension " + detail::trim(*sd) + " is not supported (3 is)");
     }
+    if (const std::string* sp = field("space")) {
+        // The patient space, kept so that a decode writes it back and other
+        // formats convert consistently (DenseVolume::space).
+        static const std::map<std::string, std::string> spaces{
+            {"left-posterior-superior", "LPS"}, {"lps", "LPS"}, {"right-anterior-superior", "RAS"}, {"ras", "RAS"},
+            {"left-anterior-superior", "LAS"}, {"las", "LAS"}, {"scanner-xyz", ""}, {"3d-right-handed", ""}, {"3d-left-handed", ""}};
+        const auto it = spaces.find(detail::lower(detail::trim(*sp)));
+        if (it == spaces.end()) throw Error(path + ": NRRD space '" + detail::trim(*sp) + "' is not a 3-D space this reader knows");
+        v.space = it->second;
+    }
     if (const std::string* dirs = field("space directions")) {
         if (field("spacings")) throw Error(path + ": NRRD header has both 'space directions' and 'spacings'");
         const auto vectors = parseVectors(*dirs, path + ": space directions");
