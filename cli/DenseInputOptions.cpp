@@ -16,10 +16,14 @@ void DenseInputOptions::addTo(CLI::App& cmd) {
     cmd.add_option("--endian", endian, "raw input: little (default) or big")->check(CLI::IsMember({"little", "big"}));
     cmd.add_option("--spacing", spacing, "raw input: voxel spacing sx sy sz (default 1 1 1)")->expected(3);
     cmd.add_option("--origin", origin, "raw input: world position of sample (0,0,0) (default 0 0 0)")->expected(3);
+    cmd.add_option("--series", series, "DICOM input: the series to read, by its number in `vdbdag info` or its Series Instance UID");
     belowOption = cmd.add_option("--background-below", below, "dense input: samples below V become inactive background (lossy; the cost is reported)")
                       ->check(finiteNumber());
     aboveOption = cmd.add_option("--background-above", above, "dense input: samples above V become inactive background (lossy; the cost is reported)")
                       ->check(finiteNumber());
+    backgroundValueOption =
+        cmd.add_option("--background-value", backgroundValue, "dense input: the value removed samples become (default: their mean)")->check(finiteNumber());
+    volumeOption = cmd.add_option("--volume", volume, "4-D NIfTI input: which volume (0-based)")->check(CLI::NonNegativeNumber);
     cmd.add_flag("--allow-external-data", allowExternalData,
                  "dense header: read a data file outside the header's folder (an absolute path, '..', or a link leading out)");
 }
@@ -34,9 +38,19 @@ bridge::DenseImportOptions DenseInputOptions::resolve(const std::string& path) c
     if (!endian.empty()) o.raw.bigEndian = endian == "big";
     if (!spacing.empty()) o.raw.spacing = {spacing[0], spacing[1], spacing[2]};
     if (!origin.empty()) o.raw.origin = {origin[0], origin[1], origin[2]};
+    if (!series.empty()) {
+        if (bridge::denseFormatOf(path) != bridge::DenseFormat::Dicom)
+            throw Error(path + ": --series applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
+        o.series = series;
+    }
     if (belowOption && belowOption->count()) o.backgroundBelow = below;
     if (aboveOption && aboveOption->count()) o.backgroundAbove = above;
+    if (backgroundValueOption && backgroundValueOption->count()) o.backgroundValue = backgroundValue;
     o.allowExternalData = allowExternalData;
+    if (volumeOption && volumeOption->count()) {
+        if (bridge::denseFormatOf(path) != bridge::DenseFormat::Nifti) throw Error(path + ": --volume applies to NIfTI inputs only");
+        o.volume = volume;
+    }
     return o;
 }
 
@@ -51,16 +65,27 @@ nlohmann::json thresholdJson(const bridge::ThresholdReport& r) {
             {"max_abs_change", r.maxAbsChange},
             {"mean_abs_change", r.meanAbsChange},
             {"rms_change", r.rmsChange},
-            {"psnr_db", std::isfinite(r.psnr) ? nlohmann::json(r.psnr) : nlohmann::json(nullptr)}};
+            {"psnr_db", std::isfinite(r.psnr) ? nlohmann::json(r.psnr) : nlohmann::json(nullptr)},
+            {"psnr_peak", "input range"},
+            {"stored_bits", r.storedBits},
+            {"psnr_stored_range_db", r.storedBits && std::isfinite(r.psnrStoredRange) ? nlohmann::json(r.psnrStoredRange) : nlohmann::json(nullptr)},
+            {"background_is", r.backgroundChosen ? "chosen" : "mean of removed samples"},
+            {"shared_background", r.sharedBackground}};
 }
 
 std::string thresholdText(const bridge::ThresholdReport& r) {
     if (!r.applied) return "";
-    return fmt::format("  background {}: {} of {} samples inactive ({:.1f}%), {} changed; max |change| {:.6g}, mean {:.6g}, RMS {:.6g}; "
-                       "PSNR {} (peak = input range {:.6g}..{:.6g})\n",
-                       r.background, r.inactive, r.samples, r.samples ? 100.0 * double(r.inactive) / double(r.samples) : 0.0, r.changed,
-                       r.maxAbsChange, r.meanAbsChange, r.rmsChange, std::isfinite(r.psnr) ? fmt::format("{:.2f} dB", r.psnr) : "inf (lossless)",
-                       r.inputMin, r.inputMax);
+    auto db = [](double x) { return std::isfinite(x) ? fmt::format("{:.2f} dB", x) : std::string("inf (lossless)"); };
+    std::string text = fmt::format("  background {} ({}): {} of {} samples inactive ({:.1f}%), {} changed; max |change| {:.6g}, mean {:.6g}, RMS {:.6g}; "
+                                   "PSNR {} (peak = input range {:.6g}..{:.6g})",
+                                   r.background, r.backgroundChosen ? "--background-value" : "mean of the removed samples", r.inactive, r.samples,
+                                   r.samples ? 100.0 * double(r.inactive) / double(r.samples) : 0.0, r.changed, r.maxAbsChange, r.meanAbsChange,
+                                   r.rmsChange, db(r.psnr), r.inputMin, r.inputMax);
+    if (r.storedBits) text += fmt::format(", {} (peak = the {}-bit stored range)", db(r.psnrStoredRange), r.storedBits);
+    text += "\n";
+    if (r.sharedBackground)
+        text += "  note: the samples below and above the thresholds became one background value; a decode gives both back as that value\n";
+    return text;
 }
 
 } // namespace vdbdag::cli
@@ -71,8 +96,12 @@ std::vector<std::string> denseInputFiles(const std::string& input, const DenseIn
     const bridge::DenseFormat format = bridge::denseFormatOf(input);
     if (format == bridge::DenseFormat::None || format == bridge::DenseFormat::Raw) return {input};
     const bridge::DenseImportOptions resolved = options.resolve(input);
-    const bridge::DenseVolume header = bridge::describeDense(input, resolved.raw, resolved.allowExternalData);
-    return {input, header.dataPath};
+    const bridge::DenseVolume header = bridge::describeDense(input, resolved);
+    if (format != bridge::DenseFormat::Dicom) return {input, header.dataPath};
+    std::vector<std::string> files{input};
+    for (const bridge::DicomSlice& s : header.slices)
+        if (files.back() != s.file) files.push_back(s.file);  // frames of one file are listed once
+    return files;
 }
 
 } // namespace vdbdag::cli

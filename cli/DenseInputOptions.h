@@ -17,11 +17,16 @@ namespace vdbdag::cli {
 struct DenseInputOptions {
     std::vector<int64_t> dims;
     std::string type, endian;
+    std::string series;  // DICOM input: --series N|UID
     std::vector<double> spacing, origin;
     double below = 0, above = 0;
     bool allowExternalData = false;
+    int64_t volume = 0;
+    CLI::Option* volumeOption = nullptr;
     CLI::Option* belowOption = nullptr;
     CLI::Option* aboveOption = nullptr;
+    double backgroundValue = 0;
+    CLI::Option* backgroundValueOption = nullptr;
 
     void addTo(CLI::App& cmd);
     // Throws vdbdag::Error naming `path` for inconsistent values.
@@ -29,7 +34,8 @@ struct DenseInputOptions {
 };
 
 // The files a command reads for `input`: the input itself and, for a dense
-// header (.nhdr, .mhd), the data file it names (an output must be neither).
+// header (.nhdr, .mhd), the data file it names, for DICOM every slice file of
+// the series (an output must be none of them).
 std::vector<std::string> denseInputFiles(const std::string& input, const DenseInputOptions& options);
 
 nlohmann::json thresholdJson(const bridge::ThresholdReport& report);

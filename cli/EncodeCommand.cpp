@@ -57,7 +57,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         DenseInputOptions dense;
     };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha scan) into an .ssvdag file");
+    CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha/.nii scan, or one DICOM series) into an .ssvdag file");
     cmd->add_option("input", opt->input, "input .vdb file or dense scan")->required();
     cmd->add_option("-o,--output", opt->output, "output .ssvdag file")->required();
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
@@ -117,6 +117,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                     g.background.clear();
                 }
         } else {
+            if (!opt->dense.series.empty()) throw Error(opt->input + ": --series applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
             if (!opt->dense.dims.empty() || !opt->dense.type.empty() || !opt->dense.endian.empty() || !opt->dense.spacing.empty() ||
                 !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
                 throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "

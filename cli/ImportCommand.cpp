@@ -24,8 +24,8 @@ void addImportCommand(CLI::App& app, int& exitCode) {
         DenseInputOptions dense;
     };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("import", "Convert a dense scan (.raw, .nrrd, .nhdr, .mhd, .mha) into a .vdb grid");
-    cmd->add_option("input", opt->input, "input volume")->required();
+    CLI::App* cmd = app.add_subcommand("import", "Convert a dense scan (.raw, .nrrd, .nhdr, .mhd, .mha, .nii, or one DICOM series: a folder, .dcm or DICOMDIR with --series) into a .vdb grid");
+    cmd->add_option("input", opt->input, "input volume, or DICOM folder / .dcm / DICOMDIR")->required();
     cmd->add_option("-o,--output", opt->output, "output .vdb file")->required();
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the summary as JSON");

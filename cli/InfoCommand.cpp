@@ -1,12 +1,15 @@
 // `vdbdag info FILE [--json]` for .ssvdag files and for .vdb files (which
 // are encoded in memory, with the plain-SVDAG reduction run too so all three
-// node counts show).
+// node counts show). For DICOM input (a folder, a .dcm file, a DICOMDIR):
+// the series found (what `encode --series N|UID` picks from) and the files
+// skipped.
 #include <fmt/core.h>
 
 #include "cli/Commands.h"
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "src/pipeline/GridCodec.h"
+#include "vdb_bridge/DicomSeries.h"
 #include "vdb_bridge/VdbImport.h"
 
 namespace vdbdag::cli {
@@ -16,17 +19,58 @@ namespace {
 bool isVdbFile(std::span<const uint8_t> bytes) {
     return bytes.size() >= 4 && bytes[0] == 0x20 && bytes[1] == 0x42 && bytes[2] == 0x44 && bytes[3] == 0x56;
 }
+
+nlohmann::json dicomReport(const std::string& input, const bridge::DicomScan& scan) {
+    nlohmann::json series = nlohmann::json::array();
+    for (size_t i = 0; i < scan.series.size(); ++i) {
+        const bridge::DicomSeriesInfo& s = scan.series[i];
+        series.push_back({{"index", i + 1}, {"uid", s.uid}, {"modality", s.modality}, {"description", s.description},
+                          {"series_number", s.seriesNumber}, {"slices", s.dims[2]}, {"dims", {s.dims[0], s.dims[1], s.dims[2]}},
+                          {"spacing", {s.spacing[0], s.spacing[1], s.spacing[2]}}, {"sample_type", s.sampleType},
+                          {"convertible", s.problem.empty()}, {"problem", s.problem}, {"notes", s.notes}});
+    }
+    return {{"input", input}, {"format", "dicom"}, {"series", series}, {"skipped_files", scan.skipped.size()}, {"skipped", scan.skipped}};
+}
+
+std::string formatDicomReport(const nlohmann::json& r) {
+    std::string out = fmt::format("{}: DICOM, {} series, {} file(s) skipped\n", r["input"].get<std::string>(), r["series"].size(),
+                                  r["skipped_files"].get<size_t>());
+    for (const auto& s : r["series"]) {
+        const auto& d = s["dims"];
+        const auto& sp = s["spacing"];
+        out += fmt::format("  {}) {}  {}  \"{}\"  {} slices  {}x{}x{} {}  spacing {:.6g} x {:.6g} x {:.6g} mm\n", s["index"].get<size_t>(),
+                           s["uid"].get<std::string>(), s["modality"].get<std::string>(), s["description"].get<std::string>(),
+                           s["slices"].get<int64_t>(), d[0].get<int64_t>(), d[1].get<int64_t>(), d[2].get<int64_t>(),
+                           s["sample_type"].get<std::string>().empty() ? "?" : s["sample_type"].get<std::string>(), sp[0].get<double>(),
+                           sp[1].get<double>(), sp[2].get<double>());
+        for (const auto& n : s["notes"]) out += fmt::format("       note: {}\n", n.get<std::string>());
+        if (!s["convertible"].get<bool>()) out += fmt::format("       not convertible: {}\n", s["problem"].get<std::string>());
+    }
+    const auto& skipped = r["skipped"];
+    constexpr size_t kShown = 10;
+    for (size_t i = 0; i < skipped.size() && i < kShown; ++i) out += fmt::format("  skipped {}\n", skipped[i].get<std::string>());
+    if (skipped.size() > kShown) out += fmt::format("  ... and {} more skipped (--json lists all)\n", skipped.size() - kShown);
+    return out;
+}
 } // namespace
 
 void addInfoCommand(CLI::App& app, int& exitCode) {
     struct Options { std::string input; bool json = false; bool noSymmetry = false; };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("info", "Print per-grid DAG statistics and section sizes of a .ssvdag or .vdb file");
-    cmd->add_option("input", opt->input, ".ssvdag or .vdb file")->required();
+    CLI::App* cmd = app.add_subcommand("info", "Print per-grid DAG statistics and section sizes of a .ssvdag or .vdb file (or the series of DICOM input)");
+    cmd->add_option("input", opt->input, ".ssvdag or .vdb file, or DICOM input (a folder, a .dcm file, a DICOMDIR)")->required();
     cmd->add_flag("--json", opt->json, "print JSON");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "for .vdb input: report the plain SVDAG encoding");
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "reading");
+        if (bridge::denseFormatOf(opt->input) == bridge::DenseFormat::Dicom) {
+            const nlohmann::json report = dicomReport(opt->input, bridge::scanDicom(opt->input));
+            // Descriptions may be Latin-1 (Specific Character Set): never throw on them.
+            if (opt->json) fmt::print("{}\n", report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
+            else fmt::print("{}", formatDicomReport(report));
+            exitCode = 0;
+            return;
+        }
         std::vector<uint8_t> bytes = format::readFileBytes(opt->input);
         format::SsvdagScene scene;
         if (!isVdbFile(bytes)) {

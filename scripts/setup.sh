@@ -14,6 +14,8 @@ PACKAGES=(
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils
   libzfp-dev fonts-dejavu-core
   libopenmpi-dev openmpi-bin
+  libgdcm-dev libgdcm-tools python3-pydicom
+  libnifti2-dev python3-nibabel
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils zlib1g-dev
   libzfp-dev
 )

@@ -4,6 +4,7 @@
 // count. Bricks at the volume's far faces are partial (their mask says so).
 #include "vdb_bridge/DenseImport.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -28,6 +29,7 @@ constexpr int64_t kSlab = 4;
 struct Thresholds {
     bool below = false, above = false;
     double belowValue = 0, aboveValue = 0;
+    std::optional<double> background;  // --background-value; else the removed samples' mean
     bool any() const { return below || above; }
     bool removes(double x) const { return (below && x < belowValue) || (above && x > aboveValue); }
 };
@@ -60,6 +62,90 @@ void forEachSlab(const DenseVolume& v, Progress* progress, const std::function<v
         fn(z0, nz, reinterpret_cast<const S*>(slab.data()));
         if (progress) progress->advance();
     }
+}
+
+// The grid's name: the file's name without its extension(s) (".nii.gz" too).
+std::string gridNameOf(const std::string& path) {
+    std::string name = std::filesystem::path(path).filename().string();
+    std::string lower = name;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (lower.size() > 7 && lower.ends_with(".nii.gz")) return name.substr(0, name.size() - 7);
+    return std::filesystem::path(name).stem().string();
+}
+
+// The grid header (OpenVDB's own serialisation of an empty grid, with the
+// scan's transform and the metadata a decode back to the scan needs).
+template <typename V>
+void describeGrid(const DenseVolume& v, const V& background, const Thresholds* th, GridRecord& record) {
+    detail::initializeOpenVdb();
+    using GridT = openvdb::Grid<typename openvdb::tree::Tree4<V, 5, 4, 3>::Type>;
+    typename GridT::Ptr grid = GridT::create(background);
+    grid->setName(v.colour ? "Cd" : gridNameOf(v.headerPath));
+    grid->setGridClass(openvdb::GRID_UNKNOWN);
+    openvdb::Mat4d m = openvdb::Mat4d::identity();
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) m(a, c) = v.axes[size_t(a)][size_t(c)];
+    for (int c = 0; c < 3; ++c) m(3, c) = v.origin[size_t(c)];
+    grid->setTransform(openvdb::math::Transform::Ptr(new openvdb::math::Transform(openvdb::math::MapBase::Ptr(new openvdb::math::AffineMap(m)))));
+    grid->insertMeta("source_file", openvdb::StringMetadata(std::filesystem::path(v.headerPath).filename().string()));
+    grid->insertMeta("source_sample_type", openvdb::StringMetadata(sampleTypeName(v.type)));
+    // What `decode -o SCAN.nrrd|.nii.gz|...` needs to give the scan back as
+    // it came: its full extent (thresholds may leave the borders inactive),
+    // its stored samples (before any rescale) and its patient space.
+    grid->insertMeta("source_dims", openvdb::Vec3IMetadata(openvdb::Vec3i(int(v.dims[0]), int(v.dims[1]), int(v.dims[2]))));
+    if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) {
+        grid->insertMeta("source_rescale_slope", openvdb::DoubleMetadata(v.rescaleSlope));
+        grid->insertMeta("source_rescale_intercept", openvdb::DoubleMetadata(v.rescaleIntercept));
+    }
+    grid->insertMeta("source_format", openvdb::StringMetadata(denseFormatName(v.format)));
+    if (v.colour) grid->insertMeta("source_colour", openvdb::StringMetadata("rgb"));
+    if (!v.space.empty()) grid->insertMeta("space", openvdb::StringMetadata(v.space));  // of the grid's world coordinates
+    if (th && th->below) grid->insertMeta("background_below", openvdb::DoubleMetadata(th->belowValue));
+    if (th && th->above) grid->insertMeta("background_above", openvdb::DoubleMetadata(th->aboveValue));
+    record.name = grid->getName();
+    record.gridClass = openvdb::GridBase::gridClassToString(grid->getGridClass());
+    record.indexToWorld = detail::indexToWorldOf(*grid);
+    record.vdbDescriptor = detail::descriptorOf(*grid);
+    const auto* bg = reinterpret_cast<const uint8_t*>(&background);
+    record.background.assign(bg, bg + sizeof(V));
+}
+
+// Vector and colour scans: every sample an active voxel whose value is its
+// 3 components (C: int32 for integer samples, float, double), no thresholds.
+template <typename S, typename C>
+DenseImportResult importVector(const DenseVolume& v, ValueType valueType, bool showProgress) {
+    using V = openvdb::math::Vec3<C>;
+    openSliceReader(v);  // sizes checked before anything is reserved
+    const int64_t nx = v.dims[0], ny = v.dims[1];
+    const int64_t rows = (ny + 3) / 4, cols = (nx + 3) / 4;
+    std::unique_ptr<Progress> progress;
+    if (showProgress) progress = std::make_unique<Progress>("import " + std::filesystem::path(v.headerPath).filename().string(), uint64_t((v.dims[2] + kSlab - 1) / kSlab));
+    GridRecord record;
+    record.valueType = valueType;
+    record.values.bricks.reserve(size_t(v.sampleCount() * sizeof(V)));
+    forEachSlab<S>(v, progress.get(), [&](int64_t z0, int64_t nz, const S* s) {
+        for (int64_t by = 0; by < rows; ++by)
+            for (int64_t bx = 0; bx < cols; ++bx) {
+                uint64_t mask = 0;
+                for (int bit = 0; bit < 64; ++bit) {
+                    const int64_t x = bx * 4 + (bit & 3), y = by * 4 + ((bit >> 2) & 3), z = bit >> 4;
+                    if (x >= nx || y >= ny || z >= nz) continue;
+                    const S* sample = s + size_t(((z * ny + y) * nx + x) * 3);
+                    const V value{C(sample[0]), C(sample[1]), C(sample[2])};
+                    const auto* p = reinterpret_cast<const uint8_t*>(&value);
+                    record.values.bricks.insert(record.values.bricks.end(), p, p + sizeof(V));
+                    mask |= uint64_t(1) << bit;
+                }
+                if (mask) record.topology.bricks.push_back({int32_t(bx * 4), int32_t(by * 4), int32_t(z0), mask});
+            }
+    });
+    if (progress) progress->finish();
+    DenseImportResult result;
+    result.source = v;
+    result.threshold.samples = v.sampleCount();
+    describeGrid<V>(v, V(C(0)), nullptr, record);
+    result.volume.grids.push_back(std::move(record));
+    return result;
 }
 
 template <typename S, typename V>
@@ -96,7 +182,14 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
             }
             first.add(st);
         });
-        if (first.removed) {
+        if (th.background) {
+            if constexpr (std::is_integral_v<V>) {
+                if (*th.background != std::trunc(*th.background) || *th.background < double(std::numeric_limits<V>::min()) ||
+                    *th.background > double(std::numeric_limits<V>::max()))
+                    throw Error(v.headerPath + ": --background-value " + std::to_string(*th.background) + " is not a value of this integer grid");
+            }
+            background = V(*th.background);
+        } else if (first.removed) {
             const double mean = first.removedSum / double(first.removed);
             if constexpr (std::is_integral_v<V>) background = V(std::llround(mean));
             else background = V(mean);
@@ -168,40 +261,19 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
         r.meanAbsChange = second.sumAbs / double(r.samples);
         const double mse = second.sumSq / double(r.samples);
         r.rmsChange = std::sqrt(mse);
-        const double peak = r.inputMax - r.inputMin;
-        r.psnr = mse == 0 ? std::numeric_limits<double>::infinity() : (peak > 0 ? 10 * std::log10(peak * peak / mse) : 0.0);
+        auto psnrAt = [&](double peak) {
+            return mse == 0 ? std::numeric_limits<double>::infinity() : (peak > 0 ? 10 * std::log10(peak * peak / mse) : 0.0);
+        };
+        r.psnr = psnrAt(r.inputMax - r.inputMin);
+        if (isIntegerSample(v.type)) {  // peak = the stored range, in grid units
+            r.storedBits = 8 * sampleBytes(v.type);
+            r.psnrStoredRange = psnrAt(std::abs(v.rescaleSlope) * (std::ldexp(1.0, int(r.storedBits)) - 1));
+        }
+        r.sharedBackground = th.below && th.above;
+        r.backgroundChosen = th.background.has_value();
     }
 
-    // The grid header: OpenVDB's own serialisation of an empty grid.
-    detail::initializeOpenVdb();
-    using GridT = openvdb::Grid<typename openvdb::tree::Tree4<V, 5, 4, 3>::Type>;
-    typename GridT::Ptr grid = GridT::create(background);
-    grid->setName(std::filesystem::path(v.headerPath).stem().string());
-    grid->setGridClass(openvdb::GRID_UNKNOWN);
-    openvdb::Mat4d m = openvdb::Mat4d::identity();
-    for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 3; ++c) m(a, c) = v.axes[size_t(a)][size_t(c)];
-    for (int c = 0; c < 3; ++c) m(3, c) = v.origin[size_t(c)];
-    grid->setTransform(openvdb::math::Transform::Ptr(new openvdb::math::Transform(openvdb::math::MapBase::Ptr(new openvdb::math::AffineMap(m)))));
-    grid->insertMeta("source_file", openvdb::StringMetadata(name));
-    grid->insertMeta("source_sample_type", openvdb::StringMetadata(sampleTypeName(v.type)));
-    // What `decode -o SCAN.nrrd|.nii.gz|...` needs to give the scan back as
-    // it came: its full extent (thresholds may leave the borders inactive),
-    // its stored samples (before any rescale) and its patient space.
-    grid->insertMeta("source_dims", openvdb::Vec3IMetadata(openvdb::Vec3i(int(v.dims[0]), int(v.dims[1]), int(v.dims[2]))));
-    if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) {
-        grid->insertMeta("source_rescale_slope", openvdb::DoubleMetadata(v.rescaleSlope));
-        grid->insertMeta("source_rescale_intercept", openvdb::DoubleMetadata(v.rescaleIntercept));
-    }
-    if (!v.space.empty()) grid->insertMeta("source_space", openvdb::StringMetadata(v.space));
-    if (th.below) grid->insertMeta("background_below", openvdb::DoubleMetadata(th.belowValue));
-    if (th.above) grid->insertMeta("background_above", openvdb::DoubleMetadata(th.aboveValue));
-    record.name = grid->getName();
-    record.gridClass = openvdb::GridBase::gridClassToString(grid->getGridClass());
-    record.indexToWorld = detail::indexToWorldOf(*grid);
-    record.vdbDescriptor = detail::descriptorOf(*grid);
-    const auto* bg = reinterpret_cast<const uint8_t*>(&background);
-    record.background.assign(bg, bg + sizeof(V));
+    describeGrid<V>(v, background, &th, record);
     result.volume.grids.push_back(std::move(record));
     return result;
 }
@@ -228,20 +300,35 @@ void checkDataFileLocation(const DenseVolume& v, const std::string& nameInHeader
     if (rel.empty() || *rel.begin() == "..") throw Error(refuse + "leads out of the header's folder through a link" + hint);
 }
 
+// RAS and LAS coordinates to LPS: the axes that point the other way change
+// sign (world x for R/L, world y for A/P).
+void toLps(DenseVolume& v) {
+    if (v.space.size() != 3 || v.space == "LPS") return;
+    const double sx = v.space[0] == 'R' ? -1 : 1, sy = v.space[1] == 'A' ? -1 : 1;
+    for (auto& axis : v.axes) {
+        axis[0] *= sx;
+        axis[1] *= sy;
+    }
+    v.origin[0] *= sx;
+    v.origin[1] *= sy;
+    v.space = "LPS";
+}
+
 } // namespace
 
-DenseVolume describeDense(const std::string& path, const RawLayout& raw, bool allowExternalData, const std::string& series) {
+DenseVolume describeDense(const std::string& path, const DenseImportOptions& options) {
     DenseVolume v;
     switch (denseFormatOf(path)) {
-        case DenseFormat::Raw: v = describeRaw(path, raw); v.format = DenseFormat::Raw; return v;
+        case DenseFormat::Raw: v = describeRaw(path, options.raw); v.format = DenseFormat::Raw; return v;
         case DenseFormat::Nrrd: v = readNrrdHeader(path); break;
         case DenseFormat::MetaImage: v = readMetaImageHeader(path); break;
-        case DenseFormat::Nifti: v = readNiftiHeader(path); break;
-        case DenseFormat::Dicom: v = describeDicomSeries(path, series); v.format = DenseFormat::Dicom; return v;
+        case DenseFormat::Nifti: v = readNiftiHeader(path, options.volume); break;
+        case DenseFormat::Dicom: v = describeDicomSeries(path, options.series); v.format = DenseFormat::Dicom; return v;
         case DenseFormat::None: throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
     }
     v.format = denseFormatOf(path);
-    if (!allowExternalData && v.dataPath != v.headerPath) checkDataFileLocation(v, v.dataNameInHeader);
+    toLps(v);
+    if (!options.allowExternalData && v.dataPath != v.headerPath) checkDataFileLocation(v, v.dataNameInHeader);
     return v;
 }
 
@@ -293,7 +380,7 @@ DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, boo
 } // namespace
 
 DenseImportResult importDense(const std::string& path, const DenseImportOptions& options) {
-    const DenseVolume v = describeDense(path, options.raw, options.allowExternalData, options.series);
+    const DenseVolume v = describeDense(path, options);
     Thresholds th;
     for (auto [set, value, flag] : {std::tuple{&th.below, &th.belowValue, options.backgroundBelow},
                                     std::tuple{&th.above, &th.aboveValue, options.backgroundAbove}}) {
@@ -302,9 +389,29 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
         *set = true;
         *value = *flag;
     }
+    if (options.backgroundValue) {
+        if (!th.any()) throw Error(path + ": --background-value needs --background-below or --background-above (it is the value removed samples become)");
+        if (!std::isfinite(*options.backgroundValue)) throw Error(path + ": --background-value must be a finite number");
+        th.background = options.backgroundValue;
+    }
     if (th.below && th.above && th.aboveValue < th.belowValue)
         throw Error(path + ": --background-above is below --background-below: every sample would become background");
     const bool p = options.showProgress;
+    if (v.components != 1) {
+        if (v.components != 3) throw Error(path + ": " + std::to_string(v.components) + " components per sample are not supported (1 and 3 are)");
+        if (th.any()) throw Error(path + ": background thresholds apply to scalar scans only (this one has 3 components per sample)");
+        if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) throw Error(path + ": a rescaled vector scan is not supported");
+        switch (v.type) {
+            case SampleType::U8: return importVector<uint8_t, int32_t>(v, ValueType::Vec3I, p);
+            case SampleType::I8: return importVector<int8_t, int32_t>(v, ValueType::Vec3I, p);
+            case SampleType::U16: return importVector<uint16_t, int32_t>(v, ValueType::Vec3I, p);
+            case SampleType::I16: return importVector<int16_t, int32_t>(v, ValueType::Vec3I, p);
+            case SampleType::I32: return importVector<int32_t, int32_t>(v, ValueType::Vec3I, p);
+            case SampleType::F32: return importVector<float, float>(v, ValueType::Vec3S, p);
+            case SampleType::F64: return importVector<double, double>(v, ValueType::Vec3D, p);
+            case SampleType::U32: throw Error(path + ": u32 vector samples are not supported (a Vec3I grid cannot hold them)");
+        }
+    }
     if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) return importRescaled(v, th, p);
     switch (v.type) {
         case SampleType::U8: return importTyped<uint8_t, int32_t>(v, th, ValueType::Int32, p);

@@ -12,8 +12,8 @@
 //
 // Thresholds (--background-below V / --background-above V): samples < V (or
 // > V) become inactive background, so the DAG's sparsity applies. The
-// background value is the mean of the removed samples (rounded for integer
-// grids), the least-squares choice; a first pass over the data finds it. The
+// background value is --background-value, or else the mean of the removed
+// samples (rounded for integer grids), the least-squares choice; a first pass over the data finds it. The
 // report states what that costs against the input: samples changed, max,
 // mean and RMS absolute change, PSNR with peak = the input's value range.
 #pragma once
@@ -33,9 +33,14 @@ struct DenseImportOptions {
     // unless this is set (`--allow-external-data`).
     bool allowExternalData = false;
     std::optional<double> backgroundBelow, backgroundAbove;
+    // The value removed samples become (`--background-value`, e.g. -1000
+    // HU); without it, their mean.
+    std::optional<double> backgroundValue;
     bool showProgress = true;  // a Progress line on a terminal
     // DICOM: which series (`--series N|UID`); empty when the input holds one.
     std::string series;
+    // NIfTI: which volume of a 4-D file (`--volume N`, 0-based).
+    std::optional<int64_t> volume;
 };
 
 struct ThresholdReport {
@@ -46,7 +51,11 @@ struct ThresholdReport {
     double background = 0;      // the background value chosen
     double inputMin = 0, inputMax = 0;  // finite input range (peak = max - min)
     double maxAbsChange = 0, meanAbsChange = 0, rmsChange = 0;  // over all samples
-    double psnr = 0;            // dB; +inf when nothing changed
+    double psnr = 0;            // dB, peak = inputMax - inputMin; +inf when nothing changed
+    unsigned storedBits = 0;    // integer scans: bits per stored sample (0 for float scans)
+    double psnrStoredRange = 0; // dB, peak = the stored type's range (2^bits - 1, times the rescale slope)
+    bool sharedBackground = false;  // both thresholds: the samples below and above became one background
+    bool backgroundChosen = false;  // --background-value, not the mean
 };
 
 struct DenseImportResult {
@@ -57,8 +66,8 @@ struct DenseImportResult {
 
 // The header of `path`, by extension (see DenseVolume.h's denseFormatOf),
 // its data file checked as DenseImportOptions::allowExternalData says.
-// A DICOM input: the series `series` names (DicomSeries.h).
-DenseVolume describeDense(const std::string& path, const RawLayout& raw, bool allowExternalData = false, const std::string& series = "");
+// Only the layout, external-data, series and volume options are used.
+DenseVolume describeDense(const std::string& path, const DenseImportOptions& options);
 
 // Throws vdbdag::Error naming the file on any malformed header, missing or
 // short data, unsupported type or bad threshold.

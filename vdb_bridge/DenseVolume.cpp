@@ -100,8 +100,44 @@ const char* denseFormatName(DenseFormat format) {
     return "none";
 }
 
+namespace {
+
+// Component planes (NIfTI's 5th dimension), one stream each, interleaved
+// slab by slab.
+class PlanarReader : public SliceReader {
+public:
+    explicit PlanarReader(const DenseVolume& v) : sampleBytes_(sampleBytes(v.type)), components_(v.components) {
+        for (unsigned c = 0; c < v.components; ++c) {
+            DenseVolume plane = v;
+            plane.components = 1;
+            plane.componentStride = 0;
+            const int64_t shift = int64_t(c * v.componentStride);
+            if (v.encoding == DataEncoding::Zlib) plane.decodedSkip += shift;
+            else plane.dataOffset += shift;
+            planes_.push_back(std::make_unique<DenseSampleStream>(plane));
+        }
+    }
+    void readSlices(int64_t slices, std::vector<uint8_t>& out) override {
+        std::vector<uint8_t> plane;
+        for (unsigned c = 0; c < components_; ++c) {
+            planes_[c]->readSlices(slices, plane);
+            const size_t n = plane.size() / sampleBytes_;
+            if (c == 0) out.resize(plane.size() * components_);
+            for (size_t i = 0; i < n; ++i)
+                std::memcpy(out.data() + (i * components_ + c) * sampleBytes_, plane.data() + i * sampleBytes_, sampleBytes_);
+        }
+    }
+
+private:
+    unsigned sampleBytes_, components_;
+    std::vector<std::unique_ptr<DenseSampleStream>> planes_;
+};
+
+} // namespace
+
 std::unique_ptr<SliceReader> openSliceReader(const DenseVolume& volume) {
     if (volume.format == DenseFormat::Dicom) return openDicomSlices(volume);
+    if (volume.components > 1 && volume.componentStride > 0) return std::make_unique<PlanarReader>(volume);
     return std::make_unique<DenseSampleStream>(volume);
 }
 
@@ -122,7 +158,7 @@ DenseSampleStream::DenseSampleStream(const DenseVolume& volume) : volume_(volume
         throw Error(volume_.headerPath + ": data file " + data + " is not a regular file (a directory, device or FIFO is never read)");
     const uint64_t fileSize = std::filesystem::file_size(data, ec);
     if (ec) throw Error(where() + ": cannot read the file size (" + ec.message() + ")");
-    const uint64_t need = volume_.sampleCount() * sampleBytes(volume_.type);
+    const uint64_t need = volume_.sampleCount() * sampleBytes(volume_.type) * volume_.components;
     file_ = std::fopen(data.c_str(), "rb");
     if (!file_) throw Error(where() + ": cannot open (" + std::strerror(errno) + ")");
     int64_t offset = volume_.dataOffset;
@@ -143,7 +179,8 @@ DenseSampleStream::DenseSampleStream(const DenseVolume& volume) : volume_(volume
         if (fileSize < at || fileSize - at < need)
             throw Error(where() + ": too short: " + std::to_string(fileSize < at ? 0 : fileSize - at) + " bytes of samples, the header describes " +
                         std::to_string(volume_.dims[0]) + "x" + std::to_string(volume_.dims[1]) + "x" + std::to_string(volume_.dims[2]) + " " +
-                        sampleTypeName(volume_.type) + " = " + std::to_string(need) + " bytes");
+                        sampleTypeName(volume_.type) + (volume_.components > 1 ? " x " + std::to_string(volume_.components) + " components" : "") +
+                        " = " + std::to_string(need) + " bytes");
         if (volume_.decodedSkip && std::fseek(file_, long(volume_.decodedSkip), SEEK_CUR) != 0)
             throw Error(where() + ": cannot skip " + std::to_string(volume_.decodedSkip) + " bytes");
     } else {
@@ -214,7 +251,7 @@ void DenseSampleStream::skipDecoded(uint64_t n) {
 void DenseSampleStream::readSlices(int64_t slices, std::vector<uint8_t>& out) {
     if (slices < 0 || slicesRead_ + slices > volume_.dims[2]) throw Error(volume_.headerPath + ": internal error: reading past the last slice");
     const unsigned sb = sampleBytes(volume_.type);
-    const size_t n = size_t(uint64_t(slices) * volume_.sliceSamples() * sb);
+    const size_t n = size_t(uint64_t(slices) * volume_.sliceSamples() * sb * volume_.components);
     out.resize(n);
     readBytes(out.data(), n);
     slicesRead_ += slices;

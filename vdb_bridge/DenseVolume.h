@@ -58,12 +58,20 @@ struct DenseVolume {
     std::array<double, 3> origin{0, 0, 0};
     std::array<std::array<double, 3>, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
     // The patient space of origin and axes: "LPS" (DICOM, NRRD
-    // "left-posterior-superior", MetaImage by default), "RAS" (NIfTI), or
-    // empty when the header names none.
+    // "left-posterior-superior"), "RAS" (NIfTI), "LAS", or empty when the
+    // header names none. describeDense turns RAS and LAS into LPS, so every
+    // grid of a scan with a patient space is in LPS (as DICOM, ITK, Slicer).
     std::string space;
     // value = stored sample * slope + intercept (DICOM Rescale Slope and
     // Intercept, NIfTI scl_slope / scl_inter); identity by default.
     double rescaleSlope = 1, rescaleIntercept = 0;
+    // Vector and colour scans: components per sample (1 or 3), interleaved
+    // in the file (NRRD's leading axis, MetaImage ElementNumberOfChannels,
+    // NIfTI RGB24) or, when componentStride > 0, in planes that many bytes
+    // apart (NIfTI's 5th dimension). Readers always give them interleaved.
+    unsigned components = 1;
+    uint64_t componentStride = 0;
+    bool colour = false;  // RGB: a colour grid named "Cd"
     // DICOM: the slices in order along the slice normal (dims[2] of them).
     std::vector<DicomSlice> slices;
 

@@ -1,16 +1,856 @@
-// See DicomSeries.h.
+// See DicomSeries.h. GDCM reads the headers (gdcm::Reader up to the Pixel
+// Data, then a second look for the Pixel Data element itself) and decodes
+// the pixel data (gdcm::ImageReader, any transfer syntax it supports).
+// Every file, or every frame of a multi-frame file, becomes one candidate
+// slice; candidates are grouped by Series Instance UID, rows/columns and
+// Image Orientation (Patient), and each group is sorted by its position along
+// the slice normal. What makes a group unconvertible (duplicates, gaps,
+// mixed rescales, colour samples) is found at scan time and kept as its
+// `problem`, so `info` can show it and describeDicomSeries refuses with it.
 #include "vdb_bridge/DicomSeries.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+
+#include <fmt/core.h>
+
+#include <gdcmDataSet.h>
+#include <gdcmImage.h>
+#include <gdcmImageReader.h>
+#include <gdcmMediaStorage.h>
+#include <gdcmReader.h>
+#include <gdcmSequenceOfItems.h>
+#include <gdcmStringFilter.h>
+#include <gdcmTrace.h>
+#include <gdcmUIDs.h>
 
 #include "src/util/Error.h"
 
 namespace vdbdag::bridge {
+namespace {
 
-DicomScan scanDicom(const std::string& path) { throw Error(path + ": DICOM input is not available yet"); }
+namespace fs = std::filesystem;
+using Vec3 = std::array<double, 3>;
 
-DenseVolume describeDicomSeries(const std::string& path, const std::string&) { throw Error(path + ": DICOM input is not available yet"); }
-
-std::unique_ptr<SliceReader> openDicomSlices(const DenseVolume& volume) {
-    throw Error(volume.headerPath + ": DICOM input is not available yet");
+// GDCM reports problems on std::cerr unless told not to; vdbdag reports
+// them itself, as one-line errors.
+void quietGdcm() {
+    static const bool done = [] {
+        gdcm::Trace::DebugOff();
+        gdcm::Trace::WarningOff();
+        gdcm::Trace::ErrorOff();
+        return true;
+    }();
+    (void)done;
 }
+
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 cross(const Vec3& a, const Vec3& b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
+Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Vec3 scaled(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+
+std::string trim(std::string s) {
+    const auto junk = [](char c) { return c == ' ' || c == '\0' || c == '\t' || c == '\r' || c == '\n'; };
+    while (!s.empty() && junk(s.back())) s.pop_back();
+    size_t i = 0;
+    while (i < s.size() && junk(s[i])) ++i;
+    return s.substr(i);
+}
+
+// "a\b\c" (DS, IS) as numbers; nullopt when any value is not a number.
+std::optional<std::vector<double>> parseNumbers(const std::string& text) {
+    std::vector<double> out;
+    if (trim(text).empty()) return out;
+    size_t start = 0;
+    while (start <= text.size()) {
+        const size_t end = std::min(text.find('\\', start), text.size());
+        std::string item = trim(text.substr(start, end - start));
+        if (!item.empty() && item[0] == '+') item.erase(0, 1);
+        double v = 0;
+        const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+        if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || !std::isfinite(v)) return std::nullopt;
+        out.push_back(v);
+        start = end + 1;
+    }
+    return out;
+}
+
+std::string formatNumber(double v) { return fmt::format("{:.6g}", v); }
+std::string formatVec(const Vec3& v) { return fmt::format("({:.6g}, {:.6g}, {:.6g})", v[0], v[1], v[2]); }
+
+// One element of a data set (top level or an item's), as text.
+class Fields {
+public:
+    explicit Fields(const gdcm::File& file) { filter_.SetFile(file); }
+    std::string text(const gdcm::DataSet& ds, uint16_t group, uint16_t element) const {
+        const gdcm::Tag tag(group, element);
+        if (!ds.FindDataElement(tag)) return "";
+        const gdcm::DataElement& de = ds.GetDataElement(tag);
+        if (de.IsEmpty()) return "";
+        return trim(filter_.ToString(de));
+    }
+    // Empty when absent; nullopt when present but not numbers.
+    std::optional<std::vector<double>> numbers(const gdcm::DataSet& ds, uint16_t group, uint16_t element) const {
+        return parseNumbers(text(ds, group, element));
+    }
+
+private:
+    gdcm::StringFilter filter_;
+};
+
+// The first item of sequence (group, element) in `ds`, or null.
+const gdcm::DataSet* firstItem(const gdcm::DataSet& ds, uint16_t group, uint16_t element, gdcm::SmartPointer<gdcm::SequenceOfItems>& keep) {
+    const gdcm::Tag tag(group, element);
+    if (!ds.FindDataElement(tag)) return nullptr;
+    keep = ds.GetDataElement(tag).GetValueAsSQ();
+    if (!keep || keep->GetNumberOfItems() < 1) return nullptr;
+    return &keep->GetItem(1).GetNestedDataSet();
+}
+
+// A candidate slice: one file, or one frame of a multi-frame file.
+struct Frame {
+    std::string file;
+    uint32_t frame = 0;
+    bool multiFrame = false;
+    Vec3 position{0, 0, 0};
+    std::array<double, 6> orientation{1, 0, 0, 0, 1, 0};
+    double rowSpacing = 1, columnSpacing = 1;  // Pixel Spacing [0], [1]
+    bool pixelSpacingGiven = false;
+    double thickness = 0;  // 0: not given
+    double slope = 1, intercept = 0;
+};
+
+// What every frame of one file shares.
+struct FileInfo {
+    std::string file;
+    std::string seriesUid, modality, description;
+    int64_t seriesNumber = 0;
+    uint32_t rows = 0, columns = 0;
+    unsigned bitsAllocated = 0, pixelRepresentation = 0, samplesPerPixel = 1;
+    std::string photometric;
+    std::string damaged;  // why its pixel data cannot be read (a truncated file), or ""
+};
+
+struct Group {
+    DicomSeriesInfo info;
+    FileInfo first;  // the first file's shared values (bits, samples)
+    std::vector<Frame> frames;
+    std::vector<const FileInfo*> files;  // parallel to frames
+    std::string problem;                 // empty when convertible
+    Vec3 rowDir{1, 0, 0}, colDir{0, 1, 0}, normal{0, 0, 1};
+    std::optional<SampleType> type;
+};
+
+struct ScanState {
+    DicomScan scan;
+    std::vector<std::unique_ptr<FileInfo>> files;
+    std::vector<Group> groups;  // parallel to scan.series
+};
+
+std::string sopClassName(const std::string& uid) {
+    gdcm::UIDs u;
+    if (!uid.empty() && u.SetFromUID(uid.c_str()) && u.GetName()) return std::string(u.GetName()) + " (" + uid + ")";
+    return uid.empty() ? std::string("no SOP Class UID") : uid;
+}
+
+bool startsWith(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
+
+// A SOP class that is not a greyscale image stack however it looks.
+std::string nonImageClass(const std::string& sop) {
+    if (sop == "1.2.840.10008.5.1.4.1.1.66.4") return "a DICOM-SEG segmentation object, not an image series";
+    if (startsWith(sop, "1.2.840.10008.5.1.4.1.1.88.")) return "a structured report (SR), not an image";
+    if (startsWith(sop, "1.2.840.10008.5.1.4.1.1.11.")) return "a presentation state, not an image";
+    if (startsWith(sop, "1.2.840.10008.5.1.4.1.1.104.")) return "an encapsulated document, not an image";
+    if (startsWith(sop, "1.2.840.10008.5.1.4.1.1.481.") && sop != "1.2.840.10008.5.1.4.1.1.481.1" && sop != "1.2.840.10008.5.1.4.1.1.481.2")
+        return "a radiotherapy object (" + sopClassName(sop) + "), not an image";
+    if (sop == "1.2.840.10008.5.1.4.1.1.66" || startsWith(sop, "1.2.840.10008.5.1.4.1.1.66."))
+        return "a non-image object (" + sopClassName(sop) + ")";
+    if (sop == "1.2.840.10008.1.3.10") return "a DICOMDIR (media directory), not an image";
+    return "";
+}
+
+constexpr uint16_t kPixelGroup = 0x7fe0;
+
+// GDCM reads a file cut short inside native (uncompressed) pixel data
+// without complaint. The Pixel Data element's header is found in the file
+// (its tag followed by its length, explicit or implicit VR, the first such
+// match) and the file must hold all of its value. Returns "" when it does or
+// when the element cannot be found (deflated data sets).
+std::string checkNativeLength(const std::string& path, uint32_t length, bool bigEndian) {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (!file) return "";
+    std::error_code ec;
+    const uint64_t size = fs::file_size(path, ec);
+    const uint8_t tag[4] = {uint8_t(bigEndian ? 0x7f : 0xe0), uint8_t(bigEndian ? 0xe0 : 0x7f), uint8_t(bigEndian ? 0x00 : 0x10),
+                            uint8_t(bigEndian ? 0x10 : 0x00)};
+    const auto u32 = [&](const uint8_t* p) {
+        return bigEndian ? uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]
+                         : uint32_t(p[3]) << 24 | uint32_t(p[2]) << 16 | uint32_t(p[1]) << 8 | p[0];
+    };
+    constexpr size_t kChunk = size_t(1) << 16, kKeep = 12;
+    std::vector<uint8_t> buf;
+    uint64_t bufStart = 0;  // file offset of buf[0]
+    std::string result;
+    std::vector<uint8_t> chunk(kChunk);
+    for (;;) {
+        const size_t got = std::fread(chunk.data(), 1, kChunk, file);
+        buf.insert(buf.end(), chunk.begin(), chunk.begin() + ptrdiff_t(got));
+        bool found = false;
+        for (size_t i = 0; i + kKeep <= buf.size() && !found; ++i) {
+            if (std::memcmp(buf.data() + i, tag, 4) != 0) continue;
+            const uint8_t* p = buf.data() + i + 4;
+            uint64_t header = 0;
+            if ((p[0] == 'O' && (p[1] == 'W' || p[1] == 'B')) && p[2] == 0 && p[3] == 0 && u32(p + 4) == length) header = 12;
+            else if (u32(p) == length) header = 8;
+            if (!header) continue;
+            found = true;
+            const uint64_t end = bufStart + i + header + length;
+            if (end > size)
+                result = fmt::format("is truncated: its pixel data are {} bytes from byte {} on, but the file holds only {} of them", length, bufStart + i + header,
+                                     size - (bufStart + i + header));
+        }
+        if (found || got < kChunk) break;
+        if (buf.size() > kKeep) {  // keep the tail: a header may straddle chunks
+            bufStart += buf.size() - kKeep;
+            buf.erase(buf.begin(), buf.end() - ptrdiff_t(kKeep));
+        }
+    }
+    std::fclose(file);
+    return result;
+}
+
+// Reads one file's header into `frames` (one per frame); returns the reason
+// to skip it, or "" when it is an image.
+std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>& frames) {
+    quietGdcm();
+    gdcm::Reader reader;
+    reader.SetFileName(path.c_str());
+    if (!reader.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008))) return "not a DICOM file (or unreadable)";
+    const gdcm::File& file = reader.GetFile();
+    const gdcm::DataSet& ds = file.GetDataSet();
+    const Fields f(file);
+    std::string sop = f.text(ds, 0x0008, 0x0016);
+    if (sop.empty()) sop = trim(f.text(file.GetHeader(), 0x0002, 0x0002));
+    if (const std::string why = nonImageClass(sop); !why.empty()) return why;
+    const auto rows = f.numbers(ds, 0x0028, 0x0010), cols = f.numbers(ds, 0x0028, 0x0011);
+    if (!rows || !cols || rows->size() != 1 || cols->size() != 1 || (*rows)[0] < 1 || (*cols)[0] < 1)
+        return "no image (no Rows/Columns; SOP class " + sopClassName(sop) + ")";
+    info.rows = uint32_t((*rows)[0]);
+    info.columns = uint32_t((*cols)[0]);
+
+    // The pixel data element itself (the header read stops before it).
+    {
+        gdcm::Reader pixels;
+        pixels.SetFileName(path.c_str());
+        const std::set<gdcm::Tag> tags{gdcm::Tag(kPixelGroup, 0x0008), gdcm::Tag(kPixelGroup, 0x0009), gdcm::Tag(kPixelGroup, 0x0010)};
+        // A file whose header reads but whose pixel data does not is part of
+        // its series all the same (damaged): the series is refused naming it,
+        // rather than showing a gap.
+        const bool read = pixels.ReadSelectedTags(tags, false);
+        const gdcm::DataSet& p = pixels.GetFile().GetDataSet();
+        const gdcm::Tag pixelData(kPixelGroup, 0x0010);
+        if (!read) {
+            info.damaged = "is truncated or corrupt: its pixel data cannot be read";
+        } else {
+            if (p.FindDataElement(gdcm::Tag(kPixelGroup, 0x0008)) || p.FindDataElement(gdcm::Tag(kPixelGroup, 0x0009)))
+                return "float or double pixel data (Float/Double Float Pixel Data) is not supported";
+            if (!p.FindDataElement(pixelData)) return "no pixel data (SOP class " + sopClassName(sop) + ")";
+            const gdcm::VL vl = p.GetDataElement(pixelData).GetVL();
+            const bool bigEndian = file.GetHeader().GetDataSetTransferSyntax() == gdcm::TransferSyntax::ExplicitVRBigEndian;
+            if (!vl.IsUndefined() && uint32_t(vl) > 0) info.damaged = checkNativeLength(path, uint32_t(vl), bigEndian);
+        }
+    }
+
+    info.file = path;
+    info.seriesUid = f.text(ds, 0x0020, 0x000e);
+    if (info.seriesUid.empty()) return "no Series Instance UID";
+    info.modality = f.text(ds, 0x0008, 0x0060);
+    info.description = f.text(ds, 0x0008, 0x103e);
+    if (const auto n = f.numbers(ds, 0x0020, 0x0011); n && n->size() == 1) info.seriesNumber = int64_t((*n)[0]);
+    const auto number = [&](uint16_t g, uint16_t e, unsigned fallback) {
+        const auto v = f.numbers(ds, g, e);
+        return v && v->size() == 1 && (*v)[0] >= 0 ? unsigned((*v)[0]) : fallback;
+    };
+    info.bitsAllocated = number(0x0028, 0x0100, 0);
+    info.pixelRepresentation = number(0x0028, 0x0103, 0);
+    info.samplesPerPixel = number(0x0028, 0x0002, 1);
+    info.photometric = f.text(ds, 0x0028, 0x0004);
+
+    // Geometry, rescale: from `where` (a functional group item or the top level).
+    const auto readPlane = [&](const gdcm::DataSet* posDs, const gdcm::DataSet* oriDs, const gdcm::DataSet* pixDs, const gdcm::DataSet* resDs,
+                               Frame& fr, bool& havePosition, bool& haveOrientation) -> std::string {
+        if (posDs) {
+            const auto p = f.numbers(*posDs, 0x0020, 0x0032);
+            if (!p) return "unreadable Image Position (Patient)";
+            if (p->size() == 3) { fr.position = {(*p)[0], (*p)[1], (*p)[2]}; havePosition = true; }
+            else if (!p->empty()) return "Image Position (Patient) does not hold 3 numbers";
+        }
+        if (oriDs) {
+            const auto o = f.numbers(*oriDs, 0x0020, 0x0037);
+            if (!o) return "unreadable Image Orientation (Patient)";
+            if (o->size() == 6) { std::copy(o->begin(), o->end(), fr.orientation.begin()); haveOrientation = true; }
+            else if (!o->empty()) return "Image Orientation (Patient) does not hold 6 numbers";
+        }
+        if (pixDs) {
+            auto s = f.numbers(*pixDs, 0x0028, 0x0030);
+            if (!s || s->size() != 2) s = f.numbers(*pixDs, 0x0018, 0x1164);  // Imager Pixel Spacing
+            if (s && s->size() == 2 && (*s)[0] > 0 && (*s)[1] > 0) {
+                fr.rowSpacing = (*s)[0];
+                fr.columnSpacing = (*s)[1];
+                fr.pixelSpacingGiven = true;
+            }
+            if (const auto t = f.numbers(*pixDs, 0x0018, 0x0050); t && t->size() == 1 && (*t)[0] > 0) fr.thickness = (*t)[0];
+        }
+        if (resDs) {
+            const auto a = f.numbers(*resDs, 0x0028, 0x1053), b = f.numbers(*resDs, 0x0028, 0x1052);
+            if (!a || !b || a->size() > 1 || b->size() > 1) return "unreadable Rescale Slope/Intercept";
+            if (a->size() == 1) fr.slope = (*a)[0];
+            if (b->size() == 1) fr.intercept = (*b)[0];
+        }
+        return "";
+    };
+
+    Frame base;
+    base.file = path;
+    bool basePos = false, baseOri = false;
+    if (std::string why = readPlane(&ds, &ds, &ds, &ds, base, basePos, baseOri); !why.empty()) return why;
+
+    const auto nf = f.numbers(ds, 0x0028, 0x0008);
+    const int64_t frameCount = nf && nf->size() == 1 && (*nf)[0] >= 1 ? int64_t((*nf)[0]) : 1;
+    gdcm::SmartPointer<gdcm::SequenceOfItems> sharedSq, perFrameSq;
+    const gdcm::DataSet* shared = firstItem(ds, 0x5200, 0x9229, sharedSq);
+    if (ds.FindDataElement(gdcm::Tag(0x5200, 0x9230))) perFrameSq = ds.GetDataElement(gdcm::Tag(0x5200, 0x9230)).GetValueAsSQ();
+
+    if (perFrameSq && perFrameSq->GetNumberOfItems() > 0) {
+        // Enhanced multi-frame: each frame's plane from its functional
+        // groups, falling back on the shared ones.
+        if (int64_t(perFrameSq->GetNumberOfItems()) != frameCount)
+            return fmt::format("multi-frame file with {} frames but {} Per-frame Functional Groups items", frameCount, perFrameSq->GetNumberOfItems());
+        for (int64_t k = 0; k < frameCount; ++k) {
+            const gdcm::DataSet& item = perFrameSq->GetItem(size_t(k + 1)).GetNestedDataSet();
+            Frame fr = base;
+            fr.frame = uint32_t(k);
+            fr.multiFrame = true;
+            bool havePos = basePos, haveOri = baseOri;
+            std::vector<gdcm::SmartPointer<gdcm::SequenceOfItems>> keep(8);
+            const auto group = [&](uint16_t g, uint16_t e, size_t slot) -> const gdcm::DataSet* {
+                if (const gdcm::DataSet* d = firstItem(item, g, e, keep[slot])) return d;
+                return shared ? firstItem(*shared, g, e, keep[slot + 4]) : nullptr;
+            };
+            const gdcm::DataSet* pos = group(0x0020, 0x9113, 0);
+            const gdcm::DataSet* ori = group(0x0020, 0x9116, 1);
+            const gdcm::DataSet* pix = group(0x0028, 0x9110, 2);
+            const gdcm::DataSet* res = group(0x0028, 0x9145, 3);
+            if (std::string why = readPlane(pos, ori, pix, res, fr, havePos, haveOri); !why.empty()) return fmt::format("frame {}: {}", k + 1, why);
+            if (!havePos || !haveOri) return fmt::format("multi-frame file: frame {} has no Plane Position/Orientation", k + 1);
+            frames.push_back(fr);
+        }
+        return "";
+    }
+    if (!basePos || !baseOri) return "no Image Position/Orientation (Patient) (SOP class " + sopClassName(sop) + "), so no place in a volume";
+    if (frameCount == 1) {
+        frames.push_back(base);
+        return "";
+    }
+    // Multi-frame without per-frame positions: frames stepped along the
+    // normal by Spacing Between Slices (or the RT Grid Frame Offset Vector).
+    const Vec3 r{base.orientation[0], base.orientation[1], base.orientation[2]}, c{base.orientation[3], base.orientation[4], base.orientation[5]};
+    Vec3 n = cross(r, c);
+    const double nn = norm(n);
+    if (!(nn > 0)) return "degenerate Image Orientation (Patient)";
+    n = scaled(n, 1 / nn);
+    std::vector<double> offsets;
+    if (const auto sbs = f.numbers(ds, 0x0018, 0x0088); sbs && sbs->size() == 1 && (*sbs)[0] != 0) {
+        for (int64_t k = 0; k < frameCount; ++k) offsets.push_back(double(k) * (*sbs)[0]);
+    } else if (const auto g = f.numbers(ds, 0x3004, 0x000c); g && int64_t(g->size()) == frameCount) {
+        offsets = *g;
+    } else {
+        return fmt::format("multi-frame file with {} frames but no per-frame positions (Per-frame Functional Groups) nor Spacing Between Slices; not supported",
+                           frameCount);
+    }
+    for (int64_t k = 0; k < frameCount; ++k) {
+        Frame fr = base;
+        fr.frame = uint32_t(k);
+        fr.multiFrame = true;
+        for (int a = 0; a < 3; ++a) fr.position[size_t(a)] += offsets[size_t(k)] * n[size_t(a)];
+        frames.push_back(fr);
+    }
+    return "";
+}
+
+// The files a DICOMDIR lists (Referenced File ID, relative to its folder).
+std::vector<std::string> dicomdirFiles(const std::string& path, std::vector<std::string>& skipped) {
+    quietGdcm();
+    gdcm::Reader reader;
+    reader.SetFileName(path.c_str());
+    if (!reader.Read()) throw Error(path + ": not a readable DICOMDIR");
+    const gdcm::File& file = reader.GetFile();
+    const gdcm::DataSet& ds = file.GetDataSet();
+    const Fields f(file);
+    const gdcm::Tag records(0x0004, 0x1220);
+    if (!ds.FindDataElement(records)) throw Error(path + ": a DICOMDIR without a Directory Record Sequence");
+    const gdcm::SmartPointer<gdcm::SequenceOfItems> sq = ds.GetDataElement(records).GetValueAsSQ();
+    const fs::path folder = fs::path(path).parent_path();
+    std::vector<std::string> out;
+    std::set<std::string> seen;
+    for (size_t i = 1; sq && i <= sq->GetNumberOfItems(); ++i) {
+        const std::string id = f.text(sq->GetItem(i).GetNestedDataSet(), 0x0004, 0x1500);
+        if (id.empty()) continue;
+        fs::path p = folder;
+        bool outside = false;
+        size_t start = 0;
+        while (start <= id.size()) {
+            const size_t end = std::min(id.find('\\', start), id.size());
+            const std::string part = trim(id.substr(start, end - start));
+            if (part == ".." || part.find('/') != std::string::npos) outside = true;  // file IDs never leave the DICOMDIR's folder
+            if (!part.empty() && !outside) {
+                fs::path next = p / part;
+                std::error_code ec;
+                if (!fs::exists(next, ec)) {  // media file IDs are upper case; the disk may not be
+                    for (const auto& e : fs::directory_iterator(p, ec)) {
+                        std::string a = e.path().filename().string(), b = part;
+                        std::transform(a.begin(), a.end(), a.begin(), [](unsigned char ch) { return char(std::toupper(ch)); });
+                        std::transform(b.begin(), b.end(), b.begin(), [](unsigned char ch) { return char(std::toupper(ch)); });
+                        if (a == b) { next = e.path(); break; }
+                    }
+                }
+                p = next;
+            }
+            start = end + 1;
+        }
+        std::error_code ec;
+        if (outside) {
+            skipped.push_back(path + ": its file ID '" + id + "' leads out of its folder; not read");
+            continue;
+        }
+        if (!fs::is_regular_file(p, ec)) {
+            skipped.push_back(p.string() + ": listed in " + path + " but missing");
+            continue;
+        }
+        if (seen.insert(p.string()).second) out.push_back(p.string());
+    }
+    return out;
+}
+
+bool isDicomdirName(const fs::path& p) {
+    std::string name = p.filename().string();
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return name == "dicomdir";
+}
+
+std::optional<SampleType> sampleTypeOf(unsigned bits, unsigned representation) {
+    if (bits == 8) return representation ? SampleType::I8 : SampleType::U8;
+    if (bits == 16) return representation ? SampleType::I16 : SampleType::U16;
+    if (bits == 32) return representation ? SampleType::I32 : SampleType::U32;
+    return std::nullopt;
+}
+
+bool sameOrientation(const std::array<double, 6>& a, const std::array<double, 6>& b) {
+    for (size_t i = 0; i < 6; ++i)
+        if (std::abs(a[i] - b[i]) > 1e-4) return false;
+    return true;
+}
+
+std::string frameName(const Frame& fr, const FileInfo&) { return fr.multiFrame ? fmt::format("{} (frame {})", fr.file, fr.frame + 1) : fr.file; }
+
+// Sorts the group's frames along the normal and finds what keeps it from
+// being one regular grid.
+void analyse(Group& g) {
+    const auto& o = g.frames.front().orientation;
+    g.rowDir = {o[0], o[1], o[2]};
+    g.colDir = {o[3], o[4], o[5]};
+    Vec3 n = cross(g.rowDir, g.colDir);
+    const double nn = norm(n);
+    const auto fail = [&](const std::string& why) {
+        if (g.problem.empty()) g.problem = why;
+    };
+    if (!(nn > 1e-6) || std::abs(norm(g.rowDir) - 1) > 1e-3 || std::abs(norm(g.colDir) - 1) > 1e-3)
+        fail("Image Orientation (Patient) " + fmt::format("{:.6g}\\{:.6g}\\{:.6g}\\{:.6g}\\{:.6g}\\{:.6g}", o[0], o[1], o[2], o[3], o[4], o[5]) +
+             " is not two unit directions");
+    g.normal = nn > 0 ? scaled(n, 1 / nn) : Vec3{0, 0, 1};
+
+    // Order by position along the normal (ties: by file, frame).
+    std::vector<size_t> order(g.frames.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::vector<double> s(g.frames.size());
+    for (size_t i = 0; i < s.size(); ++i) s[i] = dot(g.frames[i].position, g.normal);
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        if (s[a] != s[b]) return s[a] < s[b];
+        if (g.frames[a].file != g.frames[b].file) return g.frames[a].file < g.frames[b].file;
+        return g.frames[a].frame < g.frames[b].frame;
+    });
+    std::vector<Frame> frames;
+    std::vector<const FileInfo*> files;
+    std::vector<double> sorted;
+    for (size_t i : order) {
+        frames.push_back(g.frames[i]);
+        files.push_back(g.files[i]);
+        sorted.push_back(s[i]);
+    }
+    g.frames = std::move(frames);
+    g.files = std::move(files);
+    const size_t count = g.frames.size();
+
+    // Samples.
+    g.first = *g.files.front();
+    if (g.first.samplesPerPixel != 1)
+        fail(fmt::format("{} samples per pixel (Photometric Interpretation {}); only greyscale (1 sample per pixel) is supported for now",
+                         g.first.samplesPerPixel, g.first.photometric.empty() ? "unknown" : g.first.photometric));
+    else if (g.first.photometric == "PALETTE COLOR")
+        fail("PALETTE COLOR (indexed colour); only greyscale is supported for now");
+    for (const FileInfo* f : g.files)
+        if (!f->damaged.empty()) {
+            fail(f->file + " " + f->damaged);
+            break;
+        }
+    g.type = sampleTypeOf(g.first.bitsAllocated, g.first.pixelRepresentation);
+    if (!g.type) fail(fmt::format("Bits Allocated {}; only 8, 16 or 32 are supported", g.first.bitsAllocated));
+    for (size_t i = 1; i < count; ++i) {
+        const FileInfo& b = *g.files[i];
+        if (b.bitsAllocated != g.first.bitsAllocated || b.pixelRepresentation != g.first.pixelRepresentation ||
+            b.samplesPerPixel != g.first.samplesPerPixel) {
+            fail(fmt::format("{} (Bits Allocated {}, Pixel Representation {}) and {} (Bits Allocated {}, Pixel Representation {}) store "
+                             "different sample types",
+                             g.first.file, g.first.bitsAllocated, g.first.pixelRepresentation, b.file, b.bitsAllocated, b.pixelRepresentation));
+            break;
+        }
+    }
+
+    // Rescale and pixel spacing: one value for the whole series.
+    const Frame& f0 = g.frames.front();
+    for (size_t i = 1; i < count; ++i) {
+        const Frame& f = g.frames[i];
+        if (f.slope != f0.slope || f.intercept != f0.intercept) {
+            fail(fmt::format("Rescale Slope/Intercept differ between slices ({}: {}/{}, {}: {}/{}); one rescale per series is supported",
+                             frameName(f0, *g.files.front()), formatNumber(f0.slope), formatNumber(f0.intercept), frameName(f, *g.files[i]),
+                             formatNumber(f.slope), formatNumber(f.intercept)));
+            break;
+        }
+    }
+    for (size_t i = 1; i < count; ++i) {
+        const Frame& f = g.frames[i];
+        if (std::abs(f.rowSpacing - f0.rowSpacing) > 1e-4 * f0.rowSpacing || std::abs(f.columnSpacing - f0.columnSpacing) > 1e-4 * f0.columnSpacing) {
+            fail(fmt::format("Pixel Spacing differs between slices ({}: {}\\{}, {}: {}\\{})", frameName(f0, *g.files.front()),
+                             formatNumber(f0.rowSpacing), formatNumber(f0.columnSpacing), frameName(f, *g.files[i]), formatNumber(f.rowSpacing),
+                             formatNumber(f.columnSpacing)));
+            break;
+        }
+    }
+    if (!f0.pixelSpacingGiven) g.info.notes.push_back("no Pixel Spacing: 1 mm assumed in-plane");
+
+    // Positions: no duplicates, one regular step, on one line.
+    double step = f0.thickness > 0 ? f0.thickness : 1;
+    if (count > 1) {
+        const double span = sorted.back() - sorted.front();
+        for (size_t i = 0; i + 1 < count; ++i) {
+            if (std::abs(sorted[i + 1] - sorted[i]) <= 1e-6 * std::max(1.0, std::abs(span))) {
+                fail(fmt::format("{} and {} are at the same slice position ({} mm along the normal): duplicate slices", frameName(g.frames[i], *g.files[i]),
+                                 frameName(g.frames[i + 1], *g.files[i + 1]), formatNumber(sorted[i])));
+                g.info.notes.push_back("duplicate slice positions");
+                break;
+            }
+        }
+        std::vector<double> steps;
+        for (size_t i = 0; i + 1 < count; ++i) steps.push_back(sorted[i + 1] - sorted[i]);
+        std::vector<double> tmp = steps;
+        std::nth_element(tmp.begin(), tmp.begin() + ptrdiff_t(tmp.size() / 2), tmp.end());
+        const double median = tmp[tmp.size() / 2];
+        step = median;
+        if (g.problem.empty() && median > 0) {
+            std::vector<std::string> bad;
+            size_t badCount = 0;
+            for (size_t i = 0; i < steps.size(); ++i) {
+                if (std::abs(steps[i] - median) <= 1e-3 * median) continue;
+                if (++badCount <= 4)
+                    bad.push_back(fmt::format("{} mm ({}) -> {} mm ({}), a step of {} mm", formatNumber(sorted[i]), frameName(g.frames[i], *g.files[i]),
+                                              formatNumber(sorted[i + 1]), frameName(g.frames[i + 1], *g.files[i + 1]), formatNumber(steps[i])));
+            }
+            if (badCount) {
+                std::string list;
+                for (size_t i = 0; i < bad.size(); ++i) list += (i ? ", " : "") + bad[i];
+                if (badCount > bad.size()) list += fmt::format(" and {} more", badCount - bad.size());
+                fail(fmt::format("uneven slice spacing or missing slices: the median step is {} mm, but along the normal {}",
+                                 formatNumber(median), list));
+                g.info.notes.push_back("uneven spacing or missing slices");
+            }
+        }
+        if (g.problem.empty()) {
+            const Vec3 axis = scaled(sub(g.frames.back().position, f0.position), 1.0 / double(count - 1));
+            double worst = 0;
+            size_t at = 0;
+            for (size_t i = 0; i < count; ++i) {
+                const Vec3 expect{f0.position[0] + double(i) * axis[0], f0.position[1] + double(i) * axis[1], f0.position[2] + double(i) * axis[2]};
+                const double d = norm(sub(g.frames[i].position, expect));
+                if (d > worst) { worst = d; at = i; }
+            }
+            if (worst > 1e-2 * norm(axis))
+                fail(fmt::format("the slice positions do not lie on a line: {} is at {}, {} mm off", frameName(g.frames[at], *g.files[at]),
+                                 formatVec(g.frames[at].position), formatNumber(worst)));
+            const double cosAngle = dot(axis, g.normal) / norm(axis);
+            if (cosAngle < 1 - 1e-6)
+                g.info.notes.push_back(fmt::format("sheared stack (slices step {:.3g} degrees off the normal, e.g. gantry tilt)",
+                                                   std::acos(std::min(1.0, cosAngle)) * 180 / M_PI));
+        }
+    }
+
+    g.info.dims = {int64_t(g.first.columns), int64_t(g.first.rows), int64_t(count)};
+    g.info.spacing = {f0.columnSpacing, f0.rowSpacing, step};
+    g.info.sampleType = g.type ? sampleTypeName(*g.type) : "";
+    g.info.problem = g.problem;
+    std::set<std::string> distinctFiles;
+    for (const Frame& f : g.frames) distinctFiles.insert(f.file);
+    if (distinctFiles.size() < count) g.info.notes.push_back(fmt::format("multi-frame: {} frames from {} file(s)", count, distinctFiles.size()));
+}
+
+ScanState scan(const std::string& path) {
+    ScanState st;
+    std::error_code ec;
+    const fs::path root(path);
+    if (!fs::exists(root, ec)) throw Error(path + ": does not exist");
+    std::vector<std::string> candidates;
+    bool fromFolder = false;
+    if (fs::is_directory(root, ec)) {
+        fromFolder = true;
+        fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, ec), end;
+        if (ec) throw Error(path + ": cannot list the folder (" + ec.message() + ")");
+        for (; it != end; it.increment(ec)) {
+            if (ec) throw Error(path + ": cannot list the folder (" + ec.message() + ")");
+            std::error_code fe;
+            if (it->is_regular_file(fe)) candidates.push_back(it->path().string());
+        }
+        std::sort(candidates.begin(), candidates.end());
+        if (candidates.empty()) throw Error(path + ": the folder holds no files");
+    } else if (fs::is_regular_file(root, ec)) {
+        bool dicomdir = isDicomdirName(root);
+        if (!dicomdir) {  // a DICOMDIR by its Media Storage SOP Class, whatever its name
+            quietGdcm();
+            gdcm::Reader r;
+            r.SetFileName(path.c_str());
+            if (r.ReadUpToTag(gdcm::Tag(0x0004, 0x1220))) {
+                const Fields f(r.GetFile());
+                dicomdir = f.text(r.GetFile().GetHeader(), 0x0002, 0x0002) == "1.2.840.10008.1.3.10";
+            }
+        }
+        candidates = dicomdir ? dicomdirFiles(path, st.scan.skipped) : std::vector<std::string>{path};
+        if (dicomdir && candidates.empty())
+            throw Error(path + ": the DICOMDIR lists no files that exist" + (st.scan.skipped.empty() ? std::string() : " (e.g. " + st.scan.skipped.front() + ")"));
+    } else {
+        throw Error(path + ": is neither a folder nor a regular file");
+    }
+
+    for (const std::string& file : candidates) {
+        if (fromFolder && isDicomdirName(file)) {
+            st.scan.skipped.push_back(file + ": a DICOMDIR (the files in the folder are scanned themselves)");
+            continue;
+        }
+        auto info = std::make_unique<FileInfo>();
+        std::vector<Frame> frames;
+        const std::string why = readFile(file, *info, frames);
+        if (!why.empty()) {
+            st.scan.skipped.push_back(file + ": " + why);
+            continue;
+        }
+        for (const Frame& fr : frames) {
+            Group* target = nullptr;
+            for (Group& g : st.groups)
+                if (g.info.uid == info->seriesUid && g.first.rows == info->rows && g.first.columns == info->columns &&
+                    sameOrientation(g.frames.front().orientation, fr.orientation)) {
+                    target = &g;
+                    break;
+                }
+            if (!target) {
+                Group g;
+                g.info.uid = info->seriesUid;
+                g.info.modality = info->modality;
+                g.info.description = info->description;
+                g.info.seriesNumber = info->seriesNumber;
+                g.first = *info;
+                st.groups.push_back(std::move(g));
+                target = &st.groups.back();
+            }
+            target->frames.push_back(fr);
+            target->files.push_back(info.get());
+        }
+        st.files.push_back(std::move(info));
+    }
+
+    // Listing order: series number, UID, then the order parts were found.
+    std::vector<size_t> order(st.groups.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        const DicomSeriesInfo &x = st.groups[a].info, &y = st.groups[b].info;
+        if (x.seriesNumber != y.seriesNumber) return x.seriesNumber < y.seriesNumber;
+        return x.uid < y.uid;
+    });
+    std::vector<Group> groups;
+    for (size_t i : order) groups.push_back(std::move(st.groups[i]));
+    st.groups = std::move(groups);
+    std::map<std::string, int> parts;
+    for (const Group& g : st.groups) ++parts[g.info.uid];
+    std::map<std::string, int> seen;
+    for (Group& g : st.groups) {
+        analyse(g);
+        if (parts[g.info.uid] > 1)
+            g.info.notes.insert(g.info.notes.begin(), fmt::format("part {} of {} of this Series Instance UID (split by orientation or image size)",
+                                                                   ++seen[g.info.uid], parts[g.info.uid]));
+        st.scan.series.push_back(g.info);
+    }
+    return st;
+}
+
+std::string oneLine(size_t index, const DicomSeriesInfo& s) {
+    std::string line = fmt::format("{}) {} {} \"{}\" {}x{}x{}", index + 1, s.uid, s.modality.empty() ? "?" : s.modality, s.description, s.dims[0],
+                                   s.dims[1], s.dims[2]);
+    if (!s.problem.empty()) line += " (not convertible)";
+    return line;
+}
+
+std::string listing(const DicomScan& scan) {
+    std::string out;
+    for (size_t i = 0; i < scan.series.size(); ++i) out += (i ? "; " : "") + oneLine(i, scan.series[i]);
+    return out;
+}
+
+} // namespace
+
+DicomScan scanDicom(const std::string& path) { return scan(path).scan; }
+
+DenseVolume describeDicomSeries(const std::string& path, const std::string& choice) {
+    ScanState st = scan(path);
+    const DicomScan& sc = st.scan;
+    if (sc.series.empty()) {
+        if (sc.skipped.size() == 1 && sc.skipped.front().compare(0, path.size(), path) == 0 && !fs::is_directory(path))
+            throw Error(sc.skipped.front());
+        throw Error(fmt::format("{}: holds no DICOM image series; {} file(s) skipped, e.g. {}", path, sc.skipped.size(),
+                                sc.skipped.empty() ? std::string("none") : sc.skipped.front()));
+    }
+    size_t index = 0;
+    const std::string c = trim(choice);
+    if (c.empty()) {
+        if (sc.series.size() > 1)
+            throw Error(fmt::format("{}: holds {} series, pick one with --series N or UID: {}", path, sc.series.size(), listing(sc)));
+    } else if (c.find_first_not_of("0123456789") == std::string::npos) {
+        const unsigned long long n = c.size() > 9 ? 0 : std::stoull(c);
+        if (n < 1 || n > sc.series.size())
+            throw Error(fmt::format("{}: there is no series {}; it holds {}: {}", path, c, sc.series.size(), listing(sc)));
+        index = size_t(n - 1);
+    } else {
+        std::vector<size_t> matches;
+        for (size_t i = 0; i < sc.series.size(); ++i)
+            if (sc.series[i].uid == c) matches.push_back(i);
+        if (matches.empty()) throw Error(fmt::format("{}: no series has the UID {}; it holds {}: {}", path, c, sc.series.size(), listing(sc)));
+        if (matches.size() > 1) {
+            std::string list;
+            for (size_t i = 0; i < matches.size(); ++i) list += (i ? "; " : "") + oneLine(matches[i], sc.series[matches[i]]);
+            throw Error(fmt::format("{}: the series {} is split into {} parts (by orientation or image size), pick one with --series N: {}", path, c,
+                                    matches.size(), list));
+        }
+        index = matches.front();
+    }
+    const Group& g = st.groups[index];
+    if (!g.problem.empty()) throw Error(fmt::format("{}: series {} ({}): {}", path, index + 1, g.info.uid, g.problem));
+
+    DenseVolume v;
+    v.format = DenseFormat::Dicom;
+    v.headerPath = path;
+    v.dataPath = path;
+    v.dims = g.info.dims;
+    v.type = *g.type;
+    v.bigEndian = false;
+    const Frame& f0 = g.frames.front();
+    v.origin = f0.position;
+    v.axes[0] = scaled(g.rowDir, f0.columnSpacing);
+    v.axes[1] = scaled(g.colDir, f0.rowSpacing);
+    const size_t n = g.frames.size();
+    v.axes[2] = n > 1 ? scaled(sub(g.frames.back().position, f0.position), 1.0 / double(n - 1)) : scaled(g.normal, f0.thickness > 0 ? f0.thickness : 1.0);
+    v.space = "LPS";
+    v.rescaleSlope = f0.slope;
+    v.rescaleIntercept = f0.intercept;
+    for (const Frame& f : g.frames) v.slices.push_back({f.file, f.frame});
+    v.validate();
+    return v;
+}
+
+namespace {
+
+class DicomSliceReader : public SliceReader {
+public:
+    explicit DicomSliceReader(const DenseVolume& volume) : v_(volume) {
+        v_.validate();
+        if (v_.slices.size() != size_t(v_.dims[2]))
+            throw Error(fmt::format("{}: the series lists {} slice files for {} slices", v_.headerPath, v_.slices.size(), v_.dims[2]));
+        if (!isIntegerSample(v_.type)) throw Error(v_.headerPath + ": float DICOM samples are not supported");
+        for (const DicomSlice& s : v_.slices) {
+            std::error_code ec;
+            if (!fs::is_regular_file(s.file, ec)) throw Error(s.file + ": slice file of " + v_.headerPath + " is missing or not a regular file");
+        }
+    }
+
+    void readSlices(int64_t slices, std::vector<uint8_t>& out) override {
+        if (slices < 0 || next_ + slices > v_.dims[2])
+            throw Error(fmt::format("{}: asked for slices {} to {} of a series of {}", v_.headerPath, next_, next_ + slices, v_.dims[2]));
+        const size_t sliceBytes = size_t(v_.sliceSamples()) * sampleBytes(v_.type);
+        out.resize(size_t(slices) * sliceBytes);
+        for (int64_t i = 0; i < slices; ++i) decode(v_.slices[size_t(next_ + i)], out.data() + size_t(i) * sliceBytes, sliceBytes);
+        next_ += slices;
+    }
+
+private:
+    void decode(const DicomSlice& slice, uint8_t* out, size_t sliceBytes) {
+        if (slice.file != cachedFile_) {
+            cachedFile_.clear();
+            cache_.clear();
+            quietGdcm();
+            const std::string where = fmt::format("{}: slice file of {}", slice.file, v_.headerPath);
+            gdcm::ImageReader reader;
+            reader.SetFileName(slice.file.c_str());
+            if (!reader.Read()) throw Error(where + ": GDCM cannot read it as a DICOM image (truncated or corrupt?)");
+            const gdcm::Image& image = reader.GetImage();
+            const gdcm::PixelFormat& pf = image.GetPixelFormat();
+            const unsigned dimsCount = image.GetNumberOfDimensions();
+            const uint64_t cols = image.GetDimension(0), rows = image.GetDimension(1);
+            const uint64_t frames = dimsCount >= 3 ? image.GetDimension(2) : 1;
+            if (int64_t(cols) != v_.dims[0] || int64_t(rows) != v_.dims[1])
+                throw Error(fmt::format("{}: holds {}x{} pixels where the series has {}x{}", where, cols, rows, v_.dims[0], v_.dims[1]));
+            if (pf.GetSamplesPerPixel() != 1) throw Error(fmt::format("{}: holds {} samples per pixel; the series has 1", where, pf.GetSamplesPerPixel()));
+            const std::optional<SampleType> t = sampleTypeOf(pf.GetBitsAllocated(), pf.GetPixelRepresentation());
+            if (!t || *t != v_.type)
+                throw Error(fmt::format("{}: its pixels decode as {} bits {} (Pixel Representation {}), not the series' {}", where, pf.GetBitsAllocated(),
+                                        pf.GetPixelRepresentation() ? "signed" : "unsigned", pf.GetPixelRepresentation(), sampleTypeName(v_.type)));
+            if (frames <= slice.frame) throw Error(fmt::format("{}: holds {} frame(s); frame {} is missing", where, frames, slice.frame + 1));
+            const uint64_t length = image.GetBufferLength();
+            if (length < frames * sliceBytes)
+                throw Error(fmt::format("{}: its pixel data decode to {} bytes, fewer than the {} its {} frame(s) need", where, length, frames * sliceBytes, frames));
+            cache_.resize(size_t(length));
+            if (!image.GetBuffer(reinterpret_cast<char*>(cache_.data())))
+                throw Error(fmt::format("{}: GDCM cannot decode its pixel data (transfer syntax {}; truncated or corrupt?)", where,
+                                        reader.GetFile().GetHeader().GetDataSetTransferSyntax().GetString()
+                                            ? reader.GetFile().GetHeader().GetDataSetTransferSyntax().GetString()
+                                            : "unknown"));
+            cachedFile_ = slice.file;
+            cachedFrames_ = frames;
+        }
+        if (slice.frame >= cachedFrames_) throw Error(fmt::format("{}: frame {} is missing", slice.file, slice.frame + 1));
+        std::copy_n(cache_.data() + size_t(slice.frame) * sliceBytes, sliceBytes, out);
+    }
+
+    DenseVolume v_;
+    int64_t next_ = 0;
+    std::string cachedFile_;  // the last file decoded (a multi-frame file is decoded once)
+    std::vector<uint8_t> cache_;
+    uint64_t cachedFrames_ = 0;
+};
+
+} // namespace
+
+std::unique_ptr<SliceReader> openDicomSlices(const DenseVolume& volume) { return std::make_unique<DicomSliceReader>(volume); }
 
 } // namespace vdbdag::bridge

@@ -24,6 +24,9 @@ struct DicomSeriesInfo {
     std::array<double, 3> spacing{1, 1, 1};     // column, row, slice spacing (mm)
     std::string sampleType;   // "u16", ... (sampleTypeName)
     std::vector<std::string> notes;  // e.g. uneven spacing, duplicates
+    // Why describeDicomSeries refuses this series (duplicate positions, gaps,
+    // uneven spacing, mixed rescales, colour samples...); empty when it converts.
+    std::string problem;
 };
 
 struct DicomScan {

@@ -67,8 +67,11 @@ DenseVolume readMetaImageHeader(const std::string& path) {
     if (dims.size() != 3) throw Error(path + ": DimSize has " + std::to_string(dims.size()) + " values, NDims is 3");
     for (int a = 0; a < 3; ++a) v.dims[size_t(a)] = detail::parseInteger(dims[size_t(a)], path + ": DimSize");
 
-    if (const std::string* ch = field({"elementnumberofchannels"}); ch && detail::parseInteger(*ch, path + ": ElementNumberOfChannels") != 1)
-        throw Error(path + ": ElementNumberOfChannels " + *ch + " is not supported (scalar volumes only)");
+    int64_t channels = 1;
+    if (const std::string* ch = field({"elementnumberofchannels"})) channels = detail::parseInteger(*ch, path + ": ElementNumberOfChannels");
+    if (channels != 1 && channels != 3)
+        throw Error(path + ": ElementNumberOfChannels " + std::to_string(channels) + " is not supported (1, and 3 for vectors or RGB)");
+    v.components = unsigned(channels);
     const std::string* et = field({"elementtype"});
     if (!et) throw Error(path + ": MetaImage header has no ElementType field");
     static const std::map<std::string, SampleType> types{{"MET_UCHAR", SampleType::U8}, {"MET_CHAR", SampleType::I8},

@@ -109,11 +109,26 @@ DenseVolume readNrrdHeader(const std::string& path) {
     DenseVolume v;
     v.headerPath = path;
     const int64_t dimension = detail::parseInteger(detail::trim(required("dimension")), path + ": dimension");
-    if (dimension != 3) throw Error(path + ": NRRD dimension " + std::to_string(dimension) + " is not supported (only 3-D scalar volumes)");
+    if (dimension != 3 && dimension != 4)
+        throw Error(path + ": NRRD dimension " + std::to_string(dimension) + " is not supported (3-D volumes, and 4-D with a leading axis of 3 components)");
     v.type = nrrdType(required("type"), path);
     const std::vector<std::string> sizes = detail::tokens(required("sizes"));
-    if (sizes.size() != 3) throw Error(path + ": 'sizes' has " + std::to_string(sizes.size()) + " values, dimension is 3");
-    for (int a = 0; a < 3; ++a) v.dims[size_t(a)] = detail::parseInteger(sizes[size_t(a)], path + ": sizes");
+    if (int64_t(sizes.size()) != dimension)
+        throw Error(path + ": 'sizes' has " + std::to_string(sizes.size()) + " values, dimension is " + std::to_string(dimension));
+    // 4-D: a leading (fastest) axis of 3 components per sample, a vector or
+    // an RGB colour (kinds "RGB-color"); the other three axes are space.
+    const size_t first = dimension == 4 ? 1 : 0;
+    if (dimension == 4) {
+        const int64_t components = detail::parseInteger(sizes[0], path + ": sizes");
+        if (components != 3)
+            throw Error(path + ": a 4-D NRRD needs a leading axis of 3 components (a vector or RGB per sample); this one has " + sizes[0]);
+        v.components = 3;
+        if (const std::string* k = field("kinds")) {
+            const std::vector<std::string> kinds = detail::tokens(*k);
+            if (!kinds.empty() && detail::lower(kinds[0]) == "rgb-color") v.colour = true;
+        }
+    }
+    for (int a = 0; a < 3; ++a) v.dims[size_t(a)] = detail::parseInteger(sizes[first + size_t(a)], path + ": sizes");
 
     const std::string encoding = detail::lower(detail::trim(required("encoding")));
     if (encoding == "raw") v.encoding = DataEncoding::Raw;
@@ -145,16 +160,23 @@ DenseVolume readNrrdHeader(const std::string& path) {
     }
     if (const std::string* dirs = field("space directions")) {
         if (field("spacings")) throw Error(path + ": NRRD header has both 'space directions' and 'spacings'");
-        const auto vectors = parseVectors(*dirs, path + ": space directions");
-        if (vectors.size() != 3) throw Error(path + ": 'space directions' has " + std::to_string(vectors.size()) + " entries, dimension is 3");
+        auto vectors = parseVectors(*dirs, path + ": space directions");
+        if (int64_t(vectors.size()) != dimension)
+            throw Error(path + ": 'space directions' has " + std::to_string(vectors.size()) + " entries, dimension is " + std::to_string(dimension));
+        if (first) {
+            if (!vectors[0].empty()) throw Error(path + ": the component axis of a 4-D NRRD must have space direction 'none'");
+            vectors.erase(vectors.begin());
+        }
         for (int a = 0; a < 3; ++a) {
             if (vectors[size_t(a)].empty()) throw Error(path + ": axis " + std::to_string(a) + " has space direction 'none' (non-spatial axes are not supported)");
             if (vectors[size_t(a)].size() != 3) throw Error(path + ": space direction of axis " + std::to_string(a) + " does not have 3 components");
             for (int c = 0; c < 3; ++c) v.axes[size_t(a)][size_t(c)] = vectors[size_t(a)][size_t(c)];
         }
     } else if (const std::string* sp = field("spacings")) {
-        const std::vector<std::string> t = detail::tokens(*sp);
-        if (t.size() != 3) throw Error(path + ": 'spacings' has " + std::to_string(t.size()) + " values, dimension is 3");
+        std::vector<std::string> t = detail::tokens(*sp);
+        if (int64_t(t.size()) != dimension)
+            throw Error(path + ": 'spacings' has " + std::to_string(t.size()) + " values, dimension is " + std::to_string(dimension));
+        if (first) t.erase(t.begin());
         for (int a = 0; a < 3; ++a) {
             // NRRD writes "nan" for an unknown spacing: take 1.
             const double s = detail::lower(t[size_t(a)]) == "nan" ? 1.0 : detail::parseNumber(t[size_t(a)], path + ": spacings");

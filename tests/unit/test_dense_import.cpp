@@ -376,7 +376,7 @@ TEST(DenseErrors, MalformedInputsGiveOneLineErrorsAndNoOutput) {
         {"gzbad.nhdr", "NRRD0004\ntype: int16\ndimension: 3\nsizes: 4 4 4\nendian: little\nencoding: gzip\ndata file: data.raw\n", "compressed data"},
         {"nofile.mhd", "ObjectType = Image\nNDims = 3\nDimSize = 4 4 4\nElementType = MET_SHORT\n", "no ElementDataFile"},
         {"long.mhd", "NDims = 3\nDimSize = 4 4 4\nElementType = MET_LONG\nElementDataFile = data.raw\n", "MET_LONG"},
-        {"channels.mhd", "NDims = 3\nDimSize = 4 4 4\nElementNumberOfChannels = 3\nElementType = MET_SHORT\nElementDataFile = data.raw\n", "Channels"},
+        {"channels.mhd", "NDims = 3\nDimSize = 4 4 4\nElementNumberOfChannels = 4\nElementType = MET_SHORT\nElementDataFile = data.raw\n", "Channels"},
         {"shortmhd.mhd", "NDims = 3\nDimSize = 4 4 4\nElementType = MET_SHORT\nElementDataFile = short.raw\n", "too short"},
         {"nanspacing.mhd", "NDims = 3\nDimSize = 4 4 4\nElementSpacing = 1 nan 1\nElementType = MET_SHORT\nElementDataFile = data.raw\n", "finite"},
     };
