@@ -109,6 +109,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             if (!opt->grids.empty()) throw Error(opt->input + ": --grid applies to .vdb inputs only (a dense scan has one grid)");
             bridge::DenseImportResult dense = bridge::importDense(opt->input, opt->dense.resolve(opt->input));
             threshold = dense.threshold;
+            imported.warnings = dense.source.notes;
             imported.volume = std::move(dense.volume);
             if (opt->topologyOnly)
                 for (GridRecord& g : imported.volume.grids) {

@@ -25,7 +25,7 @@ nlohmann::json dicomReport(const std::string& input, const bridge::DicomScan& sc
     for (size_t i = 0; i < scan.series.size(); ++i) {
         const bridge::DicomSeriesInfo& s = scan.series[i];
         series.push_back({{"index", i + 1}, {"uid", s.uid}, {"modality", s.modality}, {"description", s.description},
-                          {"series_number", s.seriesNumber}, {"slices", s.dims[2]}, {"dims", {s.dims[0], s.dims[1], s.dims[2]}},
+                          {"series_number", s.seriesNumber}, {"slices", s.dims[2]}, {"missing_slices", s.missingSlices}, {"dims", {s.dims[0], s.dims[1], s.dims[2]}},
                           {"spacing", {s.spacing[0], s.spacing[1], s.spacing[2]}}, {"sample_type", s.sampleType},
                           {"convertible", s.problem.empty()}, {"problem", s.problem}, {"notes", s.notes}});
     }

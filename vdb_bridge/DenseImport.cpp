@@ -154,6 +154,8 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
     // Stored sample -> grid value: the header's rescale (DICOM Rescale
     // Slope/Intercept, NIfTI scl_slope/scl_inter), exact in integers when
     // both are integral (importDense chose V so that the range fits).
+    const auto missing = [&](int64_t z) { return !v.missingSlices.empty() && std::binary_search(v.missingSlices.begin(), v.missingSlices.end(), z); };
+    const uint64_t missingSamples = uint64_t(v.missingSlices.size()) * v.sliceSamples();
     const bool rescaled = v.rescaleSlope != 1 || v.rescaleIntercept != 0;
     const auto convert = [&](S s) -> V {
         if (!rescaled) return V(s);
@@ -172,10 +174,11 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
     V background = V(0);
     if (th.any()) {
         if (progress) progress->setLabel("import " + name + ": background statistics");
-        forEachSlab<S>(v, progress.get(), [&](int64_t, int64_t nz, const S* s) {
+        forEachSlab<S>(v, progress.get(), [&](int64_t z0, int64_t nz, const S* s) {
             const uint64_t n = uint64_t(nz) * uint64_t(nx * ny);
             PassStats st;
             for (uint64_t i = 0; i < n; ++i) {
+                if (missing(z0 + int64_t(i / uint64_t(nx * ny)))) continue;
                 const double x = double(convert(s[i]));
                 if (std::isfinite(x)) { st.min = std::min(st.min, x); st.max = std::max(st.max, x); }
                 if (th.removes(x)) { ++st.removed; st.removedSum += x; }
@@ -199,7 +202,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
     // Pass 2: bricks and values.
     GridRecord record;
     record.valueType = valueType;
-    const uint64_t expectedKept = v.sampleCount() - first.removed;
+    const uint64_t expectedKept = v.sampleCount() - missingSamples - first.removed;
     record.values.bricks.reserve(size_t(expectedKept * sizeof(V)));
     record.topology.bricks.reserve(size_t(uint64_t(slabs) * uint64_t(rows) * uint64_t(cols)));
     PassStats second;
@@ -220,7 +223,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
                 uint64_t mask = 0;
                 for (int bit = 0; bit < 64; ++bit) {
                     const int64_t x = bx * 4 + (bit & 3), y = by * 4 + ((bit >> 2) & 3), z = bit >> 4;
-                    if (x >= nx || y >= ny || z >= nz) continue;
+                    if (x >= nx || y >= ny || z >= nz || missing(z0 + z)) continue;
                     const V sample = convert(s[(z * ny + y) * nx + x]);
                     const double d = double(sample);
                     if (th.any() && th.removes(d)) {
@@ -249,7 +252,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
     DenseImportResult result;
     result.source = v;
     ThresholdReport& r = result.threshold;
-    r.samples = v.sampleCount();
+    r.samples = v.sampleCount() - missingSamples;  // samples with data
     if (th.any()) {
         r.applied = true;
         r.inactive = first.removed;

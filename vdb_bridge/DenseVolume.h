@@ -74,6 +74,12 @@ struct DenseVolume {
     bool colour = false;  // RGB: a colour grid named "Cd"
     // DICOM: the slices in order along the slice normal (dims[2] of them).
     std::vector<DicomSlice> slices;
+    // Slices with no data (a DICOM series missing some): their samples are
+    // not read and become inactive voxels. Sorted.
+    std::vector<int64_t> missingSlices;
+    // What a user should know about how the file was read (e.g. missing
+    // slices kept empty); `encode` prints them as warnings.
+    std::vector<std::string> notes;
 
     uint64_t sampleCount() const { return uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]); }
     uint64_t sliceSamples() const { return uint64_t(dims[0]) * uint64_t(dims[1]); }

@@ -145,6 +145,10 @@ struct Group {
     std::vector<Frame> frames;
     std::vector<const FileInfo*> files;  // parallel to frames
     std::string problem;                 // empty when convertible
+    // The slice index of each frame: consecutive, except where slices are
+    // missing (a step of k times the series' step leaves k - 1 empty slots).
+    std::vector<int64_t> slots;
+    std::vector<int64_t> missing;  // the empty slots
     Vec3 rowDir{1, 0, 0}, colDir{0, 1, 0}, normal{0, 0, 1};
     std::optional<SampleType> type;
 };
@@ -564,10 +568,22 @@ void analyse(Group& g) {
         std::nth_element(tmp.begin(), tmp.begin() + ptrdiff_t(tmp.size() / 2), tmp.end());
         const double median = tmp[tmp.size() / 2];
         step = median;
+        g.slots.assign(1, 0);
         if (g.problem.empty() && median > 0) {
-            std::vector<std::string> bad;
+            std::vector<std::string> bad, gaps;
             size_t badCount = 0;
             for (size_t i = 0; i < steps.size(); ++i) {
+                // A step of k (>= 2) series steps: k - 1 missing slices,
+                // kept as empty slots so the spacing stays regular.
+                const double k = std::round(steps[i] / median);
+                if (k >= 2 && std::abs(steps[i] - k * median) <= 2e-3 * k * median) {
+                    for (int64_t m = 1; m < int64_t(k); ++m) g.missing.push_back(g.slots.back() + m);
+                    if (gaps.size() < 4)
+                        gaps.push_back(fmt::format("{} after {} mm ({})", int64_t(k) - 1, formatNumber(sorted[i]), frameName(g.frames[i], *g.files[i])));
+                    g.slots.push_back(g.slots.back() + int64_t(k));
+                    continue;
+                }
+                g.slots.push_back(g.slots.back() + 1);
                 if (std::abs(steps[i] - median) <= 1e-3 * median) continue;
                 if (++badCount <= 4)
                     bad.push_back(fmt::format("{} mm ({}) -> {} mm ({}), a step of {} mm", formatNumber(sorted[i]), frameName(g.frames[i], *g.files[i]),
@@ -581,13 +597,22 @@ void analyse(Group& g) {
                                  formatNumber(median), list));
                 g.info.notes.push_back("uneven spacing or missing slices");
             }
+            if (!g.missing.empty()) {
+                std::string list;
+                for (size_t i = 0; i < gaps.size(); ++i) list += (i ? ", " : "") + gaps[i];
+                g.info.notes.push_back(fmt::format("{} missing slice{} ({}{}): kept as empty slices, inactive voxels with no data, at the regular {} mm step",
+                                                   g.missing.size(), g.missing.size() == 1 ? "" : "s", list, gaps.size() < g.missing.size() ? ", ..." : "",
+                                                   formatNumber(median)));
+            }
         }
         if (g.problem.empty()) {
-            const Vec3 axis = scaled(sub(g.frames.back().position, f0.position), 1.0 / double(count - 1));
+            const double last = double(g.slots.back());
+            const Vec3 axis = scaled(sub(g.frames.back().position, f0.position), 1.0 / last);
             double worst = 0;
             size_t at = 0;
             for (size_t i = 0; i < count; ++i) {
-                const Vec3 expect{f0.position[0] + double(i) * axis[0], f0.position[1] + double(i) * axis[1], f0.position[2] + double(i) * axis[2]};
+                const double t = double(g.slots[i]);
+                const Vec3 expect{f0.position[0] + t * axis[0], f0.position[1] + t * axis[1], f0.position[2] + t * axis[2]};
                 const double d = norm(sub(g.frames[i].position, expect));
                 if (d > worst) { worst = d; at = i; }
             }
@@ -601,7 +626,13 @@ void analyse(Group& g) {
         }
     }
 
-    g.info.dims = {int64_t(g.first.columns), int64_t(g.first.rows), int64_t(count)};
+    if (g.slots.size() != count) {  // one slice, or a refused series
+        g.slots.resize(count);
+        for (size_t i = 0; i < count; ++i) g.slots[i] = int64_t(i);
+        g.missing.clear();
+    }
+    g.info.dims = {int64_t(g.first.columns), int64_t(g.first.rows), g.slots.empty() ? 0 : g.slots.back() + 1};
+    g.info.missingSlices = int64_t(g.missing.size());
     g.info.spacing = {f0.columnSpacing, f0.rowSpacing, step};
     g.info.sampleType = g.type ? sampleTypeName(*g.type) : "";
     g.info.problem = g.problem;
@@ -769,12 +800,15 @@ DenseVolume describeDicomSeries(const std::string& path, const std::string& choi
     v.origin = f0.position;
     v.axes[0] = scaled(g.rowDir, f0.columnSpacing);
     v.axes[1] = scaled(g.colDir, f0.rowSpacing);
-    const size_t n = g.frames.size();
+    const int64_t n = v.dims[2];  // slots, the missing ones included
     v.axes[2] = n > 1 ? scaled(sub(g.frames.back().position, f0.position), 1.0 / double(n - 1)) : scaled(g.normal, f0.thickness > 0 ? f0.thickness : 1.0);
     v.space = "LPS";
     v.rescaleSlope = f0.slope;
     v.rescaleIntercept = f0.intercept;
-    for (const Frame& f : g.frames) v.slices.push_back({f.file, f.frame});
+    v.slices.assign(size_t(n), DicomSlice{});  // missing slots keep an empty file name
+    for (size_t i = 0; i < g.frames.size(); ++i) v.slices[size_t(g.slots[i])] = {g.frames[i].file, g.frames[i].frame};
+    v.missingSlices = g.missing;
+    for (const std::string& note : g.info.notes) v.notes.push_back(fmt::format("{}: series {}: {}", path, index + 1, note));
     v.validate();
     return v;
 }
@@ -790,6 +824,7 @@ public:
         if (!isIntegerSample(v_.type)) throw Error(v_.headerPath + ": float DICOM samples are not supported");
         for (const DicomSlice& s : v_.slices) {
             std::error_code ec;
+            if (s.file.empty()) continue;  // a missing slice (no file)
             if (!fs::is_regular_file(s.file, ec)) throw Error(s.file + ": slice file of " + v_.headerPath + " is missing or not a regular file");
         }
     }
@@ -805,6 +840,10 @@ public:
 
 private:
     void decode(const DicomSlice& slice, uint8_t* out, size_t sliceBytes) {
+        if (slice.file.empty()) {  // a missing slice (DenseVolume::missingSlices): no data
+            std::memset(out, 0, sliceBytes);
+            return;
+        }
         if (slice.file != cachedFile_) {
             cachedFile_.clear();
             cache_.clear();

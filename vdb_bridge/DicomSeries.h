@@ -20,7 +20,8 @@ struct DicomSeriesInfo {
     std::string modality;     // (0008,0060)
     std::string description;  // Series Description (0008,103E)
     int64_t seriesNumber = 0; // (0020,0011)
-    std::array<int64_t, 3> dims{0, 0, 0};       // columns, rows, slices
+    std::array<int64_t, 3> dims{0, 0, 0};       // columns, rows, slices (missing slices included)
+    int64_t missingSlices = 0;                  // empty slots where the stack lacks a slice
     std::array<double, 3> spacing{1, 1, 1};     // column, row, slice spacing (mm)
     std::string sampleType;   // "u16", ... (sampleTypeName)
     std::vector<std::string> notes;  // e.g. uneven spacing, duplicates

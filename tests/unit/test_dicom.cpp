@@ -197,18 +197,22 @@ TEST(DicomScan, AdiBrainListsItsSeriesLikePydicom) {
         const DicomSeriesInfo& s = scan.series[i];
         EXPECT_EQ(s.uid, uids[i]);
         EXPECT_EQ(s.modality, "MR");
-        EXPECT_EQ(s.dims[2], ref["series"][s.uid].get<int64_t>()) << s.uid;
+        // The two stacks each miss one slice (instances 115 and 35): one empty slot each.
+        EXPECT_EQ(s.dims[2], ref["series"][s.uid].get<int64_t>() + (i < 2 ? 1 : 0)) << s.uid;
         EXPECT_EQ(s.sampleType, "u16");
     }
-    EXPECT_EQ(scan.series[0].dims, (std::array<int64_t, 3>{192, 192, 175}));
-    EXPECT_EQ(scan.series[1].dims, (std::array<int64_t, 3>{384, 512, 55}));
+    EXPECT_EQ(scan.series[0].dims, (std::array<int64_t, 3>{192, 192, 176}));
+    EXPECT_EQ(scan.series[1].dims, (std::array<int64_t, 3>{384, 512, 56}));
     EXPECT_EQ(scan.series[2].dims, (std::array<int64_t, 3>{256, 256, 1}));
     EXPECT_EQ(scan.series[1].description, "AX FSE T2");
     EXPECT_NEAR(scan.series[1].spacing[0], 0.4296875, 1e-6);
     EXPECT_NEAR(scan.series[1].spacing[2], 2.5, 1e-6);
-    // Both stacks miss one slice (instances 35 and 115): refused, the single slices convert.
-    EXPECT_NE(scan.series[0].problem.find("uneven slice spacing or missing slices"), std::string::npos) << scan.series[0].problem;
-    EXPECT_NE(scan.series[1].problem.find("uneven slice spacing or missing slices"), std::string::npos) << scan.series[1].problem;
+    // Both stacks miss one slice: they convert, with a note; so do the single slices.
+    for (int i = 0; i < 2; ++i) {
+        EXPECT_TRUE(scan.series[size_t(i)].problem.empty()) << scan.series[size_t(i)].problem;
+        ASSERT_FALSE(scan.series[size_t(i)].notes.empty());
+        EXPECT_NE(scan.series[size_t(i)].notes.back().find("1 missing slice"), std::string::npos) << scan.series[size_t(i)].notes.back();
+    }
     EXPECT_TRUE(scan.series[2].problem.empty()) << scan.series[2].problem;
     EXPECT_TRUE(scan.series[3].problem.empty()) << scan.series[3].problem;
     // The files that are not DICOM, each with its reason.
@@ -220,19 +224,55 @@ TEST(DicomScan, AdiBrainListsItsSeriesLikePydicom) {
     }
 }
 
-TEST(DicomSeries, GapsAreRefusedNamingThePositions) {
+// A stack missing slices keeps the regular step: each missing slice is an
+// empty slot of inactive voxels, named in a note, and every other slice
+// equals pydicom's at the slot its position gives (independently: the
+// position over the median step).
+TEST(DicomSeries, MissingSlicesAreEmptySlotsAtTheRegularStep) {
     REQUIRE_REFERENCE();
-    // pydicom: in the T2 stack, 36444406 (instance 34, 51.062 mm along the
-    // normal) is followed by 36444434 (instance 36, 56.062 mm).
-    const std::string e = errorOf([] { describeDicomSeries(kAdi.string(), "2"); });
-    ASSERT_TRUE(oneLine(e)) << e;
-    EXPECT_EQ(e.rfind(kAdi.string() + ": series 2 (" + kT2Uid + "): uneven slice spacing", 0), 0u) << e;
-    EXPECT_NE(e.find("51.062 mm (" + (kAdi / "36444406").string() + ") -> 56.062 mm (" + (kAdi / "36444434").string() + "), a step of 5 mm"),
-              std::string::npos)
-        << e;
-    const std::string t1 = errorOf([] { describeDicomSeries(kAdi.string(), kT1Uid); });
-    EXPECT_TRUE(oneLine(t1)) << t1;
-    EXPECT_NE(t1.find((kAdi / "36749446").string()), std::string::npos) << t1;
+    for (const auto& [uid, after] : {std::pair{kT2Uid, std::string("36444406")}, std::pair{kT1Uid, std::string("36749446")}}) {
+        SCOPED_TRACE(uid);
+        const Reference ref = reference(kAdi, uid);
+        std::vector<double> pos;
+        for (const auto& p : ref.meta["positions"]) pos.push_back(p.get<double>());
+        std::vector<double> steps;
+        for (size_t i = 1; i < pos.size(); ++i) steps.push_back(pos[i] - pos[i - 1]);
+        std::nth_element(steps.begin(), steps.begin() + ptrdiff_t(steps.size() / 2), steps.end());
+        const double step = steps[steps.size() / 2];
+        std::vector<int64_t> slotOf;
+        for (double p : pos) slotOf.push_back(std::llround((p - pos[0]) / step));
+        std::vector<int64_t> missing;
+        for (int64_t z = 0, i = 0; z <= slotOf.back(); ++z) {
+            if (i < int64_t(slotOf.size()) && slotOf[size_t(i)] == z) ++i;
+            else missing.push_back(z);
+        }
+        ASSERT_EQ(missing.size(), 1u);
+        const DenseVolume v = describeDicomSeries(kAdi.string(), uid);
+        EXPECT_EQ(v.dims[2], slotOf.back() + 1);
+        EXPECT_EQ(v.missingSlices, missing);
+        ASSERT_FALSE(v.notes.empty());
+        EXPECT_NE(v.notes.back().find("1 missing slice"), std::string::npos) << v.notes.back();
+        EXPECT_NE(v.notes.back().find((kAdi / after).string()), std::string::npos) << v.notes.back();
+        const int64_t n = int64_t(pos.size());
+        for (int c = 0; c < 3; ++c)  // pydicom's step over the present slices, spread over the slots
+            EXPECT_NEAR(v.axes[2][size_t(c)], ref.meta["axes"][2][c].get<double>() * double(n - 1) / double(v.dims[2] - 1), 1e-6);
+        const DenseImportResult imported = importDense(kAdi.string(), quietOptions(uid));
+        const GridRecord& g = imported.volume.grids.front();
+        ASSERT_EQ(g.valueType, ValueType::Int32);
+        const auto* stored = reinterpret_cast<const uint16_t*>(ref.raw.data());
+        const auto* values = reinterpret_cast<const int32_t*>(g.values.bricks.data());
+        std::vector<int64_t> sliceOfSlot(size_t(v.dims[2]), -1);
+        for (size_t i = 0; i < slotOf.size(); ++i) sliceOfSlot[size_t(slotOf[i])] = int64_t(i);
+        uint64_t count = 0, wrong = 0;
+        forEachVoxel(g, [&](int64_t x, int64_t y, int64_t z, uint64_t i) {
+            const int64_t slice = sliceOfSlot[size_t(z)];
+            if (slice < 0) { ++wrong; return; }  // a voxel in the missing slot
+            if (values[i] != int32_t(stored[(slice * v.dims[1] + y) * v.dims[0] + x])) ++wrong;
+            ++count;
+        });
+        EXPECT_EQ(wrong, 0u);
+        EXPECT_EQ(count, uint64_t(n) * v.sliceSamples());
+    }
 }
 
 TEST(DicomSeries, SingleSliceSeriesMatchPydicom) {
@@ -295,7 +335,7 @@ TEST(DicomSeries, AFolderOfSeveralSeriesNeedsAChoice) {
     REQUIRE_REFERENCE();
     const std::string e = errorOf([] { describeDicomSeries(kAdi.string(), ""); });
     ASSERT_TRUE(oneLine(e)) << e;
-    EXPECT_EQ(e.rfind(kAdi.string() + ": holds 4 series, pick one with --series N or UID: 1) " + kT1Uid + " MR \"mocoMEMPRAGE_220FOV RMS\" 192x192x175", 0),
+    EXPECT_EQ(e.rfind(kAdi.string() + ": holds 4 series, pick one with --series N or UID: 1) " + kT1Uid + " MR \"mocoMEMPRAGE_220FOV RMS\" 192x192x176", 0),
               0u)
         << e;
     for (const std::string& uid : {kT1Uid, kT2Uid, kPerfUid, kRelCbfUid}) EXPECT_NE(e.find(uid), std::string::npos) << uid;
@@ -521,11 +561,14 @@ TEST(DicomCli, EncodeAndInfo) {
     EXPECT_NE(r.err.find("holds 4 series, pick one with --series N or UID"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
     EXPECT_TRUE(fs::is_empty(dir));
-    // A refused series: one line too.
-    r = runCli("encode " + quote(kAdi) + " --series 2 -o " + quote(out));
-    EXPECT_EQ(r.exitCode, 1);
+    // The stack missing a slice converts, saying so in one warning line;
+    // its active voxels are the 55 slices that have data.
+    r = runCli("encode " + quote(kAdi) + " --series 2 -o " + quote(out) + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_FALSE(fs::exists(out));
+    EXPECT_NE(r.err.find("warning: " + kAdi.string() + ": series 2: 1 missing slice"), std::string::npos) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["active_voxels"], 384 * 512 * 55);
+    fs::remove(out);
     // By number and by UID.
     r = runCli("encode " + quote(kAdi) + " --series 3 -o " + quote(out) + " --json");
     ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -550,9 +593,10 @@ TEST(DicomCli, EncodeAndInfo) {
     ASSERT_EQ(info["series"].size(), 4u);
     EXPECT_EQ(info["skipped_files"], 3);
     EXPECT_EQ(info["series"][1]["uid"], kT2Uid);
-    EXPECT_EQ(info["series"][1]["slices"], 55);
-    EXPECT_EQ(info["series"][1]["dims"], nlohmann::json({384, 512, 55}));
-    EXPECT_EQ(info["series"][1]["convertible"], false);
+    EXPECT_EQ(info["series"][1]["slices"], 56);
+    EXPECT_EQ(info["series"][1]["missing_slices"], 1);
+    EXPECT_EQ(info["series"][1]["dims"], nlohmann::json({384, 512, 56}));
+    EXPECT_EQ(info["series"][1]["convertible"], true);
     EXPECT_EQ(info["series"][2]["convertible"], true);
     EXPECT_EQ(info["series"][2]["description"], "Perfusion_Weighted");
     r = runCli("info " + quote(kAdi));
