@@ -31,7 +31,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
         uint64_t maxCells = 20'000'000;
     };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("diff", "Compare two volumes voxel by voxel (.vdb or .ssvdag); exit 0 only if they are the same");
+    CLI::App* cmd = app.add_subcommand("diff", "Compare two volumes voxel by voxel (.vdb, .ssvdag or a dense scan); exit 0 only if they are the same");
     cmd->add_option("a", opt->a, "first volume (A: the reference)")->required();
     cmd->add_option("b", opt->b, "second volume (B)")->required();
     cmd->add_option("-o,--output", opt->output, "write the cells (a, b, abs_error, rel_error, status) to a .vtu or .vtm");
@@ -61,7 +61,9 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
             report["grids"].push_back({{"name", g.name}, {"index_a", g.indexA}, {"index_b", g.indexB}, {"value_type", g.valueType}, {"voxels", counts},
                                        {"cells_written", g.cells}, {"non_finite_errors", g.nonFiniteErrors}, {"max_abs_error", g.maxAbsError},
                                        {"mean_abs_error", g.meanAbsError}, {"rms_error", g.rmsError}, {"max_rel_error", g.maxRelError},
-                                       {"peak", g.peak}, {"psnr_db", number(g.psnr)}});
+                                       {"peak", g.peak}, {"psnr_db", number(g.psnr)},
+                                       {"over_all_of_a", {{"voxels", g.ofA.voxels}, {"max_abs_error", g.ofA.maxAbsError}, {"mean_abs_error", g.ofA.meanAbsError},
+                                                          {"rms_error", g.ofA.rmsError}, {"psnr_db", number(g.ofA.psnr)}}}});
         }
         if (opt->json) {
             fmt::print("{}\n", report.dump(2));
@@ -74,6 +76,10 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
                 fmt::print("    error over voxels active in both: max {:.6g}, mean {:.6g}, RMS {:.6g}, max relative {:.6g}; PSNR {} (peak {:.6g} = A's value range)\n",
                            g.maxAbsError, g.meanAbsError, g.rmsError, g.maxRelError,
                            std::isinf(g.psnr) ? std::string("inf") : std::isnan(g.psnr) ? std::string("undefined") : fmt::format("{:.2f} dB", g.psnr), g.peak);
+                if (g.voxels[2])
+                    fmt::print("    error over all of A's voxels (B's inactive value where B has none, e.g. a threshold): max {:.6g}, mean {:.6g}, RMS {:.6g}; PSNR {}\n",
+                               g.ofA.maxAbsError, g.ofA.meanAbsError, g.ofA.rmsError,
+                               std::isinf(g.ofA.psnr) ? std::string("inf") : std::isnan(g.ofA.psnr) ? std::string("undefined") : fmt::format("{:.2f} dB", g.ofA.psnr));
                 if (g.nonFiniteErrors) fmt::print("    {} voxels differ by NaN or inf (not in the statistics)\n", g.nonFiniteErrors);
             }
             if (!opt->output.empty()) fmt::print("  wrote {} ({} bytes)\n", opt->output, r.bytes);

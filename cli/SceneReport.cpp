@@ -1,9 +1,12 @@
 // See SceneReport.h.
 #include "cli/SceneReport.h"
 
+#include <cmath>
 #include <tuple>
 
 #include <fmt/core.h>
+
+#include "vdb_bridge/DenseImport.h"
 
 namespace vdbdag::cli {
 
@@ -97,6 +100,18 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
                           {"max_abs_error", grid.lossy.maxAbsError}, {"mean_abs_error", grid.lossy.meanAbsError},
                           {"rms_error", grid.lossy.rmsError}, {"max_rel_error", grid.lossy.maxRelError}};
         j["bits_per_active_voxel"] = grid.activeVoxels ? 8.0 * double(gridBytes) / double(grid.activeVoxels) : 0.0;
+        if (const auto scan = bridge::scanProvenanceOf(grid.record)) {
+            json sj{{"source_file", scan->sourceFile}, {"format", scan->format}, {"sample_type", scan->sampleType},
+                    {"dims", {scan->dims[0], scan->dims[1], scan->dims[2]}}, {"space", scan->space}};
+            if (scan->below) sj["background_below"] = *scan->below;
+            if (scan->above) sj["background_above"] = *scan->above;
+            if (scan->threshold) {
+                const bridge::ThresholdReport& t = *scan->threshold;
+                sj["threshold"] = {{"inactive_samples", t.inactive}, {"changed_samples", t.changed}, {"max_abs_change", t.maxAbsChange},
+                                   {"rms_change", t.rmsChange}, {"psnr_db", std::isfinite(t.psnr) ? json(t.psnr) : json(nullptr)}, {"psnr_peak", "input range"}};
+            }
+            j["scan"] = sj;
+        }
         report["grids"].push_back(j);
     }
     report["container_overhead_bytes"] = fileLevelBytes;
@@ -134,6 +149,21 @@ std::string formatSceneReport(const nlohmann::json& r) {
             out += fmt::format("  lossy values ({}): {} changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
                                g["lossy"]["tolerance"].get<std::string>(), g["lossy"]["changed"].get<uint64_t>(), g["lossy"]["max_abs_error"].get<double>(),
                                g["lossy"]["mean_abs_error"].get<double>(), g["lossy"]["rms_error"].get<double>(), g["lossy"]["max_rel_error"].get<double>());
+        if (g.contains("scan")) {
+            const auto& sc = g["scan"];
+            out += fmt::format("  scan: {} ({}, {} samples, {}x{}x{}{})\n", sc["source_file"].get<std::string>(), sc["format"].get<std::string>(),
+                               sc["sample_type"].get<std::string>(), sc["dims"][0].get<int64_t>(), sc["dims"][1].get<int64_t>(), sc["dims"][2].get<int64_t>(),
+                               sc["space"].get<std::string>().empty() ? std::string() : ", " + sc["space"].get<std::string>());
+            if (sc.contains("threshold")) {
+                const auto& t = sc["threshold"];
+                std::string which;
+                if (sc.contains("background_below")) which += fmt::format("below {:g}", sc["background_below"].get<double>());
+                if (sc.contains("background_above")) which += fmt::format("{}above {:g}", which.empty() ? "" : " and ", sc["background_above"].get<double>());
+                out += fmt::format("  threshold ({}): {} samples inactive, {} changed; max |change| {:.6g}, RMS {:.6g}; PSNR {} (peak = input range)\n", which,
+                                   t["inactive_samples"].get<uint64_t>(), t["changed_samples"].get<uint64_t>(), t["max_abs_change"].get<double>(),
+                                   t["rms_change"].get<double>(), t["psnr_db"].is_null() ? std::string("inf") : fmt::format("{:.2f} dB", t["psnr_db"].get<double>()));
+            }
+        }
         if (g.contains("colour")) out += "  " + formatColour(g["colour"]) + "\n";
         if (g.contains("normals")) out += "  " + formatNormals(g["normals"]) + "\n";
         out += fmt::format("  total {} bytes in file ({:.4f} bits/active voxel), {} bytes traceable in memory\n", g["stored_bytes"].get<uint64_t>(),

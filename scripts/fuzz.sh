@@ -6,6 +6,8 @@
 #                         mutations reach the structural checks), then the
 #                         section parsers, DAG validation and a DAG walk
 #   fuzz_ssvdag_sections  section payloads and DAG validation behind the checksums
+#   fuzz_scan_headers     NRRD, MetaImage, NIfTI (libnifti) and DICOM (GDCM)
+#                         headers, then their samples, seeded from ../shared/data
 # Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
 # Crash inputs are written to build-fuzz/artifacts/; the corpus grows in
 # build-fuzz/corpus_*. Exit status is non-zero if any target found a bug.
@@ -14,17 +16,32 @@ cd "$(dirname "$0")/.."
 SECONDS_TO_RUN=${1:-120}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(fuzz_ssvdag_reader fuzz_ssvdag_sections)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(fuzz_ssvdag_reader fuzz_ssvdag_sections fuzz_scan_headers)
 JOBS=${JOBS:-2}
 
 CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVDBDAG_BUILD_FUZZERS=ON -DVDBDAG_BUILD_TESTS=OFF >/dev/null
 cmake --build build-fuzz -j"$JOBS" --target "${TARGETS[@]}" make_seed_corpus
 mkdir -p build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/artifacts
 build-fuzz/make_seed_corpus build-fuzz/corpus_reader build-fuzz/corpus_sections
+# Scan seeds: a format byte (0 NRRD, 1 MetaImage, 2 NIfTI, 3 gzip NIfTI, 4
+# DICOM) and the first 64 KiB of a real file of that format.
+mkdir -p build-fuzz/corpus_scan_headers
+seed() {  # KIND FILE
+  [ -f "$2" ] || return 0
+  { printf "\\$(printf '%03o' "$1")"; head -c 65000 "$2"; } > "build-fuzz/corpus_scan_headers/seed_$1_$(basename "$2")"
+}
+DATA=../shared/data
+seed 0 "$DATA/dense/FLAIR.nrrd"; seed 0 "$DATA/dense/cthead_256x256x99_uint8.nhdr"; seed 1 "$DATA/dense/tooth_103x94x161_uint8.mhd"
+for f in "$DATA"/medical/nifti/*.nii.gz; do
+  seed 3 "$f"
+  [ -f "$f" ] && { printf '\002'; zcat "$f" | head -c 65000 || true; } > "build-fuzz/corpus_scan_headers/seed_2_$(basename "$f" .gz)"
+done
+for f in $(ls "$DATA"/medical/dicom/rsna_2/PET 2>/dev/null | head -3); do seed 4 "$DATA/medical/dicom/rsna_2/PET/$f"; done
 
 status=0
 for target in "${TARGETS[@]}"; do
   corpus=build-fuzz/corpus_${target#fuzz_ssvdag_}
+  [ "$target" = fuzz_scan_headers ] && corpus=build-fuzz/corpus_scan_headers
   echo "== $target: ${SECONDS_TO_RUN}s from $(ls "$corpus" | wc -l) corpus files"
   if ! build-fuzz/"$target" -max_total_time="$SECONDS_TO_RUN" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
         -print_final_stats=1 -artifact_prefix=build-fuzz/artifacts/"$target"- "$corpus" > build-fuzz/"$target".log 2>&1; then

@@ -76,7 +76,7 @@ std::string gridNameOf(const std::string& path) {
 // The grid header (OpenVDB's own serialisation of an empty grid, with the
 // scan's transform and the metadata a decode back to the scan needs).
 template <typename V>
-void describeGrid(const DenseVolume& v, const V& background, const Thresholds* th, GridRecord& record) {
+void describeGrid(const DenseVolume& v, const V& background, const Thresholds* th, const ThresholdReport* report, GridRecord& record) {
     detail::initializeOpenVdb();
     using GridT = openvdb::Grid<typename openvdb::tree::Tree4<V, 5, 4, 3>::Type>;
     typename GridT::Ptr grid = GridT::create(background);
@@ -102,6 +102,13 @@ void describeGrid(const DenseVolume& v, const V& background, const Thresholds* t
     if (!v.space.empty()) grid->insertMeta("space", openvdb::StringMetadata(v.space));  // of the grid's world coordinates
     if (th && th->below) grid->insertMeta("background_below", openvdb::DoubleMetadata(th->belowValue));
     if (th && th->above) grid->insertMeta("background_above", openvdb::DoubleMetadata(th->aboveValue));
+    if (report && report->applied) {  // what the thresholds cost, for `info` (scanProvenanceOf)
+        grid->insertMeta("threshold_inactive_samples", openvdb::Int64Metadata(int64_t(report->inactive)));
+        grid->insertMeta("threshold_changed_samples", openvdb::Int64Metadata(int64_t(report->changed)));
+        grid->insertMeta("threshold_max_abs_change", openvdb::DoubleMetadata(report->maxAbsChange));
+        grid->insertMeta("threshold_rms_change", openvdb::DoubleMetadata(report->rmsChange));
+        grid->insertMeta("threshold_psnr_db", openvdb::DoubleMetadata(report->psnr));
+    }
     record.name = grid->getName();
     record.gridClass = openvdb::GridBase::gridClassToString(grid->getGridClass());
     record.indexToWorld = detail::indexToWorldOf(*grid);
@@ -143,7 +150,7 @@ DenseImportResult importVector(const DenseVolume& v, ValueType valueType, bool s
     DenseImportResult result;
     result.source = v;
     result.threshold.samples = v.sampleCount();
-    describeGrid<V>(v, V(C(0)), nullptr, record);
+    describeGrid<V>(v, V(C(0)), nullptr, nullptr, record);
     result.volume.grids.push_back(std::move(record));
     return result;
 }
@@ -276,7 +283,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
         r.backgroundChosen = th.background.has_value();
     }
 
-    describeGrid<V>(v, background, &th, record);
+    describeGrid<V>(v, background, &th, &r, record);
     result.volume.grids.push_back(std::move(record));
     return result;
 }
@@ -381,6 +388,32 @@ DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, boo
 }
 
 } // namespace
+
+std::optional<ScanProvenance> scanProvenanceOf(const GridRecord& grid) {
+    const openvdb::GridBase::Ptr g = detail::readDescriptor(grid.vdbDescriptor, "grid '" + grid.name + "'");
+    const auto format = g->getMetadata<openvdb::StringMetadata>("source_format");
+    const auto type = g->getMetadata<openvdb::StringMetadata>("source_sample_type");
+    if (!type) return std::nullopt;
+    ScanProvenance p;
+    if (auto f = g->getMetadata<openvdb::StringMetadata>("source_file")) p.sourceFile = f->value();
+    p.format = format ? format->value() : "";
+    p.sampleType = type->value();
+    if (auto d = g->getMetadata<openvdb::Vec3IMetadata>("source_dims")) p.dims = {d->value()[0], d->value()[1], d->value()[2]};
+    if (auto s = g->getMetadata<openvdb::StringMetadata>("space")) p.space = s->value();
+    if (auto b = g->getMetadata<openvdb::DoubleMetadata>("background_below")) p.below = b->value();
+    if (auto a = g->getMetadata<openvdb::DoubleMetadata>("background_above")) p.above = a->value();
+    if (auto n = g->getMetadata<openvdb::Int64Metadata>("threshold_inactive_samples")) {
+        ThresholdReport r;
+        r.applied = true;
+        r.inactive = uint64_t(n->value());
+        if (auto c = g->getMetadata<openvdb::Int64Metadata>("threshold_changed_samples")) r.changed = uint64_t(c->value());
+        if (auto m = g->getMetadata<openvdb::DoubleMetadata>("threshold_max_abs_change")) r.maxAbsChange = m->value();
+        if (auto m = g->getMetadata<openvdb::DoubleMetadata>("threshold_rms_change")) r.rmsChange = m->value();
+        if (auto m = g->getMetadata<openvdb::DoubleMetadata>("threshold_psnr_db")) r.psnr = m->value();
+        p.threshold = r;
+    }
+    return p;
+}
 
 DenseImportResult importDense(const std::string& path, const DenseImportOptions& options) {
     const DenseVolume v = describeDense(path, options);

@@ -17,6 +17,7 @@
 // report states what that costs against the input: samples changed, max,
 // mean and RMS absolute change, PSNR with peak = the input's value range.
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 
@@ -72,5 +73,15 @@ DenseVolume describeDense(const std::string& path, const DenseImportOptions& opt
 // Throws vdbdag::Error naming the file on any malformed header, missing or
 // short data, unsupported type or bad threshold.
 DenseImportResult importDense(const std::string& path, const DenseImportOptions& options);
+
+// Where a grid imported from a scan came from and what its thresholds cost
+// (DenseImport's metadata); nullopt for grids that did not come from a scan.
+struct ScanProvenance {
+    std::string sourceFile, format, sampleType, space;
+    std::array<int64_t, 3> dims{0, 0, 0};
+    std::optional<double> below, above;
+    std::optional<ThresholdReport> threshold;  // inactive, changed, max and RMS change, PSNR (input range)
+};
+std::optional<ScanProvenance> scanProvenanceOf(const GridRecord& grid);
 
 } // namespace vdbdag::bridge

@@ -116,6 +116,18 @@ public:
             }
         } else {
             status = aOn ? 2 : 3;
+            if (aOn && kHasValues) {  // against what B stores there (its background or inactive value)
+                double dbInactive[3] = {kNaN, kNaN, kNaN}, sq = 0;
+                toDoubles(vb, dbInactive);
+                for (int c = 0; c < kComps; ++c) sq += (da[c] - dbInactive[c]) * (da[c] - dbInactive[c]);
+                const double e = std::sqrt(sq);
+                if (std::isfinite(e)) {
+                    maxOnlyA_ = std::max(maxOnlyA_, e);
+                    sumOnlyA_ += e * double(weight);
+                    sumSqOnlyA_ += e * e * double(weight);
+                    onlyA_ += weight;
+                }
+            }
         }
         if (aOn && kHasValues) {
             double mag = 0;
@@ -149,6 +161,14 @@ public:
         d.rmsError = compared_ ? std::sqrt(sumSq_ / double(compared_)) : 0.0;
         d.peak = maxA_ >= minA_ ? maxA_ - minA_ : 0.0;
         d.psnr = d.rmsError == 0 ? std::numeric_limits<double>::infinity() : d.peak > 0 ? 20.0 * std::log10(d.peak / d.rmsError) : kNaN;
+        // Over every voxel of A, B's inactive value standing where B has no
+        // active one: what a threshold (encode --background-below) costs.
+        const uint64_t all = compared_ + onlyA_;
+        d.ofA.voxels = all;
+        d.ofA.maxAbsError = std::max(maxAbs_, maxOnlyA_);
+        d.ofA.meanAbsError = all ? (sum_ + sumOnlyA_) / double(all) : 0.0;
+        d.ofA.rmsError = all ? std::sqrt((sumSq_ + sumSqOnlyA_) / double(all)) : 0.0;
+        d.ofA.psnr = d.ofA.rmsError == 0 ? std::numeric_limits<double>::infinity() : d.peak > 0 ? 20.0 * std::log10(d.peak / d.ofA.rmsError) : kNaN;
         d.cells = cells_.cellCount();
     }
 
@@ -175,6 +195,8 @@ private:
     std::array<uint64_t, 4> voxels_{};
     uint64_t compared_ = 0, nonFinite_ = 0;
     double maxAbs_ = 0, maxRel_ = 0, sum_ = 0, sumSq_ = 0;
+    uint64_t onlyA_ = 0;
+    double maxOnlyA_ = 0, sumOnlyA_ = 0, sumSqOnlyA_ = 0;
     double minA_ = std::numeric_limits<double>::infinity(), maxA_ = -std::numeric_limits<double>::infinity();
 };
 

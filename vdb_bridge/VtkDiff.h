@@ -1,4 +1,4 @@
-// Voxel-by-voxel comparison of two volumes (.vdb or .ssvdag each) for
+// Voxel-by-voxel comparison of two volumes (.vdb, .ssvdag or a dense scan each) for
 // ParaView and scripts (`vdbdag diff A B [-o DIFF.vtu]`). Grids are paired
 // in file order (after --grid selection). For each pair, every voxel active
 // in either grid gets a status: 0 same (bit-identical value), 1 value differs,
@@ -37,6 +37,13 @@ struct GridDiff {
     double maxAbsError = 0, meanAbsError = 0, rmsError = 0, maxRelError = 0;
     double peak = 0;                   // value range of A
     double psnr = 0;                   // dB; +inf when RMS is 0, NaN when the peak is 0
+    // The same over every voxel active in A, with B's stored (inactive)
+    // value where B has none: for a thresholded scan against its source,
+    // encode's report (samples made inactive = voxels[2]).
+    struct OverA {
+        uint64_t voxels = 0;
+        double maxAbsError = 0, meanAbsError = 0, rmsError = 0, psnr = 0;
+    } ofA;
     bool differs() const { return voxels[1] + voxels[2] + voxels[3] > 0; }
 };
 

@@ -125,7 +125,8 @@ vtkSmartPointer<vtkDataObject> buildUnstructured(const GridT& grid, const Loaded
     const TreeT& tree = grid.tree();
     detail::VoxelCellBuilder cells(grid.transform());
     std::optional<detail::ValueColumn<ValueT>> values;
-    if constexpr (kHasValues<GridT>) values.emplace(arrayName(loaded), detail::isColourGrid(grid), vtkIdType(plan.cells));
+    if constexpr (kHasValues<GridT>)
+        values.emplace(arrayName(loaded), detail::isColourGrid(grid), vtkIdType(plan.cells), detail::scanSampleVtkType(grid));
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
         progress.advance();
         if (plan.clip && !leaf->getNodeBoundingBox().hasOverlap(plan.region)) continue;
@@ -182,7 +183,7 @@ vtkSmartPointer<vtkDataObject> buildImage(const GridT& grid, const LoadedGrid& l
     if constexpr (kHasValues<GridT>) {
         openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(region);  // x fastest, as VTK's cells
         openvdb::tools::copyToDense(grid, dense);
-        detail::ValueColumn<ValueT> values(arrayName(loaded), detail::isColourGrid(grid), vtkIdType(cells));
+        detail::ValueColumn<ValueT> values(arrayName(loaded), detail::isColourGrid(grid), vtkIdType(cells), detail::scanSampleVtkType(grid));
         const ValueT* data = dense.data();
         for (uint64_t i = 0; i < cells; ++i) values.push(data[i]);
         image->GetCellData()->AddArray(values.array());

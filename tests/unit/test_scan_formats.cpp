@@ -398,6 +398,16 @@ TEST(ScanFormats, BackgroundValueComesBackAndPsnrStatesItsPeak) {
     EXPECT_NEAR(report["psnr_db"].get<double>(), 10 * std::log10((hi - lo) * (hi - lo) / mse), 1e-9);
     EXPECT_EQ(report["stored_bits"].get<unsigned>(), 8u);
     EXPECT_NEAR(report["psnr_stored_range_db"].get<double>(), 10 * std::log10(255.0 * 255.0 / mse), 1e-9);
+    // `info` shows where the grid came from and what the threshold cost.
+    const CommandResult info = runCli("info " + ss.string() + " --json");
+    ASSERT_EQ(info.exitCode, 0) << info.err;
+    const nlohmann::json scan = nlohmann::json::parse(info.out)["grids"][0]["scan"];
+    EXPECT_EQ(scan["sample_type"], "u8");
+    EXPECT_EQ(scan["dims"], nlohmann::json({256, 256, 99}));
+    EXPECT_EQ(scan["background_below"].get<double>(), 30.0);
+    EXPECT_EQ(scan["threshold"]["inactive_samples"].get<uint64_t>(), removed);
+    EXPECT_NEAR(scan["threshold"]["psnr_db"].get<double>(), 10 * std::log10((hi - lo) * (hi - lo) / mse), 1e-9);
+    EXPECT_NE(runCli("info " + ss.string()).out.find("threshold (below 30): " + std::to_string(removed) + " samples inactive"), std::string::npos);
     expectOneLineError(encode(in, ss, "--background-value 7"), "needs --background-below", "value without threshold");
     expectOneLineError(encode(in, ss, "--background-below 30 --background-value 7.5"), "not a value of this integer grid", "fractional");
 }
@@ -476,4 +486,27 @@ nib.save(img, d + '/vec.nii.gz')
             expectSameScan(ref, reference(again), 2e-6, name + " -> " + out + " -> nii.gz");
         }
     }
+}
+
+// `diff SCAN THRESHOLDED.ssvdag` counts the samples the threshold made
+// inactive and, over all the scan's samples, gives encode's own figures.
+TEST(ScanFormats, DiffOfAThresholdedScanEqualsTheEncodeReport) {
+    const fs::path in = denseDir() / "cthead_256x256x99_uint8.nhdr";
+    if (!fs::exists(in)) GTEST_SKIP() << "needs ../shared/data/dense";
+    const fs::path ss = workDir() / "diff_th.ssvdag";
+    const CommandResult e = encode(in, ss, "--background-below 40 --json");
+    ASSERT_EQ(e.exitCode, 0) << e.err;
+    const nlohmann::json th = nlohmann::json::parse(e.out)["threshold"];
+    const CommandResult d = runCli("diff " + in.string() + " " + ss.string() + " --json");
+    EXPECT_EQ(d.exitCode, 1) << d.err;  // they differ
+    const nlohmann::json g = nlohmann::json::parse(d.out)["grids"][0];
+    EXPECT_EQ(g["voxels"]["only_in_a"].get<uint64_t>(), th["inactive_samples"].get<uint64_t>());
+    EXPECT_EQ(g["voxels"]["only_in_b"].get<uint64_t>(), 0u);
+    EXPECT_EQ(g["voxels"]["value_differs"].get<uint64_t>(), 0u);
+    const nlohmann::json all = g["over_all_of_a"];
+    EXPECT_EQ(all["voxels"].get<uint64_t>(), th["samples"].get<uint64_t>());
+    EXPECT_DOUBLE_EQ(all["max_abs_error"].get<double>(), th["max_abs_change"].get<double>());
+    EXPECT_NEAR(all["mean_abs_error"].get<double>(), th["mean_abs_change"].get<double>(), 1e-9);
+    EXPECT_NEAR(all["rms_error"].get<double>(), th["rms_change"].get<double>(), 1e-9);
+    EXPECT_NEAR(all["psnr_db"].get<double>(), th["psnr_db"].get<double>(), 1e-9);
 }

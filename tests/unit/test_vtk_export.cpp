@@ -353,3 +353,34 @@ TEST(VtkExport, SharedDataLevelSetAndMultiGridFile) {
         }
     }
 }
+
+// A scan's 8- and 16-bit samples stay 8 and 16 bits in .vti (VTK's own
+// reader gives the array type), each cell equal to the data file's sample
+// (read here with fread); a grid whose values do not fit widens to Int32.
+TEST(VtkExport, ScanSamplesKeepTheirWidthInVti) {
+    struct Case {
+        std::string header, raw;
+        int vtkType;
+        size_t bytes;
+    };
+    for (const Case& c : {Case{"cthead_256x256x99_uint8.nhdr", "cthead_256x256x99_uint8.raw", VTK_UNSIGNED_CHAR, 1},
+                          Case{"cranium_256x256x108_int16le.nhdr", "cranium_256x256x108_int16le.raw", VTK_SHORT, 2}}) {
+        const fs::path in = sharedData("dense/" + c.header);
+        if (!fs::exists(in)) GTEST_SKIP() << "needs ../shared/data/dense";
+        const fs::path ss = workDir() / "scan.ssvdag", out = workDir() / "scan.vti";
+        ASSERT_EQ(runCli("encode " + in.string() + " -o " + ss.string() + " -f").exitCode, 0);
+        const auto r = runCli("export " + ss.string() + " -o " + out.string() + " -f");
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        auto image = readVti(out);
+        vtkDataArray* values = image->GetCellData()->GetArray(0);
+        ASSERT_NE(values, nullptr);
+        EXPECT_EQ(values->GetDataType(), c.vtkType) << c.header << ": " << values->GetDataTypeAsString();
+        std::ifstream rawIn(sharedData("dense/" + c.raw), std::ios::binary);
+        const std::string raw((std::istreambuf_iterator<char>(rawIn)), {});
+        ASSERT_EQ(uint64_t(values->GetNumberOfTuples()) * c.bytes, raw.size()) << c.header;
+        for (vtkIdType i = 0; i < values->GetNumberOfTuples(); i += 997) {
+            const double want = c.bytes == 1 ? double(uint8_t(raw[size_t(i)])) : double(int16_t(uint16_t(uint8_t(raw[size_t(2 * i)])) | uint16_t(uint8_t(raw[size_t(2 * i + 1)])) << 8));
+            ASSERT_EQ(values->GetTuple1(i), want) << c.header << " cell " << i;
+        }
+    }
+}

@@ -1,12 +1,15 @@
 // See GridSource.h.
 #include "vdb_bridge/detail/GridSource.h"
 
+#include "vdb_bridge/DenseImport.h"
+
 #include <algorithm>
 #include <filesystem>
 
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
+#include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/detail/GridBuilder.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/VdbFile.h"
@@ -40,8 +43,17 @@ std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std
     initializeOpenVdb();
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
-    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a .vdb or .ssvdag file");
     std::vector<LoadedGrid> out;
+    if (denseFormatOf(path) != DenseFormat::None && !isSsvdagPath(path)) {  // a scan, read as `import` reads it (no thresholds)
+        DenseImportOptions options;
+        options.showProgress = false;
+        DenseImportResult imported = importDense(path, options);
+        checkNames(path, {imported.volume.grids.front().name}, onlyGrids);
+        if (selected(onlyGrids, imported.volume.grids.front().name))
+            out.push_back({0, buildGrid(imported.volume.grids.front(), path + ": grid 0")});
+        return out;
+    }
+    if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a .vdb or .ssvdag file");
     if (isSsvdagPath(path)) {
         format::SsvdagScene scene = format::readSceneFile(path);
         std::vector<std::string> names;

@@ -3,7 +3,10 @@
 // -> Int64, bool -> UInt8 (0/1), vec3s/vec3d -> 3-component Float32 (normals,
 // vectors), vec3i -> 3-component Int32; colour grids (isColourGrid) -> 3-component
 // UInt8: float colours are taken as 0..1 (clamped, x255, rounded), integer
-// colours as 0..255 (clamped). Mask grids have no values (no array).
+// colours as 0..255 (clamped). Mask grids have no values (no array). An
+// int32 grid imported from an 8- or 16-bit scan (metadata
+// source_sample_type, no rescale) keeps that width: UInt8, Int8, UInt16 or
+// Int16, widened to Int32 should a value not fit.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -35,6 +38,18 @@ template <> struct VtkValueTraits<openvdb::Vec3i> { using Array = vtkIntArray; s
 template <typename T>
 constexpr bool kIsVec3 = VtkValueTraits<T>::comps == 3;
 
+// The VTK type that holds an int32 grid's values as its scan stored them
+// (VTK_UNSIGNED_CHAR, VTK_SIGNED_CHAR, VTK_UNSIGNED_SHORT, VTK_SHORT), or 0.
+inline int scanSampleVtkType(const openvdb::GridBase& grid) {
+    const auto type = grid.getMetadata<openvdb::StringMetadata>("source_sample_type");
+    if (!type || grid.getMetadata<openvdb::DoubleMetadata>("source_rescale_slope")) return 0;
+    if (type->value() == "u8") return VTK_UNSIGNED_CHAR;
+    if (type->value() == "i8") return VTK_SIGNED_CHAR;
+    if (type->value() == "u16") return VTK_UNSIGNED_SHORT;
+    if (type->value() == "i16") return VTK_SHORT;
+    return 0;
+}
+
 inline unsigned char colourByte(double v, bool unitRange) {
     if (std::isnan(v)) return 0;
     const double scaled = unitRange ? std::round(std::clamp(v, 0.0, 1.0) * 255.0) : std::clamp(v, 0.0, 255.0);
@@ -45,9 +60,17 @@ inline unsigned char colourByte(double v, bool unitRange) {
 template <typename T>
 class ValueColumn {
 public:
-    ValueColumn(const std::string& name, bool colour, vtkIdType reserve = 0) : colour_(colour && kIsVec3<T>) {
+    // `narrowType`: scanSampleVtkType of an int32 grid (0: the usual type).
+    ValueColumn(const std::string& name, bool colour, vtkIdType reserve = 0, int narrowType = 0) : colour_(colour && kIsVec3<T>) {
+        if constexpr (std::is_same_v<T, int32_t>) {
+            if (narrowType) {
+                narrow_.TakeReference(vtkDataArray::CreateDataArray(narrowType));
+                narrowMin_ = narrow_->GetDataTypeMin();
+                narrowMax_ = narrow_->GetDataTypeMax();
+            }
+        }
         if (colour_) bytes_ = vtkSmartPointer<vtkUnsignedCharArray>::New();
-        else typed_ = vtkSmartPointer<typename VtkValueTraits<T>::Array>::New();
+        else if (!narrow_) typed_ = vtkSmartPointer<typename VtkValueTraits<T>::Array>::New();
         vtkDataArray* a = array();
         a->SetName(name.c_str());
         a->SetNumberOfComponents(VtkValueTraits<T>::comps);
@@ -67,13 +90,36 @@ public:
         } else if constexpr (std::is_same_v<T, bool>) {
             typed_->InsertNextValue(v ? 1 : 0);
         } else {
+            if constexpr (std::is_same_v<T, int32_t>) {
+                if (narrow_) {
+                    if (double(v) >= narrowMin_ && double(v) <= narrowMax_) {
+                        narrow_->InsertNextTuple1(double(v));
+                        return;
+                    }
+                    widen();  // a value the scan's type cannot hold: Int32 after all
+                }
+            }
             typed_->InsertNextValue(v);
         }
     }
-    vtkDataArray* array() const { return colour_ ? static_cast<vtkDataArray*>(bytes_.Get()) : static_cast<vtkDataArray*>(typed_.Get()); }
+    vtkDataArray* array() const {
+        if (colour_) return bytes_.Get();
+        if (narrow_) return narrow_.Get();
+        return typed_.Get();
+    }
 
 private:
+    void widen() {
+        typed_ = vtkSmartPointer<typename VtkValueTraits<T>::Array>::New();
+        typed_->SetName(narrow_->GetName());
+        typed_->SetNumberOfComponents(1);
+        typed_->Allocate(narrow_->GetNumberOfTuples());
+        for (vtkIdType i = 0; i < narrow_->GetNumberOfTuples(); ++i) typed_->InsertNextValue(T(narrow_->GetTuple1(i)));
+        narrow_ = nullptr;
+    }
     bool colour_;
+    vtkSmartPointer<vtkDataArray> narrow_;
+    double narrowMin_ = 0, narrowMax_ = 0;
     vtkSmartPointer<vtkUnsignedCharArray> bytes_;
     vtkSmartPointer<typename VtkValueTraits<T>::Array> typed_;
 };
