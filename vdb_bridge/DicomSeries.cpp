@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cctype>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -231,10 +232,105 @@ std::string checkNativeLength(const std::string& path, uint32_t length, bool big
     return result;
 }
 
+// GDCM allocates each element's declared length before it reads the bytes,
+// so a 1 KB file that declares a 3 GB element makes it allocate (and touch)
+// 3 GB. This walk reads only the element headers (tag, VR, length; into
+// sequences and items of undefined length) and refuses any length that runs
+// past the end of the file, before GDCM sees it. "" when the file passes
+// (or is not DICOM at all, which GDCM then reports). `beforePixels`: stop at
+// the Pixel Data element (a header read; a short pixel data element is a
+// truncated slice, which the series check names).
+std::string elementLengthProblem(const std::string& path, bool beforePixels = false) {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (!file) return "";
+    struct Closer {
+        std::FILE* f;
+        ~Closer() { std::fclose(f); }
+    } closer{file};
+    std::error_code ec;
+    const uint64_t size = fs::file_size(path, ec);
+    if (ec) return "";
+    auto readAt = [&](uint64_t at, void* out, size_t n) {
+        return at + n <= size && std::fseek(file, long(at), SEEK_SET) == 0 && std::fread(out, 1, n, file) == n;
+    };
+    uint64_t pos = 0;
+    char magic[4];
+    if (readAt(128, magic, 4) && std::memcmp(magic, "DICM", 4) == 0) pos = 132;
+    bool explicitVr = true, bigEndian = false, metaGroup = pos == 132;
+    if (pos == 0) {  // no preamble: walk only what starts like a DICOM dataset (else GDCM refuses it as not DICOM)
+        uint8_t h[6];
+        if (!readAt(0, h, 6)) return "";
+        const uint16_t group = uint16_t(h[0] | h[1] << 8);
+        if (group != 0x0002 && group != 0x0008) return "";
+        explicitVr = std::isupper(h[4]) && std::isupper(h[5]);
+        metaGroup = group == 0x0002;
+    }
+    auto u16 = [&](const uint8_t* b) { return bigEndian ? uint16_t(b[0] << 8 | b[1]) : uint16_t(b[0] | b[1] << 8); };
+    auto u32 = [&](const uint8_t* b) {
+        return bigEndian ? uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | b[3] : uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+    };
+    std::string transferSyntax;
+    for (unsigned steps = 0; pos + 8 <= size && steps < 10'000'000; ++steps) {
+        uint8_t h[12];
+        if (!readAt(pos, h, 8)) break;
+        const bool inMeta = metaGroup && (h[0] | h[1] << 8) == 0x0002;
+        if (metaGroup && !inMeta) {  // the meta group ends: the dataset's encoding from its transfer syntax
+            metaGroup = false;
+            if (transferSyntax == "1.2.840.10008.1.2") explicitVr = false;
+            else if (transferSyntax == "1.2.840.10008.1.2.2") bigEndian = true;
+            else if (transferSyntax == "1.2.840.10008.1.2.1.99") return "";  // deflated: GDCM inflates and checks
+        }
+        const bool le = inMeta || !bigEndian;
+        const uint16_t group = le ? uint16_t(h[0] | h[1] << 8) : u16(h), element = le ? uint16_t(h[2] | h[3] << 8) : u16(h + 2);
+        uint64_t length, header;
+        if (group == 0xFFFE) {  // item and delimiters: always a 4-byte length
+            length = le ? uint32_t(h[4]) | uint32_t(h[5]) << 8 | uint32_t(h[6]) << 16 | uint32_t(h[7]) << 24 : u32(h + 4);
+            header = 8;
+            if (element != 0xE000) length = 0;  // delimiters
+            if (length == 0xFFFFFFFFu) length = 0;  // an item of undefined length: walk into it
+            else if (element == 0xE000 && length > size - pos - header)
+                return fmt::format("item at byte {} claims {} bytes, but only {} follow", pos, length, size - pos - header);
+            pos += header + (element == 0xE000 && length ? length : 0);
+            continue;
+        }
+        if (inMeta || explicitVr) {
+            const char vr[3] = {char(h[4]), char(h[5]), 0};
+            static const std::set<std::string> longVr{"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
+            if (longVr.count(vr)) {
+                if (!readAt(pos, h, 12)) return fmt::format("element ({:04X},{:04X}) at byte {} is cut off", group, element, pos);
+                length = le ? uint32_t(h[8]) | uint32_t(h[9]) << 8 | uint32_t(h[10]) << 16 | uint32_t(h[11]) << 24 : u32(h + 8);
+                header = 12;
+            } else {
+                length = le ? uint16_t(h[6] | h[7] << 8) : u16(h + 6);
+                header = 8;
+            }
+        } else {
+            length = u32(h + 4);
+            header = 8;
+        }
+        if (beforePixels && group == kPixelGroup && element == 0x0010) return "";
+        if (length == 0xFFFFFFFFu) {  // a sequence or encapsulated pixel data: walk into it
+            pos += header;
+            continue;
+        }
+        if (length > size - pos - header)
+            return fmt::format("element ({:04X},{:04X}) at byte {} claims {} bytes, but only {} follow", group, element, pos, length, size - pos - header);
+        if (inMeta && element == 0x0010 && length < 256) {
+            std::string uid(length, '\0');
+            readAt(pos + header, uid.data(), length);
+            while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' ')) uid.pop_back();
+            transferSyntax = uid;
+        }
+        pos += header + length;
+    }
+    return "";
+}
+
 // Reads one file's header into `frames` (one per frame); returns the reason
 // to skip it, or "" when it is an image.
 std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>& frames) {
     quietGdcm();
+    if (const std::string bad = elementLengthProblem(path, true); !bad.empty()) return "corrupt DICOM: " + bad;
     gdcm::Reader reader;
     reader.SetFileName(path.c_str());
     if (!reader.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008))) return "not a DICOM file (or unreadable)";
@@ -393,6 +489,7 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
 // The files a DICOMDIR lists (Referenced File ID, relative to its folder).
 std::vector<std::string> dicomdirFiles(const std::string& path, std::vector<std::string>& skipped) {
     quietGdcm();
+    if (const std::string bad = elementLengthProblem(path); !bad.empty()) throw Error(path + ": corrupt DICOMDIR: " + bad);
     gdcm::Reader reader;
     reader.SetFileName(path.c_str());
     if (!reader.Read()) throw Error(path + ": not a readable DICOMDIR");
@@ -665,7 +762,7 @@ ScanState scan(const std::string& path) {
             quietGdcm();
             gdcm::Reader r;
             r.SetFileName(path.c_str());
-            if (r.ReadUpToTag(gdcm::Tag(0x0004, 0x1220))) {
+            if (elementLengthProblem(path).empty() && r.ReadUpToTag(gdcm::Tag(0x0004, 0x1220))) {
                 const Fields f(r.GetFile());
                 dicomdir = f.text(r.GetFile().GetHeader(), 0x0002, 0x0002) == "1.2.840.10008.1.3.10";
             }
@@ -849,6 +946,7 @@ private:
             cache_.clear();
             quietGdcm();
             const std::string where = fmt::format("{}: slice file of {}", slice.file, v_.headerPath);
+            if (const std::string bad = elementLengthProblem(slice.file); !bad.empty()) throw Error(where + ": corrupt DICOM: " + bad);
             gdcm::ImageReader reader;
             reader.SetFileName(slice.file.c_str());
             if (!reader.Read()) throw Error(where + ": GDCM cannot read it as a DICOM image (truncated or corrupt?)");

@@ -604,3 +604,40 @@ TEST(DicomCli, EncodeAndInfo) {
     EXPECT_NE(r.out.find("4 series, 3 file(s) skipped"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("3) " + kPerfUid + "  MR  \"Perfusion_Weighted\"  1 slices  256x256x1 u16"), std::string::npos) << r.out;
 }
+
+// A file that declares a 3 GB element in a few hundred kilobytes is refused
+// from its element headers, before GDCM would allocate the 3 GB: `info`
+// under a 1.5 GB address-space cap skips it with the reason, and a slice
+// reader given it names it.
+TEST(DicomSeries, AnElementLongerThanItsFileIsRefusedBeforeItIsAllocated) {
+    REQUIRE_REFERENCE();
+    const fs::path dir = freshDir("huge_element");
+    const std::string source = petByPosition().front();
+    std::ifstream in(source, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    // Implicit VR little endian: (0010,0010) Patient's Name, then a 4-byte length.
+    const std::string tag("\x10\x00\x10\x00", 4);
+    const size_t at = bytes.find(tag);
+    ASSERT_NE(at, std::string::npos);
+    const uint32_t huge = 0xBF000000u;
+    std::memcpy(&bytes[at + 4], &huge, 4);
+    const fs::path bad = dir / "huge.dcm";
+    std::ofstream(bad, std::ios::binary) << bytes;
+    const auto r = runShell("ulimit -v 1500000; " + std::string(VDBDAG_BINARY) + " info " + quote(dir) + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;  // no series, one file skipped with its reason
+    const nlohmann::json info = nlohmann::json::parse(r.out);
+    EXPECT_EQ(info["series"].size(), 0u);
+    ASSERT_EQ(info["skipped"].size(), 1u);
+    EXPECT_NE(info["skipped"][0].get<std::string>().find("claims 3204448256 bytes"), std::string::npos) << info.dump();
+    const DicomScan scan = [&] {
+        try {
+            return scanDicom(bad.string());
+        } catch (const Error& e) {
+            ADD_FAILURE() << e.what();
+            return DicomScan{};
+        }
+    }();
+    ASSERT_EQ(scan.skipped.size(), 1u);
+    EXPECT_NE(scan.skipped[0].find("element (0010,0010)"), std::string::npos) << scan.skipped[0];
+    EXPECT_NE(scan.skipped[0].find("claims 3204448256 bytes"), std::string::npos) << scan.skipped[0];
+}
