@@ -80,7 +80,7 @@ void describeGrid(const DenseVolume& v, const V& background, const Thresholds* t
     detail::initializeOpenVdb();
     using GridT = openvdb::Grid<typename openvdb::tree::Tree4<V, 5, 4, 3>::Type>;
     typename GridT::Ptr grid = GridT::create(background);
-    grid->setName(v.colour ? "Cd" : gridNameOf(v.headerPath));
+    grid->setName(v.colour ? "Cd" : !v.gridName.empty() ? v.gridName : gridNameOf(v.headerPath));
     grid->setGridClass(openvdb::GRID_UNKNOWN);
     openvdb::Mat4d m = openvdb::Mat4d::identity();
     for (int a = 0; a < 3; ++a)
@@ -332,7 +332,9 @@ DenseVolume describeDense(const std::string& path, const DenseImportOptions& opt
         case DenseFormat::Raw: v = describeRaw(path, options.raw); v.format = DenseFormat::Raw; return v;
         case DenseFormat::Nrrd: v = readNrrdHeader(path); break;
         case DenseFormat::MetaImage: v = readMetaImageHeader(path); break;
-        case DenseFormat::Nifti: v = readNiftiHeader(path, options.volume); break;
+        case DenseFormat::Nifti:  // a 4-D file without --volume: described by its first volume (importDense reads them all)
+            v = readNiftiHeader(path, options.volume ? options.volume : (niftiVolumeCount(path) > 1 ? std::optional<int64_t>(0) : std::nullopt));
+            break;
         case DenseFormat::Dicom: v = describeDicomSeries(path, options.series); v.format = DenseFormat::Dicom; return v;
         case DenseFormat::None: throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
     }
@@ -416,6 +418,28 @@ std::optional<ScanProvenance> scanProvenanceOf(const GridRecord& grid) {
 }
 
 DenseImportResult importDense(const std::string& path, const DenseImportOptions& options) {
+    if (denseFormatOf(path) == DenseFormat::Nifti && !options.volume) {
+        // A 4-D NIfTI file without --volume: one grid per volume, NAME_t0, NAME_t1, ...
+        const int64_t volumes = niftiVolumeCount(path);
+        if (volumes > 1) {
+            if (options.backgroundBelow || options.backgroundAbove)
+                throw Error(path + ": background thresholds apply to one volume of a 4-D NIfTI file: pick it with --volume N");
+            DenseImportResult all;
+            for (int64_t t = 0; t < volumes; ++t) {
+                DenseImportOptions one = options;
+                one.volume = t;
+                DenseImportResult r = importDense(path, one);
+                if (t == 0) {
+                    all.source = r.source;
+                    all.threshold = r.threshold;
+                } else {
+                    all.threshold.samples += r.threshold.samples;
+                }
+                for (GridRecord& g : r.volume.grids) all.volume.grids.push_back(std::move(g));
+            }
+            return all;
+        }
+    }
     const DenseVolume v = describeDense(path, options);
     Thresholds th;
     for (auto [set, value, flag] : {std::tuple{&th.below, &th.belowValue, options.backgroundBelow},

@@ -60,7 +60,7 @@ struct ThresholdReport {
 };
 
 struct DenseImportResult {
-    Volume volume;  // one grid
+    Volume volume;  // one grid (a 4-D NIfTI file without --volume: one per volume)
     DenseVolume source;
     ThresholdReport threshold;
 };

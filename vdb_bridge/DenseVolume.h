@@ -41,6 +41,7 @@ struct DicomSlice {
 struct DenseVolume {
     DenseFormat format = DenseFormat::Raw;
     std::string headerPath;  // the file the user named (for messages)
+    std::string gridName;    // the grid's name when not the file's (a NIfTI volume: NAME_tN)
     std::string dataPath;    // where the samples are (may equal headerPath)
     std::string dataNameInHeader;  // the data file as the header names it (empty when attached)
     std::array<int64_t, 3> dims{0, 0, 0};

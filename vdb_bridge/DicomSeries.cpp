@@ -295,6 +295,12 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
         }
         if (inMeta || explicitVr) {
             const char vr[3] = {char(h[4]), char(h[5]), 0};
+            // GDCM asserts (aborts) on a meta group element whose VR is not one of DICOM's.
+            static const std::set<std::string> knownVr{"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL", "IS", "LO", "LT", "OB", "OD", "OF",
+                                                       "OL", "OV", "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC", "UI", "UL", "UN",
+                                                       "UR", "US", "UT", "UV"};
+            if (inMeta && !knownVr.count(vr))
+                return fmt::format("file meta element ({:04X},{:04X}) at byte {} has no valid VR", group, element, pos);
             static const std::set<std::string> longVr{"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
             if (longVr.count(vr)) {
                 if (!readAt(pos, h, 12)) return fmt::format("element ({:04X},{:04X}) at byte {} is cut off", group, element, pos);

@@ -4,11 +4,14 @@
 // libnifti reports (inside the gzip stream for a .nii.gz).
 #include "vdb_bridge/NiftiHeader.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <mutex>
 
 #include <nifti2_io.h>
+#include <zlib.h>
 
 #include "src/util/Error.h"
 
@@ -46,11 +49,44 @@ SampleType sampleTypeOf(const nifti_image& nim, const std::string& path) {
     }
 }
 
+// What libnifti would complain about on stderr (whatever its debug level)
+// rather than in its return value, checked first: the header size and the
+// datatype code. A .nii.gz is read through zlib, as libnifti reads it.
+void precheck(const std::string& path) {
+    gzFile f = gzopen(path.c_str(), "rb");
+    if (!f) return;  // libnifti reports it
+    uint8_t h[540] = {};
+    const int got = gzread(f, h, sizeof h);
+    gzclose(f);
+    if (got < 348) throw Error(path + ": too short for a NIfTI header (" + std::to_string(got < 0 ? 0 : got) + " bytes, at least 348)");
+    auto i32 = [&](size_t at, bool swap) {
+        uint32_t v = uint32_t(h[at]) | uint32_t(h[at + 1]) << 8 | uint32_t(h[at + 2]) << 16 | uint32_t(h[at + 3]) << 24;
+        return swap ? __builtin_bswap32(v) : v;
+    };
+    auto i16 = [&](size_t at, bool swap) {
+        const uint16_t v = uint16_t(h[at] | h[at + 1] << 8);
+        return int16_t(swap ? __builtin_bswap16(v) : v);
+    };
+    size_t datatypeAt = 0;
+    bool swap = false;
+    for (bool s : {false, true}) {
+        if (i32(0, s) == 348) { datatypeAt = 70; swap = s; }
+        if (i32(0, s) == 540 && got >= 540) { datatypeAt = 12; swap = s; }
+    }
+    if (!datatypeAt) throw Error(path + ": not a NIfTI header (sizeof_hdr is " + std::to_string(i32(0, false)) + ", neither 348 nor 540)");
+    const int datatype = i16(datatypeAt, swap);
+    static const int known[] = {DT_UINT8, DT_INT16, DT_INT32, DT_FLOAT32, DT_COMPLEX64, DT_FLOAT64, DT_RGB24, DT_INT8, DT_UINT16,
+                                DT_UINT32, DT_INT64, DT_UINT64, DT_FLOAT128, DT_COMPLEX128, DT_COMPLEX256, DT_RGBA32};
+    if (std::find(std::begin(known), std::end(known), datatype) == std::end(known))
+        throw Error(path + ": NIfTI datatype code " + std::to_string(datatype) + " is not a NIfTI datatype");
+}
+
 } // namespace
 
 DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volume) {
     static std::once_flag quiet;
     std::call_once(quiet, [] { nifti_set_debug_level(0); });  // errors come back as one vdbdag::Error, never on stderr
+    precheck(path);
     std::unique_ptr<nifti_image, NiftiDeleter> nim(nifti_image_read(path.c_str(), 0));
     if (!nim) throw Error(path + ": not a readable NIfTI-1 or NIfTI-2 header (missing, truncated, or a field out of range)");
     const nifti_image& n = *nim;
@@ -82,6 +118,12 @@ DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volu
             throw Error(path + ": --volume " + std::to_string(*volume) + " is out of range: the file holds " + std::to_string(volumes) + " volume" +
                         (volumes == 1 ? "" : "s") + " (0.." + std::to_string(volumes - 1) + ")");
         chosen = *volume;
+        if (volumes > 1) {
+            std::string name = path.substr(path.find_last_of('/') + 1);
+            for (const char* ext : {".nii.gz", ".nii", ".hdr", ".NII.GZ", ".NII", ".HDR"})
+                if (name.size() > std::strlen(ext) && name.ends_with(ext)) { name.resize(name.size() - std::strlen(ext)); break; }
+            v.gridName = name + "_t" + std::to_string(chosen);
+        }
     } else if (volumes > 1) {
         throw Error(path + ": a 4-D NIfTI file with " + std::to_string(volumes) + " volumes of " + std::to_string(n.nx) + "x" + std::to_string(n.ny) +
                     "x" + std::to_string(n.nz) + ": pick one with --volume 0.." + std::to_string(volumes - 1));
@@ -132,6 +174,13 @@ DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volu
     }
     v.validate();
     return v;
+}
+
+int64_t niftiVolumeCount(const std::string& path) {
+    precheck(path);
+    std::unique_ptr<nifti_image, NiftiDeleter> nim(nifti_image_read(path.c_str(), 0));
+    if (!nim) throw Error(path + ": not a readable NIfTI-1 or NIfTI-2 header (missing, truncated, or a field out of range)");
+    return nim->nt > 1 ? nim->nt : 1;
 }
 
 } // namespace vdbdag::bridge

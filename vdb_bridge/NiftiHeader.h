@@ -7,8 +7,8 @@
 // Coordinates are RAS (DenseVolume::space "RAS"); scl_slope / scl_inter go
 // to DenseVolume::rescaleSlope / rescaleIntercept when scl_slope is neither
 // 0 nor 1-with-intercept-0. A 4-D file is one volume per t (`volume` picks
-// one, 0-based); complex, RGB and vector data types are refused by name
-// until the colour and vector grids read them.
+// one, 0-based; DenseImport makes one grid per volume without it); RGB24 is
+// a colour, a 5th dimension of 3 a vector; complex and RGBA are refused.
 #pragma once
 #include <optional>
 #include <string>
@@ -18,6 +18,10 @@
 namespace vdbdag::bridge {
 
 // Throws vdbdag::Error naming the file and the header field that is wrong.
+// A volume chosen from a 4-D file names its grid NAME_tN (DenseVolume::gridName).
 DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volume = std::nullopt);
+
+// The number of volumes (dim[4], at least 1). Throws like readNiftiHeader.
+int64_t niftiVolumeCount(const std::string& path);
 
 } // namespace vdbdag::bridge
