@@ -240,7 +240,9 @@ std::string checkNativeLength(const std::string& path, uint32_t length, bool big
 // (or is not DICOM at all, which GDCM then reports). `beforePixels`: stop at
 // the Pixel Data element (a header read; a short pixel data element is a
 // truncated slice, which the series check names).
-std::string elementLengthProblem(const std::string& path, bool beforePixels = false) {
+// `pixelLength`: set to the Pixel Data element's declared length when it is
+// that element that runs past the end.
+std::string elementLengthProblem(const std::string& path, bool beforePixels = false, uint64_t* pixelLength = nullptr) {
     std::FILE* file = std::fopen(path.c_str(), "rb");
     if (!file) return "";
     struct Closer {
@@ -256,13 +258,14 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
     uint64_t pos = 0;
     char magic[4];
     if (readAt(128, magic, 4) && std::memcmp(magic, "DICM", 4) == 0) pos = 132;
-    bool explicitVr = true, bigEndian = false, metaGroup = pos == 132;
+    bool explicitVr = true, bigEndian = false, metaGroup = pos == 132, declaredImplicit = false;
     if (pos == 0) {  // no preamble: walk only what starts like a DICOM dataset (else GDCM refuses it as not DICOM)
         uint8_t h[6];
         if (!readAt(0, h, 6)) return "";
         const uint16_t group = uint16_t(h[0] | h[1] << 8);
         if (group != 0x0002 && group != 0x0008) return "";
         explicitVr = std::isupper(h[4]) && std::isupper(h[5]);
+        declaredImplicit = !explicitVr;
         metaGroup = group == 0x0002;
     }
     auto u16 = [&](const uint8_t* b) { return bigEndian ? uint16_t(b[0] << 8 | b[1]) : uint16_t(b[0] | b[1] << 8); };
@@ -276,7 +279,7 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
         const bool inMeta = metaGroup && (h[0] | h[1] << 8) == 0x0002;
         if (metaGroup && !inMeta) {  // the meta group ends: the dataset's encoding from its transfer syntax
             metaGroup = false;
-            if (transferSyntax == "1.2.840.10008.1.2") explicitVr = false;
+            if (transferSyntax == "1.2.840.10008.1.2") explicitVr = false, declaredImplicit = true;
             else if (transferSyntax == "1.2.840.10008.1.2.2") bigEndian = true;
             else if (transferSyntax == "1.2.840.10008.1.2.1.99") return "";  // deflated: GDCM inflates and checks
         }
@@ -293,14 +296,16 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
             pos += header + (element == 0xE000 && length ? length : 0);
             continue;
         }
+        const char vr[3] = {char(h[4]), char(h[5]), 0};
+        // GDCM asserts (aborts) on a meta group element whose VR is not one of DICOM's.
+        static const std::set<std::string> knownVr{"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL", "IS", "LO", "LT", "OB", "OD", "OF",
+                                                   "OL", "OV", "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC", "UI", "UL", "UN",
+                                                   "UR", "US", "UT", "UV"};
+        if (inMeta && !knownVr.count(vr)) return fmt::format("file meta element ({:04X},{:04X}) at byte {} has no valid VR", group, element, pos);
+        // An implicit transfer syntax is read as implicit (as GDCM does); under
+        // an explicit one, an element whose VR bytes are no VR as implicit.
+        if (!inMeta && !declaredImplicit) explicitVr = knownVr.count(vr) > 0;
         if (inMeta || explicitVr) {
-            const char vr[3] = {char(h[4]), char(h[5]), 0};
-            // GDCM asserts (aborts) on a meta group element whose VR is not one of DICOM's.
-            static const std::set<std::string> knownVr{"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL", "IS", "LO", "LT", "OB", "OD", "OF",
-                                                       "OL", "OV", "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC", "UI", "UL", "UN",
-                                                       "UR", "US", "UT", "UV"};
-            if (inMeta && !knownVr.count(vr))
-                return fmt::format("file meta element ({:04X},{:04X}) at byte {} has no valid VR", group, element, pos);
             static const std::set<std::string> longVr{"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
             if (longVr.count(vr)) {
                 if (!readAt(pos, h, 12)) return fmt::format("element ({:04X},{:04X}) at byte {} is cut off", group, element, pos);
@@ -319,8 +324,10 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
             pos += header;
             continue;
         }
-        if (length > size - pos - header)
+        if (length > size - pos - header) {
+            if (pixelLength && group == kPixelGroup && element == 0x0010) *pixelLength = length;
             return fmt::format("element ({:04X},{:04X}) at byte {} claims {} bytes, but only {} follow", group, element, pos, length, size - pos - header);
+        }
         if (inMeta && element == 0x0010 && length < 256) {
             std::string uid(length, '\0');
             readAt(pos + header, uid.data(), length);
@@ -339,7 +346,9 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
     if (const std::string bad = elementLengthProblem(path, true); !bad.empty()) return "corrupt DICOM: " + bad;
     gdcm::Reader reader;
     reader.SetFileName(path.c_str());
-    if (!reader.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008))) return "not a DICOM file (or unreadable)";
+    // GDCM reads the element it stops at: the pixel data are skipped, not
+    // loaded (their length is checked below).
+    if (!reader.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008), {gdcm::Tag(kPixelGroup, 0x0010)})) return "not a DICOM file (or unreadable)";
     const gdcm::File& file = reader.GetFile();
     const gdcm::DataSet& ds = file.GetDataSet();
     const Fields f(file);
@@ -360,10 +369,21 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
         // A file whose header reads but whose pixel data does not is part of
         // its series all the same (damaged): the series is refused naming it,
         // rather than showing a gap.
-        const bool read = pixels.ReadSelectedTags(tags, false);
+        // GDCM would allocate a declared pixel length past the file's end
+        // before reading it: such a file is damaged without asking GDCM.
+        uint64_t declaredPixels = 0;
+        const std::string bad = elementLengthProblem(path, false, &declaredPixels);
+        if (!bad.empty()) {
+            const bool bigEndian = file.GetHeader().GetDataSetTransferSyntax() == gdcm::TransferSyntax::ExplicitVRBigEndian;
+            if (declaredPixels) info.damaged = checkNativeLength(path, uint32_t(declaredPixels), bigEndian);
+            if (info.damaged.empty()) info.damaged = "is corrupt: " + bad;
+        }
+        const bool read = bad.empty() && pixels.ReadSelectedTags(tags, false);
         const gdcm::DataSet& p = pixels.GetFile().GetDataSet();
         const gdcm::Tag pixelData(kPixelGroup, 0x0010);
-        if (!read) {
+        if (!bad.empty()) {
+            // damaged, named above
+        } else if (!read) {
             info.damaged = "is truncated or corrupt: its pixel data cannot be read";
         } else {
             if (p.FindDataElement(gdcm::Tag(kPixelGroup, 0x0008)) || p.FindDataElement(gdcm::Tag(kPixelGroup, 0x0009)))

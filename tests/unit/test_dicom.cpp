@@ -520,7 +520,10 @@ TEST(DicomSeries, BadInputsGiveOneLineNamingTheFile) {
         fs::resize_file(bad, fs::file_size(bad) - 300);
         const std::string c = errorOf([&] { importDense(rle.string(), quietOptions()); });
         EXPECT_TRUE(oneLine(c)) << c;
-        EXPECT_EQ(c.rfind(bad.string() + ": slice file of " + rle.string() + ": ", 0), 0u) << c;
+        // Found from its element lengths when the folder is scanned, or when it is decoded.
+        EXPECT_TRUE(c.rfind(bad.string() + ": slice file of " + rle.string() + ": ", 0) == 0 ||
+                    c.find(bad.string() + " is corrupt: item at byte") != std::string::npos)
+            << c;
     }
 
     // The same slice twice under another name.
