@@ -319,6 +319,8 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
             length = u32(h + 4);
             header = 8;
         }
+        if (inMeta && length == 0xFFFFFFFFu)  // GDCM asserts on it too
+            return fmt::format("file meta element ({:04X},{:04X}) at byte {} has an undefined length", group, element, pos);
         if (beforePixels && group == kPixelGroup && element == 0x0010) return "";
         if (length == 0xFFFFFFFFu) {  // a sequence or encapsulated pixel data: walk into it
             pos += header;
@@ -336,6 +338,8 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
         }
         pos += header + length;
     }
+    // A file that ends inside its file meta group (GDCM asserts on it).
+    if (metaGroup) return fmt::format("the file ends inside its file meta group (at byte {} of {})", pos, size);
     return "";
 }
 

@@ -74,6 +74,20 @@ void precheck(const std::string& path) {
         if (i32(0, s) == 540 && got >= 540) { datatypeAt = 12; swap = s; }
     }
     if (!datatypeAt) throw Error(path + ": not a NIfTI header (sizeof_hdr is " + std::to_string(i32(0, false)) + ", neither 348 nor 540)");
+    // dim[0] in 1..7 and dim[1..dim[0]] positive (NIfTI-1: int16 at byte
+    // 40; NIfTI-2: int64 at byte 16).
+    int64_t dim[8];
+    for (int d = 0; d < 8; ++d) {
+        if (datatypeAt == 70) {
+            dim[d] = i16(40 + 2 * size_t(d), swap);
+        } else {
+            const uint64_t lo = i32(16 + 8 * size_t(d), swap), hi = i32(20 + 8 * size_t(d), swap);
+            dim[d] = int64_t(swap ? (lo << 32 | hi) : (hi << 32 | lo));
+        }
+    }
+    if (dim[0] < 1 || dim[0] > 7) throw Error(path + ": NIfTI dim[0] = " + std::to_string(dim[0]) + " is outside 1..7");
+    for (int d = 1; d <= dim[0]; ++d)
+        if (dim[d] < 1) throw Error(path + ": NIfTI dim[" + std::to_string(d) + "] = " + std::to_string(dim[d]) + " is not positive");
     const int datatype = i16(datatypeAt, swap);
     static const int known[] = {DT_UINT8, DT_INT16, DT_INT32, DT_FLOAT32, DT_COMPLEX64, DT_FLOAT64, DT_RGB24, DT_INT8, DT_UINT16,
                                 DT_UINT32, DT_INT64, DT_UINT64, DT_FLOAT128, DT_COMPLEX128, DT_COMPLEX256, DT_RGBA32};
