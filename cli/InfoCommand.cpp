@@ -3,13 +3,17 @@
 // node counts show). For DICOM input (a folder, a .dcm file, a DICOMDIR):
 // the series found (what `encode --series N|UID` picks from) and the files
 // skipped.
+#include <cmath>
+
 #include <fmt/core.h>
 
 #include "cli/Commands.h"
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "src/pipeline/GridCodec.h"
+#include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/DicomSeries.h"
+#include "vdb_bridge/NiftiHeader.h"
 #include "vdb_bridge/VdbImport.h"
 
 namespace vdbdag::cli {
@@ -52,12 +56,57 @@ std::string formatDicomReport(const nlohmann::json& r) {
     if (skipped.size() > kShown) out += fmt::format("  ... and {} more skipped (--json lists all)\n", skipped.size() - kShown);
     return out;
 }
+// A scan's header as vdbdag reads it (NRRD, MetaImage, NIfTI; .raw from
+// its name): what `encode` would make of it.
+nlohmann::json scanHeaderReport(const std::string& input, const bridge::DenseVolume& v) {
+    nlohmann::json axes = nlohmann::json::array();
+    nlohmann::json spacing = nlohmann::json::array();
+    for (const auto& a : v.axes) {
+        axes.push_back({a[0], a[1], a[2]});
+        spacing.push_back(std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]));
+    }
+    nlohmann::json r{{"input", input},
+                     {"format", bridge::denseFormatName(v.format)},
+                     {"dims", {v.dims[0], v.dims[1], v.dims[2]}},
+                     {"sample_type", bridge::sampleTypeName(v.type)},
+                     {"components", v.components},
+                     {"colour", v.colour},
+                     {"space", v.space},
+                     {"origin", {v.origin[0], v.origin[1], v.origin[2]}},
+                     {"axes", axes},
+                     {"spacing", spacing},
+                     {"rescale_slope", v.rescaleSlope},
+                     {"rescale_intercept", v.rescaleIntercept},
+                     {"data_file", v.dataPath},
+                     {"compressed", v.encoding == bridge::DataEncoding::Zlib}};
+    if (v.format == bridge::DenseFormat::Nifti) r["volumes"] = bridge::niftiVolumeCount(input);
+    return r;
+}
+
+std::string formatScanHeaderReport(const nlohmann::json& r) {
+    const auto& d = r["dims"];
+    const auto& sp = r["spacing"];
+    std::string out = fmt::format("{}: {} scan, {}x{}x{} {}{} samples{}, spacing {:.6g} x {:.6g} x {:.6g}{}\n", r["input"].get<std::string>(),
+                                  r["format"].get<std::string>(), d[0].get<int64_t>(), d[1].get<int64_t>(), d[2].get<int64_t>(),
+                                  r["sample_type"].get<std::string>(), r["components"].get<unsigned>() > 1 ? fmt::format(" x{}", r["components"].get<unsigned>()) : "",
+                                  r["colour"].get<bool>() ? " (RGB)" : "", sp[0].get<double>(), sp[1].get<double>(), sp[2].get<double>(),
+                                  r["space"].get<std::string>().empty() ? "" : " (" + r["space"].get<std::string>() + ")");
+    const auto& o = r["origin"];
+    out += fmt::format("  origin ({:.6g}, {:.6g}, {:.6g}); data {}{}\n", o[0].get<double>(), o[1].get<double>(), o[2].get<double>(),
+                       r["data_file"].get<std::string>(), r["compressed"].get<bool>() ? " (gzip)" : "");
+    if (r["rescale_slope"].get<double>() != 1 || r["rescale_intercept"].get<double>() != 0)
+        out += fmt::format("  rescale: value = stored x {:.17g} + {:.17g}\n", r["rescale_slope"].get<double>(), r["rescale_intercept"].get<double>());
+    if (r.contains("volumes") && r["volumes"].get<int64_t>() > 1)
+        out += fmt::format("  {} volumes: encode makes one grid per volume, or pick one with --volume N\n", r["volumes"].get<int64_t>());
+    return out;
+}
+
 } // namespace
 
 void addInfoCommand(CLI::App& app, int& exitCode) {
     struct Options { std::string input; bool json = false; bool noSymmetry = false; };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("info", "Print per-grid DAG statistics and section sizes of a .ssvdag or .vdb file (or the series of DICOM input)");
+    CLI::App* cmd = app.add_subcommand("info", "Print per-grid DAG statistics and section sizes of a .ssvdag or .vdb file (or a scan's header, or the series of DICOM input)");
     cmd->add_option("input", opt->input, ".ssvdag or .vdb file, or DICOM input (a folder, a .dcm file, a DICOMDIR)")->required();
     cmd->add_flag("--json", opt->json, "print JSON");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "for .vdb input: report the plain SVDAG encoding");
@@ -68,6 +117,15 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
             // Descriptions may be Latin-1 (Specific Character Set): never throw on them.
             if (opt->json) fmt::print("{}\n", report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
             else fmt::print("{}", formatDicomReport(report));
+            exitCode = 0;
+            return;
+        }
+        if (const bridge::DenseFormat f = bridge::denseFormatOf(opt->input); f != bridge::DenseFormat::None && f != bridge::DenseFormat::Raw) {
+            bridge::DenseImportOptions described;
+            if (f == bridge::DenseFormat::Nifti && bridge::niftiVolumeCount(opt->input) > 1) described.volume = 0;
+            const nlohmann::json report = scanHeaderReport(opt->input, bridge::describeDense(opt->input, described));
+            if (opt->json) fmt::print("{}\n", report.dump(2));
+            else fmt::print("{}", formatScanHeaderReport(report));
             exitCode = 0;
             return;
         }

@@ -181,6 +181,19 @@ TEST(ScanFormats, FlairNiftiEqualsFlairNrrd) {
     ASSERT_EQ(runCli("decode " + b.string() + " -o " + bBack.string() + " -f").exitCode, 0);
     expectSameScan(reference(aBack), reference(bBack), 1e-6, "FLAIR nii vs nrrd");
     expectSameScan(reference(nii), reference(nrrd), 1e-6, "FLAIR inputs (reference reader)");
+    // `info` on either gives the header as read: the same extent, type, origin and axes.
+    const Reference ref = reference(nii);
+    for (const fs::path& scan : {nii, nrrd}) {
+        const CommandResult info = runCli("info " + scan.string() + " --json");
+        ASSERT_EQ(info.exitCode, 0) << info.err;
+        const nlohmann::json h = nlohmann::json::parse(info.out);
+        EXPECT_EQ(h["dims"], nlohmann::json(ref.dims)) << scan;
+        EXPECT_EQ(h["sample_type"], "u8") << scan;
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(h["origin"][c].get<double>(), ref.lps[size_t(c)][3], 1e-4) << scan;
+            for (int a = 0; a < 3; ++a) EXPECT_NEAR(h["axes"][a][c].get<double>(), ref.lps[size_t(c)][size_t(a)], 1e-6) << scan;
+        }
+    }
 }
 
 // Every shared dense scan, encoded once, comes back in every scan format
