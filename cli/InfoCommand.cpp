@@ -121,9 +121,8 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
             return;
         }
         if (const bridge::DenseFormat f = bridge::denseFormatOf(opt->input); f != bridge::DenseFormat::None && f != bridge::DenseFormat::Raw) {
-            bridge::DenseImportOptions described;
-            if (f == bridge::DenseFormat::Nifti && bridge::niftiVolumeCount(opt->input) > 1) described.volume = 0;
-            const nlohmann::json report = scanHeaderReport(opt->input, bridge::describeDense(opt->input, described));
+            // describeDense describes a 4-D NIfTI file by its first volume.
+            const nlohmann::json report = scanHeaderReport(opt->input, bridge::describeDense(opt->input, bridge::DenseImportOptions{}));
             if (opt->json) fmt::print("{}\n", report.dump(2));
             else fmt::print("{}", formatScanHeaderReport(report));
             exitCode = 0;

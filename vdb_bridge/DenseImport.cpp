@@ -64,15 +64,6 @@ void forEachSlab(const DenseVolume& v, Progress* progress, const std::function<v
     }
 }
 
-// The grid's name: the file's name without its extension(s) (".nii.gz" too).
-std::string gridNameOf(const std::string& path) {
-    std::string name = std::filesystem::path(path).filename().string();
-    std::string lower = name;
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (lower.size() > 7 && lower.ends_with(".nii.gz")) return name.substr(0, name.size() - 7);
-    return std::filesystem::path(name).stem().string();
-}
-
 // The grid header (OpenVDB's own serialisation of an empty grid, with the
 // scan's transform and the metadata a decode back to the scan needs).
 template <typename V>
@@ -80,7 +71,7 @@ void describeGrid(const DenseVolume& v, const V& background, const Thresholds* t
     detail::initializeOpenVdb();
     using GridT = openvdb::Grid<typename openvdb::tree::Tree4<V, 5, 4, 3>::Type>;
     typename GridT::Ptr grid = GridT::create(background);
-    grid->setName(v.colour ? "Cd" : !v.gridName.empty() ? v.gridName : gridNameOf(v.headerPath));
+    grid->setName(v.colour ? "Cd" : !v.gridName.empty() ? v.gridName : scanNameOf(v.headerPath));
     grid->setGridClass(openvdb::GRID_UNKNOWN);
     openvdb::Mat4d m = openvdb::Mat4d::identity();
     for (int a = 0; a < 3; ++a)

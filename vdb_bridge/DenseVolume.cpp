@@ -88,6 +88,14 @@ DenseFormat denseFormatOf(const std::string& path) {
     return DenseFormat::None;
 }
 
+std::string scanNameOf(const std::string& path) {
+    std::string name = std::filesystem::path(path).filename().string();
+    std::string lower = name;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (lower.size() > 7 && lower.ends_with(".nii.gz")) return name.substr(0, name.size() - 7);
+    return std::filesystem::path(name).stem().string();
+}
+
 const char* denseFormatName(DenseFormat format) {
     switch (format) {
         case DenseFormat::None: return "none";

@@ -30,6 +30,8 @@ enum class DataEncoding : uint8_t { Raw, Zlib };  // Zlib: gzip or zlib stream (
 enum class DenseFormat { None, Raw, Nrrd, MetaImage, Nifti, Dicom };
 DenseFormat denseFormatOf(const std::string& path);
 const char* denseFormatName(DenseFormat format);  // "raw", "nrrd", "metaimage", "nifti", "dicom"
+// A scan's name: its file name without the extension (".nii.gz" as one).
+std::string scanNameOf(const std::string& path);
 
 // One slice of a DICOM series: a file, and the frame within it (0 for
 // single-frame files).

@@ -133,10 +133,7 @@ DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volu
                         (volumes == 1 ? "" : "s") + " (0.." + std::to_string(volumes - 1) + ")");
         chosen = *volume;
         if (volumes > 1) {
-            std::string name = path.substr(path.find_last_of('/') + 1);
-            for (const char* ext : {".nii.gz", ".nii", ".hdr", ".NII.GZ", ".NII", ".HDR"})
-                if (name.size() > std::strlen(ext) && name.ends_with(ext)) { name.resize(name.size() - std::strlen(ext)); break; }
-            v.gridName = name + "_t" + std::to_string(chosen);
+            v.gridName = scanNameOf(path) + "_t" + std::to_string(chosen);
         }
     } else if (volumes > 1) {
         throw Error(path + ": a 4-D NIfTI file with " + std::to_string(volumes) + " volumes of " + std::to_string(n.nx) + "x" + std::to_string(n.ny) +
