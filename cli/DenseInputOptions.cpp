@@ -28,8 +28,19 @@ void DenseInputOptions::addTo(CLI::App& cmd) {
                  "dense header: read a data file outside the header's folder (an absolute path, '..', or a link leading out)");
 }
 
+std::string DenseInputOptions::takeInputs(const std::vector<std::string>& inputs) {
+    if (inputs.empty()) throw Error("no input given");
+    moreInputs.assign(inputs.begin() + 1, inputs.end());
+    if (!moreInputs.empty())
+        for (const std::string& in : inputs)
+            if (bridge::denseFormatOf(in) != bridge::DenseFormat::Dicom)
+                throw Error(in + ": not DICOM; several inputs are read as one set of DICOM files, folders or DICOMDIRs only");
+    return inputs.front();
+}
+
 bridge::DenseImportOptions DenseInputOptions::resolve(const std::string& path) const {
     bridge::DenseImportOptions o;
+    o.moreInputs = moreInputs;
     const bool rawInput = bridge::denseFormatOf(path) == bridge::DenseFormat::Raw;
     if (!rawInput && (!dims.empty() || !type.empty() || !endian.empty() || !spacing.empty() || !origin.empty()))
         throw Error(path + ": --dims/--type/--endian/--spacing/--origin apply to .raw inputs only (this file has a header)");
@@ -99,6 +110,7 @@ std::vector<std::string> denseInputFiles(const std::string& input, const DenseIn
     const bridge::DenseVolume header = bridge::describeDense(input, resolved);
     if (format != bridge::DenseFormat::Dicom) return {input, header.dataPath};
     std::vector<std::string> files{input};
+    files.insert(files.end(), options.moreInputs.begin(), options.moreInputs.end());
     for (const bridge::DicomSlice& s : header.slices)
         if (files.back() != s.file) files.push_back(s.file);  // frames of one file are listed once
     return files;

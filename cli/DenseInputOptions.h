@@ -27,8 +27,13 @@ struct DenseInputOptions {
     CLI::Option* aboveOption = nullptr;
     double backgroundValue = 0;
     CLI::Option* backgroundValueOption = nullptr;
+    std::vector<std::string> moreInputs;  // DICOM: the inputs after the first
 
     void addTo(CLI::App& cmd);
+    // The command's positional inputs: the first is the input; more than one
+    // are allowed for DICOM only (files, folders, DICOMDIRs scanned as one
+    // set). Throws vdbdag::Error naming the input that is not DICOM.
+    std::string takeInputs(const std::vector<std::string>& inputs);
     // Throws vdbdag::Error naming `path` for inconsistent values.
     bridge::DenseImportOptions resolve(const std::string& path) const;
 };

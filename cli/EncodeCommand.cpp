@@ -43,6 +43,7 @@ uint64_t defaultMemoryLimit() {
 
 void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
+        std::vector<std::string> inputs;
         std::string input, output;
         std::vector<std::string> grids;
         bool force = false, noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
@@ -58,7 +59,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha/.nii scan, or one DICOM series) into an .ssvdag file");
-    cmd->add_option("input", opt->input, "input .vdb file or dense scan")->required();
+    cmd->add_option("input", opt->inputs, "input .vdb file or dense scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
     cmd->add_option("-o,--output", opt->output, "output .ssvdag file")->required();
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_option("--grid", opt->grids, "encode only grids with this name (repeatable)");
@@ -89,6 +90,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
     cmd->callback([opt, &exitCode] {
+        opt->input = opt->dense.takeInputs(opt->inputs);
         setActivity(opt->input, "encoding");
         const auto start = std::chrono::steady_clock::now();
         std::optional<tbb::global_control> threads;

@@ -19,22 +19,24 @@ namespace vdbdag::cli {
 
 void addImportCommand(CLI::App& app, int& exitCode) {
     struct Options {
+        std::vector<std::string> inputs;
         std::string input, output;
         bool json = false, force = false;
         DenseInputOptions dense;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("import", "Convert a dense scan (.raw, .nrrd, .nhdr, .mhd, .mha, .nii, or one DICOM series: a folder, .dcm or DICOMDIR with --series) into a .vdb grid");
-    cmd->add_option("input", opt->input, "input volume, or DICOM folder / .dcm / DICOMDIR")->required();
+    cmd->add_option("input", opt->inputs, "input volume, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
     cmd->add_option("-o,--output", opt->output, "output .vdb file")->required();
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
     cmd->callback([opt, &exitCode] {
+        opt->input = opt->dense.takeInputs(opt->inputs);
         setActivity(opt->input, "importing");
         const auto start = std::chrono::steady_clock::now();
         if (bridge::denseFormatOf(opt->input) == bridge::DenseFormat::None)
-            throw Error(opt->input + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
+            throw Error(opt->input + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz, .hdr or DICOM)");
         checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".vdb"}, "import", opt->force});
         const bridge::DenseImportResult imported = bridge::importDense(opt->input, opt->dense.resolve(opt->input));
         {

@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "cli/Commands.h"
+#include "cli/DenseInputOptions.h"
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "src/pipeline/GridCodec.h"
@@ -104,16 +105,18 @@ std::string formatScanHeaderReport(const nlohmann::json& r) {
 } // namespace
 
 void addInfoCommand(CLI::App& app, int& exitCode) {
-    struct Options { std::string input; bool json = false; bool noSymmetry = false; };
+    struct Options { std::vector<std::string> inputs; std::string input; bool json = false; bool noSymmetry = false; };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("info", "Print per-grid DAG statistics and section sizes of a .ssvdag or .vdb file (or a scan's header, or the series of DICOM input)");
-    cmd->add_option("input", opt->input, ".ssvdag or .vdb file, or DICOM input (a folder, a .dcm file, a DICOMDIR)")->required();
+    cmd->add_option("input", opt->inputs, ".ssvdag or .vdb file, a scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
     cmd->add_flag("--json", opt->json, "print JSON");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "for .vdb input: report the plain SVDAG encoding");
     cmd->callback([opt, &exitCode] {
+        DenseInputOptions dicomInputs;
+        opt->input = dicomInputs.takeInputs(opt->inputs);
         setActivity(opt->input, "reading");
         if (bridge::denseFormatOf(opt->input) == bridge::DenseFormat::Dicom) {
-            const nlohmann::json report = dicomReport(opt->input, bridge::scanDicom(opt->input));
+            const nlohmann::json report = dicomReport(bridge::dicomInputName(opt->inputs), bridge::scanDicom(opt->inputs));
             // Descriptions may be Latin-1 (Specific Character Set): never throw on them.
             if (opt->json) fmt::print("{}\n", report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
             else fmt::print("{}", formatDicomReport(report));

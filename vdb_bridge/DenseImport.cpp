@@ -89,7 +89,8 @@ void describeGrid(const DenseVolume& v, const V& background, const Thresholds* t
         grid->insertMeta("source_rescale_intercept", openvdb::DoubleMetadata(v.rescaleIntercept));
     }
     grid->insertMeta("source_format", openvdb::StringMetadata(denseFormatName(v.format)));
-    if (v.colour) grid->insertMeta("source_colour", openvdb::StringMetadata("rgb"));
+    if (v.colour) grid->insertMeta("source_colour", openvdb::StringMetadata(v.storedComponents == 4 ? "rgba" : "rgb"));
+    else if (v.storedComponents == 4) grid->insertMeta("source_colour", openvdb::StringMetadata("alpha"));  // the A of RGBA
     if (!v.space.empty()) grid->insertMeta("space", openvdb::StringMetadata(v.space));  // of the grid's world coordinates
     if (th && th->below) grid->insertMeta("background_below", openvdb::DoubleMetadata(th->belowValue));
     if (th && th->above) grid->insertMeta("background_above", openvdb::DoubleMetadata(th->aboveValue));
@@ -326,8 +327,14 @@ DenseVolume describeDense(const std::string& path, const DenseImportOptions& opt
         case DenseFormat::Nifti:  // a 4-D file without --volume: described by its first volume (importDense reads them all)
             v = readNiftiHeader(path, options.volume ? options.volume : (niftiVolumeCount(path) > 1 ? std::optional<int64_t>(0) : std::nullopt));
             break;
-        case DenseFormat::Dicom: v = describeDicomSeries(path, options.series); v.format = DenseFormat::Dicom; return v;
-        case DenseFormat::None: throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd or .mha)");
+        case DenseFormat::Dicom: {
+            std::vector<std::string> inputs{path};
+            inputs.insert(inputs.end(), options.moreInputs.begin(), options.moreInputs.end());
+            v = describeDicomSeries(inputs, options.series);
+            v.format = DenseFormat::Dicom;
+            return v;
+        }
+        case DenseFormat::None: throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz, .hdr or DICOM)");
     }
     v.format = denseFormatOf(path);
     toLps(v);
@@ -452,6 +459,18 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
         if (v.components != 3) throw Error(path + ": " + std::to_string(v.components) + " components per sample are not supported (1 and 3 are)");
         if (th.any()) throw Error(path + ": background thresholds apply to scalar scans only (this one has 3 components per sample)");
         if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) throw Error(path + ": a rescaled vector scan is not supported");
+        if (v.colour && v.storedComponents == 4 && v.type == SampleType::U8) {
+            // RGBA (NIfTI RGBA32): the colour grid "Cd" and an Int32 grid "alpha", both every sample.
+            DenseImportResult rgba = importVector<uint8_t, int32_t>(v, ValueType::Vec3I, p);
+            DenseVolume alpha = v;
+            alpha.colour = false;
+            alpha.components = 1;
+            alpha.firstComponent = 3;
+            alpha.gridName = "alpha";
+            DenseImportResult a = importTyped<uint8_t, int32_t>(alpha, th, ValueType::Int32, p);
+            for (GridRecord& g : a.volume.grids) rgba.volume.grids.push_back(std::move(g));
+            return rgba;
+        }
         switch (v.type) {
             case SampleType::U8: return importVector<uint8_t, int32_t>(v, ValueType::Vec3I, p);
             case SampleType::I8: return importVector<int8_t, int32_t>(v, ValueType::Vec3I, p);

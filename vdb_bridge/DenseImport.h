@@ -20,6 +20,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "src/volume/GridRecord.h"
 #include "vdb_bridge/DenseVolume.h"
@@ -40,6 +41,9 @@ struct DenseImportOptions {
     bool showProgress = true;  // a Progress line on a terminal
     // DICOM: which series (`--series N|UID`); empty when the input holds one.
     std::string series;
+    // DICOM: further files, folders or DICOMDIRs named beside the path,
+    // scanned with it as one set (`encode a.dcm b.dcm ... -o x.ssvdag`).
+    std::vector<std::string> moreInputs;
     // NIfTI: which volume of a 4-D file (`--volume N`, 0-based).
     std::optional<int64_t> volume;
 };

@@ -85,6 +85,16 @@ DenseFormat denseFormatOf(const std::string& path) {
     if (ext == ".dcm" || name == "dicomdir") return DenseFormat::Dicom;
     std::error_code ec;
     if (std::filesystem::is_directory(p, ec)) return DenseFormat::Dicom;
+    // A DICOM file by its content (slices often have no extension): the
+    // "DICM" prefix after the 128-byte preamble (PS3.10 7.1).
+    if (ext != ".vdb" && ext != ".ssvdag" && std::filesystem::is_regular_file(p, ec)) {
+        if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+            char head[132] = {};
+            const bool dicm = std::fread(head, 1, sizeof head, f) == sizeof head && std::memcmp(head + 128, "DICM", 4) == 0;
+            std::fclose(f);
+            if (dicm) return DenseFormat::Dicom;
+        }
+    }
     return DenseFormat::None;
 }
 
@@ -166,7 +176,7 @@ DenseSampleStream::DenseSampleStream(const DenseVolume& volume) : volume_(volume
         throw Error(volume_.headerPath + ": data file " + data + " is not a regular file (a directory, device or FIFO is never read)");
     const uint64_t fileSize = std::filesystem::file_size(data, ec);
     if (ec) throw Error(where() + ": cannot read the file size (" + ec.message() + ")");
-    const uint64_t need = volume_.sampleCount() * sampleBytes(volume_.type) * volume_.components;
+    const uint64_t need = volume_.sampleCount() * sampleBytes(volume_.type) * volume_.componentsInFile();
     file_ = std::fopen(data.c_str(), "rb");
     if (!file_) throw Error(where() + ": cannot open (" + std::strerror(errno) + ")");
     int64_t offset = volume_.dataOffset;
@@ -187,7 +197,7 @@ DenseSampleStream::DenseSampleStream(const DenseVolume& volume) : volume_(volume
         if (fileSize < at || fileSize - at < need)
             throw Error(where() + ": too short: " + std::to_string(fileSize < at ? 0 : fileSize - at) + " bytes of samples, the header describes " +
                         std::to_string(volume_.dims[0]) + "x" + std::to_string(volume_.dims[1]) + "x" + std::to_string(volume_.dims[2]) + " " +
-                        sampleTypeName(volume_.type) + (volume_.components > 1 ? " x " + std::to_string(volume_.components) + " components" : "") +
+                        sampleTypeName(volume_.type) + (volume_.componentsInFile() > 1 ? " x " + std::to_string(volume_.componentsInFile()) + " components" : "") +
                         " = " + std::to_string(need) + " bytes");
         if (volume_.decodedSkip && std::fseek(file_, long(volume_.decodedSkip), SEEK_CUR) != 0)
             throw Error(where() + ": cannot skip " + std::to_string(volume_.decodedSkip) + " bytes");
@@ -259,10 +269,17 @@ void DenseSampleStream::skipDecoded(uint64_t n) {
 void DenseSampleStream::readSlices(int64_t slices, std::vector<uint8_t>& out) {
     if (slices < 0 || slicesRead_ + slices > volume_.dims[2]) throw Error(volume_.headerPath + ": internal error: reading past the last slice");
     const unsigned sb = sampleBytes(volume_.type);
-    const size_t n = size_t(uint64_t(slices) * volume_.sliceSamples() * sb * volume_.components);
-    out.resize(n);
-    readBytes(out.data(), n);
+    const unsigned stored = volume_.componentsInFile(), kept = volume_.components;
+    const size_t samples = size_t(uint64_t(slices) * volume_.sliceSamples());
+    const size_t n = samples * sb * kept;
+    out.resize(samples * sb * stored);
+    readBytes(out.data(), out.size());
     slicesRead_ += slices;
+    if (stored != kept) {  // keep components [first, first + kept) of each sample, in place
+        const size_t first = size_t(volume_.firstComponent) * sb, keptBytes = size_t(kept) * sb, storedBytes = size_t(stored) * sb;
+        for (size_t i = 0; i < samples; ++i) std::memmove(out.data() + i * keptBytes, out.data() + i * storedBytes + first, keptBytes);
+        out.resize(n);
+    }
     // Samples to host (little-endian) order.
     if (volume_.bigEndian && sb > 1) {
         uint8_t* p = out.data();

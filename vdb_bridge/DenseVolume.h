@@ -75,6 +75,12 @@ struct DenseVolume {
     unsigned components = 1;
     uint64_t componentStride = 0;
     bool colour = false;  // RGB: a colour grid named "Cd"
+    // Interleaved samples with more components in the file than are read
+    // (NIfTI RGBA32: 4, read as RGB "Cd" and, separately, as "alpha"): the
+    // reader gives components [firstComponent, firstComponent + components)
+    // of each storedComponents. 0: as many as are read.
+    unsigned storedComponents = 0, firstComponent = 0;
+    unsigned componentsInFile() const { return storedComponents > components ? storedComponents : components; }
     // DICOM: the slices in order along the slice normal (dims[2] of them).
     std::vector<DicomSlice> slices;
     // Slices with no data (a DICOM series missing some): their samples are

@@ -768,13 +768,14 @@ void analyse(Group& g) {
     if (distinctFiles.size() < count) g.info.notes.push_back(fmt::format("multi-frame: {} frames from {} file(s)", count, distinctFiles.size()));
 }
 
-ScanState scan(const std::string& path) {
-    ScanState st;
+// The files one input names: a folder's files (recursively, sorted), the
+// files a DICOMDIR lists, or the file itself. `fromFolder` says which.
+std::vector<std::string> inputFiles(const std::string& path, ScanState& st, bool& fromFolder) {
     std::error_code ec;
     const fs::path root(path);
     if (!fs::exists(root, ec)) throw Error(path + ": does not exist");
     std::vector<std::string> candidates;
-    bool fromFolder = false;
+    fromFolder = false;
     if (fs::is_directory(root, ec)) {
         fromFolder = true;
         fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, ec), end;
@@ -803,8 +804,25 @@ ScanState scan(const std::string& path) {
     } else {
         throw Error(path + ": is neither a folder nor a regular file");
     }
+    return candidates;
+}
 
-    for (const std::string& file : candidates) {
+ScanState scan(const std::vector<std::string>& paths) {
+    ScanState st;
+    if (paths.empty()) throw Error("no DICOM input given");
+    std::vector<std::pair<std::string, bool>> candidates;  // file, found in a folder
+    std::set<std::string> seenFiles;
+    for (const std::string& path : paths) {
+        bool fromFolder = false;
+        for (std::string& file : inputFiles(path, st, fromFolder)) {
+            std::error_code ec;
+            const fs::path canonical = fs::weakly_canonical(file, ec);
+            if (!seenFiles.insert(ec ? file : canonical.string()).second) continue;  // a file named twice (or in two inputs) is read once
+            candidates.emplace_back(std::move(file), fromFolder);
+        }
+    }
+
+    for (const auto& [file, fromFolder] : candidates) {
         if (fromFolder && isDicomdirName(file)) {
             st.scan.skipped.push_back(file + ": a DICOMDIR (the files in the folder are scanned themselves)");
             continue;
@@ -879,13 +897,19 @@ std::string listing(const DicomScan& scan) {
 
 } // namespace
 
-DicomScan scanDicom(const std::string& path) { return scan(path).scan; }
+DicomScan scanDicom(const std::vector<std::string>& inputs) { return scan(inputs).scan; }
 
-DenseVolume describeDicomSeries(const std::string& path, const std::string& choice) {
-    ScanState st = scan(path);
+std::string dicomInputName(const std::vector<std::string>& inputs) {
+    if (inputs.size() == 1) return inputs.front();
+    return fmt::format("{} (and {} more input{})", inputs.empty() ? std::string() : inputs.front(), inputs.size() - 1, inputs.size() == 2 ? "" : "s");
+}
+
+DenseVolume describeDicomSeries(const std::vector<std::string>& inputs, const std::string& choice) {
+    ScanState st = scan(inputs);
+    const std::string path = dicomInputName(inputs);
     const DicomScan& sc = st.scan;
     if (sc.series.empty()) {
-        if (sc.skipped.size() == 1 && sc.skipped.front().compare(0, path.size(), path) == 0 && !fs::is_directory(path))
+        if (inputs.size() == 1 && sc.skipped.size() == 1 && sc.skipped.front().compare(0, path.size(), path) == 0 && !fs::is_directory(path))
             throw Error(sc.skipped.front());
         throw Error(fmt::format("{}: holds no DICOM image series; {} file(s) skipped, e.g. {}", path, sc.skipped.size(),
                                 sc.skipped.empty() ? std::string("none") : sc.skipped.front()));
@@ -918,8 +942,10 @@ DenseVolume describeDicomSeries(const std::string& path, const std::string& choi
 
     DenseVolume v;
     v.format = DenseFormat::Dicom;
-    v.headerPath = path;
-    v.dataPath = path;
+    v.headerPath = inputs.front();
+    v.dataPath = inputs.front();
+    if (inputs.size() > 1)  // a list of files: the grid is named after the first one's folder
+        v.gridName = scanNameOf(fs::absolute(inputs.front()).parent_path().filename().string());
     v.dims = g.info.dims;
     v.type = *g.type;
     v.bigEndian = false;

@@ -35,13 +35,24 @@ struct DicomScan {
     std::vector<std::string> skipped;     // "FILE: why" for files that are not DICOM images (non-DICOM, SEG, SR, ...)
 };
 
-// Throws vdbdag::Error naming the path when nothing there can be read.
-DicomScan scanDicom(const std::string& path);
+// `inputs`: folders, files and DICOMDIRs, scanned as one set (a file named
+// twice is read once). Throws vdbdag::Error naming the input when nothing
+// there can be read.
+DicomScan scanDicom(const std::vector<std::string>& inputs);
 
 // The series `choice` names (its 1-based number in scanDicom's list, or its
 // UID); an empty choice is allowed only when there is exactly one series,
-// otherwise the error lists them. Throws vdbdag::Error.
-DenseVolume describeDicomSeries(const std::string& path, const std::string& choice);
+// otherwise the error lists them. Throws vdbdag::Error. For more than one
+// input the grid is named after the first input's folder.
+DenseVolume describeDicomSeries(const std::vector<std::string>& inputs, const std::string& choice);
+
+inline DicomScan scanDicom(const std::string& input) { return scanDicom(std::vector<std::string>{input}); }
+inline DenseVolume describeDicomSeries(const std::string& input, const std::string& choice) {
+    return describeDicomSeries(std::vector<std::string>{input}, choice);
+}
+
+// How messages name a set of inputs: the input, or "FIRST (and N more inputs)".
+std::string dicomInputName(const std::vector<std::string>& inputs);
 
 // Reads the series' slices (DenseVolume::slices) in order, decoding any
 // transfer syntax GDCM decodes. Throws vdbdag::Error naming the slice file.

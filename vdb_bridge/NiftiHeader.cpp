@@ -42,8 +42,7 @@ SampleType sampleTypeOf(const nifti_image& nim, const std::string& path) {
         case DT_COMPLEX256:
             throw Error(path + ": NIfTI datatype " + niftiTypeName(nim.datatype) + " (complex samples) is not supported: convert the magnitude or the real and imaginary parts to separate files");
         case DT_RGB24: return SampleType::U8;  // 3 components, a colour grid
-        case DT_RGBA32:
-            throw Error(path + ": NIfTI datatype RGBA32 is not supported (a colour grid holds RGB; the alpha channel would be lost)");
+        case DT_RGBA32: return SampleType::U8;  // 4 components: a colour grid and an alpha grid
         default:
             throw Error(path + ": NIfTI datatype " + niftiTypeName(nim.datatype) + " (code " + std::to_string(nim.datatype) + ") is not supported");
     }
@@ -108,13 +107,14 @@ DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volu
     v.format = DenseFormat::Nifti;
     v.headerPath = path;
     v.type = sampleTypeOf(n, path);
-    if (n.datatype == DT_RGB24) {
+    if (n.datatype == DT_RGB24 || n.datatype == DT_RGBA32) {
         v.components = 3;
         v.colour = true;
+        if (n.datatype == DT_RGBA32) v.storedComponents = 4;  // importDense reads the alpha channel as a second grid
     }
-    if (n.nbyper != int(sampleBytes(v.type) * v.components))
+    if (n.nbyper != int(sampleBytes(v.type) * v.componentsInFile()))
         throw Error(path + ": NIfTI bitpix gives " + std::to_string(n.nbyper) + " bytes per sample, datatype " + niftiTypeName(n.datatype) + " needs " +
-                    std::to_string(sampleBytes(v.type)));
+                    std::to_string(sampleBytes(v.type) * v.componentsInFile()));
     if (n.ndim < 1 || n.ndim > 7) throw Error(path + ": NIfTI dim[0] = " + std::to_string(n.ndim) + " is outside 1..7");
     for (int d = 1; d <= 7; ++d)
         if (n.dim[d] < 1 && d <= n.ndim) throw Error(path + ": NIfTI dim[" + std::to_string(d) + "] = " + std::to_string(n.dim[d]) + " is not positive");

@@ -644,3 +644,53 @@ TEST(DicomSeries, AnElementLongerThanItsFileIsRefusedBeforeItIsAllocated) {
     EXPECT_NE(scan.skipped[0].find("element (0010,0010)"), std::string::npos) << scan.skipped[0];
     EXPECT_NE(scan.skipped[0].find("claims 3204448256 bytes"), std::string::npos) << scan.skipped[0];
 }
+
+// A list of files (extensionless, named on the command line in no useful
+// order, one of them twice) is one set: its series equals pydicom's stack
+// of the folder; a non-DICOM file among the inputs is refused in one line.
+TEST(DicomCli, AListOfFilesIsOneSet) {
+    REQUIRE_REFERENCE();
+    const Reference ref = reference(kPet, kPetUid);
+    const std::vector<std::string>& ordered = petByPosition();
+    const fs::path dir = freshDir("list");
+    std::vector<std::string> files;
+    for (size_t i = 0; i < ordered.size(); ++i) {
+        const fs::path to = dir / ("slice" + std::to_string((i * 7919) % ordered.size()));  // no extension: found by its DICM prefix
+        fs::copy_file(ordered[i], to);
+        files.push_back(to.string());
+    }
+    std::mt19937 rng(5);
+    std::shuffle(files.begin(), files.end(), rng);
+    files.push_back(files.front());
+    DenseImportOptions o = quietOptions();
+    o.moreInputs.assign(files.begin() + 1, files.end());
+    const DenseVolume v = describeDense(files.front(), o);
+    expectGeometry(v, ref.meta);
+    EXPECT_EQ(readSamples(v), ref.raw);
+    EXPECT_EQ(v.gridName, "list");
+
+    std::string args;
+    for (const std::string& f : files) args += " " + quote(f);
+    auto r = runCli("info" + args + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json info = nlohmann::json::parse(r.out);
+    ASSERT_EQ(info["series"].size(), 1u);
+    EXPECT_EQ(info["series"][0]["uid"], kPetUid);
+    EXPECT_EQ(info["series"][0]["slices"], int(ordered.size()));
+    const fs::path out = workDir() / "list.ssvdag";
+    r = runCli("encode" + args + " -o " + quote(out) + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["active_voxels"], v.sampleCount());
+    // An output that is one of the inputs is refused, even with -f.
+    r = runCli("encode" + args + " -f -o " + quote(files.back()));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("is the input"), std::string::npos) << r.err;
+    // A NRRD among DICOM inputs: one line naming it, nothing written.
+    const fs::path nrrd = fs::path(VDBDAG_SHARED_DATA) / "dense" / "FLAIR.nrrd";
+    r = runCli("encode" + args + " " + quote(nrrd) + " -o " + quote(workDir() / "mixed.ssvdag"));
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(nrrd.string() + ": not DICOM"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(workDir() / "mixed.ssvdag"));
+}

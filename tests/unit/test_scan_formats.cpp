@@ -538,3 +538,56 @@ TEST(ScanFormats, DiffOfAThresholdedScanEqualsTheEncodeReport) {
     EXPECT_NEAR(all["rms_error"].get<double>(), th["rms_change"].get<double>(), 1e-9);
     EXPECT_NEAR(all["psnr_db"].get<double>(), th["psnr_db"].get<double>(), 1e-9);
 }
+
+// RGBA32 NIfTI made by nibabel becomes a Vec3I colour grid "Cd" and an Int32
+// grid "alpha", every sample exact against numpy's array (read through
+// OpenVDB's accessor); `decode --grid alpha -o .nii.gz` gives the alpha
+// plane back as a u8 volume nibabel reads as the same samples.
+TEST(ScanFormats, RgbaNiftiIsAColourAndAnAlphaGrid) {
+    if (!haveNibabel()) GTEST_SKIP() << "needs python3-nibabel";
+    const fs::path dir = workDir() / "rgba";
+    fs::create_directories(dir);
+    const fs::path script = dir / "make.py";
+    std::ofstream(script) << R"(import nibabel as nib, numpy as np, sys
+d = sys.argv[1]
+rng = np.random.default_rng(12)
+a = rng.integers(0, 256, size=(5, 7, 4, 4)).astype(np.uint8)
+rgba = np.zeros((5, 7, 4), dtype=[('R', 'u1'), ('G', 'u1'), ('B', 'u1'), ('A', 'u1')])
+for i, c in enumerate('RGBA'): rgba[c] = a[..., i]
+nib.save(nib.Nifti1Image(rgba, np.diag([2.0, 1.0, 0.5, 1.0])), d + '/rgba.nii.gz')
+np.ascontiguousarray(np.transpose(a, (2, 1, 0, 3))).tofile(d + '/rgba.expected')
+np.ascontiguousarray(np.transpose(a[..., 3], (2, 1, 0))).tofile(d + '/alpha.expected')
+)";
+    const CommandResult made = runShell(kPython + " " + script.string() + " " + dir.string());
+    ASSERT_EQ(made.exitCode, 0) << made.err;
+    const std::string expected = readAll(dir / "rgba.expected");
+    ASSERT_EQ(expected.size(), size_t(5 * 7 * 4 * 4));
+    const fs::path in = dir / "rgba.nii.gz", ss = dir / "rgba.ssvdag", vdb = dir / "rgba.vdb";
+    ASSERT_EQ(encode(in, ss).exitCode, 0);
+    ASSERT_EQ(runCli("decode " + ss.string() + " -o " + vdb.string() + " -f").exitCode, 0);
+    openvdb::initialize();
+    openvdb::io::File file(vdb.string());
+    file.open();
+    auto cd = openvdb::gridPtrCast<openvdb::Vec3IGrid>(file.readGrid("Cd"));
+    auto alpha = openvdb::gridPtrCast<openvdb::Int32Grid>(file.readGrid("alpha"));
+    file.close();
+    ASSERT_TRUE(cd && alpha);
+    EXPECT_EQ(cd->activeVoxelCount(), 5u * 7u * 4u);
+    EXPECT_EQ(alpha->activeVoxelCount(), 5u * 7u * 4u);
+    auto c = cd->getConstAccessor();
+    auto al = alpha->getConstAccessor();
+    for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 7; ++j)
+            for (int i = 0; i < 5; ++i) {
+                const size_t at = size_t((k * 7 + j) * 5 + i) * 4;
+                const openvdb::Coord ijk(i, j, k);
+                for (int ch = 0; ch < 3; ++ch) ASSERT_EQ(c.getValue(ijk)[ch], int(uint8_t(expected[at + size_t(ch)]))) << i << "," << j << "," << k;
+                ASSERT_EQ(al.getValue(ijk), int(uint8_t(expected[at + 3]))) << i << "," << j << "," << k;
+            }
+    const fs::path back = dir / "alpha_back.nii.gz";
+    ASSERT_EQ(runCli("decode " + ss.string() + " --grid alpha -o " + back.string() + " -f").exitCode, 0);
+    const Reference ref = reference(back);
+    ASSERT_TRUE(ref.error.empty()) << ref.error;
+    EXPECT_EQ(ref.dtype, "u1");
+    EXPECT_TRUE(ref.samples == readAll(dir / "alpha.expected"));
+}
