@@ -214,6 +214,12 @@ void validateCompact(const CompactDag& dag, const std::string& what) {
     for (int64_t o : dag.origin)
         if (o < int64_t(std::numeric_limits<int32_t>::min()) || o > int64_t(std::numeric_limits<int32_t>::max()))
             fail("the root's origin " + std::to_string(o) + " is outside OpenVDB's int32 index range");
+    // Bricks (4^3) sit on multiples of 4 from the origin, and OpenVDB's
+    // leaves hold whole bricks only when the origin is a multiple of 4 too
+    // (every builder aligns it so); another origin would put a brick's
+    // voxels past its leaf's 512.
+    for (int64_t o : dag.origin)
+        if (o % 4 != 0) fail("the root's origin " + std::to_string(o) + " is not a multiple of 4 (bricks are 4^3 voxels on a 4-aligned grid)");
     const size_t levels = dag.innerLevelCount();
     if (levels != size_t(dag.log2Size) - 2) fail("level table has " + std::to_string(levels) + " levels, expected " + std::to_string(dag.log2Size - 2));
     if (dag.offsetWords.size() != levels) fail("offset width table has " + std::to_string(dag.offsetWords.size()) + " entries");
