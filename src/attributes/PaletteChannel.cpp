@@ -647,7 +647,13 @@ PaletteChannel deserializePalette(std::span<const uint8_t> bytes, const std::str
         if (c.indexBits.empty() || len > (uint64_t(1) << 40) || b.dataOffset > (uint64_t(1) << 62) ||
             b.dataOffset + len * b.indexBits > (c.indexBits.size() - 1) * 64)
             r.fail("indices of block " + std::to_string(i) + " out of range");
-        // Every index must land in the palette and every palette entry in M.
+        // Every index must land in the palette and every palette entry in M
+        // (0-bit indices are all 0: one check, not one per entry, so a
+        // 21-byte block cannot cost 2^40 steps).
+        if (b.indexBits == 0) {
+            if (available == 0) r.fail("index out of its palette in block " + std::to_string(i));
+            continue;
+        }
         for (uint64_t k = 0; k < len; ++k) {
             const uint64_t local = readPackedBits(c.indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
             if (local >= available) r.fail("index out of its palette in block " + std::to_string(i));

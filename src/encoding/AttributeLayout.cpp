@@ -10,7 +10,11 @@ namespace vdbdag::encoding {
 std::vector<uint64_t> attributeLayout(const CompactDag& dag) {
     std::vector<uint64_t> layout;
     if (dag.empty()) return layout;
-    layout.reserve(decodedSize(dag).emittedBricks);
+    const uint64_t emitted = decodedSize(dag).emittedBricks;
+    // The walk stops at 2^31 bricks too; checked here so the reserve never asks for more.
+    if (emitted > (uint64_t(1) << 31))
+        throw Error("the DAG emits " + std::to_string(emitted) + " bricks, more than the 2^31 a predicted-value layout holds");
+    layout.reserve(size_t(emitted));
     uint64_t next = 0;
     visitInAttributeOrder(
         dag,

@@ -103,3 +103,27 @@ TEST(Palette, OutputIsByteIdenticalForOneAndTwoThreads) {
     EXPECT_EQ(one, two);
     expectExact(input, 4, attributes::deserializePalette(two, "two threads"));
 }
+
+// A 0-bit block (every entry the one palette value) is checked once, not per
+// entry: a forged 2^40-entry channel of a few dozen bytes is read at once
+// (one check per entry would take hours), and its value is the material.
+TEST(Palette, ZeroBitBlockOfHugeLengthIsCheckedOnce) {
+    attributes::PaletteChannel c;
+    c.valueSize = 4;
+    c.entryCount = uint64_t(1) << 40;
+    c.materials = {1, 2, 3, 4};
+    attributes::PaletteBlock b;
+    b.firstEntry = 0;
+    b.dataOffset = 0;
+    b.paletteOffset = attributes::PaletteBlock::kWholeMaterialArray;
+    b.indexBits = 0;
+    c.blocks.push_back(b);
+    c.indexBits = {0, 0};
+    const std::vector<uint8_t> bytes = attributes::serializePalette(c);
+    EXPECT_LT(bytes.size(), 128u);
+    const attributes::PaletteChannel back = attributes::deserializePalette(bytes, "forged");
+    EXPECT_EQ(back.entryCount, uint64_t(1) << 40);
+    // With no material the same block is refused.
+    c.materials.clear();
+    EXPECT_THROW(attributes::deserializePalette(attributes::serializePalette(c), "forged"), Error);
+}
