@@ -13,7 +13,7 @@
 namespace vdbdag::format {
 
 // Section kinds. A file holds a section only when the scene needs it
-// (DESIGN.md invariant 3). Unknown kinds are rejected by readers that need
+// (../shared/DESIGN.md invariant 3). Unknown kinds are rejected by readers that need
 // them and skipped by those that do not.
 enum class SectionKind : uint32_t {
     FileInfo = 1,       // whole-file facts (grid count, writer version)
@@ -31,7 +31,7 @@ enum class SectionKind : uint32_t {
     ValueErrors = 13,   // per grid, lossy encodings only: the tolerance and the measured errors
     ColourErrors = 14,  // per colour grid encoded with --colour-bits: bits and the measured colour errors
     Normals = 15,       // per grid, only with --normals: k-bit ONV codes in attribute order (palette channel) + angular errors
-    // 14-19: reserved for another branch.
+    // 16-19: unassigned.
     PredictedValues = 20,          // per grid: integer active values predicted in attribute order (instead of Values)
     InactivePredictedValues = 21,  // the same for the inactive layer (instead of InactiveValues)
     FileMetadata = 22,  // file-level: the .vdb file's own metadata (opaque, vdb_bridge); absent when it has none
