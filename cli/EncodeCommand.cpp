@@ -84,7 +84,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                     "a .vdb is read region by region (a dense scan is read whole); the output is the same bytes")
         ->transform(CLI::AsSizeValue(false))
         ->excludes(normals);
-    cmd->add_option("--scratch", opt->scratch, "folder for the scratch file of a region-by-region read (default: the output's folder)")
+    cmd->add_option("--scratch", opt->scratch, "folder for the scratch files of a region-by-region encode: the input's bricks and the coded values (default: the output's folder)")
         ->check(CLI::ExistingDirectory);
     cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
@@ -188,6 +188,9 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             if (cubeInput || team.size() > 1) {
                 pipeline::CubeBudget budget;
                 budget.bytes = std::max<uint64_t>((opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()) / 2, 1);
+                // The coded values wait in a scratch file, not in memory, until the file is written.
+                budget.spillNear =
+                    opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
                 std::vector<std::unique_ptr<CubeSource>> sources;
                 if (cubeInput) {
                     sources = std::move(cubeInput->grids);
@@ -217,16 +220,18 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         progress.setLabel("encode: writing " + opt->output);
         format::ContainerOptions containerOptions;
         containerOptions.compress = !opt->noCompress;
-        const std::vector<uint8_t> bytes = format::writeScene(scene, containerOptions);
-        writeFileAtomically(opt->output, bytes);
+        // Section by section, the DAGs and values released as they go: the
+        // file is never whole in memory.
+        uint64_t fileBytes = 0;
+        writeStreamAtomically(opt->output, [&](std::ostream& out) { fileBytes = format::writeSceneReleasing(scene, out, containerOptions); });
         progress.finish();
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
         uint64_t voxels = 0;
         for (const auto& g : scene.grids) voxels += g.activeVoxels;
-        nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"bytes", bytes.size()}, {"grids", scene.grids.size()},
+        nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"bytes", fileBytes}, {"grids", scene.grids.size()},
                               {"active_voxels", voxels}, {"seconds", seconds},
-                              {"bits_per_active_voxel", voxels ? 8.0 * double(bytes.size()) / double(voxels) : 0.0}};
+                              {"bits_per_active_voxel", voxels ? 8.0 * double(fileBytes) / double(voxels) : 0.0}};
         if (threshold.applied) report["threshold"] = thresholdJson(threshold);
         report["grids_lossy"] = nlohmann::json::array();
         for (const auto& g : scene.grids) {
@@ -246,7 +251,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             fmt::print("{}\n", report.dump(2));
         } else {
             fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output,
-                       scene.grids.size(), voxels, bytes.size(), report["bits_per_active_voxel"].get<double>(), seconds);
+                       scene.grids.size(), voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);
             fmt::print("{}", thresholdText(threshold));
             for (const auto& l : report["grids_lossy"])
                 fmt::print("  grid '{}' {}: {} of {} values changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",

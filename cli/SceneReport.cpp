@@ -80,11 +80,12 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
         j["channels"] = json::array();
         const unsigned vs = valueSize(grid.record.valueType);
         uint64_t traceable = grid.dag.byteSize() + grid.inactiveDag.byteSize();
-        for (const auto& [layer, raw, channel] : {std::tuple{"active", &grid.attributes, &grid.values},
-                                                  std::tuple{"inactive", &grid.inactiveAttributes, &grid.inactiveValues}}) {
+        for (const auto& [layer, raw, inactive] : {std::tuple{"active", &grid.attributes, false},
+                                                   std::tuple{"inactive", &grid.inactiveAttributes, true}}) {
             if (!vs || raw->empty()) continue;
-            const attributes::ChannelStats cs = attributes::channelStats(*raw, vs, *channel);
-            traceable += channel->byteSize();
+            const attributes::PaletteChannel channel = format::traceableValues(grid, inactive);
+            const attributes::ChannelStats cs = attributes::channelStats(*raw, vs, channel);
+            traceable += channel.byteSize();
             j["channels"].push_back({{"layer", layer}, {"entries", cs.entries}, {"unique", cs.unique}, {"raw_bytes", cs.rawBytes},
                                      {"material_index_bytes", cs.materialIndexBytes}, {"palette_bytes", cs.paletteBytes},
                                      {"palette_blocks", cs.paletteBlocks}, {"direct_blocks", cs.directBlocks}, {"palettes", cs.palettesStored}});

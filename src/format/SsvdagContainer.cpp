@@ -51,6 +51,7 @@
 #include <limits>
 #include <memory>
 #include <new>
+#include <ostream>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -255,46 +256,102 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::Normals: return "Normals";
         case SectionKind::PredictedValues: return "PredictedValues";
         case SectionKind::InactivePredictedValues: return "InactivePredictedValues";
+        case SectionKind::ValueWindows: return "ValueWindows";
+        case SectionKind::InactiveValueWindows: return "InactiveValueWindows";
     }
     return "unknown";
 }
 
-std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const ContainerOptions& options) {
+bool isPrecompressed(SectionKind kind) { return kind == SectionKind::ValueWindows || kind == SectionKind::InactiveValueWindows; }
+
+namespace {
+
+// Compresses every section in place (its raw bytes released as soon as the
+// compressed ones exist), then hands the header, the table and each payload
+// to `put` in file order, releasing each payload once put.
+template <typename Put>
+uint64_t emitContainer(std::vector<Section>& sections, const ContainerOptions& options, Put&& put) {
     if (sections.size() > std::numeric_limits<uint32_t>::max()) throw Error("too many sections for one .ssvdag file: " + num(sections.size()));
-    std::vector<std::vector<uint8_t>> packed(sections.size());
-    std::vector<std::span<const uint8_t>> stored(sections.size());
+    std::vector<uint64_t> rawSize(sections.size());
     std::vector<uint32_t> codec(sections.size(), kCodecRaw);
+    // A spilled payload is read back in pieces: once for its checksum, once to copy it.
+    constexpr size_t kPiece = size_t(4) << 20;
+    std::vector<uint64_t> spilledChecksum(sections.size(), 0);
     for (size_t i = 0; i < sections.size(); ++i) {
-        const auto& data = sections[i].data;
-        stored[i] = data;
-        if (options.compress && data.size() > kMinBytesToCompress && compressSection(data, options, packed[i])) {
-            stored[i] = packed[i];
+        if (const auto& file = sections[i].spilled) {
+            if (!isPrecompressed(sections[i].kind) || !sections[i].data.empty()) throw Error("internal error: only a precompressed section is spilled");
+            rawSize[i] = file->size();
+            std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
+            if (!state) throw std::bad_alloc();
+            XXH3_64bits_reset(state.get());
+            std::vector<uint8_t> piece;
+            for (uint64_t at = 0; at < file->size(); at += kPiece) {
+                file->read(at, size_t(std::min<uint64_t>(kPiece, file->size() - at)), piece);
+                XXH3_64bits_update(state.get(), piece.data(), piece.size());
+            }
+            spilledChecksum[i] = XXH3_64bits_digest(state.get());
+            continue;
+        }
+        std::vector<uint8_t>& data = sections[i].data;
+        rawSize[i] = data.size();
+        std::vector<uint8_t> packed;
+        if (options.compress && data.size() > kMinBytesToCompress && !isPrecompressed(sections[i].kind) && compressSection(data, options, packed)) {
+            data = std::move(packed);
             codec[i] = kCodecZstd;
         }
     }
     const uint64_t tableEnd = kHeaderBytes + sections.size() * kEntryBytes;
-    uint64_t total = tableEnd + kChecksumBytes;
-    for (const auto& s : stored) total += s.size();
     ByteWriter w;
-    w.bytes().reserve(total);
     w.putBytes(std::span<const uint8_t>(kMagic, sizeof(kMagic)));
     w.put<uint32_t>(kFormatVersion);
     w.put<uint32_t>(uint32_t(sections.size()));
     uint64_t offset = tableEnd + kChecksumBytes;
     for (size_t i = 0; i < sections.size(); ++i) {
+        const std::vector<uint8_t>& stored = sections[i].data;
+        const uint64_t storedSize = sections[i].spilled ? rawSize[i] : stored.size();
         w.put<uint32_t>(uint32_t(sections[i].kind));
         w.put<uint32_t>(sections[i].grid);
         w.put<uint32_t>(codec[i]);
         w.put<uint32_t>(0);
         w.put<uint64_t>(offset);
-        w.put<uint64_t>(stored[i].size());
-        w.put<uint64_t>(sections[i].data.size());
-        w.put<uint64_t>(XXH3_64bits(stored[i].data(), stored[i].size()));
-        offset += stored[i].size();
+        w.put<uint64_t>(storedSize);
+        w.put<uint64_t>(rawSize[i]);
+        w.put<uint64_t>(sections[i].spilled ? spilledChecksum[i] : XXH3_64bits(stored.data(), stored.size()));
+        offset += storedSize;
     }
     w.put<uint64_t>(XXH3_64bits(w.bytes().data(), w.bytes().size()));
-    for (const auto& s : stored) w.putBytes(s);
-    return w.take();
+    put(std::span<const uint8_t>(w.bytes()));
+    for (Section& section : sections) {
+        if (const auto& file = section.spilled) {
+            std::vector<uint8_t> piece;
+            for (uint64_t at = 0; at < file->size(); at += kPiece) {
+                file->read(at, size_t(std::min<uint64_t>(kPiece, file->size() - at)), piece);
+                put(std::span<const uint8_t>(piece));
+            }
+            section.spilled.reset();
+            continue;
+        }
+        put(std::span<const uint8_t>(section.data));
+        std::vector<uint8_t>().swap(section.data);
+    }
+    return offset;
+}
+
+} // namespace
+
+std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const ContainerOptions& options) {
+    std::vector<Section> copy = sections;
+    std::vector<uint8_t> out;
+    emitContainer(copy, options, [&](std::span<const uint8_t> bytes) { out.insert(out.end(), bytes.begin(), bytes.end()); });
+    return out;
+}
+
+uint64_t writeContainerTo(std::vector<Section>&& sections, std::ostream& out, const ContainerOptions& options) {
+    std::vector<Section> owned = std::move(sections);
+    return emitContainer(owned, options, [&](std::span<const uint8_t> bytes) {
+        out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        if (!out) throw Error("writing the .ssvdag file failed");
+    });
 }
 
 std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, const std::string& sourceName) {

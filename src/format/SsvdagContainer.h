@@ -8,7 +8,11 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <iosfwd>
+#include <memory>
 #include <vector>
+
+#include "src/util/ScratchFile.h"
 
 namespace vdbdag::format {
 
@@ -31,17 +35,25 @@ enum class SectionKind : uint32_t {
     ValueErrors = 13,   // per grid, lossy encodings only: the tolerance and the measured errors
     ColourErrors = 14,  // per colour grid encoded with --colour-bits: bits and the measured colour errors
     Normals = 15,       // per grid, only with --normals: k-bit ONV codes in attribute order (palette channel) + angular errors
-    // 16-19: unassigned.
+    ValueWindows = 16,          // per grid: active values in attribute order, palette-coded and zstd'd in fixed windows (ValueWindows.h)
+    InactiveValueWindows = 17,  // the same for the inactive layer
+    // 18-19: unassigned.
     PredictedValues = 20,          // per grid: integer active values predicted in attribute order (instead of Values)
     InactivePredictedValues = 21,  // the same for the inactive layer (instead of InactiveValues)
     FileMetadata = 22,  // file-level: the .vdb file's own metadata (opaque, vdb_bridge); absent when it has none
 };
 const char* sectionKindName(SectionKind kind);
+// Sections whose payload is compressed already (the writer stores them raw).
+bool isPrecompressed(SectionKind kind);
 
 struct Section {
     SectionKind kind{};
     uint32_t grid = 0;          // grid index the section belongs to (0 for file-level)
     std::vector<uint8_t> data;  // raw (uncompressed) payload
+    // For the writer only: a precompressed payload too large to hold (the
+    // value windows of a grid encoded in bounded memory) is this whole
+    // scratch file instead of `data`, copied into the file as it is.
+    std::shared_ptr<const ScratchFile> spilled;
 };
 
 // What a reader learns about a section without decoding it (for `info`).
@@ -60,6 +72,11 @@ struct ContainerOptions {
 
 // Serialises sections into the container bytes.
 std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const ContainerOptions& options = {});
+// The same bytes, written to `out` section by section: each section's raw
+// bytes are released once compressed and its payload once written, so the
+// file is never whole in memory twice. Returns the bytes written; throws
+// vdbdag::Error when the stream fails.
+uint64_t writeContainerTo(std::vector<Section>&& sections, std::ostream& out, const ContainerOptions& options = {});
 
 // Parses and validates container bytes; throws vdbdag::Error with a one-line
 // message starting with `sourceName` on any truncation, corruption, checksum

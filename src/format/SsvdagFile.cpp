@@ -12,8 +12,11 @@
 //   DagInner      u16[inner words]     (absent for an empty grid)
 //   DagLeaves     u64[leaves]          (absent for an empty grid)
 //   DagStats      u32 n, u8 hasSvdag, then n x (u64 svo, u64 svdag, u64 stored)
-//   Values        the active values in attribute order as a palette channel
-//                 (serializePalette in src/attributes/PaletteChannel.cpp)
+//   ValueWindows  the active values in attribute order, palette-coded and
+//                 zstd'd in fixed windows (src/attributes/ValueWindows.h);
+//                 what the encoder writes
+//   Values        the same as one palette channel (serializePalette in
+//                 src/attributes/PaletteChannel.cpp), still read
 //   PredictedValues  instead of Values, for int32/int64 channels when it is
 //                 smaller: the same values as brick-MED residuals
 //                 (src/attributes/PredictedChannel.h); the reader decodes them
@@ -31,6 +34,7 @@
 #include <map>
 
 #include "src/attributes/PredictedChannel.h"
+#include "src/attributes/ValueWindows.h"
 #include "src/format/ByteIO.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/util/Error.h"
@@ -56,14 +60,30 @@ std::vector<T> fromRawBytes(const std::vector<uint8_t>& bytes, uint64_t expected
 }
 
 struct LayerKinds {
-    SectionKind levels, inner, leaves, values, predicted;
+    SectionKind levels, inner, leaves, values, predicted, windows;
 };
-constexpr LayerKinds kActive{SectionKind::DagLevels, SectionKind::DagInner, SectionKind::DagLeaves, SectionKind::Values, SectionKind::PredictedValues};
+constexpr LayerKinds kActive{SectionKind::DagLevels, SectionKind::DagInner, SectionKind::DagLeaves, SectionKind::Values, SectionKind::PredictedValues,
+                             SectionKind::ValueWindows};
 constexpr LayerKinds kInactive{SectionKind::InactiveLevels, SectionKind::InactiveInner, SectionKind::InactiveLeaves, SectionKind::InactiveValues,
-                               SectionKind::InactivePredictedValues};
+                               SectionKind::InactivePredictedValues, SectionKind::InactiveValueWindows};
+
+// `take`: move (or release) the layer's payloads out of the scene instead of copying them.
+template <typename T>
+std::vector<T> takeOrCopy(const std::vector<T>& v, bool take) {
+    if (!take) return v;
+    std::vector<T> out = std::move(const_cast<std::vector<T>&>(v));
+    const_cast<std::vector<T>&>(v) = {};
+    return out;
+}
+template <typename T>
+void releaseIf(const std::vector<T>& v, bool take) {
+    if (take) std::vector<T>().swap(const_cast<std::vector<T>&>(v));
+}
 
 void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, const encoding::CompactDag& dag,
-              const attributes::PaletteChannel& channel, const std::vector<uint8_t>& predicted, unsigned valueSize) {
+              const attributes::PaletteChannel& channel, const attributes::ValueWindowsPayload& windows, const std::vector<uint8_t>& predicted,
+              unsigned valueSize,
+              bool take) {
     ByteWriter levels;
     for (int64_t o : dag.origin) levels.put<int64_t>(o);
     levels.put<uint8_t>(dag.log2Size);
@@ -76,15 +96,32 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
     sections.push_back({kinds.levels, g, levels.take()});
     if (!dag.empty()) {
         sections.push_back({kinds.inner, g, rawBytes(dag.inner)});
+        releaseIf(dag.inner, take);
         if (!dag.leaves.empty()) sections.push_back({kinds.leaves, g, rawBytes(dag.leaves)});
-        if (valueSize && !predicted.empty()) sections.push_back({kinds.predicted, g, predicted});
+        releaseIf(dag.leaves, take);
+        if (valueSize && !predicted.empty()) sections.push_back({kinds.predicted, g, takeOrCopy(predicted, take)});
+        else if (valueSize && windows.file) sections.push_back({kinds.windows, g, {}, windows.file});
+        else if (valueSize && !windows.empty()) sections.push_back({kinds.windows, g, takeOrCopy(windows.bytes, take)});
         else if (valueSize) sections.push_back({kinds.values, g, attributes::serializePalette(channel)});
     }
 }
 
 } // namespace
 
-std::vector<Section> sceneToSections(const SsvdagScene& scene) {
+attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactive) {
+    const attributes::PaletteChannel& values = inactive ? grid.inactiveValues : grid.values;
+    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+    const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
+    if (values.entryCount || values.valueSize) return values;
+    if (!windows.empty()) return attributes::decodeValueWindows(windows.load(), "grid '" + grid.record.name + "' value windows");
+    return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
+}
+
+namespace {
+
+// With `take`, the scene's DAGs, value payloads and descriptors move into the
+// sections (the headers and reports stay).
+std::vector<Section> toSections(const SsvdagScene& scene, bool take) {
     std::vector<Section> sections;
     {
         ByteWriter w;
@@ -105,11 +142,13 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
         info.putString(std::string(grid.record.background.begin(), grid.record.background.end()));
         info.put<uint64_t>(grid.inactiveVoxels);
         sections.push_back({SectionKind::GridInfo, g, info.take()});
-        sections.push_back({SectionKind::VdbDescriptor, g, grid.record.vdbDescriptor});
+        sections.push_back({SectionKind::VdbDescriptor, g, takeOrCopy(grid.record.vdbDescriptor, take)});
 
         const unsigned vs = valueSize(grid.record.valueType);
-        putLayer(sections, g, kActive, grid.dag, grid.values, grid.predictedValues, vs);
-        if (!grid.inactiveDag.empty()) putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveValues, grid.inactivePredictedValues, vs);
+        const bool emptyInactive = grid.inactiveDag.empty();
+        putLayer(sections, g, kActive, grid.dag, grid.values, grid.valueWindows, grid.predictedValues, vs, take);
+        if (!emptyInactive)
+            putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveValues, grid.inactiveValueWindows, grid.inactivePredictedValues, vs, take);
         if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact) {
             ByteWriter e;
             const auto& l = grid.lossy;
@@ -143,6 +182,14 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene) {
         sections.push_back({SectionKind::DagStats, g, stats.take()});
     }
     return sections;
+}
+
+} // namespace
+
+std::vector<Section> sceneToSections(const SsvdagScene& scene) { return toSections(scene, false); }
+
+uint64_t writeSceneReleasing(SsvdagScene& scene, std::ostream& out, const ContainerOptions& options) {
+    return writeContainerTo(toSections(scene, true), out, options);
 }
 
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName) {
@@ -236,8 +283,12 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 throw Error(what + ": the " + layer + " DAG holds " + std::to_string(size.activeVoxels) + " voxels but the header says " +
                             std::to_string(expectedVoxels) + "; the file is corrupted");
             Section* predictedSection = find(g, kinds.predicted, false);
-            if (predictedSection && (!vs || dag.empty() || find(g, kinds.values, false)))
-                throw Error(what + ": unexpected " + layer + " predicted-values section");
+            Section* windowSection = find(g, kinds.windows, false);
+            Section* paletteSection = find(g, kinds.values, false);
+            if (int(predictedSection != nullptr) + int(windowSection != nullptr) + int(paletteSection != nullptr) > 1)
+                throw Error(what + ": the " + layer + " values are stored twice (more than one of Values, ValueWindows, PredictedValues)");
+            if ((predictedSection || windowSection) && (!vs || dag.empty()))
+                throw Error(what + ": unexpected " + layer + " values section for a grid without values");
             if (predictedSection) {
                 if (grid.record.valueType != ValueType::Int32 && grid.record.valueType != ValueType::Int64)
                     throw Error(what + ": predicted values for a " + valueTypeName(grid.record.valueType) + " grid");
@@ -248,7 +299,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                                 std::to_string(size.attributeEntries));
                 if (options.rebuildPalettes) channel = attributes::compressPalette(attributes, vs);  // the traceable layout, rebuilt
             } else if (vs && !dag.empty()) {
-                channel = attributes::deserializePalette(find(g, kinds.values, true)->data, what + " " + layer + " values");
+                if (windowSection) channel = attributes::decodeValueWindows(windowSection->data, what + " " + layer + " value windows");
+                else channel = attributes::deserializePalette(find(g, kinds.values, true)->data, what + " " + layer + " values");
                 if (channel.valueSize != vs || channel.entryCount != size.attributeEntries)
                     throw Error(what + ": " + layer + " values hold " + std::to_string(channel.entryCount) + " entries of " +
                                 std::to_string(channel.valueSize) + " bytes, expected " + std::to_string(size.attributeEntries) + " of " + std::to_string(vs));

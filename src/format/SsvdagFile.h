@@ -4,6 +4,7 @@
 // itself before returning, so callers can walk the DAG without checks.
 #pragma once
 #include <cstdint>
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "src/attributes/NormalChannel.h"
 #include "src/attributes/PaletteChannel.h"
 #include "src/attributes/ScalarTolerance.h"
+#include "src/attributes/ValueWindows.h"
 #include "src/encoding/CompactDag.h"
 #include "src/format/SsvdagContainer.h"
 #include "src/volume/GridRecord.h"
@@ -31,7 +33,10 @@ struct EncodedGrid {
     bool symmetry = true;       // SSVDAG (true) or plain SVDAG
     encoding::CompactDag dag;
     std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
-    attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout
+    attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout (what a reader builds)
+    // What an encoder writes instead: the ValueWindows section payload
+    // (attributes/ValueWindows.h); when empty, `values` is written.
+    attributes::ValueWindowsPayload valueWindows;
     // Integer channels only, when smaller at rest: the same values predicted
     // (attributes/PredictedChannel.h); the file then stores this instead of
     // the palettes, which a reader rebuilds.
@@ -49,6 +54,7 @@ struct EncodedGrid {
     encoding::CompactDag inactiveDag;
     std::vector<uint8_t> inactiveAttributes;
     attributes::PaletteChannel inactiveValues;
+    attributes::ValueWindowsPayload inactiveValueWindows;
     std::vector<uint8_t> inactivePredictedValues;
 };
 
@@ -56,6 +62,11 @@ struct SsvdagScene {
     std::vector<EncodedGrid> grids;
     std::vector<uint8_t> fileMetadata;  // Volume::fileMetadata (opaque)
 };
+
+// The traceable value channel of a layer as a reader builds it: `values`
+// when set (a scene read from a file), else from the windows or the raw
+// attributes an encoder left (a scene just encoded).
+attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactive = false);
 
 std::vector<Section> sceneToSections(const SsvdagScene& scene);
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName);
@@ -68,6 +79,11 @@ struct ReadOptions {
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options);
 
 std::vector<uint8_t> writeScene(const SsvdagScene& scene, const ContainerOptions& options = {});
+// The same bytes written to `out`, in bounded memory: the scene's DAGs,
+// value payloads and descriptors are moved out of it as they are written
+// (the grid headers, statistics and reports stay, for a report). Returns
+// the bytes written.
+uint64_t writeSceneReleasing(SsvdagScene& scene, std::ostream& out, const ContainerOptions& options = {});
 SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName);
 SsvdagScene readSceneFile(const std::string& path);
 SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options);

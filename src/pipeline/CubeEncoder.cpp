@@ -8,6 +8,7 @@
 #include <tbb/info.h>
 #include <tbb/parallel_pipeline.h>
 
+#include "src/attributes/ValueWindows.h"
 #include "src/dag/ReducedDagBytes.h"
 #include "src/dag/SubDagMerge.h"
 #include "src/encoding/CompactDag.h"
@@ -191,9 +192,12 @@ dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& pla
 
 // The layer's values in attribute order, cube by cube. With several
 // processes each gathers a contiguous share of the subtrees and process 0
-// receives them; elsewhere the result is empty.
+// receives them; elsewhere the result is empty. With `stream` (one process
+// only) each subtree's values go to it in order as they are gathered and
+// the result is empty: the layer's values are never held whole.
 std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPlan& plan, const encoding::CompactDag& dag, unsigned vs,
-                                 const CubeBudget& budget, CubeTeam& team, const StepProgress& progress) {
+                                 const CubeBudget& budget, CubeTeam& team, const StepProgress& progress,
+                                 attributes::ValueWindowWriter* stream = nullptr) {
     if (vs == 0 || dag.empty()) return {};
     const uint64_t entries = encoding::decodedSize(dag).attributeEntries;
     const unsigned cut = std::min<unsigned>(plan.cubeLog2, dag.log2Size);
@@ -205,8 +209,10 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
     const uint64_t firstEntry = begin < subtrees.size() ? subtrees[begin].firstEntry : entries;
     const uint64_t endEntry = end < subtrees.size() ? subtrees[end].firstEntry : entries;
     // This process's entries, [firstEntry, endEntry); process 0 of a solo
-    // team fills the whole array directly.
-    std::vector<uint8_t> attributes((endEntry - firstEntry) * vs);
+    // team fills the whole array directly (unless it streams them).
+    if (stream && team.size() != 1) throw Error("internal error: streamed values need a single process");
+    std::vector<uint8_t> attributes(stream ? 0 : (endEntry - firstEntry) * vs);
+    auto entriesOf = [&](size_t i) { return (i + 1 < subtrees.size() ? subtrees[i + 1].firstEntry : entries) - subtrees[i].firstEntry; };
     GridTopology largeTopology;
     LayerValues largeValues;
     source.largeTiles(layer, plan.cubeLog2, largeTopology, largeValues);
@@ -215,6 +221,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         size_t index;
         GridTopology topology;
         LayerValues values;
+        std::vector<uint8_t> gathered;  // streaming: the subtree's entries
     };
     throughCubes<Piece>(
         budget, begin, end,
@@ -225,10 +232,18 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         [&](Piece& piece) {
             const encoding::SubtreeInstance& s = subtrees[piece.index];
             const bool large = s.log2Size > plan.cubeLog2;
-            gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, attributes.data(), firstEntry);
-            piece = {piece.index, {}, {}};
+            if (stream) {
+                piece.gathered.resize(entriesOf(piece.index) * vs);
+                gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, piece.gathered.data(), s.firstEntry);
+            } else {
+                gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, attributes.data(), firstEntry);
+            }
+            piece.topology = {};
+            piece.values = {};
         },
         [&](Piece& piece) {
+            if (stream) stream->add(piece.gathered);
+            piece.gathered = {};
             if (progress) progress(piece.index + 1 - begin, end - begin);
         });
     source.endPass();
@@ -272,6 +287,13 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
 
 uint64_t cubeBytesPerBrick(unsigned valueSize) { return 160 + 64ull * valueSize; }
 
+unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize) {
+    // A window being coded holds its values, their ids and the partitioner's
+    // per-distinct-value arrays: about 24 bytes per entry beyond the value.
+    const uint64_t perWindow = attributes::kValueWindowEntries * (valueSize + 24);
+    return unsigned(std::clamp<uint64_t>(budget.bytes / perWindow, 1, workersOf(budget)));
+}
+
 format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget, CubeTeam& team) {
     if (options.normalBits) throw Error("--normals needs the whole grid in memory (the gradient reads across cubes): use it without --memory-limit");
     format::EncodedGrid out = encodedHeader(source.header(), options);
@@ -282,18 +304,42 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     step("reducing the DAG");
     LayerPlan plan;
     if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan, team);
-    step("ordering values");
-    if (!active.empty()) out.attributes = gatherLayer(source, Layer::Active, plan, out.dag, vs, budget, team, options.onStepProgress);
-    step("palette compression");
-    if (!active.empty() && team.isRoot()) codeActiveValues(out, options);
+    // Lossless values that only palettes code (no tolerance, colour
+    // quantisation or integer prediction, which need the whole channel)
+    // stream from the gather into the value windows: never held whole.
+    const bool integers = source.header().valueType == ValueType::Int32 || source.header().valueType == ValueType::Int64;
+    const bool streamValues = team.size() == 1 && vs > 0 && options.tolerance.mode == attributes::ScalarTolerance::Mode::Exact &&
+                              !isColourGrid(source.header(), options) && !(options.predictIntegers && integers);
+    if (streamValues) {
+        step("ordering and coding values");
+        if (active.empty()) step("coding the last value windows");
+        if (!active.empty()) {
+            attributes::ValueWindowWriter writer(vs, encoding::decodedSize(out.dag).attributeEntries, valueWindowsInFlight(budget, vs), budget.spillNear);
+            gatherLayer(source, Layer::Active, plan, out.dag, vs, budget, team, options.onStepProgress, &writer);
+            step("coding the last value windows");
+            out.valueWindows = writer.finish();
+            out.lossy = {options.tolerance, writer.entries()};
+        }
+    } else {
+        step("ordering values");
+        if (!active.empty()) out.attributes = gatherLayer(source, Layer::Active, plan, out.dag, vs, budget, team, options.onStepProgress);
+        step("palette compression");
+        if (!active.empty() && team.isRoot()) codeActiveValues(out, options);
+    }
     const LayerSummary inactive = source.summary(Layer::Inactive);
     out.inactiveVoxels = inactive.voxels;
     step("inactive values");
     if (!inactive.empty()) {
         LayerPlan inactivePlan;
         out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, inactivePlan, team);
-        out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team, options.onStepProgress);
-        if (team.isRoot()) codeInactiveValues(out, options);
+        if (team.size() == 1 && vs > 0 && !(options.predictIntegers && integers)) {  // streamed, as the active values above
+            attributes::ValueWindowWriter writer(vs, encoding::decodedSize(out.inactiveDag).attributeEntries, valueWindowsInFlight(budget, vs), budget.spillNear);
+            gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team, options.onStepProgress, &writer);
+            out.inactiveValueWindows = writer.finish();
+        } else {
+            out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team, options.onStepProgress);
+            if (team.isRoot()) codeInactiveValues(out, options);
+        }
     }
     return out;
 }

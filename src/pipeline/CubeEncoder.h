@@ -7,11 +7,15 @@
 // count.
 //
 // Bounded: the cubes in flight (at most `workers`, each within its share of
-// the budget) and the reduced DAG. Not yet bounded: the attribute array of
-// each layer (entries x value size) and its palettes, which are built whole.
+// the budget), the value windows being coded (one per core, ValueWindows.h)
+// and the reduced DAG; the coded values wait in a scratch file
+// (CubeBudget::spillNear). Not yet bounded: the reduced DAG itself, and the
+// attribute array of a layer whose coding needs it whole (a lossy tolerance,
+// colour quantisation, integer prediction, or several processes).
 #pragma once
 #include <cstdint>
 #include <optional>
+#include <string>
 
 #include "src/pipeline/CubeTeam.h"
 #include "src/pipeline/GridCodec.h"
@@ -23,10 +27,15 @@ struct CubeBudget {
     uint64_t bytes = 256ull << 20;  // working memory of the cubes in flight, all workers together
     unsigned workers = 0;           // cubes in flight; 0 = TBB's concurrency
     std::optional<unsigned> cubeLog2;  // force the cube size (tests); else the largest that fits
+    // Where the coded values of a layer go while the rest is encoded (a
+    // scratch file in this path's folder); empty: kept in memory.
+    std::string spillNear;
 };
 
 // Rough working bytes per brick of a cube being reduced or gathered.
 uint64_t cubeBytesPerBrick(unsigned valueSize);
+// Value windows coded at once within the budget (at least 1, at most the workers).
+unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize);
 
 // Throws vdbdag::Error for --normals (which needs the whole grid: the
 // gradient reads neighbours across cubes).

@@ -10,6 +10,7 @@
 #include <zstd_errors.h>
 
 #include "src/attributes/PredictedChannel.h"
+#include "src/attributes/ValueWindows.h"
 #include "src/dag/DagBuilder.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/pipeline/AttributeOrder.h"
@@ -90,13 +91,12 @@ size_t zstdEstimate(const std::vector<uint8_t>& bytes) {
 
 // The predicted coding of an integer channel if it beats its palettes at
 // rest, else empty.
-std::vector<uint8_t> predictedIfSmaller(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes,
-                                        const attributes::PaletteChannel& palettes, ValueType type, const EncodeOptions& options) {
+std::vector<uint8_t> predictedIfSmaller(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, uint64_t paletteEstimate,
+                                        ValueType type, const EncodeOptions& options) {
     if (!options.predictIntegers || (type != ValueType::Int32 && type != ValueType::Int64) || attributes.empty()) return {};
     std::vector<uint8_t> predicted = attributes::encodePredicted(attributes, valueSize(type), encoding::attributeLayout(dag));
     const size_t predictedBytes = zstdEstimate(predicted);
-    const size_t paletteBytes = zstdEstimate(attributes::serializePalette(palettes));
-    if (predictedBytes < paletteBytes) return predicted;
+    if (predictedBytes < paletteEstimate) return predicted;
     return {};
 }
 
@@ -163,14 +163,18 @@ void codeActiveValues(format::EncodedGrid& out, const EncodeOptions& options) {
     out.lossy = attributes::applyScalarTolerance(out.attributes, type, options.tolerance);
     if (isColourGrid(out.record, options))
         out.colour = attributes::quantiseColours(out.attributes, type, options.colourBits, "grid '" + out.record.name + "'");
-    out.values = attributes::compressPalette(out.attributes, valueSize(type));
-    out.predictedValues = predictedIfSmaller(out.dag, out.attributes, out.values, type, options);
+    uint64_t estimate = 0;
+    out.valueWindows.bytes = attributes::encodeValueWindows(out.attributes, valueSize(type), &estimate);
+    out.predictedValues = predictedIfSmaller(out.dag, out.attributes, estimate, type, options);
+    if (!out.predictedValues.empty()) out.valueWindows = {};
 }
 
 void codeInactiveValues(format::EncodedGrid& out, const EncodeOptions& options) {
     const ValueType type = out.record.valueType;
-    out.inactiveValues = attributes::compressPalette(out.inactiveAttributes, valueSize(type));
-    out.inactivePredictedValues = predictedIfSmaller(out.inactiveDag, out.inactiveAttributes, out.inactiveValues, type, options);
+    uint64_t estimate = 0;
+    out.inactiveValueWindows.bytes = attributes::encodeValueWindows(out.inactiveAttributes, valueSize(type), &estimate);
+    out.inactivePredictedValues = predictedIfSmaller(out.inactiveDag, out.inactiveAttributes, estimate, type, options);
+    if (!out.inactivePredictedValues.empty()) out.inactiveValueWindows = {};
 }
 
 bool isColourGrid(const GridRecord& grid, const EncodeOptions& options) {
@@ -225,11 +229,28 @@ format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& 
 
 format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) { return encodeGridImpl(grid, options, nullptr); }
 
+namespace {
+
+// A layer's values in attribute order: as read or gathered, or (a grid just
+// encoded whose values were streamed into windows) decoded from its windows.
+// `store` holds decoded values when they had to be decoded.
+const std::vector<uint8_t>& attributesOf(const format::EncodedGrid& grid, bool inactive, std::vector<uint8_t>& store) {
+    const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
+    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+    if (!attributes.empty() || windows.empty()) return attributes;
+    store = attributes::decodeValueWindows(windows.load(), "grid '" + grid.record.name + "' value windows").decodeAll();
+    return store;
+}
+
+} // namespace
+
 GridRecord decodeGrid(const format::EncodedGrid& grid) {
     GridRecord record = grid.record;
     const unsigned vs = valueSize(grid.record.valueType);
-    scatterAttributes(grid.dag, grid.attributes, vs, record.topology, record.values);
-    scatterAttributes(grid.inactiveDag, grid.inactiveAttributes, vs, record.inactiveTopology, record.inactiveValues);
+    std::vector<uint8_t> store;
+    scatterAttributes(grid.dag, attributesOf(grid, false, store), vs, record.topology, record.values);
+    store = {};
+    scatterAttributes(grid.inactiveDag, attributesOf(grid, true, store), vs, record.inactiveTopology, record.inactiveValues);
     return record;
 }
 

@@ -43,7 +43,12 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
     const bool scalarFloat = out.valueType == ValueType::Float || out.valueType == ValueType::Double;
     out.levelSet = grid.record.gridClass == "level set" && scalarFloat;
     out.fog = grid.record.gridClass == "fog volume" && scalarFloat;
-    if (valueSize(out.valueType) > 0 && grid.values.entryCount > 0) out.values = &grid.values;
+    if (valueSize(out.valueType) > 0 && grid.values.entryCount > 0) {
+        out.values = &grid.values;
+    } else if (valueSize(out.valueType) > 0 && (!grid.valueWindows.empty() || !grid.attributes.empty())) {
+        out.ownValues = std::make_shared<const attributes::PaletteChannel>(format::traceableValues(grid));
+        if (out.ownValues->entryCount > 0) out.values = out.ownValues.get();
+    }
     if (grid.normals && grid.normals->entryCount() > 0) out.normals = &*grid.normals;
     if (out.levelSet && out.values) out.inside = std::make_shared<const InsideBits>(insideBitsOf(*out.values, out.valueType));
     switch (out.valueType) {
@@ -60,20 +65,20 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
     if (out.values && out.colouring == ValueColouring::Scalar) {
         // Range over the material array and the directly stored values.
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        const unsigned vs = grid.values.valueSize;
+        const unsigned vs = out.values->valueSize;
         auto take = [&](const uint8_t* bytes) {
             const double v = decodeValue(out.valueType, bytes)[0];
             if (std::isfinite(v)) { lo = std::min(lo, v); hi = std::max(hi, v); }
         };
-        for (size_t i = 0; i + vs <= grid.values.materials.size(); i += vs) take(&grid.values.materials[i]);
-        for (size_t i = 0; i + vs <= grid.values.direct.size(); i += vs) take(&grid.values.direct[i]);
+        for (size_t i = 0; i + vs <= out.values->materials.size(); i += vs) take(&out.values->materials[i]);
+        for (size_t i = 0; i + vs <= out.values->direct.size(); i += vs) take(&out.values->direct[i]);
         if (lo <= hi) { out.valueMin = lo; out.valueMax = hi > lo ? hi : lo + 1; }
     }
     if (out.fog && out.values) {
         double hi = 0;
-        const unsigned vs = grid.values.valueSize;
-        for (size_t i = 0; i + vs <= grid.values.materials.size(); i += vs) hi = std::max(hi, decodeValue(out.valueType, &grid.values.materials[i])[0]);
-        for (size_t i = 0; i + vs <= grid.values.direct.size(); i += vs) hi = std::max(hi, decodeValue(out.valueType, &grid.values.direct[i])[0]);
+        const unsigned vs = out.values->valueSize;
+        for (size_t i = 0; i + vs <= out.values->materials.size(); i += vs) hi = std::max(hi, decodeValue(out.valueType, &out.values->materials[i])[0]);
+        for (size_t i = 0; i + vs <= out.values->direct.size(); i += vs) hi = std::max(hi, decodeValue(out.valueType, &out.values->direct[i])[0]);
         out.valueMax = std::isfinite(hi) && hi > 0 ? hi : 1;
         out.valueMin = 0;
     }

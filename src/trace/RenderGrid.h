@@ -24,6 +24,9 @@ enum class ValueColouring {
 struct RenderGrid {
     const encoding::CompactDag* dag = nullptr;
     const attributes::PaletteChannel* values = nullptr;  // null when the grid stores none
+    // The channel `values` points to when the grid had only its coded
+    // windows (a grid just encoded, not read): built here, shared by copies.
+    std::shared_ptr<const attributes::PaletteChannel> ownValues;
     // ONV shading normals (`encode --normals K`, Dado et al. §4.3), one per
     // attribute entry; null when the grid stores none. Preferred to the
     // level-set gradient and the face normal when present.

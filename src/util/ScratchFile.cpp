@@ -27,6 +27,17 @@ ScratchFile::~ScratchFile() {
 
 uint64_t ScratchFile::append(const void* data, size_t size) {
     const uint64_t at = size_;
+    writeAt(at, data, size);
+    size_ += size;
+    return at;
+}
+
+void ScratchFile::overwrite(uint64_t offset, const void* data, size_t size) {
+    if (offset > size_ || size > size_ - offset) throw Error("internal error: a scratch overwrite past the end of " + path_);
+    writeAt(offset, data, size);
+}
+
+void ScratchFile::writeAt(uint64_t at, const void* data, size_t size) {
     const auto* p = static_cast<const uint8_t*>(data);
     for (size_t done = 0; done < size;) {
         const ssize_t n = ::pwrite(fd_, p + done, size - done, off_t(at + done));
@@ -36,8 +47,6 @@ uint64_t ScratchFile::append(const void* data, size_t size) {
                         "); free some space or choose another folder with --scratch DIR");
         done += size_t(n);
     }
-    size_ += size;
-    return at;
 }
 
 void ScratchFile::read(uint64_t offset, size_t size, std::vector<uint8_t>& out) const {

@@ -24,12 +24,15 @@ public:
 
     // Appends `size` bytes; returns their offset.
     uint64_t append(const void* data, size_t size);
+    // Replaces bytes already written (`offset + size` <= size()).
+    void overwrite(uint64_t offset, const void* data, size_t size);
     // Reads `size` bytes at `offset` into `out` (resized).
     void read(uint64_t offset, size_t size, std::vector<uint8_t>& out) const;
     uint64_t size() const { return size_; }
     const std::string& path() const { return path_; }
 
 private:
+    void writeAt(uint64_t offset, const void* data, size_t size);
     std::string path_;
     int fd_ = -1;
     uint64_t size_ = 0;

@@ -1,0 +1,272 @@
+// See ValueWindows.h.
+#include "src/attributes/ValueWindows.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <memory>
+#include <new>
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <zstd.h>
+#include <zstd_errors.h>
+
+#include "src/format/ByteIO.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::attributes {
+namespace {
+
+// Windows of at most this many raw bytes get zstd's level 9, larger ones
+// level 3 (the container's rule for whole sections).
+constexpr uint64_t kSmallWindowBytes = uint64_t(4) << 20;
+// A zstd frame restores at most this many bytes per stored byte (the
+// container's bound), so a forged raw size is refused before allocation.
+constexpr uint64_t kMaxZstdRatio = uint64_t(1) << 16, kMaxZstdSlack = 4096;
+
+struct CCtx {
+    ZSTD_CCtx* c = ZSTD_createCCtx();
+    CCtx() {
+        if (!c) throw std::bad_alloc();
+    }
+    ~CCtx() { ZSTD_freeCCtx(c); }
+    CCtx(const CCtx&) = delete;
+    CCtx& operator=(const CCtx&) = delete;
+};
+
+void checkZstd(size_t r) {
+    if (!ZSTD_isError(r)) return;
+    if (ZSTD_getErrorCode(r) == ZSTD_error_memory_allocation) throw std::bad_alloc();  // out of memory, never different bytes
+    throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(r));
+}
+
+// zstd at `level`; empty when it does not make `data` smaller.
+std::vector<uint8_t> zstdOrNothing(std::span<const uint8_t> data, int level) {
+    CCtx cctx;
+    checkZstd(ZSTD_CCtx_setParameter(cctx.c, ZSTD_c_compressionLevel, level));
+    checkZstd(ZSTD_CCtx_setParameter(cctx.c, ZSTD_c_contentSizeFlag, 1));
+    checkZstd(ZSTD_CCtx_setParameter(cctx.c, ZSTD_c_checksumFlag, 1));  // each window checks itself (a reader may inflate just one)
+    std::vector<uint8_t> out(data.size() > 0 ? data.size() - 1 : 0);
+    if (out.empty()) return {};
+    const size_t n = ZSTD_compress2(cctx.c, out.data(), out.size(), data.data(), data.size());
+    if (ZSTD_isError(n)) {
+        if (ZSTD_getErrorCode(n) == ZSTD_error_dstSize_tooSmall) return {};
+        checkZstd(n);
+    }
+    out.resize(n);
+    return out;
+}
+
+// zstd level 1 size, streamed through a small buffer (no full-size output).
+uint64_t fastEstimate(std::span<const uint8_t> data) {
+    CCtx cctx;
+    checkZstd(ZSTD_CCtx_setParameter(cctx.c, ZSTD_c_compressionLevel, 1));
+    std::vector<uint8_t> buffer(size_t(1) << 18);
+    ZSTD_inBuffer in{data.data(), data.size(), 0};
+    uint64_t total = 0;
+    for (;;) {
+        ZSTD_outBuffer out{buffer.data(), buffer.size(), 0};
+        const size_t left = ZSTD_compressStream2(cctx.c, &out, &in, ZSTD_e_end);
+        checkZstd(left);
+        total += out.pos;
+        if (left == 0) return total;
+    }
+}
+
+} // namespace
+
+constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;
+
+std::vector<uint8_t> ValueWindowsPayload::load() const {
+    if (!file) return bytes;
+    std::vector<uint8_t> out;
+    file->read(0, size_t(file->size()), out);
+    return out;
+}
+
+ValueWindowWriter::ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntries, unsigned parallel, const std::string& spillNear)
+    : valueSize_(valueSize), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
+    if (valueSize == 0 || valueSize > 64) throw Error("internal error: a value window needs 1 to 64 bytes per value");
+    // A window stored raw is its serialised channel: at most its values plus
+    // the channel's fixed fields and a directory entry per block, bounded
+    // here by 1/16 of the values and 4 KiB.
+    const uint64_t windows = (expectedEntries + kValueWindowEntries - 1) / kValueWindowEntries;
+    const uint64_t bound = kHeaderBytes + expectedEntries * valueSize + expectedEntries * valueSize / 16 + windows * (4096 + 16);
+    if (!spillNear.empty()) {
+        spill_ = std::make_shared<ScratchFile>(spillNear);
+        const uint8_t zeros[kHeaderBytes] = {};
+        spill_->append(zeros, kHeaderBytes);
+        return;
+    }
+    if (expectedEntries && bound < (uint64_t(1) << 40)) payload_.reserve(size_t(bound));
+    payload_.resize(kHeaderBytes);
+}
+
+void ValueWindowWriter::add(std::span<const uint8_t> values) {
+    if (values.size() % valueSize_) throw Error("internal error: values are not whole entries");
+    const uint64_t windowBytes = kValueWindowEntries * valueSize_;
+    while (!values.empty()) {
+        if (pending_.empty() || pending_.back().size() == windowBytes) {
+            if (pending_.size() == parallel_) codePending();  // every pending window is full
+            pending_.emplace_back();
+            pending_.back().reserve(size_t(std::min<uint64_t>(windowBytes, std::max<uint64_t>(values.size(), 1u << 16))));
+        }
+        std::vector<uint8_t>& w = pending_.back();
+        const size_t take = size_t(std::min<uint64_t>(windowBytes - w.size(), values.size()));
+        w.insert(w.end(), values.begin(), values.begin() + long(take));
+        values = values.subspan(take);
+        entries_ += take / valueSize_;
+    }
+}
+
+void ValueWindowWriter::codePending() {
+    struct Coded {
+        std::vector<uint8_t> stored;
+        uint64_t rawBytes = 0, estimate = 0;
+    };
+    std::vector<Coded> coded(pending_.size());
+    // Each window on its own core (compressPalette parallelises inside a
+    // window too); the result is the same for any number of threads.
+    tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
+        std::vector<uint8_t> raw = serializePalette(compressPalette(pending_[i], valueSize_));
+        std::vector<uint8_t>().swap(pending_[i]);
+        Coded& c = coded[i];
+        c.rawBytes = raw.size();
+        c.estimate = fastEstimate(raw);
+        c.stored = zstdOrNothing(raw, raw.size() <= kSmallWindowBytes ? 9 : 3);
+        if (c.stored.empty()) c.stored = std::move(raw);
+    });
+    pending_.clear();
+    for (Coded& c : coded) {
+        if (spill_) spill_->append(c.stored.data(), c.stored.size());
+        else payload_.insert(payload_.end(), c.stored.begin(), c.stored.end());
+        directory_.push_back({c.stored.size(), c.rawBytes});
+        estimate_ += c.estimate;
+        std::vector<uint8_t>().swap(c.stored);
+    }
+}
+
+ValueWindowsPayload ValueWindowWriter::finish() {
+    if (!pending_.empty()) codePending();
+    format::ByteWriter head;
+    head.put<uint32_t>(valueSize_);
+    head.put<uint64_t>(entries_);
+    head.put<uint64_t>(kValueWindowEntries);
+    head.put<uint64_t>(directory_.size());
+    format::ByteWriter dir;
+    for (const auto& [stored, raw] : directory_) {
+        dir.put<uint64_t>(stored);
+        dir.put<uint64_t>(raw);
+    }
+    estimate_ += kHeaderBytes + dir.bytes().size();
+    directory_.clear();
+    ValueWindowsPayload out;
+    if (spill_) {
+        spill_->overwrite(0, head.bytes().data(), kHeaderBytes);
+        spill_->append(dir.bytes().data(), dir.bytes().size());
+        out.file = std::move(spill_);
+        return out;
+    }
+    std::memcpy(payload_.data(), head.bytes().data(), kHeaderBytes);
+    payload_.insert(payload_.end(), dir.bytes().begin(), dir.bytes().end());
+    out.bytes = std::move(payload_);
+    return out;
+}
+
+std::vector<uint8_t> encodeValueWindows(std::span<const uint8_t> values, uint32_t valueSize, uint64_t* estimate) {
+    if (estimate) *estimate = 0;
+    if (valueSize == 0) return {};  // a mask grid stores no values
+    ValueWindowWriter writer(valueSize, values.size() / valueSize);
+    writer.add(values);
+    std::vector<uint8_t> out = std::move(writer.finish().bytes);
+    if (estimate) *estimate = writer.estimate();
+    return out;
+}
+
+PaletteChannel decodeValueWindows(std::span<const uint8_t> payload, const std::string& what) {
+    format::ByteReader r(payload, what);
+    PaletteChannel out;
+    out.valueSize = r.get<uint32_t>();
+    if (out.valueSize == 0 || out.valueSize > 64) r.fail("bad value size " + std::to_string(out.valueSize));
+    out.entryCount = r.get<uint64_t>();
+    const uint64_t windowEntries = r.get<uint64_t>();
+    if (!std::has_single_bit(windowEntries) || windowEntries < (uint64_t(1) << 10) || windowEntries > (uint64_t(1) << 30))
+        r.fail("window of " + std::to_string(windowEntries) + " entries (a power of two from 2^10 to 2^30 is expected)");
+    const uint64_t windows = r.get<uint64_t>();
+    if (out.entryCount > (uint64_t(1) << 40)) r.fail(std::to_string(out.entryCount) + " entries is implausible");
+    if (windows != (out.entryCount + windowEntries - 1) / windowEntries)
+        r.fail(std::to_string(windows) + " windows for " + std::to_string(out.entryCount) + " entries of " + std::to_string(windowEntries));
+    if (windows > r.remaining() / 16) r.fail("window directory runs past the end");
+    const size_t framesBegin = r.position(), directoryBegin = payload.size() - size_t(windows) * 16;
+    format::ByteReader d(payload.subspan(directoryBegin), what + " window directory");
+    std::vector<std::pair<uint64_t, uint64_t>> sizes(windows);  // stored, raw
+    uint64_t storedTotal = 0;
+    const uint64_t frameBytes = directoryBegin - framesBegin;
+    for (auto& [stored, raw] : sizes) {
+        stored = d.get<uint64_t>();
+        raw = d.get<uint64_t>();
+        if (stored > frameBytes || raw < stored || raw > stored * kMaxZstdRatio + kMaxZstdSlack) r.fail("window sizes are implausible");
+        storedTotal += stored;
+    }
+    if (storedTotal != frameBytes) r.fail("windows hold " + std::to_string(frameBytes) + " bytes, the directory says " + std::to_string(storedTotal));
+    const uint8_t* at = payload.data() + framesBegin;
+    std::vector<uint32_t> wholeBase;  // per window: where its material range sits in `palettes`, once needed
+    for (uint64_t w = 0; w < windows; ++w) {
+        const auto [stored, rawSize] = sizes[w];
+        const std::string where = what + " window " + std::to_string(w);
+        std::vector<uint8_t> inflated;
+        std::span<const uint8_t> raw(at, size_t(stored));
+        if (rawSize != stored) {
+            if (ZSTD_findFrameCompressedSize(at, size_t(stored)) != stored || ZSTD_getFrameContentSize(at, size_t(stored)) != rawSize)
+                throw Error(where + ": not one zstd frame of the declared size");
+            inflated.resize(size_t(rawSize));
+            const size_t n = ZSTD_decompress(inflated.data(), inflated.size(), at, size_t(stored));
+            if (ZSTD_isError(n)) {
+                if (ZSTD_getErrorCode(n) == ZSTD_error_memory_allocation) throw std::bad_alloc();
+                throw Error(where + ": corrupted zstd data (" + ZSTD_getErrorName(n) + ")");
+            }
+            if (n != rawSize) throw Error(where + ": zstd restored " + std::to_string(n) + " bytes instead of " + std::to_string(rawSize));
+            raw = inflated;
+        }
+        at += stored;
+        const PaletteChannel c = deserializePalette(raw, where);
+        const uint64_t first = w * windowEntries, expect = std::min(windowEntries, out.entryCount - first);
+        if (c.valueSize != out.valueSize || c.entryCount != expect)
+            throw Error(where + ": holds " + std::to_string(c.entryCount) + " entries of " + std::to_string(c.valueSize) + " bytes, expected " +
+                        std::to_string(expect) + " of " + std::to_string(out.valueSize));
+        // Merge: materials and palettes appended (palette entries moved by
+        // the material base), blocks moved to the merged arrays.
+        const uint64_t materialBase = out.materialCount(), paletteBase = out.palettes.size();
+        const uint64_t bitBase = uint64_t(out.indexBits.size()) * 64, directBase = out.direct.size();
+        if (materialBase + c.materialCount() > 0xFFFFFFF0u || paletteBase + c.palettes.size() + c.materialCount() > 0xFFFFFFF0u)
+            throw Error(where + ": more than 2^32 materials or palette entries in one channel");
+        out.materials.insert(out.materials.end(), c.materials.begin(), c.materials.end());
+        for (uint32_t m : c.palettes) out.palettes.push_back(uint32_t(materialBase + m));
+        uint32_t wholeOffset = PaletteBlock::kWholeMaterialArray;
+        for (PaletteBlock b : c.blocks) {
+            b.firstEntry += first;
+            if (b.indexBits == PaletteBlock::kDirect) {
+                b.dataOffset += directBase;
+            } else {
+                b.dataOffset += bitBase;
+                if (b.paletteOffset == PaletteBlock::kWholeMaterialArray) {
+                    if (wholeOffset == PaletteBlock::kWholeMaterialArray) {  // this window's materials as one palette
+                        wholeOffset = uint32_t(out.palettes.size());
+                        for (uint64_t m = 0; m < c.materialCount(); ++m) out.palettes.push_back(uint32_t(materialBase + m));
+                    }
+                    b.paletteOffset = wholeOffset;
+                } else {
+                    b.paletteOffset = uint32_t(paletteBase + b.paletteOffset);
+                }
+            }
+            out.blocks.push_back(b);
+        }
+        out.indexBits.insert(out.indexBits.end(), c.indexBits.begin(), c.indexBits.end());
+        out.direct.insert(out.direct.end(), c.direct.begin(), c.direct.end());
+    }
+    if (out.indexBits.empty() && !out.blocks.empty()) out.indexBits.assign(2, 0);
+    return out;
+}
+
+} // namespace vdbdag::attributes

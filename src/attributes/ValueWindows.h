@@ -1,0 +1,85 @@
+// A value channel at rest in fixed windows: the entries, in attribute
+// order, cut into windows of kValueWindowEntries entries (the last one
+// shorter); each window palette-compressed on its own (compressPalette, its
+// own material array) and zstd-compressed on its own. So an encoder holds one
+// window (per core) at a time, never the whole channel, whatever the grid's
+// size; windows are coded in parallel; and the bytes do not depend on how
+// the entries arrived (all at once or cube by cube), the memory limit or the
+// thread count, because the windows are cut at fixed entry counts.
+//
+// Payload of a ValueWindows / InactiveValueWindows section (the container
+// stores it as it is: its frames are compressed already):
+//   u32 value size, u64 entries, u64 window entries (a power of two),
+//   u64 window count W = ceil(entries / window entries),
+//   the W windows back to back,
+//   W x (u64 stored bytes, u64 raw bytes), the directory, last (a writer
+//     appends each window as soon as it is coded): raw == stored: the
+//     window is its serializePalette bytes as they are; else one zstd frame
+//     of them that declares the raw size and carries zstd's checksum.
+// A reader (decodeValueWindows) merges the windows into one traceable
+// PaletteChannel: their material arrays and palettes concatenated, and each
+// window's whole-material-array blocks turned into palette blocks over its
+// own part of the merged material array.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "src/attributes/PaletteChannel.h"
+#include "src/util/ScratchFile.h"
+
+namespace vdbdag::attributes {
+
+inline constexpr uint64_t kValueWindowEntries = uint64_t(1) << 22;
+
+// A coded payload, in memory or (an encoder in bounded memory) the whole of
+// a scratch file.
+struct ValueWindowsPayload {
+    std::vector<uint8_t> bytes;
+    std::shared_ptr<const ScratchFile> file;
+    bool empty() const { return bytes.empty() && !file; }
+    uint64_t size() const { return file ? file->size() : bytes.size(); }
+    std::vector<uint8_t> load() const;  // the bytes, read back when spilled
+};
+
+// Takes the entries in order (any number per call) and codes every full
+// window; at most `parallel` windows (0: one per core) wait to be coded
+// together, so memory holds about that many windows.
+class ValueWindowWriter {
+public:
+    // `expectedEntries`: how many entries will come, if known; the payload's
+    // memory is then reserved once (untouched reserve costs no resident
+    // memory), so it is never copied while it grows.
+    // With `spillNear`, coded windows go to a scratch file in that path's
+    // folder (ScratchFile.h) instead of memory.
+    explicit ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntries = 0, unsigned parallel = 0, const std::string& spillNear = "");
+    void add(std::span<const uint8_t> values);
+    // The section payload. The writer is spent afterwards.
+    ValueWindowsPayload finish();
+    // A fast-zstd estimate of the payload (the sum of the windows'
+    // zstd level-1 sizes), the yardstick GridCodec compares other codings
+    // with; valid after finish().
+    uint64_t estimate() const { return estimate_; }
+    uint64_t entries() const { return entries_; }
+
+private:
+    void codePending();
+    uint32_t valueSize_;
+    unsigned parallel_;
+    uint64_t entries_ = 0, estimate_ = 0;
+    std::vector<std::vector<uint8_t>> pending_;  // full windows not yet coded, and the one filling (last)
+    std::vector<uint8_t> payload_;               // header placeholder, then the coded windows
+    std::shared_ptr<ScratchFile> spill_;         // ... or there
+    std::vector<std::pair<uint64_t, uint64_t>> directory_;  // stored, raw bytes per window
+};
+
+// All of `values` at once.
+std::vector<uint8_t> encodeValueWindows(std::span<const uint8_t> values, uint32_t valueSize, uint64_t* estimate = nullptr);
+
+// Validates the payload (sizes, frames, every window's palette channel) and
+// merges it; throws vdbdag::Error starting with `what`.
+PaletteChannel decodeValueWindows(std::span<const uint8_t> payload, const std::string& what);
+
+} // namespace vdbdag::attributes
