@@ -9,10 +9,9 @@
 
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
-#include <zstd.h>
-#include <zstd_errors.h>
 
 #include "src/format/ByteIO.h"
+#include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::attributes {
@@ -21,62 +20,9 @@ namespace {
 // Windows of at most this many raw bytes get zstd's level 9, larger ones
 // level 3 (the container's rule for whole sections).
 constexpr uint64_t kSmallWindowBytes = uint64_t(4) << 20;
-// A zstd frame restores at most this many bytes per stored byte (the
-// container's bound), so a forged raw size is refused before allocation.
-constexpr uint64_t kMaxZstdRatio = uint64_t(1) << 16, kMaxZstdSlack = 4096;
-
-struct CCtx {
-    ZSTD_CCtx* c = ZSTD_createCCtx();
-    CCtx() {
-        if (!c) throw std::bad_alloc();
-    }
-    ~CCtx() { ZSTD_freeCCtx(c); }
-    CCtx(const CCtx&) = delete;
-    CCtx& operator=(const CCtx&) = delete;
-};
-
-void checkZstd(size_t r) {
-    if (!ZSTD_isError(r)) return;
-    if (ZSTD_getErrorCode(r) == ZSTD_error_memory_allocation) throw std::bad_alloc();  // out of memory, never different bytes
-    throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(r));
-}
-
-// zstd at `level`; empty when it does not make `data` smaller.
-std::vector<uint8_t> zstdOrNothing(std::span<const uint8_t> data, int level) {
-    CCtx cctx;
-    checkZstd(ZSTD_CCtx_setParameter(cctx.c, ZSTD_c_compressionLevel, level));
-    checkZstd(ZSTD_CCtx_setParameter(cctx.c, ZSTD_c_contentSizeFlag, 1));
-    checkZstd(ZSTD_CCtx_setParameter(cctx.c, ZSTD_c_checksumFlag, 1));  // each window checks itself (a reader may inflate just one)
-    std::vector<uint8_t> out(data.size() > 0 ? data.size() - 1 : 0);
-    if (out.empty()) return {};
-    const size_t n = ZSTD_compress2(cctx.c, out.data(), out.size(), data.data(), data.size());
-    if (ZSTD_isError(n)) {
-        if (ZSTD_getErrorCode(n) == ZSTD_error_dstSize_tooSmall) return {};
-        checkZstd(n);
-    }
-    out.resize(n);
-    return out;
-}
-
-// zstd level 1 size, streamed through a small buffer (no full-size output).
-uint64_t fastEstimate(std::span<const uint8_t> data) {
-    CCtx cctx;
-    checkZstd(ZSTD_CCtx_setParameter(cctx.c, ZSTD_c_compressionLevel, 1));
-    std::vector<uint8_t> buffer(size_t(1) << 18);
-    ZSTD_inBuffer in{data.data(), data.size(), 0};
-    uint64_t total = 0;
-    for (;;) {
-        ZSTD_outBuffer out{buffer.data(), buffer.size(), 0};
-        const size_t left = ZSTD_compressStream2(cctx.c, &out, &in, ZSTD_e_end);
-        checkZstd(left);
-        total += out.pos;
-        if (left == 0) return total;
-    }
-}
+constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;  // value size, entries, window entries, window count
 
 } // namespace
-
-constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;
 
 std::vector<uint8_t> ValueWindowsPayload::load() const {
     if (!file) return bytes;
@@ -133,8 +79,8 @@ void ValueWindowWriter::codePending() {
         std::vector<uint8_t>().swap(pending_[i]);
         Coded& c = coded[i];
         c.rawBytes = raw.size();
-        c.estimate = fastEstimate(raw);
-        c.stored = zstdOrNothing(raw, raw.size() <= kSmallWindowBytes ? 9 : 3);
+        c.estimate = format::zstdFastSize(raw);
+        c.stored = format::zstdCompressIfSmaller(raw, {raw.size() <= kSmallWindowBytes ? 9 : 3, /*checksum: a reader may inflate one window*/ true, 0});
         if (c.stored.empty()) c.stored = std::move(raw);
     });
     pending_.clear();
@@ -206,7 +152,7 @@ PaletteChannel decodeValueWindows(std::span<const uint8_t> payload, const std::s
     for (auto& [stored, raw] : sizes) {
         stored = d.get<uint64_t>();
         raw = d.get<uint64_t>();
-        if (stored > frameBytes || raw < stored || raw > stored * kMaxZstdRatio + kMaxZstdSlack) r.fail("window sizes are implausible");
+        if (stored > frameBytes || raw < stored || !format::zstdCanProduce(stored, raw)) r.fail("window sizes are implausible");
         storedTotal += stored;
     }
     if (storedTotal != frameBytes) r.fail("windows hold " + std::to_string(frameBytes) + " bytes, the directory says " + std::to_string(storedTotal));
@@ -218,15 +164,7 @@ PaletteChannel decodeValueWindows(std::span<const uint8_t> payload, const std::s
         std::vector<uint8_t> inflated;
         std::span<const uint8_t> raw(at, size_t(stored));
         if (rawSize != stored) {
-            if (ZSTD_findFrameCompressedSize(at, size_t(stored)) != stored || ZSTD_getFrameContentSize(at, size_t(stored)) != rawSize)
-                throw Error(where + ": not one zstd frame of the declared size");
-            inflated.resize(size_t(rawSize));
-            const size_t n = ZSTD_decompress(inflated.data(), inflated.size(), at, size_t(stored));
-            if (ZSTD_isError(n)) {
-                if (ZSTD_getErrorCode(n) == ZSTD_error_memory_allocation) throw std::bad_alloc();
-                throw Error(where + ": corrupted zstd data (" + ZSTD_getErrorName(n) + ")");
-            }
-            if (n != rawSize) throw Error(where + ": zstd restored " + std::to_string(n) + " bytes instead of " + std::to_string(rawSize));
+            inflated = format::zstdInflateFrame(raw, rawSize, where);
             raw = inflated;
         }
         at += stored;

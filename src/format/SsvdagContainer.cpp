@@ -60,6 +60,7 @@
 #include <zstd_errors.h>
 
 #include "src/format/ByteIO.h"
+#include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
 #include "src/util/InputPath.h"
 
@@ -72,11 +73,6 @@ constexpr uint64_t kHeaderBytes = 16;
 constexpr uint64_t kEntryBytes = 48;
 constexpr uint64_t kChecksumBytes = 8;
 constexpr uint32_t kCodecRaw = 0, kCodecZstd = 1;
-// zstd cannot expand data by more than this factor (a 128 KiB RLE block costs
-// 4 bytes, a 128 KiB single-match block about 8); a claim beyond it is a
-// corrupt or forged table.
-constexpr uint64_t kMaxZstdRatio = uint64_t(1) << 16;
-constexpr uint64_t kMaxZstdSlack = 4096;
 constexpr size_t kMinBytesToCompress = 64;
 constexpr size_t kLargeSection = size_t(4) << 20;
 
@@ -168,8 +164,7 @@ std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string&
         if (e.codec == kCodecRaw && e.raw != e.stored)
             fail(what + " claims " + num(e.raw) + " raw bytes for " + num(e.stored) + " bytes stored uncompressed");
         // e.stored <= size < 2^48 in practice, but stay overflow-safe anyway.
-        if (e.codec == kCodecZstd &&
-            (e.stored > (std::numeric_limits<uint64_t>::max() - kMaxZstdSlack) / kMaxZstdRatio || e.raw > e.stored * kMaxZstdRatio + kMaxZstdSlack))
+        if (e.codec == kCodecZstd && !zstdCanProduce(e.stored, e.raw))
             fail(what + " claims " + num(e.raw) + " bytes from " + num(e.stored) + " compressed bytes, which zstd cannot produce");
         expectedOffset = end;
         entries.push_back(e);
@@ -181,57 +176,13 @@ std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string&
 std::vector<uint8_t> restore(const Entry& e, std::span<const uint8_t> stored, const std::string& what) {
     if (XXH3_64bits(stored.data(), stored.size()) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
     if (e.codec == kCodecRaw) return std::vector<uint8_t>(stored.begin(), stored.end());
-    const size_t frameBytes = ZSTD_findFrameCompressedSize(stored.data(), stored.size());
-    if (ZSTD_isError(frameBytes)) throw Error(what + ": corrupted zstd frame (" + ZSTD_getErrorName(frameBytes) + ")");
-    if (frameBytes != stored.size())
-        throw Error(what + ": the zstd frame takes " + num(frameBytes) + " of the section's " + num(stored.size()) + " bytes, the file is corrupted");
-    const unsigned long long declared = ZSTD_getFrameContentSize(stored.data(), stored.size());
-    if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN)
-        throw Error(what + ": the zstd frame does not declare its size, the file is corrupted");
-    if (declared != e.raw)
-        throw Error(what + ": the zstd frame declares " + num(declared) + " bytes but the table " + num(e.raw) + ", the file is corrupted");
-    std::vector<uint8_t> data(e.raw);  // raw <= stored * 2^16 + 4096 (parseTable)
-    const size_t n = ZSTD_decompress(data.data(), data.size(), stored.data(), stored.size());
-    if (ZSTD_isError(n)) {
-        if (ZSTD_getErrorCode(n) == ZSTD_error_memory_allocation) throw std::bad_alloc();
-        throw Error(what + ": corrupted zstd data (" + ZSTD_getErrorName(n) + ")");
-    }
-    if (n != e.raw) throw Error(what + ": zstd restored " + num(n) + " bytes instead of " + num(e.raw) + ", the file is corrupted");
-    return data;
+    return zstdInflateFrame(stored, e.raw, what);  // raw <= stored * 2^16 + 4096 (parseTable)
 }
 
-// Compresses `data` into `out`; returns false (leaving `out` empty) when zstd
-// does not make it smaller.
-bool compressSection(std::span<const uint8_t> data, const ContainerOptions& options, std::vector<uint8_t>& out) {
-    struct CCtxDeleter {
-        void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
-    };
-    std::unique_ptr<ZSTD_CCtx, CCtxDeleter> cctx(ZSTD_createCCtx());
-    if (!cctx) throw std::bad_alloc();
+// The section's zstd frame, or empty when zstd does not make it smaller.
+std::vector<uint8_t> compressSection(std::span<const uint8_t> data, const ContainerOptions& options) {
     const bool large = data.size() > kLargeSection;
-    const int level = large ? std::min(options.zstdLevel, 3) : options.zstdLevel;
-    // zstd reports a failed allocation as an error code; it is the same out
-    // of memory as a failed `new`, and the command line says so in one line.
-    auto check = [](size_t r) {
-        if (!ZSTD_isError(r)) return;
-        if (ZSTD_getErrorCode(r) == ZSTD_error_memory_allocation) throw std::bad_alloc();
-        throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(r));
-    };
-    check(ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, level));
-    check(ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_contentSizeFlag, 1));  // the reader requires the frame content size
-    if (large) ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_nbWorkers, 2);  // fails harmlessly if libzstd lacks threads
-    // A destination one byte smaller than the input: if zstd cannot fit there
-    // it does not shrink the data, and we keep it raw without a full-size bound.
-    out.resize(data.size() - 1);
-    const size_t n = ZSTD_compress2(cctx.get(), out.data(), out.size(), data.data(), data.size());
-    if (ZSTD_isError(n)) {
-        out.clear();
-        out.shrink_to_fit();
-        if (ZSTD_getErrorCode(n) == ZSTD_error_dstSize_tooSmall) return false;
-        check(n);
-    }
-    out.resize(n);
-    return true;
+    return zstdCompressIfSmaller(data, {large ? std::min(options.zstdLevel, 3) : options.zstdLevel, false, large ? 2 : 0});
 }
 
 } // namespace
@@ -266,21 +217,23 @@ bool isPrecompressed(SectionKind kind) { return kind == SectionKind::ValueWindow
 
 namespace {
 
-// Compresses every section in place (its raw bytes released as soon as the
-// compressed ones exist), then hands the header, the table and each payload
-// to `put` in file order, releasing each payload once put.
+// Compresses the sections (into `packed`, or in place when `release`: each
+// raw payload is dropped once compressed), then hands the header, the table
+// and each payload to `put` in file order (with `release`, dropping each
+// payload once put).
 template <typename Put>
-uint64_t emitContainer(std::vector<Section>& sections, const ContainerOptions& options, Put&& put) {
+uint64_t emitContainer(std::vector<Section>& sections, bool release, const ContainerOptions& options, Put&& put) {
     if (sections.size() > std::numeric_limits<uint32_t>::max()) throw Error("too many sections for one .ssvdag file: " + num(sections.size()));
-    std::vector<uint64_t> rawSize(sections.size());
-    std::vector<uint32_t> codec(sections.size(), kCodecRaw);
     // A spilled payload is read back in pieces: once for its checksum, once to copy it.
     constexpr size_t kPiece = size_t(4) << 20;
-    std::vector<uint64_t> spilledChecksum(sections.size(), 0);
+    std::vector<uint64_t> rawSize(sections.size()), storedSize(sections.size()), checksum(sections.size());
+    std::vector<uint32_t> codec(sections.size(), kCodecRaw);
+    std::vector<std::vector<uint8_t>> packed(sections.size());
+    auto stored = [&](size_t i) -> const std::vector<uint8_t>& { return codec[i] == kCodecZstd && !release ? packed[i] : sections[i].data; };
     for (size_t i = 0; i < sections.size(); ++i) {
         if (const auto& file = sections[i].spilled) {
             if (!isPrecompressed(sections[i].kind) || !sections[i].data.empty()) throw Error("internal error: only a precompressed section is spilled");
-            rawSize[i] = file->size();
+            rawSize[i] = storedSize[i] = file->size();
             std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
             if (!state) throw std::bad_alloc();
             XXH3_64bits_reset(state.get());
@@ -289,16 +242,20 @@ uint64_t emitContainer(std::vector<Section>& sections, const ContainerOptions& o
                 file->read(at, size_t(std::min<uint64_t>(kPiece, file->size() - at)), piece);
                 XXH3_64bits_update(state.get(), piece.data(), piece.size());
             }
-            spilledChecksum[i] = XXH3_64bits_digest(state.get());
+            checksum[i] = XXH3_64bits_digest(state.get());
             continue;
         }
-        std::vector<uint8_t>& data = sections[i].data;
+        const std::vector<uint8_t>& data = sections[i].data;
         rawSize[i] = data.size();
-        std::vector<uint8_t> packed;
-        if (options.compress && data.size() > kMinBytesToCompress && !isPrecompressed(sections[i].kind) && compressSection(data, options, packed)) {
-            data = std::move(packed);
-            codec[i] = kCodecZstd;
+        if (options.compress && data.size() > kMinBytesToCompress && !isPrecompressed(sections[i].kind)) {
+            std::vector<uint8_t> frame = compressSection(data, options);
+            if (!frame.empty()) {
+                codec[i] = kCodecZstd;
+                (release ? sections[i].data : packed[i]) = std::move(frame);
+            }
         }
+        storedSize[i] = stored(i).size();
+        checksum[i] = XXH3_64bits(stored(i).data(), stored(i).size());
     }
     const uint64_t tableEnd = kHeaderBytes + sections.size() * kEntryBytes;
     ByteWriter w;
@@ -307,32 +264,33 @@ uint64_t emitContainer(std::vector<Section>& sections, const ContainerOptions& o
     w.put<uint32_t>(uint32_t(sections.size()));
     uint64_t offset = tableEnd + kChecksumBytes;
     for (size_t i = 0; i < sections.size(); ++i) {
-        const std::vector<uint8_t>& stored = sections[i].data;
-        const uint64_t storedSize = sections[i].spilled ? rawSize[i] : stored.size();
         w.put<uint32_t>(uint32_t(sections[i].kind));
         w.put<uint32_t>(sections[i].grid);
         w.put<uint32_t>(codec[i]);
         w.put<uint32_t>(0);
         w.put<uint64_t>(offset);
-        w.put<uint64_t>(storedSize);
+        w.put<uint64_t>(storedSize[i]);
         w.put<uint64_t>(rawSize[i]);
-        w.put<uint64_t>(sections[i].spilled ? spilledChecksum[i] : XXH3_64bits(stored.data(), stored.size()));
-        offset += storedSize;
+        w.put<uint64_t>(checksum[i]);
+        offset += storedSize[i];
     }
     w.put<uint64_t>(XXH3_64bits(w.bytes().data(), w.bytes().size()));
     put(std::span<const uint8_t>(w.bytes()));
-    for (Section& section : sections) {
-        if (const auto& file = section.spilled) {
+    for (size_t i = 0; i < sections.size(); ++i) {
+        if (const auto& file = sections[i].spilled) {
             std::vector<uint8_t> piece;
             for (uint64_t at = 0; at < file->size(); at += kPiece) {
                 file->read(at, size_t(std::min<uint64_t>(kPiece, file->size() - at)), piece);
                 put(std::span<const uint8_t>(piece));
             }
-            section.spilled.reset();
-            continue;
+        } else {
+            put(std::span<const uint8_t>(stored(i)));
         }
-        put(std::span<const uint8_t>(section.data));
-        std::vector<uint8_t>().swap(section.data);
+        if (release) {
+            sections[i].spilled.reset();
+            std::vector<uint8_t>().swap(sections[i].data);
+        }
+        std::vector<uint8_t>().swap(packed[i]);
     }
     return offset;
 }
@@ -340,15 +298,16 @@ uint64_t emitContainer(std::vector<Section>& sections, const ContainerOptions& o
 } // namespace
 
 std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const ContainerOptions& options) {
-    std::vector<Section> copy = sections;
     std::vector<uint8_t> out;
-    emitContainer(copy, options, [&](std::span<const uint8_t> bytes) { out.insert(out.end(), bytes.begin(), bytes.end()); });
+    // Not released, so the sections stay as they are.
+    emitContainer(const_cast<std::vector<Section>&>(sections), false, options,
+                  [&](std::span<const uint8_t> bytes) { out.insert(out.end(), bytes.begin(), bytes.end()); });
     return out;
 }
 
 uint64_t writeContainerTo(std::vector<Section>&& sections, std::ostream& out, const ContainerOptions& options) {
     std::vector<Section> owned = std::move(sections);
-    return emitContainer(owned, options, [&](std::span<const uint8_t> bytes) {
+    return emitContainer(owned, true, options, [&](std::span<const uint8_t> bytes) {
         out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
         if (!out) throw Error("writing the .ssvdag file failed");
     });

@@ -53,7 +53,7 @@ struct Section {
     // For the writer only: a precompressed payload too large to hold (the
     // value windows of a grid encoded in bounded memory) is this whole
     // scratch file instead of `data`, copied into the file as it is.
-    std::shared_ptr<const ScratchFile> spilled;
+    std::shared_ptr<const ScratchFile> spilled = nullptr;
 };
 
 // What a reader learns about a section without decoding it (for `info`).

@@ -69,21 +69,19 @@ constexpr LayerKinds kInactive{SectionKind::InactiveLevels, SectionKind::Inactiv
 
 // `take`: move (or release) the layer's payloads out of the scene instead of copying them.
 template <typename T>
-std::vector<T> takeOrCopy(const std::vector<T>& v, bool take) {
+std::vector<T> takeOrCopy(std::vector<T>& v, bool take) {
     if (!take) return v;
-    std::vector<T> out = std::move(const_cast<std::vector<T>&>(v));
-    const_cast<std::vector<T>&>(v) = {};
+    std::vector<T> out;
+    out.swap(v);
     return out;
 }
 template <typename T>
-void releaseIf(const std::vector<T>& v, bool take) {
-    if (take) std::vector<T>().swap(const_cast<std::vector<T>&>(v));
+void releaseIf(std::vector<T>& v, bool take) {
+    if (take) std::vector<T>().swap(v);
 }
 
-void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, const encoding::CompactDag& dag,
-              const attributes::PaletteChannel& channel, const attributes::ValueWindowsPayload& windows, const std::vector<uint8_t>& predicted,
-              unsigned valueSize,
-              bool take) {
+void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, encoding::CompactDag& dag, const attributes::PaletteChannel& channel,
+              attributes::ValueWindowsPayload& windows, std::vector<uint8_t>& predicted, unsigned valueSize, bool take) {
     ByteWriter levels;
     for (int64_t o : dag.origin) levels.put<int64_t>(o);
     levels.put<uint8_t>(dag.log2Size);
@@ -100,7 +98,7 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
         if (!dag.leaves.empty()) sections.push_back({kinds.leaves, g, rawBytes(dag.leaves)});
         releaseIf(dag.leaves, take);
         if (valueSize && !predicted.empty()) sections.push_back({kinds.predicted, g, takeOrCopy(predicted, take)});
-        else if (valueSize && windows.file) sections.push_back({kinds.windows, g, {}, windows.file});
+        else if (valueSize && windows.file) sections.push_back({kinds.windows, g, {}, take ? std::move(windows.file) : windows.file});
         else if (valueSize && !windows.empty()) sections.push_back({kinds.windows, g, takeOrCopy(windows.bytes, take)});
         else if (valueSize) sections.push_back({kinds.values, g, attributes::serializePalette(channel)});
     }
@@ -120,8 +118,8 @@ attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactiv
 namespace {
 
 // With `take`, the scene's DAGs, value payloads and descriptors move into the
-// sections (the headers and reports stay).
-std::vector<Section> toSections(const SsvdagScene& scene, bool take) {
+// sections (the headers and reports stay); without it the scene is only read.
+std::vector<Section> toSections(SsvdagScene& scene, bool take) {
     std::vector<Section> sections;
     {
         ByteWriter w;
@@ -131,7 +129,7 @@ std::vector<Section> toSections(const SsvdagScene& scene, bool take) {
     }
     if (!scene.fileMetadata.empty()) sections.push_back({SectionKind::FileMetadata, 0, scene.fileMetadata});
     for (uint32_t g = 0; g < scene.grids.size(); ++g) {
-        const EncodedGrid& grid = scene.grids[g];
+        EncodedGrid& grid = scene.grids[g];
         ByteWriter info;
         info.putString(grid.record.name);
         info.putString(grid.record.gridClass);
@@ -186,7 +184,7 @@ std::vector<Section> toSections(const SsvdagScene& scene, bool take) {
 
 } // namespace
 
-std::vector<Section> sceneToSections(const SsvdagScene& scene) { return toSections(scene, false); }
+std::vector<Section> sceneToSections(const SsvdagScene& scene) { return toSections(const_cast<SsvdagScene&>(scene), false); }  // read only
 
 uint64_t writeSceneReleasing(SsvdagScene& scene, std::ostream& out, const ContainerOptions& options) {
     return writeContainerTo(toSections(scene, true), out, options);

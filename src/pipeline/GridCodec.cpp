@@ -4,15 +4,13 @@
 
 #include <algorithm>
 #include <cstring>
-#include <new>
 
-#include <zstd.h>
-#include <zstd_errors.h>
 
 #include "src/attributes/PredictedChannel.h"
 #include "src/attributes/ValueWindows.h"
 #include "src/dag/DagBuilder.h"
 #include "src/encoding/AttributeLayout.h"
+#include "src/format/ZstdFrame.h"
 #include "src/pipeline/AttributeOrder.h"
 #include "src/pipeline/GridCodecParts.h"
 
@@ -62,40 +60,14 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const dag::ActiveBounds&
 
 namespace {
 
-// Bytes after a fast zstd pass: the yardstick for choosing a channel coding
-// (the container compresses harder, by about the same factor for both).
-// Streams through a 1 MiB buffer that is overwritten, so it costs no memory.
-size_t zstdEstimate(const std::vector<uint8_t>& bytes) {
-    // A failed allocation is out of memory, never a different estimate (the
-    // bytes written must not depend on how much memory is left).
-    ZSTD_CCtx* cctx = ZSTD_createCCtx();
-    if (!cctx) throw std::bad_alloc();
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, 1);
-    std::vector<uint8_t> buffer(1u << 20);
-    ZSTD_inBuffer in{bytes.data(), bytes.size(), 0};
-    size_t total = 0;
-    for (;;) {
-        ZSTD_outBuffer out{buffer.data(), buffer.size(), 0};
-        const size_t left = ZSTD_compressStream2(cctx, &out, &in, ZSTD_e_end);
-        if (ZSTD_isError(left)) {
-            ZSTD_freeCCtx(cctx);
-            if (ZSTD_getErrorCode(left) == ZSTD_error_memory_allocation) throw std::bad_alloc();
-            return bytes.size();
-        }
-        total += out.pos;
-        if (left == 0) break;
-    }
-    ZSTD_freeCCtx(cctx);
-    return total;
-}
-
 // The predicted coding of an integer channel if it beats its palettes at
 // rest, else empty.
 std::vector<uint8_t> predictedIfSmaller(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, uint64_t paletteEstimate,
                                         ValueType type, const EncodeOptions& options) {
     if (!options.predictIntegers || (type != ValueType::Int32 && type != ValueType::Int64) || attributes.empty()) return {};
     std::vector<uint8_t> predicted = attributes::encodePredicted(attributes, valueSize(type), encoding::attributeLayout(dag));
-    const size_t predictedBytes = zstdEstimate(predicted);
+    // A fast zstd pass is the yardstick (the container compresses harder, by about the same factor for both).
+    const uint64_t predictedBytes = format::zstdFastSize(predicted);
     if (predictedBytes < paletteEstimate) return predicted;
     return {};
 }
@@ -236,9 +208,8 @@ namespace {
 // `store` holds decoded values when they had to be decoded.
 const std::vector<uint8_t>& attributesOf(const format::EncodedGrid& grid, bool inactive, std::vector<uint8_t>& store) {
     const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
-    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
-    if (!attributes.empty() || windows.empty()) return attributes;
-    store = attributes::decodeValueWindows(windows.load(), "grid '" + grid.record.name + "' value windows").decodeAll();
+    if (!attributes.empty() || (inactive ? grid.inactiveValueWindows : grid.valueWindows).empty()) return attributes;
+    store = format::traceableValues(grid, inactive).decodeAll();
     return store;
 }
 

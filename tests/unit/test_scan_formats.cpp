@@ -106,6 +106,17 @@ void expectOneLineError(const CommandResult& r, const std::string& mustName, con
     EXPECT_NE(r.err.find(mustName), std::string::npos) << what << ": " << r.err;
 }
 
+// Runs a nibabel script in a fresh folder `dir` (the script sees it as `d`);
+// false, with the error reported, when the script fails.
+bool runNibabel(const fs::path& dir, const std::string& body) {
+    fs::create_directories(dir);
+    const fs::path script = dir / "make.py";
+    std::ofstream(script) << "import nibabel as nib, numpy as np, sys\nd = sys.argv[1]\n" << body;
+    const CommandResult made = runShell(kPython + " " + script.string() + " " + dir.string());
+    EXPECT_EQ(made.exitCode, 0) << made.err;
+    return made.exitCode == 0;
+}
+
 fs::path niftiDir() { return fs::path(VDBDAG_SHARED_DATA) / "medical" / "nifti"; }
 fs::path denseDir() { return fs::path(VDBDAG_SHARED_DATA) / "dense"; }
 
@@ -232,11 +243,7 @@ TEST(ScanFormats, EveryDenseScanComesBackInEveryFormat) {
 TEST(ScanFormats, SyntheticNiftiFilesFromNibabel) {
     if (!haveNibabel()) GTEST_SKIP() << "needs python3-nibabel";
     const fs::path dir = workDir() / "synthetic";
-    fs::create_directories(dir);
-    const fs::path script = dir / "make.py";
-    std::ofstream(script) << R"(import nibabel as nib, numpy as np, sys
-d = sys.argv[1]
-rng = np.random.default_rng(7)
+    ASSERT_TRUE(runNibabel(dir, R"(rng = np.random.default_rng(7)
 aff = np.array([[0.0, -1.2, 0.1, 30.0], [0.9, 0.0, 0.0, -12.5], [0.0, 0.05, 2.5, 7.0], [0, 0, 0, 1]])
 def save(img, name, slope=None, inter=None):
     if slope is not None: img.header.set_slope_inter(slope, inter)
@@ -255,9 +262,7 @@ p = rng.integers(0, 255, size=(9, 4, 5)).astype(np.uint8)
 save(nib.Nifti1Pair(p, aff), 'pair.img')
 flat = rng.integers(0, 255, size=(11, 13)).astype(np.uint8)
 save(nib.Nifti1Image(flat, aff), 'flat.nii')
-)";
-    const CommandResult made = runShell(kPython + " " + script.string() + " " + dir.string());
-    ASSERT_EQ(made.exitCode, 0) << made.err;
+)"));
     struct Case {
         std::string file;
         bool intGrid;
@@ -447,11 +452,7 @@ TEST(ScanFormats, BackgroundValueComesBackAndPsnrStatesItsPeak) {
 TEST(ScanFormats, ColourAndVectorScansRoundTrip) {
     if (!haveNibabel()) GTEST_SKIP() << "needs python3-nibabel";
     const fs::path dir = workDir() / "vectors";
-    fs::create_directories(dir);
-    const fs::path script = dir / "make.py";
-    std::ofstream(script) << R"(import nibabel as nib, numpy as np, sys
-d = sys.argv[1]
-rng = np.random.default_rng(11)
+    ASSERT_TRUE(runNibabel(dir, R"(rng = np.random.default_rng(11)
 aff = np.array([[1.5, 0.0, 0.0, -4.0], [0.0, 0.75, 0.0, 2.0], [0.0, 0.0, 2.0, 9.0], [0, 0, 0, 1]])
 a = rng.integers(0, 256, size=(7, 6, 5, 3)).astype(np.uint8)
 rgb = np.zeros((7, 6, 5), dtype=[('R', 'u1'), ('G', 'u1'), ('B', 'u1')])
@@ -461,9 +462,7 @@ vec = rng.normal(size=(6, 4, 5, 1, 3)).astype(np.float32)
 img = nib.Nifti1Image(vec, aff)
 img.header.set_intent('vector')
 nib.save(img, d + '/vec.nii.gz')
-)";
-    const CommandResult made = runShell(kPython + " " + script.string() + " " + dir.string());
-    ASSERT_EQ(made.exitCode, 0) << made.err;
+)"));
     openvdb::initialize();
     for (const std::string name : {"rgb", "vec"}) {
         const fs::path in = dir / (name + ".nii.gz"), ss = dir / (name + ".ssvdag"), vdb = dir / (name + ".vdb");
@@ -546,20 +545,14 @@ TEST(ScanFormats, DiffOfAThresholdedScanEqualsTheEncodeReport) {
 TEST(ScanFormats, RgbaNiftiIsAColourAndAnAlphaGrid) {
     if (!haveNibabel()) GTEST_SKIP() << "needs python3-nibabel";
     const fs::path dir = workDir() / "rgba";
-    fs::create_directories(dir);
-    const fs::path script = dir / "make.py";
-    std::ofstream(script) << R"(import nibabel as nib, numpy as np, sys
-d = sys.argv[1]
-rng = np.random.default_rng(12)
+    ASSERT_TRUE(runNibabel(dir, R"(rng = np.random.default_rng(12)
 a = rng.integers(0, 256, size=(5, 7, 4, 4)).astype(np.uint8)
 rgba = np.zeros((5, 7, 4), dtype=[('R', 'u1'), ('G', 'u1'), ('B', 'u1'), ('A', 'u1')])
 for i, c in enumerate('RGBA'): rgba[c] = a[..., i]
 nib.save(nib.Nifti1Image(rgba, np.diag([2.0, 1.0, 0.5, 1.0])), d + '/rgba.nii.gz')
 np.ascontiguousarray(np.transpose(a, (2, 1, 0, 3))).tofile(d + '/rgba.expected')
 np.ascontiguousarray(np.transpose(a[..., 3], (2, 1, 0))).tofile(d + '/alpha.expected')
-)";
-    const CommandResult made = runShell(kPython + " " + script.string() + " " + dir.string());
-    ASSERT_EQ(made.exitCode, 0) << made.err;
+)"));
     const std::string expected = readAll(dir / "rgba.expected");
     ASSERT_EQ(expected.size(), size_t(5 * 7 * 4 * 4));
     const fs::path in = dir / "rgba.nii.gz", ss = dir / "rgba.ssvdag", vdb = dir / "rgba.vdb";
