@@ -8,6 +8,7 @@
 #include "cli/Commands.h"
 #include "cli/RunContext.h"
 #include "src/pipeline/GridCodec.h"
+#include "src/pipeline/LayerScatter.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
@@ -18,19 +19,47 @@ namespace vdbdag::cli {
 namespace {
 
 // The grid a dense output takes: the one named, or the file's only grid.
-const GridRecord& denseGridOf(const Volume& volume, const std::string& input, const std::string& name) {
+template <typename Grid, typename NameOf>
+const Grid& denseGridOf(const std::vector<Grid>& grids, const std::string& input, const std::string& name, NameOf nameOf) {
     if (!name.empty()) {
-        for (const GridRecord& g : volume.grids)
-            if (g.name == name) return g;
+        for (const Grid& g : grids)
+            if (nameOf(g) == name) return g;
         throw Error(input + ": has no grid named '" + name + "'");
     }
-    if (volume.grids.size() != 1) {
+    if (grids.size() != 1) {
         std::string names;
-        for (const GridRecord& g : volume.grids) names += (names.empty() ? "'" : ", '") + g.name + "'";
-        throw Error(input + ": holds " + std::to_string(volume.grids.size()) + " grids (" + names +
-                    "); a scan file holds one: pick it with --grid NAME");
+        for (const Grid& g : grids) names += (names.empty() ? "'" : ", '") + nameOf(g) + "'";
+        throw Error(input + ": holds " + std::to_string(grids.size()) + " grids (" + names + "); a scan file holds one: pick it with --grid NAME");
     }
-    return volume.grids.front();
+    return grids.front();
+}
+
+// A dense output straight from the DAG, cube by cube, the values decoded a
+// window at a time: never the whole grid in memory. False when the output
+// or the grid needs the whole grid (exportsByCubes).
+bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& input, const std::string& output, const std::string& gridName) {
+    const format::EncodedGrid& grid = denseGridOf(scene.grids, input, gridName, [](const format::EncodedGrid& g) { return g.record.name; });
+    if (!bridge::exportsByCubes(grid.record, output)) return false;
+    constexpr unsigned kCubeLog2 = 7;
+    const encoding::CompactDag& active = grid.dag;
+    const uint64_t total = (grid.inactiveDag.empty() ? 0 : 1) + (active.empty() ? 0 : 1);
+    Progress progress("decode " + std::filesystem::path(output).filename().string(), 1000 * std::max<uint64_t>(total, 1));
+    bridge::exportDenseByCubes(grid.record, output, [&](bridge::DenseCubeSink& sink) {
+        uint64_t layer = 0;
+        for (const bool inactive : {true, false}) {  // inactive first: active voxels win
+            if ((inactive ? grid.inactiveDag : active).empty()) continue;
+            pipeline::LayerCubes visit;
+            visit.begin = [&](const encoding::SubtreeInstance& s) { sink.beginCube(s.x, s.y, s.z, s.solid ? 2 : s.log2Size); };
+            visit.voxels.brick = [&](int64_t x, int64_t y, int64_t z, uint64_t mask, const uint8_t* values) { sink.brick(x, y, z, mask, values); };
+            visit.voxels.solid = [&](int64_t x, int64_t y, int64_t z, unsigned log2, const uint8_t* value) { sink.solid(x, y, z, log2, value); };
+            visit.end = [&] { sink.endCube(); };
+            pipeline::scatterLayerByCubes(grid, inactive, kCubeLog2, visit,
+                                          [&](uint64_t done, uint64_t all) { progress.set(layer * 1000 + done * 1000 / std::max<uint64_t>(all, 1)); });
+            ++layer;
+        }
+    });
+    progress.finish();
+    return true;
 }
 
 } // namespace
@@ -60,14 +89,19 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
                             {opt->input}, rules);
         format::ReadOptions readOptions;
         readOptions.rebuildPalettes = false;  // only the values are needed
+        readOptions.keepValueWindows = dense;  // a scan is written window by window when it can be
         Volume volume;
         {
             const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);
+            if (dense && decodeDenseByCubes(scene, opt->input, opt->output, opt->grid)) {
+                exitCode = 0;
+                return;
+            }
             Progress progress("decode", scene.grids.size());
             volume = pipeline::decodeScene(scene, [&](size_t i, size_t) { progress.set(i); });
             progress.finish();
         }  // the scene is released before the output is built
-        if (dense) bridge::exportDense(denseGridOf(volume, opt->input, opt->grid), opt->output);
+        if (dense) bridge::exportDense(denseGridOf(volume.grids, opt->input, opt->grid, [](const GridRecord& g) { return g.name; }), opt->output);
         else bridge::exportVdb(volume, opt->output);
         exitCode = 0;
     });

@@ -81,7 +81,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--normal-grid", opt->normalGrid, "take the normals from this vec3 grid (stored on its geometry) instead of a gradient")->needs(normals);
     cmd->add_option("--memory-limit", opt->memoryLimit,
                     "working memory for the cubes being encoded, e.g. 512M or 4G (default: half the physical memory); "
-                    "a .vdb is read region by region (a dense scan is read whole); the output is the same bytes")
+                    "a .vdb is read region by region, a scan's samples go to a scratch file; the output is the same bytes")
         ->transform(CLI::AsSizeValue(false))
         ->excludes(normals);
     cmd->add_option("--scratch", opt->scratch, "folder for the scratch files of a region-by-region encode: the input's bricks and the coded values (default: the output's folder)")
@@ -106,13 +106,25 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".ssvdag"}, "encode", opt->force});
         bridge::ImportResult imported;
         std::optional<bridge::VdbCubeInput> cubeInput;  // --memory-limit on a .vdb: read region by region
+        std::vector<std::unique_ptr<CubeSource>> denseCubes;  // ... on a scalar scan: its samples in a scratch file
         bridge::ThresholdReport threshold;
         if (dense) {
             if (!opt->grids.empty()) throw Error(opt->input + ": --grid applies to .vdb inputs only (a dense scan has one grid)");
-            bridge::DenseImportResult dense = bridge::importDense(opt->input, opt->dense.resolve(opt->input));
+            bridge::DenseImportOptions denseOptions = opt->dense.resolve(opt->input);
+            // Cube by cube, its samples in a scratch file, with
+            // --memory-limit, under mpirun, or when the grid would not fit
+            // in memory (about 12 bytes per sample in all, against the
+            // default limit); the same bytes either way.
+            if (!opt->topologyOnly) {
+                if (opt->memoryLimit || cubeTeam().size() > 1 || bridge::describeDense(opt->input, denseOptions).sampleCount() > defaultMemoryLimit() / 12)
+                    denseOptions.cubesNear = opt->scratch.empty() ? opt->output
+                                                                  : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
+            }
+            bridge::DenseImportResult dense = bridge::importDense(opt->input, denseOptions);
             threshold = dense.threshold;
             imported.warnings = dense.source.notes;
             imported.volume = std::move(dense.volume);
+            denseCubes = std::move(dense.cubes);
             if (opt->topologyOnly)
                 for (GridRecord& g : imported.volume.grids) {
                     g.valueType = ValueType::Mask;
@@ -182,17 +194,19 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         format::SsvdagScene scene;
         const auto onGrid = [&](size_t i, size_t) { gridName = gridNames[i]; };
         try {
-            // A dense scan or an OpenVDB stream is already whole in memory:
-            // encoding it in memory costs least (the same bytes), except
-            // under mpirun, where the processes share its cubes.
-            if (cubeInput || team.size() > 1) {
+            // A grid read whole (a small scan, an OpenVDB stream) is encoded
+            // in memory, which costs least (the same bytes), except under
+            // mpirun, where the processes share its cubes.
+            if (cubeInput || !denseCubes.empty() || team.size() > 1) {
                 pipeline::CubeBudget budget;
                 budget.bytes = std::max<uint64_t>((opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()) / 2, 1);
                 // The coded values wait in a scratch file, not in memory, until the file is written.
                 budget.spillNear =
                     opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
                 std::vector<std::unique_ptr<CubeSource>> sources;
-                if (cubeInput) {
+                if (!denseCubes.empty()) {
+                    sources = std::move(denseCubes);
+                } else if (cubeInput) {
                     sources = std::move(cubeInput->grids);
                     imported.volume.fileMetadata = cubeInput->fileMetadata;
                 } else {

@@ -14,6 +14,9 @@
 #include <optional>
 #include <ostream>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <fmt/core.h>
 #include <nifti2_io.h>
 #include <openvdb/openvdb.h>
@@ -606,6 +609,224 @@ DenseExportReport exportDense(const GridRecord& grid, const std::string& path, b
                 throw;
             }
             break;
+        }
+    }
+    return report;
+}
+
+// ---- cube by cube -----------------------------------------------------------
+
+namespace {
+
+// The samples of a raw-encoded output, written by offset: the whole data
+// region first set to the background sample (a sparse file of zeros when it
+// is 0), then each cube's runs of decoded voxels, and each solid node's rows.
+template <typename V, typename S>
+class CubeWriter final : public DenseCubeSink {
+public:
+    CubeWriter(int fd, uint64_t dataOffset, const Layout& l, const GridRecord& header, const std::string& path)
+        : fd_(fd), dataOffset_(dataOffset), l_(l), conv_{l_}, path_(path), mask_(header.valueType == ValueType::Mask) {
+        V backgroundValue{};
+        if (header.background.size() >= sizeof(V)) std::memcpy(&backgroundValue, header.background.data(), sizeof(V));
+        background_ = conv_.nearest(backgroundValue);
+        const uint64_t bytes = uint64_t(l.dims[0]) * uint64_t(l.dims[1]) * uint64_t(l.dims[2]) * sizeof(S);
+        if (::ftruncate(fd_, off_t(dataOffset_ + bytes)) != 0) fail("cannot size the output");
+        S zero{};
+        if (std::memcmp(&zero, &background_, sizeof(S)) != 0) {
+            std::vector<S> chunk(size_t(1) << 20, background_);
+            for (uint64_t at = 0; at < bytes; at += chunk.size() * sizeof(S))
+                writeAt(dataOffset_ + at, chunk.data(), size_t(std::min<uint64_t>(chunk.size() * sizeof(S), bytes - at)));
+        }
+    }
+
+    void beginCube(int64_t x, int64_t y, int64_t z, unsigned log2) override {
+        const int64_t c[3] = {x, y, z}, size = int64_t(1) << log2;
+        for (int a = 0; a < 3; ++a) {  // the cube's samples inside the extent
+            lo_[a] = std::clamp<int64_t>(c[a] - l_.lo[size_t(a)], 0, l_.dims[size_t(a)]);
+            hi_[a] = std::clamp<int64_t>(c[a] - l_.lo[size_t(a)] + size, 0, l_.dims[size_t(a)]);
+        }
+        const size_t n = size_t(std::max<int64_t>(0, hi_[0] - lo_[0]) * std::max<int64_t>(0, hi_[1] - lo_[1]) * std::max<int64_t>(0, hi_[2] - lo_[2]));
+        cube_.resize(n);
+        set_.assign((n + 63) / 64, 0);
+    }
+
+    void brick(int64_t x, int64_t y, int64_t z, uint64_t mask, const uint8_t* values) override {
+        unsigned k = 0;
+        for (uint64_t m = mask; m; m &= m - 1, ++k) {
+            const int bit = std::countr_zero(m);
+            const int64_t sx = x + (bit & 3) - l_.lo[0], sy = y + ((bit >> 2) & 3) - l_.lo[1], sz = z + (bit >> 4) - l_.lo[2];
+            if (sx < lo_[0] || sx >= hi_[0] || sy < lo_[1] || sy >= hi_[1] || sz < lo_[2] || sz >= hi_[2]) outside(sx, sy, sz);
+            const size_t i = size_t(((sz - lo_[2]) * (hi_[1] - lo_[1]) + (sy - lo_[1])) * (hi_[0] - lo_[0]) + (sx - lo_[0]));
+            cube_[i] = sample(values, k, sx, sy, sz);
+            set_[i / 64] |= uint64_t(1) << (i % 64);
+        }
+    }
+
+    void solid(int64_t x, int64_t y, int64_t z, unsigned log2, const uint8_t* value) override {
+        const int64_t size = int64_t(1) << log2;
+        int64_t a[3], b[3];
+        const int64_t c[3] = {x, y, z};
+        for (int k = 0; k < 3; ++k) {
+            a[k] = c[k] - l_.lo[size_t(k)];
+            b[k] = a[k] + size;
+            if (a[k] < 0 || b[k] > l_.dims[size_t(k)]) outside(a[0], a[1], a[2]);
+        }
+        const S s = sample(value, 0, a[0], a[1], a[2]);
+        const std::vector<S> row(size_t(size), s);
+        for (int64_t zz = a[2]; zz < b[2]; ++zz)
+            for (int64_t yy = a[1]; yy < b[1]; ++yy) writeAt(offsetOf(a[0], yy, zz), row.data(), size_t(size) * sizeof(S));
+    }
+
+    void endCube() override {
+        const int64_t rx = hi_[0] - lo_[0], ry = hi_[1] - lo_[1];
+        for (int64_t z = lo_[2]; z < hi_[2]; ++z)
+            for (int64_t y = lo_[1]; y < hi_[1]; ++y) {
+                const size_t row = size_t(((z - lo_[2]) * ry + (y - lo_[1])) * rx);
+                for (int64_t x = 0; x < rx;) {  // runs of decoded voxels
+                    auto isSet = [&](int64_t i) { return (set_[(row + size_t(i)) / 64] >> ((row + size_t(i)) % 64)) & 1u; };
+                    if (!isSet(x)) { ++x; continue; }
+                    int64_t end = x + 1;
+                    while (end < rx && isSet(end)) ++end;
+                    writeAt(offsetOf(lo_[0] + x, y, z), cube_.data() + row + size_t(x), size_t(end - x) * sizeof(S));
+                    x = end;
+                }
+            }
+    }
+
+private:
+    S sample(const uint8_t* values, unsigned k, int64_t x, int64_t y, int64_t z) const {
+        V v;
+        if (mask_) v = V(1);
+        else std::memcpy(&v, values + size_t(k) * sizeof(V), sizeof(V));
+        S out;
+        if (!conv_.exact(v, out))
+            throw Error(path_ + ": the sample at (" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) + ") is not a " +
+                        sampleTypeName(l_.type) + " sample" + (l_.rescaled ? " under the recorded rescale" : "") +
+                        ": the grid was changed after import; write it as .vdb, or as a float scan");
+        return out;
+    }
+    [[noreturn]] void outside(int64_t x, int64_t y, int64_t z) const {
+        throw Error(path_ + ": a voxel at sample (" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) +
+                    ") lies outside the recorded extent " + fmt::format("{}x{}x{}", l_.dims[0], l_.dims[1], l_.dims[2]));
+    }
+    uint64_t offsetOf(int64_t x, int64_t y, int64_t z) const {
+        return dataOffset_ + ((uint64_t(z) * uint64_t(l_.dims[1]) + uint64_t(y)) * uint64_t(l_.dims[0]) + uint64_t(x)) * sizeof(S);
+    }
+    void writeAt(uint64_t offset, const void* data, size_t n) {
+        const auto* p = static_cast<const uint8_t*>(data);
+        for (size_t done = 0; done < n;) {
+            const ssize_t w = ::pwrite(fd_, p + done, n - done, off_t(offset + done));
+            if (w < 0 && errno == EINTR) continue;
+            if (w <= 0) fail("cannot write");
+            done += size_t(w);
+        }
+    }
+    [[noreturn]] void fail(const std::string& what) const {
+        throw Error(path_ + ": " + what + " (" + std::strerror(errno) + ")");
+    }
+
+    int fd_;
+    uint64_t dataOffset_;
+    const Layout& l_;
+    ToSample<V, S> conv_;
+    std::string path_;
+    bool mask_;
+    S background_{};
+    int64_t lo_[3]{0, 0, 0}, hi_[3]{0, 0, 0};
+    std::vector<S> cube_;
+    std::vector<uint64_t> set_;
+};
+
+template <typename V>
+std::unique_ptr<DenseCubeSink> cubeWriterFor(int fd, uint64_t offset, const Layout& l, const GridRecord& h, const std::string& path) {
+    switch (l.type) {
+        case SampleType::U8: return std::make_unique<CubeWriter<V, uint8_t>>(fd, offset, l, h, path);
+        case SampleType::I8: return std::make_unique<CubeWriter<V, int8_t>>(fd, offset, l, h, path);
+        case SampleType::U16: return std::make_unique<CubeWriter<V, uint16_t>>(fd, offset, l, h, path);
+        case SampleType::I16: return std::make_unique<CubeWriter<V, int16_t>>(fd, offset, l, h, path);
+        case SampleType::U32: return std::make_unique<CubeWriter<V, uint32_t>>(fd, offset, l, h, path);
+        case SampleType::I32: return std::make_unique<CubeWriter<V, int32_t>>(fd, offset, l, h, path);
+        case SampleType::F32: return std::make_unique<CubeWriter<V, float>>(fd, offset, l, h, path);
+        case SampleType::F64: return std::make_unique<CubeWriter<V, double>>(fd, offset, l, h, path);
+    }
+    throw Error(path + ": unsupported sample type");
+}
+
+bool hasSourceDims(const GridRecord& header) {
+    const openvdb::GridBase::Ptr g = detail::readDescriptor(header.vdbDescriptor, "grid '" + header.name + "'");
+    return bool(g->getMetadata<openvdb::Vec3IMetadata>("source_dims"));
+}
+
+} // namespace
+
+bool exportsByCubes(const GridRecord& header, const std::string& path) {
+    const std::optional<OutFormat> format = outFormatOf(path);
+    if (!format || *format == OutFormat::NiiGz) return false;  // a gzip stream is written in order
+    switch (header.valueType) {
+        case ValueType::Int32:
+        case ValueType::Int64:
+        case ValueType::Float:
+        case ValueType::Double:
+        case ValueType::Mask: break;
+        default: return false;
+    }
+    return hasSourceDims(header);  // the extent, without walking the voxels
+}
+
+DenseExportReport exportDenseByCubes(const GridRecord& header, const std::string& path, const std::function<void(DenseCubeSink&)>& produce) {
+    if (!exportsByCubes(header, path)) throw Error("internal error: " + path + " cannot be written cube by cube");
+    const OutFormat format = *outFormatOf(path);
+    const Layout l = layoutOf(header, path);
+    DenseExportReport report;
+    report.dims = l.dims;
+    report.type = l.type;
+    report.dataPath = path;
+    const bool detached = format == OutFormat::Nhdr || format == OutFormat::Mhd;
+    std::string dataName;
+    if (detached) {
+        dataName = std::filesystem::path(path).stem().string() + ".raw";
+        report.dataPath = (std::filesystem::path(path).parent_path() / dataName).string();
+    }
+    std::vector<uint8_t> head;  // what precedes the samples in the data file
+    if (format == OutFormat::Nrrd || format == OutFormat::Mha) {
+        const std::string h = format == OutFormat::Nrrd ? nrrdHeader(l, "") : metaImageHeader(l, "");
+        head.assign(h.begin(), h.end());
+    } else if (format == OutFormat::Nii) {
+        head = niftiHeader(l, path);
+    }
+    writeViaTemporary(report.dataPath, [&](const std::string& tmp) {
+        const int fd = ::open(tmp.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd < 0) throw Error(path + ": cannot create " + tmp + " (" + std::strerror(errno) + ")");
+        try {
+            for (size_t done = 0; done < head.size();) {
+                const ssize_t w = ::pwrite(fd, head.data() + done, head.size() - done, off_t(done));
+                if (w < 0 && errno == EINTR) continue;
+                if (w <= 0) throw Error(path + ": cannot write (" + std::strerror(errno) + ")");
+                done += size_t(w);
+            }
+            std::unique_ptr<DenseCubeSink> sink;
+            switch (header.valueType) {
+                case ValueType::Int32: sink = cubeWriterFor<int32_t>(fd, head.size(), l, header, path); break;
+                case ValueType::Int64: sink = cubeWriterFor<int64_t>(fd, head.size(), l, header, path); break;
+                case ValueType::Float: sink = cubeWriterFor<float>(fd, head.size(), l, header, path); break;
+                case ValueType::Double: sink = cubeWriterFor<double>(fd, head.size(), l, header, path); break;
+                default: sink = cubeWriterFor<uint8_t>(fd, head.size(), l, header, path); break;  // mask: 0 / 1
+            }
+            produce(*sink);
+        } catch (...) {
+            ::close(fd);
+            throw;
+        }
+        if (::close(fd) != 0) throw Error(path + ": cannot write (" + std::strerror(errno) + ")");
+    });
+    if (detached) {
+        try {
+            const std::string h = format == OutFormat::Nhdr ? nrrdHeader(l, dataName) : metaImageHeader(l, dataName);
+            writeFileAtomically(path, {reinterpret_cast<const uint8_t*>(h.data()), h.size()});
+        } catch (...) {
+            std::error_code ec;
+            std::filesystem::remove(report.dataPath, ec);
+            throw;
         }
     }
     return report;

@@ -14,6 +14,7 @@
 // slab (4 z-slices of memory beside the grid), atomically.
 #pragma once
 #include <array>
+#include <functional>
 #include <string>
 
 #include "src/volume/GridRecord.h"
@@ -33,5 +34,29 @@ struct DenseExportReport {
 // Throws vdbdag::Error naming `path` (or the grid) when the grid cannot be
 // written as that format; nothing is left behind then.
 DenseExportReport exportDense(const GridRecord& grid, const std::string& path, bool showProgress = true);
+
+// Cube by cube, for a grid that does not fit in memory (decode from a DAG
+// layer by layer, pipeline/LayerScatter.h): the voxels come in any order,
+// a cube at a time, and are written at their offsets in the data file.
+class DenseCubeSink {
+public:
+    virtual ~DenseCubeSink() = default;
+    // A cube of 2^log2 voxels (index coordinates), then its bricks.
+    virtual void beginCube(int64_t x, int64_t y, int64_t z, unsigned log2) = 0;
+    // A brick inside the cube: its spatial mask and values (increasing
+    // bit order; none for a mask grid, whose voxels are 1).
+    virtual void brick(int64_t x, int64_t y, int64_t z, uint64_t mask, const uint8_t* values) = 0;
+    // A solid node (anywhere): every voxel is `value`.
+    virtual void solid(int64_t x, int64_t y, int64_t z, unsigned log2, const uint8_t* value) = 0;
+    virtual void endCube() = 0;
+};
+// Whether `path` can be written this way for `header` (no voxels needed):
+// a raw-encoded format (.nrrd, .nhdr, .mha, .mhd, .nii, .raw; not .nii.gz),
+// a scalar int32/int64/float/double or mask grid, and the grid's recorded
+// extent (source_dims, which DenseImport writes).
+bool exportsByCubes(const GridRecord& header, const std::string& path);
+// The same file as exportDense, atomically: `produce` hands every voxel to
+// the sink; voxels it never gives are the background.
+DenseExportReport exportDenseByCubes(const GridRecord& header, const std::string& path, const std::function<void(DenseCubeSink&)>& produce);
 
 } // namespace vdbdag::bridge

@@ -19,6 +19,7 @@
 #include "vdb_bridge/MetaImageHeader.h"
 #include "vdb_bridge/NiftiHeader.h"
 #include "vdb_bridge/NrrdHeader.h"
+#include "vdb_bridge/detail/DenseBricks.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 
 namespace vdbdag::bridge {
@@ -26,31 +27,8 @@ namespace {
 
 constexpr int64_t kSlab = 4;
 
-struct Thresholds {
-    bool below = false, above = false;
-    double belowValue = 0, aboveValue = 0;
-    std::optional<double> background;  // --background-value; else the removed samples' mean
-    bool any() const { return below || above; }
-    bool removes(double x) const { return (below && x < belowValue) || (above && x > aboveValue); }
-};
-
-// What one pass accumulates (per brick row, then reduced in row order).
-struct PassStats {
-    uint64_t removed = 0, changed = 0;
-    double removedSum = 0;
-    double min = std::numeric_limits<double>::infinity(), max = -std::numeric_limits<double>::infinity();
-    double maxAbs = 0, sumAbs = 0, sumSq = 0;
-    void add(const PassStats& o) {
-        removed += o.removed;
-        changed += o.changed;
-        removedSum += o.removedSum;
-        min = std::min(min, o.min);
-        max = std::max(max, o.max);
-        maxAbs = std::max(maxAbs, o.maxAbs);
-        sumAbs += o.sumAbs;
-        sumSq += o.sumSq;
-    }
-};
+using detail::PassStats;
+using detail::Thresholds;
 
 template <typename S>
 void forEachSlab(const DenseVolume& v, Progress* progress, const std::function<void(int64_t z0, int64_t nz, const S* samples)>& fn) {
@@ -147,20 +125,18 @@ DenseImportResult importVector(const DenseVolume& v, ValueType valueType, bool s
     return result;
 }
 
+// `cubesNear` (a scalar scan read cube by cube, DenseImportOptions): the
+// samples go to a scratch file there and the result's grid is a CubeSource.
 template <typename S, typename V>
-DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueType valueType, bool showProgress) {
+DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueType valueType, bool showProgress, const std::string& cubesNear = "") {
     { openSliceReader(v); }  // the data file's size against the header, before anything is reserved
     // Stored sample -> grid value: the header's rescale (DICOM Rescale
     // Slope/Intercept, NIfTI scl_slope/scl_inter), exact in integers when
     // both are integral (importDense chose V so that the range fits).
-    const auto missing = [&](int64_t z) { return !v.missingSlices.empty() && std::binary_search(v.missingSlices.begin(), v.missingSlices.end(), z); };
+    const detail::SampleRule<S, V> unthresholded(v, th, V(0));
+    const auto missing = [&](int64_t z) { return unthresholded.missing(z); };
     const uint64_t missingSamples = uint64_t(v.missingSlices.size()) * v.sliceSamples();
-    const bool rescaled = v.rescaleSlope != 1 || v.rescaleIntercept != 0;
-    const auto convert = [&](S s) -> V {
-        if (!rescaled) return V(s);
-        if constexpr (std::is_integral_v<V>) return V(int64_t(s) * int64_t(v.rescaleSlope) + int64_t(v.rescaleIntercept));
-        else return V(double(s) * v.rescaleSlope + v.rescaleIntercept);
-    };
+    const auto convert = [&](S s) -> V { return unthresholded.convert(s); };
     const int64_t nx = v.dims[0], ny = v.dims[1];
     const int64_t slabs = (v.dims[2] + kSlab - 1) / kSlab;
     const int64_t rows = (ny + 3) / 4, cols = (nx + 3) / 4;
@@ -199,11 +175,22 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
     }
 
     // Pass 2: bricks and values.
+    const detail::SampleRule<S, V> rule(v, th, background);
+    const bool byCubes = !cubesNear.empty();
+    detail::DenseCubeScratch scratch;
     GridRecord record;
     record.valueType = valueType;
     const uint64_t expectedKept = v.sampleCount() - missingSamples - first.removed;
-    record.values.bricks.reserve(size_t(expectedKept * sizeof(V)));
-    record.topology.bricks.reserve(size_t(uint64_t(slabs) * uint64_t(rows) * uint64_t(cols)));
+    if (byCubes) {
+        scratch.file = std::make_shared<ScratchFile>(cubesNear);
+        scratch.cols = cols;
+        scratch.rows = rows;
+        scratch.slabs = slabs;
+        scratch.nonEmpty.assign(size_t((uint64_t(slabs) * uint64_t(rows) * uint64_t(cols) + 63) / 64), 0);
+    } else {
+        record.values.bricks.reserve(size_t(expectedKept * sizeof(V)));
+        record.topology.bricks.reserve(size_t(uint64_t(slabs) * uint64_t(rows) * uint64_t(cols)));
+    }
     PassStats second;
     struct Row {
         std::vector<Brick> bricks;
@@ -213,37 +200,28 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
     std::vector<Row> rowOut(static_cast<size_t>(rows));
     if (progress) progress->setLabel("import " + name + ": bricks");
     forEachSlab<S>(v, progress.get(), [&](int64_t z0, int64_t nz, const S* s) {
+        if (byCubes) scratch.file->append(s, size_t(uint64_t(nz) * v.sliceSamples() * sizeof(S)));
         tbb::parallel_for(int64_t(0), rows, [&](int64_t by) {
             Row& row = rowOut[size_t(by)];
             row.bricks.clear();
             row.values.clear();
             row.stats = PassStats{};
             for (int64_t bx = 0; bx < cols; ++bx) {
-                uint64_t mask = 0;
-                for (int bit = 0; bit < 64; ++bit) {
-                    const int64_t x = bx * 4 + (bit & 3), y = by * 4 + ((bit >> 2) & 3), z = bit >> 4;
-                    if (x >= nx || y >= ny || z >= nz || missing(z0 + z)) continue;
-                    const V sample = convert(s[(z * ny + y) * nx + x]);
-                    const double d = double(sample);
-                    if (th.any() && th.removes(d)) {
-                        const double change = std::abs(d - double(background));
-                        if (change != 0) ++row.stats.changed;
-                        row.stats.maxAbs = std::max(row.stats.maxAbs, change);
-                        row.stats.sumAbs += change;
-                        row.stats.sumSq += change * change;
-                        continue;
-                    }
-                    mask |= uint64_t(1) << bit;
-                    row.values.push_back(sample);
-                }
+                const uint64_t mask = detail::cutBrick(rule, s + size_t((by * 4) * nx + bx * 4), size_t(nx), size_t(nx * ny), std::min<int64_t>(4, nx - bx * 4),
+                                                       std::min<int64_t>(4, ny - by * 4), nz, z0, row.stats, row.values);
                 if (mask) row.bricks.push_back({int32_t(bx * 4), int32_t(by * 4), int32_t(z0), mask});
             }
+            if (byCubes) row.values.clear();  // read back cube by cube
         });
         for (Row& row : rowOut) {
+            second.add(row.stats);
+            if (byCubes) {
+                for (const Brick& b : row.bricks) scratch.add(b);
+                continue;
+            }
             record.topology.bricks.insert(record.topology.bricks.end(), row.bricks.begin(), row.bricks.end());
             const auto* p = reinterpret_cast<const uint8_t*>(row.values.data());
             record.values.bricks.insert(record.values.bricks.end(), p, p + row.values.size() * sizeof(V));
-            second.add(row.stats);
         }
     });
     if (progress) progress->finish();
@@ -276,6 +254,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
     }
 
     describeGrid<V>(v, background, &th, &r, record);
+    if (byCubes) result.cubes.push_back(detail::makeDenseCubes<S, V>(v, rule, std::move(scratch), record));
     result.volume.grids.push_back(std::move(record));
     return result;
 }
@@ -348,7 +327,7 @@ namespace {
 // integers and every stored value maps into int32 (CT in HU), else a Float
 // grid (a Double grid for 32-bit and f64 samples, whose values float cannot
 // hold).
-DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, bool p) {
+DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, bool p, const std::string& near) {
     const double a = v.rescaleSlope, b = v.rescaleIntercept;
     if (!std::isfinite(a) || !std::isfinite(b) || a == 0)
         throw Error(v.headerPath + ": the rescale slope " + std::to_string(a) + " / intercept " + std::to_string(b) + " is not usable");
@@ -367,22 +346,22 @@ DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, boo
     const double r0 = a * lo + b, r1 = a * hi + b;
     if (integral && std::min(r0, r1) >= -2147483648.0 && std::max(r0, r1) <= 2147483647.0) {
         switch (v.type) {
-            case SampleType::U8: return importTyped<uint8_t, int32_t>(v, th, ValueType::Int32, p);
-            case SampleType::I8: return importTyped<int8_t, int32_t>(v, th, ValueType::Int32, p);
-            case SampleType::U16: return importTyped<uint16_t, int32_t>(v, th, ValueType::Int32, p);
-            case SampleType::I16: return importTyped<int16_t, int32_t>(v, th, ValueType::Int32, p);
+            case SampleType::U8: return importTyped<uint8_t, int32_t>(v, th, ValueType::Int32, p, near);
+            case SampleType::I8: return importTyped<int8_t, int32_t>(v, th, ValueType::Int32, p, near);
+            case SampleType::U16: return importTyped<uint16_t, int32_t>(v, th, ValueType::Int32, p, near);
+            case SampleType::I16: return importTyped<int16_t, int32_t>(v, th, ValueType::Int32, p, near);
             default: break;  // 32-bit samples rescaled: as doubles
         }
     }
     switch (v.type) {
-        case SampleType::U8: return importTyped<uint8_t, float>(v, th, ValueType::Float, p);
-        case SampleType::I8: return importTyped<int8_t, float>(v, th, ValueType::Float, p);
-        case SampleType::U16: return importTyped<uint16_t, float>(v, th, ValueType::Float, p);
-        case SampleType::I16: return importTyped<int16_t, float>(v, th, ValueType::Float, p);
-        case SampleType::F32: return importTyped<float, float>(v, th, ValueType::Float, p);
-        case SampleType::U32: return importTyped<uint32_t, double>(v, th, ValueType::Double, p);
-        case SampleType::I32: return importTyped<int32_t, double>(v, th, ValueType::Double, p);
-        case SampleType::F64: return importTyped<double, double>(v, th, ValueType::Double, p);
+        case SampleType::U8: return importTyped<uint8_t, float>(v, th, ValueType::Float, p, near);
+        case SampleType::I8: return importTyped<int8_t, float>(v, th, ValueType::Float, p, near);
+        case SampleType::U16: return importTyped<uint16_t, float>(v, th, ValueType::Float, p, near);
+        case SampleType::I16: return importTyped<int16_t, float>(v, th, ValueType::Float, p, near);
+        case SampleType::F32: return importTyped<float, float>(v, th, ValueType::Float, p, near);
+        case SampleType::U32: return importTyped<uint32_t, double>(v, th, ValueType::Double, p, near);
+        case SampleType::I32: return importTyped<int32_t, double>(v, th, ValueType::Double, p, near);
+        case SampleType::F64: return importTyped<double, double>(v, th, ValueType::Double, p, near);
     }
     throw Error(v.headerPath + ": unsupported sample type");
 }
@@ -434,6 +413,7 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
                     all.threshold.samples += r.threshold.samples;
                 }
                 for (GridRecord& g : r.volume.grids) all.volume.grids.push_back(std::move(g));
+                for (auto& c : r.cubes) all.cubes.push_back(std::move(c));
             }
             return all;
         }
@@ -482,16 +462,16 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
             case SampleType::U32: throw Error(path + ": u32 vector samples are not supported (a Vec3I grid cannot hold them)");
         }
     }
-    if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) return importRescaled(v, th, p);
+    if (v.rescaleSlope != 1 || v.rescaleIntercept != 0) return importRescaled(v, th, p, options.cubesNear);
     switch (v.type) {
-        case SampleType::U8: return importTyped<uint8_t, int32_t>(v, th, ValueType::Int32, p);
-        case SampleType::I8: return importTyped<int8_t, int32_t>(v, th, ValueType::Int32, p);
-        case SampleType::U16: return importTyped<uint16_t, int32_t>(v, th, ValueType::Int32, p);
-        case SampleType::I16: return importTyped<int16_t, int32_t>(v, th, ValueType::Int32, p);
-        case SampleType::U32: return importTyped<uint32_t, int64_t>(v, th, ValueType::Int64, p);
-        case SampleType::I32: return importTyped<int32_t, int32_t>(v, th, ValueType::Int32, p);
-        case SampleType::F32: return importTyped<float, float>(v, th, ValueType::Float, p);
-        case SampleType::F64: return importTyped<double, double>(v, th, ValueType::Double, p);
+        case SampleType::U8: return importTyped<uint8_t, int32_t>(v, th, ValueType::Int32, p, options.cubesNear);
+        case SampleType::I8: return importTyped<int8_t, int32_t>(v, th, ValueType::Int32, p, options.cubesNear);
+        case SampleType::U16: return importTyped<uint16_t, int32_t>(v, th, ValueType::Int32, p, options.cubesNear);
+        case SampleType::I16: return importTyped<int16_t, int32_t>(v, th, ValueType::Int32, p, options.cubesNear);
+        case SampleType::U32: return importTyped<uint32_t, int64_t>(v, th, ValueType::Int64, p, options.cubesNear);
+        case SampleType::I32: return importTyped<int32_t, int32_t>(v, th, ValueType::Int32, p, options.cubesNear);
+        case SampleType::F32: return importTyped<float, float>(v, th, ValueType::Float, p, options.cubesNear);
+        case SampleType::F64: return importTyped<double, double>(v, th, ValueType::Double, p, options.cubesNear);
     }
     throw Error(path + ": unsupported sample type");
 }

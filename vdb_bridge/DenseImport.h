@@ -18,10 +18,12 @@
 // mean and RMS absolute change, PSNR with peak = the input's value range.
 #pragma once
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "src/volume/CubeSource.h"
 #include "src/volume/GridRecord.h"
 #include "vdb_bridge/DenseVolume.h"
 #include "vdb_bridge/RawVolume.h"
@@ -46,6 +48,10 @@ struct DenseImportOptions {
     std::vector<std::string> moreInputs;
     // NIfTI: which volume of a 4-D file (`--volume N`, 0-based).
     std::optional<int64_t> volume;
+    // Read a scalar scan cube by cube (DenseImportResult::cubes): its
+    // samples go once to a scratch file beside this path (ScratchFile.h)
+    // instead of memory. Ignored for vector and colour scans.
+    std::string cubesNear;
 };
 
 struct ThresholdReport {
@@ -64,7 +70,12 @@ struct ThresholdReport {
 };
 
 struct DenseImportResult {
-    Volume volume;  // one grid (a 4-D NIfTI file without --volume: one per volume)
+    // One grid (a 4-D NIfTI file without --volume: one per volume); with
+    // DenseImportOptions::cubesNear on a scalar scan, headers only, their
+    // voxels in `cubes` (the same grids, read from the scratch file; the
+    // same bricks and values as in memory, so the same encoded bytes).
+    Volume volume;
+    std::vector<std::unique_ptr<CubeSource>> cubes;
     DenseVolume source;
     ThresholdReport threshold;
 };

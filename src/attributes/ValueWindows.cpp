@@ -130,49 +130,64 @@ std::vector<uint8_t> encodeValueWindows(std::span<const uint8_t> values, uint32_
     return out;
 }
 
-PaletteChannel decodeValueWindows(std::span<const uint8_t> payload, const std::string& what) {
+WindowDirectory readValueWindowDirectory(std::span<const uint8_t> payload, const std::string& what) {
     format::ByteReader r(payload, what);
-    PaletteChannel out;
-    out.valueSize = r.get<uint32_t>();
-    if (out.valueSize == 0 || out.valueSize > 64) r.fail("bad value size " + std::to_string(out.valueSize));
-    out.entryCount = r.get<uint64_t>();
+    WindowDirectory dir;
+    dir.valueSize = r.get<uint32_t>();
+    if (dir.valueSize == 0 || dir.valueSize > 64) r.fail("bad value size " + std::to_string(dir.valueSize));
+    dir.entries = r.get<uint64_t>();
     const uint64_t windowEntries = r.get<uint64_t>();
     if (!std::has_single_bit(windowEntries) || windowEntries < (uint64_t(1) << 10) || windowEntries > (uint64_t(1) << 30))
         r.fail("window of " + std::to_string(windowEntries) + " entries (a power of two from 2^10 to 2^30 is expected)");
     const uint64_t windows = r.get<uint64_t>();
-    if (out.entryCount > (uint64_t(1) << 40)) r.fail(std::to_string(out.entryCount) + " entries is implausible");
-    if (windows != (out.entryCount + windowEntries - 1) / windowEntries)
-        r.fail(std::to_string(windows) + " windows for " + std::to_string(out.entryCount) + " entries of " + std::to_string(windowEntries));
+    if (dir.entries > (uint64_t(1) << 40)) r.fail(std::to_string(dir.entries) + " entries is implausible");
+    if (windows != (dir.entries + windowEntries - 1) / windowEntries)
+        r.fail(std::to_string(windows) + " windows for " + std::to_string(dir.entries) + " entries of " + std::to_string(windowEntries));
     if (windows > r.remaining() / 16) r.fail("window directory runs past the end");
     const size_t framesBegin = r.position(), directoryBegin = payload.size() - size_t(windows) * 16;
     format::ByteReader d(payload.subspan(directoryBegin), what + " window directory");
-    std::vector<std::pair<uint64_t, uint64_t>> sizes(windows);  // stored, raw
     uint64_t storedTotal = 0;
     const uint64_t frameBytes = directoryBegin - framesBegin;
-    for (auto& [stored, raw] : sizes) {
-        stored = d.get<uint64_t>();
-        raw = d.get<uint64_t>();
-        if (stored > frameBytes || raw < stored || !format::zstdCanProduce(stored, raw)) r.fail("window sizes are implausible");
-        storedTotal += stored;
+    dir.windows.resize(size_t(windows));
+    for (uint64_t w = 0; w < windows; ++w) {
+        WindowDirectory::Window& e = dir.windows[size_t(w)];
+        e.stored = d.get<uint64_t>();
+        e.raw = d.get<uint64_t>();
+        if (e.stored > frameBytes || e.raw < e.stored || !format::zstdCanProduce(e.stored, e.raw)) r.fail("window sizes are implausible");
+        e.offset = framesBegin + storedTotal;
+        e.firstEntry = w * windowEntries;
+        e.entries = std::min(windowEntries, dir.entries - e.firstEntry);
+        storedTotal += e.stored;
     }
     if (storedTotal != frameBytes) r.fail("windows hold " + std::to_string(frameBytes) + " bytes, the directory says " + std::to_string(storedTotal));
-    const uint8_t* at = payload.data() + framesBegin;
-    std::vector<uint32_t> wholeBase;  // per window: where its material range sits in `palettes`, once needed
-    for (uint64_t w = 0; w < windows; ++w) {
-        const auto [stored, rawSize] = sizes[w];
+    return dir;
+}
+
+std::vector<uint8_t> windowRawBytes(std::span<const uint8_t> payload, const WindowDirectory::Window& w, const std::string& what) {
+    const std::span<const uint8_t> stored = payload.subspan(size_t(w.offset), size_t(w.stored));
+    if (w.raw == w.stored) return {stored.begin(), stored.end()};
+    return format::zstdInflateFrame(stored, w.raw, what);
+}
+
+PaletteChannel decodeValueWindow(std::span<const uint8_t> payload, const WindowDirectory& dir, size_t k, const std::string& what) {
+    const WindowDirectory::Window& w = dir.windows.at(k);
+    const std::string where = what + " window " + std::to_string(k);
+    PaletteChannel c = deserializePalette(windowRawBytes(payload, w, where), where);
+    if (c.valueSize != dir.valueSize || c.entryCount != w.entries)
+        throw Error(where + ": holds " + std::to_string(c.entryCount) + " entries of " + std::to_string(c.valueSize) + " bytes, expected " +
+                    std::to_string(w.entries) + " of " + std::to_string(dir.valueSize));
+    return c;
+}
+
+PaletteChannel decodeValueWindows(std::span<const uint8_t> payload, const std::string& what) {
+    const WindowDirectory dir = readValueWindowDirectory(payload, what);
+    PaletteChannel out;
+    out.valueSize = dir.valueSize;
+    out.entryCount = dir.entries;
+    for (size_t w = 0; w < dir.windows.size(); ++w) {
         const std::string where = what + " window " + std::to_string(w);
-        std::vector<uint8_t> inflated;
-        std::span<const uint8_t> raw(at, size_t(stored));
-        if (rawSize != stored) {
-            inflated = format::zstdInflateFrame(raw, rawSize, where);
-            raw = inflated;
-        }
-        at += stored;
-        const PaletteChannel c = deserializePalette(raw, where);
-        const uint64_t first = w * windowEntries, expect = std::min(windowEntries, out.entryCount - first);
-        if (c.valueSize != out.valueSize || c.entryCount != expect)
-            throw Error(where + ": holds " + std::to_string(c.entryCount) + " entries of " + std::to_string(c.valueSize) + " bytes, expected " +
-                        std::to_string(expect) + " of " + std::to_string(out.valueSize));
+        const PaletteChannel c = decodeValueWindow(payload, dir, w, what);
+        const uint64_t first = dir.windows[w].firstEntry;
         // Merge: materials and palettes appended (palette entries moved by
         // the material base), blocks moved to the merged arrays.
         const uint64_t materialBase = out.materialCount(), paletteBase = out.palettes.size();

@@ -39,6 +39,9 @@ inline constexpr uint64_t kValueWindowEntries = uint64_t(1) << 22;
 struct ValueWindowsPayload {
     std::vector<uint8_t> bytes;
     std::shared_ptr<const ScratchFile> file;
+    // An integer channel's PredictedWindows payload (PredictedWindows.h),
+    // not a ValueWindows one.
+    bool predicted = false;
     bool empty() const { return bytes.empty() && !file; }
     uint64_t size() const { return file ? file->size() : bytes.size(); }
     std::vector<uint8_t> load() const;  // the bytes, read back when spilled
@@ -81,5 +84,23 @@ std::vector<uint8_t> encodeValueWindows(std::span<const uint8_t> values, uint32_
 // Validates the payload (sizes, frames, every window's palette channel) and
 // merges it; throws vdbdag::Error starting with `what`.
 PaletteChannel decodeValueWindows(std::span<const uint8_t> payload, const std::string& what);
+
+// Window by window (a reader that streams, WindowCursor.h): the header and
+// directory, checked as decodeValueWindows checks them.
+struct WindowDirectory {
+    uint32_t valueSize = 0;
+    uint64_t entries = 0;
+    struct Window {
+        uint64_t offset = 0, stored = 0, raw = 0;  // in the payload
+        uint64_t firstEntry = 0, entries = 0;
+        uint64_t firstBrick = 0, bricks = 0;  // PredictedWindows: its part of the layout
+    };
+    std::vector<Window> windows;
+};
+WindowDirectory readValueWindowDirectory(std::span<const uint8_t> payload, const std::string& what);
+// Window k's channel (its entries numbered from 0), checked.
+PaletteChannel decodeValueWindow(std::span<const uint8_t> payload, const WindowDirectory& dir, size_t k, const std::string& what);
+// A window's raw bytes (inflated when stored as a frame).
+std::vector<uint8_t> windowRawBytes(std::span<const uint8_t> payload, const WindowDirectory::Window& w, const std::string& what);
 
 } // namespace vdbdag::attributes

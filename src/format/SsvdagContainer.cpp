@@ -209,11 +209,16 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::InactivePredictedValues: return "InactivePredictedValues";
         case SectionKind::ValueWindows: return "ValueWindows";
         case SectionKind::InactiveValueWindows: return "InactiveValueWindows";
+        case SectionKind::PredictedWindows: return "PredictedWindows";
+        case SectionKind::InactivePredictedWindows: return "InactivePredictedWindows";
     }
     return "unknown";
 }
 
-bool isPrecompressed(SectionKind kind) { return kind == SectionKind::ValueWindows || kind == SectionKind::InactiveValueWindows; }
+bool isPrecompressed(SectionKind kind) {
+    return kind == SectionKind::ValueWindows || kind == SectionKind::InactiveValueWindows || kind == SectionKind::PredictedWindows ||
+           kind == SectionKind::InactivePredictedWindows;
+}
 
 namespace {
 

@@ -37,8 +37,9 @@ enum class SectionKind : uint32_t {
     Normals = 15,       // per grid, only with --normals: k-bit ONV codes in attribute order (palette channel) + angular errors
     ValueWindows = 16,          // per grid: active values in attribute order, palette-coded and zstd'd in fixed windows (ValueWindows.h)
     InactiveValueWindows = 17,  // the same for the inactive layer
-    // 18-19: unassigned.
-    PredictedValues = 20,          // per grid: integer active values predicted in attribute order (instead of Values)
+    PredictedWindows = 18,          // per grid, int32/int64: active values in brick-aligned windows, each palette- or brick-predicted-coded (PredictedWindows.h)
+    InactivePredictedWindows = 19,  // the same for the inactive layer
+    PredictedValues = 20,          // per grid: integer active values predicted in attribute order (instead of Values; written before PredictedWindows, still read)
     InactivePredictedValues = 21,  // the same for the inactive layer (instead of InactiveValues)
     FileMetadata = 22,  // file-level: the .vdb file's own metadata (opaque, vdb_bridge); absent when it has none
 };

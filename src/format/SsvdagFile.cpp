@@ -17,10 +17,14 @@
 //                 what the encoder writes
 //   Values        the same as one palette channel (serializePalette in
 //                 src/attributes/PaletteChannel.cpp), still read
-//   PredictedValues  instead of Values, for int32/int64 channels when it is
-//                 smaller: the same values as brick-MED residuals
-//                 (src/attributes/PredictedChannel.h); the reader decodes them
-//                 along the DAG and rebuilds the palette channel
+//   PredictedWindows  instead, for int32/int64 channels: brick-aligned
+//                 windows, each palette-coded or brick-MED predicted
+//                 (src/attributes/PredictedWindows.h); what the encoder
+//                 writes for integers
+//   PredictedValues  the same values as brick-MED residuals in one channel
+//                 (src/attributes/PredictedChannel.h), still read; the
+//                 reader decodes them along the DAG and rebuilds the
+//                 palette channel
 //   Inactive*     the same for the inactive layer (absent if empty)
 //   ValueErrors   lossy only: u8 mode, f64 bound, u64 entries, changed, kept
 //                 exact, f64 max abs, mean abs, RMS, max relative error
@@ -34,6 +38,7 @@
 #include <map>
 
 #include "src/attributes/PredictedChannel.h"
+#include "src/attributes/PredictedWindows.h"
 #include "src/attributes/ValueWindows.h"
 #include "src/format/ByteIO.h"
 #include "src/encoding/AttributeLayout.h"
@@ -60,12 +65,13 @@ std::vector<T> fromRawBytes(const std::vector<uint8_t>& bytes, uint64_t expected
 }
 
 struct LayerKinds {
-    SectionKind levels, inner, leaves, values, predicted, windows;
+    SectionKind levels, inner, leaves, values, predicted, windows, predictedWindows;
 };
-constexpr LayerKinds kActive{SectionKind::DagLevels, SectionKind::DagInner, SectionKind::DagLeaves, SectionKind::Values, SectionKind::PredictedValues,
-                             SectionKind::ValueWindows};
-constexpr LayerKinds kInactive{SectionKind::InactiveLevels, SectionKind::InactiveInner, SectionKind::InactiveLeaves, SectionKind::InactiveValues,
-                               SectionKind::InactivePredictedValues, SectionKind::InactiveValueWindows};
+constexpr LayerKinds kActive{SectionKind::DagLevels,       SectionKind::DagInner,     SectionKind::DagLeaves,       SectionKind::Values,
+                             SectionKind::PredictedValues, SectionKind::ValueWindows, SectionKind::PredictedWindows};
+constexpr LayerKinds kInactive{SectionKind::InactiveLevels,          SectionKind::InactiveInner,        SectionKind::InactiveLeaves,
+                               SectionKind::InactiveValues,          SectionKind::InactivePredictedValues, SectionKind::InactiveValueWindows,
+                               SectionKind::InactivePredictedWindows};
 
 // `take`: move (or release) the layer's payloads out of the scene instead of copying them.
 template <typename T>
@@ -93,13 +99,14 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
     levels.put<uint64_t>(dag.leaves.size());
     sections.push_back({kinds.levels, g, levels.take()});
     if (!dag.empty()) {
+        const SectionKind windowKind = windows.predicted ? kinds.predictedWindows : kinds.windows;
         sections.push_back({kinds.inner, g, rawBytes(dag.inner)});
         releaseIf(dag.inner, take);
         if (!dag.leaves.empty()) sections.push_back({kinds.leaves, g, rawBytes(dag.leaves)});
         releaseIf(dag.leaves, take);
         if (valueSize && !predicted.empty()) sections.push_back({kinds.predicted, g, takeOrCopy(predicted, take)});
-        else if (valueSize && windows.file) sections.push_back({kinds.windows, g, {}, take ? std::move(windows.file) : windows.file});
-        else if (valueSize && !windows.empty()) sections.push_back({kinds.windows, g, takeOrCopy(windows.bytes, take)});
+        else if (valueSize && windows.file) sections.push_back({windowKind, g, {}, take ? std::move(windows.file) : windows.file});
+        else if (valueSize && !windows.empty()) sections.push_back({windowKind, g, takeOrCopy(windows.bytes, take)});
         else if (valueSize) sections.push_back({kinds.values, g, attributes::serializePalette(channel)});
     }
 }
@@ -111,6 +118,12 @@ attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactiv
     const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
     const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
     if (values.entryCount || values.valueSize) return values;
+    if (!windows.empty() && windows.predicted && !attributes.empty()) return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
+    if (!windows.empty() && windows.predicted)
+        return attributes::compressPalette(attributes::decodePredictedWindows(windows.load(), valueSize(grid.record.valueType),
+                                                                              encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
+                                                                              "grid '" + grid.record.name + "' predicted windows"),
+                                           valueSize(grid.record.valueType));
     if (!windows.empty()) return attributes::decodeValueWindows(windows.load(), "grid '" + grid.record.name + "' value windows");
     return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
 }
@@ -253,7 +266,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         grid.record.vdbDescriptor = std::move(find(g, SectionKind::VdbDescriptor, true)->data);
         const unsigned vs = valueSize(grid.record.valueType);
         auto readLayer = [&](const LayerKinds& kinds, encoding::CompactDag& dag, std::vector<uint8_t>& attributes,
-                             attributes::PaletteChannel& channel, std::vector<uint8_t>& predicted, uint64_t expectedVoxels, const std::string& layer) {
+                             attributes::PaletteChannel& channel, std::vector<uint8_t>& predicted, attributes::ValueWindowsPayload& windows,
+                             uint64_t expectedVoxels, const std::string& layer) {
             uint64_t innerWords = 0, leafCount = 0;
             {
                 ByteReader r(find(g, kinds.levels, true)->data, what + " " + layer + " levels");
@@ -283,19 +297,38 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             Section* predictedSection = find(g, kinds.predicted, false);
             Section* windowSection = find(g, kinds.windows, false);
             Section* paletteSection = find(g, kinds.values, false);
-            if (int(predictedSection != nullptr) + int(windowSection != nullptr) + int(paletteSection != nullptr) > 1)
-                throw Error(what + ": the " + layer + " values are stored twice (more than one of Values, ValueWindows, PredictedValues)");
-            if ((predictedSection || windowSection) && (!vs || dag.empty()))
+            Section* predictedWindowSection = find(g, kinds.predictedWindows, false);
+            if (int(predictedSection != nullptr) + int(windowSection != nullptr) + int(paletteSection != nullptr) + int(predictedWindowSection != nullptr) > 1)
+                throw Error(what + ": the " + layer + " values are stored twice (more than one of Values, ValueWindows, PredictedValues, PredictedWindows)");
+            if ((predictedSection || windowSection || predictedWindowSection) && (!vs || dag.empty()))
                 throw Error(what + ": unexpected " + layer + " values section for a grid without values");
-            if (predictedSection) {
+            if (predictedSection || predictedWindowSection) {
                 if (grid.record.valueType != ValueType::Int32 && grid.record.valueType != ValueType::Int64)
                     throw Error(what + ": predicted values for a " + valueTypeName(grid.record.valueType) + " grid");
-                predicted = std::move(predictedSection->data);
-                attributes = attributes::decodePredicted(predicted, vs, encoding::attributeLayout(dag), what + " " + layer + " values");
+                if (predictedSection) {
+                    predicted = std::move(predictedSection->data);
+                    attributes = attributes::decodePredicted(predicted, vs, encoding::attributeLayout(dag), what + " " + layer + " values");
+                } else if (options.keepValueWindows) {
+                    windows.bytes = std::move(predictedWindowSection->data);
+                    windows.predicted = true;
+                    attributes::readPredictedWindowDirectory(windows.bytes, vs, encoding::attributeLayout(dag), what + " " + layer + " predicted windows");
+                    return;
+                } else {
+                    attributes = attributes::decodePredictedWindows(predictedWindowSection->data, vs, encoding::attributeLayout(dag),
+                                                                    what + " " + layer + " predicted windows");
+                    windows.bytes = std::move(predictedWindowSection->data);  // kept as it is: a rewrite stores it again
+                    windows.predicted = true;
+                }
                 if (attributes.size() != size.attributeEntries * vs)
                     throw Error(what + ": " + layer + " predicted values hold " + std::to_string(attributes.size() / vs) + " entries, expected " +
                                 std::to_string(size.attributeEntries));
                 if (options.rebuildPalettes) channel = attributes::compressPalette(attributes, vs);  // the traceable layout, rebuilt
+            } else if (vs && !dag.empty() && windowSection && options.keepValueWindows) {
+                windows.bytes = std::move(windowSection->data);
+                const attributes::WindowDirectory d = attributes::readValueWindowDirectory(windows.bytes, what + " " + layer + " value windows");
+                if (d.valueSize != vs || d.entries != size.attributeEntries)
+                    throw Error(what + ": " + layer + " value windows hold " + std::to_string(d.entries) + " entries of " + std::to_string(d.valueSize) +
+                                " bytes, expected " + std::to_string(size.attributeEntries) + " of " + std::to_string(vs));
             } else if (vs && !dag.empty()) {
                 if (windowSection) channel = attributes::decodeValueWindows(windowSection->data, what + " " + layer + " value windows");
                 else channel = attributes::deserializePalette(find(g, kinds.values, true)->data, what + " " + layer + " values");
@@ -305,9 +338,10 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 attributes = channel.decodeAll();
             }
         };
-        readLayer(kActive, grid.dag, grid.attributes, grid.values, grid.predictedValues, grid.activeVoxels, "active");
+        readLayer(kActive, grid.dag, grid.attributes, grid.values, grid.predictedValues, grid.valueWindows, grid.activeVoxels, "active");
         if (grid.inactiveVoxels || find(g, kInactive.levels, false))
-            readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveValues, grid.inactivePredictedValues, grid.inactiveVoxels, "inactive");
+            readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveValues, grid.inactivePredictedValues, grid.inactiveValueWindows,
+                      grid.inactiveVoxels, "inactive");
         if (Section* e = find(g, SectionKind::ValueErrors, false)) {
             ByteReader r(e->data, what + " ValueErrors");
             auto& l = grid.lossy;

@@ -35,11 +35,12 @@ struct EncodedGrid {
     std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
     attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout (what a reader builds)
     // What an encoder writes instead: the ValueWindows section payload
-    // (attributes/ValueWindows.h); when empty, `values` is written.
+    // (attributes/ValueWindows.h), or for an integer channel (`predicted`
+    // set) the PredictedWindows one (attributes/PredictedWindows.h), which a
+    // reader keeps as read; when empty, `values` is written.
     attributes::ValueWindowsPayload valueWindows;
-    // Integer channels only, when smaller at rest: the same values predicted
-    // (attributes/PredictedChannel.h); the file then stores this instead of
-    // the palettes, which a reader rebuilds.
+    // A file written before PredictedWindows: its PredictedValues payload
+    // (attributes/PredictedChannel.h), kept as read; the palettes are rebuilt.
     std::vector<uint8_t> predictedValues;
     attributes::ToleranceReport lossy;  // what a lossy setting changed (mode Exact: nothing)
     // Colour grids encoded with --colour-bits: what the CIELAB clustering
@@ -75,6 +76,11 @@ struct ReadOptions {
     // For PredictedValues sections: rebuild the palette channel (the
     // traceable layout). A plain decode to .vdb needs only the values.
     bool rebuildPalettes = true;
+    // Keep ValueWindows and PredictedWindows payloads as they are, in
+    // EncodedGrid::valueWindows / inactiveValueWindows, with no attribute
+    // array or channel: for readers that stream a layer window by window
+    // (pipeline/LayerScatter.h). Only the directory is checked here.
+    bool keepValueWindows = false;
 };
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options);
 

@@ -98,7 +98,7 @@ std::vector<uint8_t> gatherAttributes(const encoding::CompactDag& dag, const Gri
 }
 
 void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInstance& subtree, const GridTopology& topology,
-                   const LayerValues& values, unsigned valueSize, uint8_t* buffer, uint64_t bufferFirstEntry) {
+                   const LayerValues& values, unsigned valueSize, uint8_t* buffer, uint64_t bufferFirstEntry, std::vector<uint64_t>* layout) {
     if (valueSize == 0) return;
     if (subtree.firstEntry < bufferFirstEntry) throw Error("internal error: a subtree's values start before the buffer");
     // Entry e goes to buffer + (e - bufferFirstEntry) * valueSize.
@@ -108,11 +108,50 @@ void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInsta
     const InputValues input(topology, values, valueSize);
     if (shifted.solid) {
         input.solid(shifted.x, shifted.y, shifted.z, shifted.firstEntry, attributes);
+        if (layout) layout->push_back(0);
         return;
     }
     encoding::visitSubtreeInAttributeOrder(
-        dag, shifted, [&](const encoding::BrickInstance& b) { input.brick(b, attributes); },
-        [&](int64_t x, int64_t y, int64_t z, unsigned, uint64_t entry) { input.solid(x, y, z, entry, attributes); });
+        dag, shifted,
+        [&](const encoding::BrickInstance& b) {
+            input.brick(b, attributes);
+            if (layout) layout->push_back(b.storedMask);
+        },
+        [&](int64_t x, int64_t y, int64_t z, unsigned, uint64_t entry) {
+            input.solid(x, y, z, entry, attributes);
+            if (layout) layout->push_back(0);
+        });
+}
+
+void scatterSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInstance& subtree, const uint8_t* values, unsigned valueSize,
+                    const SubtreeVoxels& visit) {
+    const uint64_t base = subtree.firstEntry;
+    if (subtree.solid) {
+        visit.solid(subtree.x, subtree.y, subtree.z, subtree.log2Size, valueSize ? values : nullptr);
+        return;
+    }
+    uint8_t brick[64 * 64];  // a brick's values in spatial order (at most 64 bytes each)
+    if (valueSize > 64) throw Error("internal error: values of more than 64 bytes");
+    encoding::visitSubtreeInAttributeOrder(
+        dag, subtree,
+        [&](const encoding::BrickInstance& b) {
+            const uint64_t spatialMask = b.spatialMask();
+            if (valueSize) {
+                uint64_t entry = b.firstEntry - base;
+                for (uint64_t bits = b.storedMask; bits; bits &= bits - 1, ++entry) {
+                    const unsigned spatial = kReflected.bit[b.mirror][std::countr_zero(bits)];
+                    std::memcpy(brick + rankBelow(spatialMask, spatial) * valueSize, values + entry * valueSize, valueSize);
+                }
+            }
+            visit.brick(b.x, b.y, b.z, spatialMask, brick);
+        },
+        [&](int64_t x, int64_t y, int64_t z, unsigned log2Size, uint64_t entry) {
+            const int64_t tileSize = int64_t(1) << log2Size;
+            if (log2Size > 31 || (x & (tileSize - 1)) || (y & (tileSize - 1)) || (z & (tileSize - 1)))
+                throw Error("solid node of 2^" + std::to_string(log2Size) + " voxels at (" + std::to_string(x) + "," + std::to_string(y) + "," +
+                            std::to_string(z) + ") is not aligned to its size: the file is corrupted");
+            visit.solid(x, y, z, log2Size, valueSize ? values + (entry - base) * valueSize : nullptr);
+        });
 }
 
 void scatterAttributes(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, unsigned valueSize,

@@ -8,6 +8,7 @@
 #include <tbb/info.h>
 #include <tbb/parallel_pipeline.h>
 
+#include "src/attributes/PredictedWindows.h"
 #include "src/attributes/ValueWindows.h"
 #include "src/dag/ReducedDagBytes.h"
 #include "src/dag/SubDagMerge.h"
@@ -190,14 +191,20 @@ dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& pla
     return dag::readReducedDag(bytes, pos);
 }
 
+// Where a streamed layer's values go: palette windows, or (integers)
+// predicted windows, which take each subtree's brick layout too.
+struct ValueStream {
+    attributes::ValueWindowWriter* palette = nullptr;
+    attributes::PredictedWindowWriter* predicted = nullptr;
+};
+
 // The layer's values in attribute order, cube by cube. With several
 // processes each gathers a contiguous share of the subtrees and process 0
 // receives them; elsewhere the result is empty. With `stream` (one process
 // only) each subtree's values go to it in order as they are gathered and
 // the result is empty: the layer's values are never held whole.
 std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPlan& plan, const encoding::CompactDag& dag, unsigned vs,
-                                 const CubeBudget& budget, CubeTeam& team, const StepProgress& progress,
-                                 attributes::ValueWindowWriter* stream = nullptr) {
+                                 const CubeBudget& budget, CubeTeam& team, const StepProgress& progress, ValueStream* stream = nullptr) {
     if (vs == 0 || dag.empty()) return {};
     const uint64_t entries = encoding::decodedSize(dag).attributeEntries;
     const unsigned cut = std::min<unsigned>(plan.cubeLog2, dag.log2Size);
@@ -222,6 +229,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         GridTopology topology;
         LayerValues values;
         std::vector<uint8_t> gathered;  // streaming: the subtree's entries
+        std::vector<uint64_t> layout;   // ... and their bricks, for predicted windows
     };
     throughCubes<Piece>(
         budget, begin, end,
@@ -234,7 +242,8 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
             const bool large = s.log2Size > plan.cubeLog2;
             if (stream) {
                 piece.gathered.resize(entriesOf(piece.index) * vs);
-                gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, piece.gathered.data(), s.firstEntry);
+                gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, piece.gathered.data(), s.firstEntry,
+                              stream->predicted ? &piece.layout : nullptr);
             } else {
                 gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, attributes.data(), firstEntry);
             }
@@ -242,8 +251,10 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
             piece.values = {};
         },
         [&](Piece& piece) {
-            if (stream) stream->add(piece.gathered);
+            if (stream && stream->predicted) stream->predicted->add(piece.gathered, piece.layout);
+            else if (stream) stream->palette->add(piece.gathered);
             piece.gathered = {};
+            piece.layout = {};
             if (progress) progress(piece.index + 1 - begin, end - begin);
         });
     source.endPass();
@@ -304,21 +315,38 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     step("reducing the DAG");
     LayerPlan plan;
     if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan, team);
-    // Lossless values that only palettes code (no tolerance, colour
-    // quantisation or integer prediction, which need the whole channel)
-    // stream from the gather into the value windows: never held whole.
-    const bool integers = source.header().valueType == ValueType::Int32 || source.header().valueType == ValueType::Int64;
+    // Lossless values (no tolerance or colour quantisation, which need the
+    // whole channel) stream from the gather into the value windows: never
+    // held whole. Several processes gather them to process 0 instead.
     const bool streamValues = team.size() == 1 && vs > 0 && options.tolerance.mode == attributes::ScalarTolerance::Mode::Exact &&
-                              !isColourGrid(source.header(), options) && !(options.predictIntegers && integers);
+                              !isColourGrid(source.header(), options);
+    const bool predicted = usesPredictedWindows(source.header().valueType, options);
+    // Gathers the layer into windows.
+    auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries) {
+        const unsigned inFlight = valueWindowsInFlight(budget, vs);
+        ValueStream stream;
+        if (predicted) {
+            attributes::PredictedWindowWriter writer(vs, inFlight, budget.spillNear);
+            stream.predicted = &writer;
+            gatherLayer(source, layer, layerPlan, dag, vs, budget, team, options.onStepProgress, &stream);
+            if (layer == Layer::Active) step("coding the last value windows");
+            entries = writer.entries();
+            return writer.finish();
+        }
+        attributes::ValueWindowWriter writer(vs, encoding::decodedSize(dag).attributeEntries, inFlight, budget.spillNear);
+        stream.palette = &writer;
+        gatherLayer(source, layer, layerPlan, dag, vs, budget, team, options.onStepProgress, &stream);
+        if (layer == Layer::Active) step("coding the last value windows");
+        entries = writer.entries();
+        return writer.finish();
+    };
     if (streamValues) {
         step("ordering and coding values");
         if (active.empty()) step("coding the last value windows");
         if (!active.empty()) {
-            attributes::ValueWindowWriter writer(vs, encoding::decodedSize(out.dag).attributeEntries, valueWindowsInFlight(budget, vs), budget.spillNear);
-            gatherLayer(source, Layer::Active, plan, out.dag, vs, budget, team, options.onStepProgress, &writer);
-            step("coding the last value windows");
-            out.valueWindows = writer.finish();
-            out.lossy = {options.tolerance, writer.entries()};
+            uint64_t entries = 0;
+            out.valueWindows = streamLayer(Layer::Active, plan, out.dag, entries);
+            out.lossy = {options.tolerance, entries};
         }
     } else {
         step("ordering values");
@@ -332,10 +360,9 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     if (!inactive.empty()) {
         LayerPlan inactivePlan;
         out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, inactivePlan, team);
-        if (team.size() == 1 && vs > 0 && !(options.predictIntegers && integers)) {  // streamed, as the active values above
-            attributes::ValueWindowWriter writer(vs, encoding::decodedSize(out.inactiveDag).attributeEntries, valueWindowsInFlight(budget, vs), budget.spillNear);
-            gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team, options.onStepProgress, &writer);
-            out.inactiveValueWindows = writer.finish();
+        if (team.size() == 1 && vs > 0) {  // streamed, as the active values above
+            uint64_t entries = 0;
+            out.inactiveValueWindows = streamLayer(Layer::Inactive, inactivePlan, out.inactiveDag, entries);
         } else {
             out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team, options.onStepProgress);
             if (team.isRoot()) codeInactiveValues(out, options);

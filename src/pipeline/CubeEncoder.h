@@ -7,11 +7,11 @@
 // count.
 //
 // Bounded: the cubes in flight (at most `workers`, each within its share of
-// the budget), the value windows being coded (one per core, ValueWindows.h)
-// and the reduced DAG; the coded values wait in a scratch file
-// (CubeBudget::spillNear). Not yet bounded: the reduced DAG itself, and the
-// attribute array of a layer whose coding needs it whole (a lossy tolerance,
-// colour quantisation, integer prediction, or several processes).
+// the budget), the value windows being coded (one per core, ValueWindows.h,
+// or PredictedWindows.h for integers) and the reduced DAG; the coded values
+// wait in a scratch file (CubeBudget::spillNear). Not yet bounded: the
+// reduced DAG itself, and the attribute array of a layer whose coding needs
+// it whole (a lossy tolerance, colour quantisation, or several processes).
 #pragma once
 #include <cstdint>
 #include <optional>

@@ -6,11 +6,10 @@
 #include <cstring>
 
 
-#include "src/attributes/PredictedChannel.h"
+#include "src/attributes/PredictedWindows.h"
 #include "src/attributes/ValueWindows.h"
 #include "src/dag/DagBuilder.h"
 #include "src/encoding/AttributeLayout.h"
-#include "src/format/ZstdFrame.h"
 #include "src/pipeline/AttributeOrder.h"
 #include "src/pipeline/GridCodecParts.h"
 
@@ -60,16 +59,19 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const dag::ActiveBounds&
 
 namespace {
 
-// The predicted coding of an integer channel if it beats its palettes at
-// rest, else empty.
-std::vector<uint8_t> predictedIfSmaller(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, uint64_t paletteEstimate,
-                                        ValueType type, const EncodeOptions& options) {
-    if (!options.predictIntegers || (type != ValueType::Int32 && type != ValueType::Int64) || attributes.empty()) return {};
-    std::vector<uint8_t> predicted = attributes::encodePredicted(attributes, valueSize(type), encoding::attributeLayout(dag));
-    // A fast zstd pass is the yardstick (the container compresses harder, by about the same factor for both).
-    const uint64_t predictedBytes = format::zstdFastSize(predicted);
-    if (predictedBytes < paletteEstimate) return predicted;
-    return {};
+// A layer's values at rest: an integer channel (unless --no-predict) in
+// predicted windows, each window predicted or palette-coded, whichever is
+// smaller; anything else in palette windows.
+attributes::ValueWindowsPayload codeValues(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, ValueType type,
+                                           const EncodeOptions& options) {
+    attributes::ValueWindowsPayload out;
+    if (usesPredictedWindows(type, options)) {
+        out.bytes = attributes::encodePredictedWindows(attributes, valueSize(type), encoding::attributeLayout(dag));
+        out.predicted = true;
+    } else {
+        out.bytes = attributes::encodeValueWindows(attributes, valueSize(type));
+    }
+    return out;
 }
 
 } // namespace
@@ -135,18 +137,15 @@ void codeActiveValues(format::EncodedGrid& out, const EncodeOptions& options) {
     out.lossy = attributes::applyScalarTolerance(out.attributes, type, options.tolerance);
     if (isColourGrid(out.record, options))
         out.colour = attributes::quantiseColours(out.attributes, type, options.colourBits, "grid '" + out.record.name + "'");
-    uint64_t estimate = 0;
-    out.valueWindows.bytes = attributes::encodeValueWindows(out.attributes, valueSize(type), &estimate);
-    out.predictedValues = predictedIfSmaller(out.dag, out.attributes, estimate, type, options);
-    if (!out.predictedValues.empty()) out.valueWindows = {};
+    out.valueWindows = codeValues(out.dag, out.attributes, type, options);
 }
 
 void codeInactiveValues(format::EncodedGrid& out, const EncodeOptions& options) {
-    const ValueType type = out.record.valueType;
-    uint64_t estimate = 0;
-    out.inactiveValueWindows.bytes = attributes::encodeValueWindows(out.inactiveAttributes, valueSize(type), &estimate);
-    out.inactivePredictedValues = predictedIfSmaller(out.inactiveDag, out.inactiveAttributes, estimate, type, options);
-    if (!out.inactivePredictedValues.empty()) out.inactiveValueWindows = {};
+    out.inactiveValueWindows = codeValues(out.inactiveDag, out.inactiveAttributes, out.record.valueType, options);
+}
+
+bool usesPredictedWindows(ValueType type, const EncodeOptions& options) {
+    return options.predictIntegers && (type == ValueType::Int32 || type == ValueType::Int64);
 }
 
 bool isColourGrid(const GridRecord& grid, const EncodeOptions& options) {
@@ -208,8 +207,13 @@ namespace {
 // `store` holds decoded values when they had to be decoded.
 const std::vector<uint8_t>& attributesOf(const format::EncodedGrid& grid, bool inactive, std::vector<uint8_t>& store) {
     const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
-    if (!attributes.empty() || (inactive ? grid.inactiveValueWindows : grid.valueWindows).empty()) return attributes;
-    store = format::traceableValues(grid, inactive).decodeAll();
+    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+    if (!attributes.empty() || windows.empty()) return attributes;
+    if (windows.predicted)
+        store = attributes::decodePredictedWindows(windows.load(), valueSize(grid.record.valueType), encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
+                                                   "grid '" + grid.record.name + "' predicted windows");
+    else
+        store = format::traceableValues(grid, inactive).decodeAll();
     return store;
 }
 

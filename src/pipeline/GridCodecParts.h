@@ -28,8 +28,12 @@ encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t
 // An EncodedGrid with `grid`'s header and nothing else.
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options);
 
+// Whether a channel of `type` is stored in predicted windows (integers,
+// unless --no-predict) rather than palette windows.
+bool usesPredictedWindows(ValueType type, const EncodeOptions& options);
+
 // From out.attributes / out.inactiveAttributes (attribute order): the lossy
-// settings, then palettes and, for integers, predicted values when smaller.
+// settings, then the value windows (predicted windows for integers).
 void codeActiveValues(format::EncodedGrid& out, const EncodeOptions& options);
 void codeInactiveValues(format::EncodedGrid& out, const EncodeOptions& options);
 

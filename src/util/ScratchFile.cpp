@@ -50,10 +50,15 @@ void ScratchFile::writeAt(uint64_t at, const void* data, size_t size) {
 }
 
 void ScratchFile::read(uint64_t offset, size_t size, std::vector<uint8_t>& out) const {
-    if (offset > size_ || size > size_ - offset) throw Error("internal error: a scratch read past the end of " + path_);
     out.resize(size);
+    readInto(offset, size, out.data());
+}
+
+void ScratchFile::readInto(uint64_t offset, size_t size, void* to) const {
+    if (offset > size_ || size > size_ - offset) throw Error("internal error: a scratch read past the end of " + path_);
+    uint8_t* const out = static_cast<uint8_t*>(to);
     for (size_t done = 0; done < size;) {
-        const ssize_t n = ::pread(fd_, out.data() + done, size - done, off_t(offset + done));
+        const ssize_t n = ::pread(fd_, out + done, size - done, off_t(offset + done));
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) throw Error(path_ + ": cannot read the scratch file back (" + std::string(n < 0 ? std::strerror(errno) : "cut short") + ")");
         done += size_t(n);

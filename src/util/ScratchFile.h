@@ -28,6 +28,8 @@ public:
     void overwrite(uint64_t offset, const void* data, size_t size);
     // Reads `size` bytes at `offset` into `out` (resized).
     void read(uint64_t offset, size_t size, std::vector<uint8_t>& out) const;
+    // The same into `size` bytes at `to`.
+    void readInto(uint64_t offset, size_t size, void* to) const;
     uint64_t size() const { return size_; }
     const std::string& path() const { return path_; }
 

@@ -23,6 +23,8 @@
 
 #include "tests/unit/CliRunner.h"
 #include "src/attributes/PredictedChannel.h"
+#include "src/attributes/PredictedWindows.h"
+#include "src/encoding/AttributeLayout.h"
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
@@ -538,7 +540,13 @@ TEST(PredictedChannel, SurvivesTheFileWithMirroredBricksAndTiles) {
 
     format::SsvdagScene scene;
     scene.grids.push_back(pipeline::encodeGrid(record));
-    ASSERT_FALSE(scene.grids[0].predictedValues.empty()) << "the predictor should win on this channel";
+    {  // one predicted window, coded by prediction (coding byte 1), not palettes
+        const attributes::ValueWindowsPayload& w = scene.grids[0].valueWindows;
+        ASSERT_TRUE(w.predicted);
+        const auto dir = attributes::readPredictedWindowDirectory(w.bytes, 4, encoding::attributeLayout(scene.grids[0].dag), "test");
+        ASSERT_EQ(dir.windows.size(), 1u);
+        EXPECT_EQ(attributes::windowRawBytes(w.bytes, dir.windows[0], "test").at(0), 1) << "the predictor should win on this channel";
+    }
     EXPECT_LT(scene.grids[0].dag.leaves.size(), 16u) << "32 distinct masks, pairs of mirror images: reflected instances must exist";
     const auto bytes = format::writeScene(scene);
     const format::SsvdagScene back = format::readScene(bytes, "mem");

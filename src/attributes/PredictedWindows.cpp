@@ -1,0 +1,211 @@
+// See PredictedWindows.h.
+#include "src/attributes/PredictedWindows.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+
+#include "src/attributes/PredictedChannel.h"
+#include "src/format/ByteIO.h"
+#include "src/format/ZstdFrame.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::attributes {
+namespace {
+
+constexpr uint64_t kSmallWindowBytes = uint64_t(4) << 20;  // level 9 up to this, then 3 (the container's rule)
+constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;
+constexpr size_t kDirectoryEntryBytes = 24;
+constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1;
+
+inline uint64_t entriesOf(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
+
+// A window's raw bytes: its coding byte, then the smaller (by zstd's fast
+// estimate) of its palettes and its residuals.
+std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, uint32_t vs) {
+    std::vector<uint8_t> palette = serializePalette(compressPalette(values, vs));
+    std::vector<uint8_t> predicted = encodePredicted(values, vs, layout);
+    const bool usePredicted = format::zstdFastSize(predicted) < format::zstdFastSize(palette);
+    std::vector<uint8_t>& chosen = usePredicted ? predicted : palette;
+    std::vector<uint8_t> raw;
+    raw.reserve(chosen.size() + 1);
+    raw.push_back(usePredicted ? kPredictedCoding : kPaletteCoding);
+    raw.insert(raw.end(), chosen.begin(), chosen.end());
+    return raw;
+}
+
+} // namespace
+
+PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear)
+    : valueSize_(valueSize), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
+    if (valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
+    const uint8_t zeros[kHeaderBytes] = {};
+    if (!spillNear.empty()) {
+        spill_ = std::make_shared<ScratchFile>(spillNear);
+        spill_->append(zeros, kHeaderBytes);
+    } else {
+        payload_.assign(zeros, zeros + kHeaderBytes);
+    }
+}
+
+void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const uint64_t> layout) {
+    size_t at = 0;  // byte position in `values`
+    for (size_t i = 0; i < layout.size();) {
+        // A brick instance belongs to the window its first entry falls in.
+        const uint64_t window = entries_ / kValueWindowEntries;
+        if (pending_.empty() || window != windows_ - 1) {
+            if (pending_.size() == parallel_) codePending();  // every pending window is full
+            pending_.emplace_back();
+            ++windows_;
+        }
+        Window& w = pending_.back();
+        // The instances that start in this window.
+        const uint64_t windowEnd = (window + 1) * kValueWindowEntries;
+        size_t j = i;
+        uint64_t n = 0;
+        while (j < layout.size() && entries_ + n < windowEnd) n += entriesOf(layout[j++]);
+        if (at + n * valueSize_ > values.size()) throw Error("internal error: the layout holds more entries than the values given");
+        w.layout.insert(w.layout.end(), layout.begin() + long(i), layout.begin() + long(j));
+        w.values.insert(w.values.end(), values.begin() + long(at), values.begin() + long(at + n * valueSize_));
+        w.entries += n;
+        entries_ += n;
+        at += size_t(n * valueSize_);
+        i = j;
+    }
+    if (at != values.size()) throw Error("internal error: the values given hold more entries than the layout");
+}
+
+void PredictedWindowWriter::codePending() {
+    std::vector<std::vector<uint8_t>> stored(pending_.size());
+    std::vector<uint64_t> rawBytes(pending_.size());
+    tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
+        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, valueSize_);
+        std::vector<uint8_t>().swap(pending_[i].values);
+        std::vector<uint64_t>().swap(pending_[i].layout);
+        rawBytes[i] = raw.size();
+        stored[i] = format::zstdCompressIfSmaller(raw, {raw.size() <= kSmallWindowBytes ? 9 : 3, /*checksum*/ true, 0});
+        if (stored[i].empty()) stored[i] = std::move(raw);
+    });
+    for (size_t i = 0; i < pending_.size(); ++i) {
+        if (spill_) spill_->append(stored[i].data(), stored[i].size());
+        else payload_.insert(payload_.end(), stored[i].begin(), stored[i].end());
+        directory_.push_back({stored[i].size(), rawBytes[i], pending_[i].entries});
+    }
+    pending_.clear();
+}
+
+ValueWindowsPayload PredictedWindowWriter::finish() {
+    if (!pending_.empty()) codePending();
+    format::ByteWriter head;
+    head.put<uint32_t>(valueSize_);
+    head.put<uint64_t>(entries_);
+    head.put<uint64_t>(kValueWindowEntries);
+    head.put<uint64_t>(directory_.size());
+    format::ByteWriter dir;
+    for (const Directory& d : directory_) {
+        dir.put<uint64_t>(d.stored);
+        dir.put<uint64_t>(d.raw);
+        dir.put<uint64_t>(d.entries);
+    }
+    directory_.clear();
+    ValueWindowsPayload out;
+    out.predicted = true;
+    if (spill_) {
+        spill_->overwrite(0, head.bytes().data(), kHeaderBytes);
+        spill_->append(dir.bytes().data(), dir.bytes().size());
+        out.file = std::move(spill_);
+        return out;
+    }
+    std::memcpy(payload_.data(), head.bytes().data(), kHeaderBytes);
+    payload_.insert(payload_.end(), dir.bytes().begin(), dir.bytes().end());
+    out.bytes = std::move(payload_);
+    return out;
+}
+
+std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout) {
+    PredictedWindowWriter writer(valueSize, 0);
+    writer.add(values, layout);
+    return std::move(writer.finish().bytes);
+}
+
+WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
+                                             const std::string& what) {
+    format::ByteReader r(payload, what);
+    WindowDirectory dir;
+    dir.valueSize = r.get<uint32_t>();
+    if (dir.valueSize != valueSize) r.fail("holds " + std::to_string(dir.valueSize) + "-byte values, expected " + std::to_string(valueSize));
+    dir.entries = r.get<uint64_t>();
+    uint64_t layoutEntries = 0;
+    for (uint64_t m : layout) layoutEntries += entriesOf(m);
+    if (dir.entries != layoutEntries) r.fail("holds " + std::to_string(dir.entries) + " entries, the DAG " + std::to_string(layoutEntries));
+    const uint64_t windowEntries = r.get<uint64_t>();
+    if (!std::has_single_bit(windowEntries) || windowEntries < (uint64_t(1) << 10) || windowEntries > (uint64_t(1) << 30))
+        r.fail("window of " + std::to_string(windowEntries) + " entries (a power of two from 2^10 to 2^30 is expected)");
+    const uint64_t windows = r.get<uint64_t>();
+    if (windows > r.remaining() / kDirectoryEntryBytes) r.fail("window directory runs past the end");
+    const size_t framesBegin = r.position(), directoryBegin = payload.size() - size_t(windows) * kDirectoryEntryBytes;
+    format::ByteReader d(payload.subspan(directoryBegin), what + " window directory");
+    dir.windows.resize(size_t(windows));
+    uint64_t storedTotal = 0, entryTotal = 0;
+    size_t brick = 0;
+    const uint64_t frameBytes = directoryBegin - framesBegin;
+    for (uint64_t k = 0; k < windows; ++k) {
+        WindowDirectory::Window& e = dir.windows[size_t(k)];
+        e.stored = d.get<uint64_t>();
+        e.raw = d.get<uint64_t>();
+        e.entries = d.get<uint64_t>();
+        if (e.stored > frameBytes || e.raw < e.stored || e.raw == 0 || !format::zstdCanProduce(e.stored, e.raw)) r.fail("window sizes are implausible");
+        if (e.entries == 0 || e.entries > windowEntries + 63) r.fail("a window of " + std::to_string(e.entries) + " entries");
+        // Window k holds the bricks whose first entry lies in [kE, (k+1)E).
+        if (entryTotal / windowEntries != k || (entryTotal + e.entries - 1) / windowEntries > k + 1)
+            r.fail("window " + std::to_string(k) + " does not hold the bricks that start in it");
+        e.offset = framesBegin + storedTotal;
+        e.firstEntry = entryTotal;
+        storedTotal += e.stored;
+        entryTotal += e.entries;
+        if (storedTotal > frameBytes || entryTotal > dir.entries) continue;  // reported below
+        // The window's brick instances.
+        e.firstBrick = brick;
+        uint64_t n = 0;
+        while (brick < layout.size() && n < e.entries) n += entriesOf(layout[brick++]);
+        e.bricks = brick - e.firstBrick;
+        if (n != e.entries) r.fail("window " + std::to_string(k) + "'s " + std::to_string(e.entries) + " entries end inside a brick");
+    }
+    if (storedTotal != frameBytes) r.fail("windows hold " + std::to_string(frameBytes) + " bytes, the directory says " + std::to_string(storedTotal));
+    if (entryTotal != dir.entries) r.fail("windows hold " + std::to_string(entryTotal) + " entries, the header says " + std::to_string(dir.entries));
+    return dir;
+}
+
+std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, const WindowDirectory& dir, size_t k, std::span<const uint64_t> layout,
+                                           const std::string& what) {
+    const WindowDirectory::Window& e = dir.windows.at(k);
+    const std::string where = what + " window " + std::to_string(k);
+    const std::vector<uint8_t> raw = windowRawBytes(payload, e, where);
+    const std::span<const uint8_t> body = std::span<const uint8_t>(raw).subspan(1);
+    if (raw[0] == kPaletteCoding) {
+        const PaletteChannel c = deserializePalette(body, where);
+        if (c.valueSize != dir.valueSize || c.entryCount != e.entries)
+            throw Error(where + ": holds " + std::to_string(c.entryCount) + " entries of " + std::to_string(c.valueSize) + " bytes, expected " +
+                        std::to_string(e.entries) + " of " + std::to_string(dir.valueSize));
+        return c.decodeAll();
+    }
+    if (raw[0] == kPredictedCoding) return decodePredicted(body, dir.valueSize, layout.subspan(size_t(e.firstBrick), size_t(e.bricks)), where);
+    throw Error(where + ": unknown coding " + std::to_string(raw[0]));
+}
+
+std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
+                                            const std::string& what) {
+    const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
+    std::vector<uint8_t> out;
+    out.reserve(size_t(dir.entries * valueSize));  // entries matched the DAG's layout
+    for (size_t k = 0; k < dir.windows.size(); ++k) {
+        const std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, what);
+        out.insert(out.end(), values.begin(), values.end());
+    }
+    return out;
+}
+
+} // namespace vdbdag::attributes

@@ -1,0 +1,80 @@
+// An integer value channel (int32 / int64) at rest in windows, each coded
+// on its own as whichever is smaller: its palettes (PaletteChannel.h) or its
+// brick-predicted residuals (PredictedChannel.h). The windowed form of both,
+// so an encoder of a dense scan holds one window per core, never the whole
+// channel (ValueWindows.h does the same for palettes alone).
+//
+// The predictor reads inside a 4^3 brick, so a window holds whole brick
+// instances: window k holds the instances (and solid nodes) whose first
+// entry lies in [k E, (k+1) E), E = kValueWindowEntries, so it starts within
+// 63 entries after kE. The cuts depend on the entries and the DAG's layout
+// only, never on how the entries arrived, the memory limit, the thread
+// count, or the windows before (a process can cut its own share). The bytes
+// do not either. Each window's prediction starts afresh (the previous entry
+// of its first brick is 0).
+//
+// Payload of a PredictedWindows / InactivePredictedWindows section (stored
+// as it is, its frames are compressed already):
+//   u32 value size (4|8), u64 entries, u64 window entries (the nominal
+//   size, a power of two), u64 window count W,
+//   the W windows back to back,
+//   W x (u64 stored bytes, u64 raw bytes, u64 entries), the directory, last.
+// A window's raw bytes are u8 coding (0: serializePalette bytes of its
+// entries; 1: encodePredicted bytes over its bricks) then that payload;
+// stored == raw: as they are, else one zstd frame of them that declares the
+// raw size and carries zstd's checksum.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "src/attributes/ValueWindows.h"
+
+namespace vdbdag::attributes {
+
+class PredictedWindowWriter {
+public:
+    // As ValueWindowWriter's (`valueSize` 4 or 8).
+    explicit PredictedWindowWriter(uint32_t valueSize, unsigned parallel = 0, const std::string& spillNear = "");
+    // `values`: the entries of the brick instances `layout` describes (per
+    // instance in attribute order its stored mask, 0 for a solid node),
+    // continuing the previous call.
+    void add(std::span<const uint8_t> values, std::span<const uint64_t> layout);
+    ValueWindowsPayload finish();  // its `predicted` is set
+    uint64_t entries() const { return entries_; }
+
+private:
+    struct Window {
+        std::vector<uint8_t> values;
+        std::vector<uint64_t> layout;
+        uint64_t entries = 0;
+    };
+    void codePending();
+    uint32_t valueSize_;
+    unsigned parallel_;
+    uint64_t entries_ = 0, windows_ = 0;
+    std::vector<Window> pending_;  // full windows not yet coded, and the one filling (last)
+    std::vector<uint8_t> payload_;
+    std::shared_ptr<ScratchFile> spill_;
+    struct Directory { uint64_t stored, raw, entries; };
+    std::vector<Directory> directory_;
+};
+
+// All at once.
+std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout);
+
+// The entries in attribute order; validates the payload against `layout`
+// (the DAG's attributeLayout) and throws vdbdag::Error starting with `what`.
+std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
+                                            const std::string& what);
+
+// Window by window (WindowCursor.h): the directory, checked against
+// `layout` as decodePredictedWindows checks it, and window k's entries.
+WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
+                                             const std::string& what);
+std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, const WindowDirectory& dir, size_t k, std::span<const uint64_t> layout,
+                                           const std::string& what);
+
+} // namespace vdbdag::attributes

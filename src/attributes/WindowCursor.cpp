@@ -1,0 +1,43 @@
+// See WindowCursor.h.
+#include "src/attributes/WindowCursor.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "src/attributes/PredictedWindows.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::attributes {
+
+WindowCursor::WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what)
+    : payload_(payload), predicted_(predicted), layout_(layout), what_(std::move(what)) {
+    dir_ = predicted ? readPredictedWindowDirectory(payload, valueSize, layout, what_) : readValueWindowDirectory(payload, what_);
+    if (dir_.valueSize != valueSize)
+        throw Error(what_ + ": holds " + std::to_string(dir_.valueSize) + "-byte values, expected " + std::to_string(valueSize));
+}
+
+void WindowCursor::load(size_t k) {
+    values_.clear();
+    values_ = predicted_ ? decodePredictedWindow(payload_, dir_, k, layout_, what_) : decodeValueWindow(payload_, dir_, k, what_).decodeAll();
+    window_ = k;
+    loaded_ = true;
+    at_ = 0;
+}
+
+void WindowCursor::read(uint64_t n, uint8_t* out) {
+    const uint32_t vs = dir_.valueSize;
+    while (n) {
+        if (!loaded_ || at_ == dir_.windows[window_].entries) {
+            const size_t next = loaded_ ? window_ + 1 : 0;
+            if (next >= dir_.windows.size()) throw Error(what_ + ": read past its " + std::to_string(dir_.entries) + " entries");
+            load(next);
+        }
+        const uint64_t take = std::min(n, dir_.windows[window_].entries - at_);
+        std::memcpy(out, values_.data() + at_ * vs, size_t(take * vs));
+        out += take * vs;
+        at_ += take;
+        n -= take;
+    }
+}
+
+} // namespace vdbdag::attributes
