@@ -113,6 +113,9 @@ std::vector<uint32_t> distinctIds(std::span<const uint8_t> values, uint32_t vs, 
         uint32_t hash;  // low 32 bits of the value's hash (also its bucket)
     };
     std::vector<uint32_t> ids(n);
+    // Reserved, not touched: growth never copies (and never holds the old
+    // and the new array at once); only the pages used become resident.
+    firstOccurrence.reserve(size_t(std::min<uint64_t>(n, uint64_t(1) << 32)));
     RandomAccessArray<Slot> slots(size_t(1) << 16);
     size_t mask = slots.size() - 1;
     auto grow = [&]() {

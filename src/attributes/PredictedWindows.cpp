@@ -51,14 +51,37 @@ PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parall
     }
 }
 
+void PredictedWindowWriter::beginShare(uint64_t firstEntry, bool endsLayer) {
+    if (entries_ || !pending_.empty() || !directory_.empty() || spill_) throw Error("internal error: a share begins before the first entry");
+    share_ = true;
+    endsLayer_ = endsLayer;
+    entries_ = firstEntry;
+    headEnd_ = (firstEntry + kValueWindowEntries - 1) / kValueWindowEntries * kValueWindowEntries;
+    head_.window = firstEntry / kValueWindowEntries;
+    windows_ = headEnd_ / kValueWindowEntries;
+    payload_.clear();  // coded windows only: process 0 writes the header
+}
+
 void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const uint64_t> layout) {
     size_t at = 0;  // byte position in `values`
-    for (size_t i = 0; i < layout.size();) {
+    size_t i = 0;
+    // The bricks that start before this share's first window: its head.
+    while (share_ && i < layout.size() && entries_ < headEnd_) {
+        const uint64_t n = entriesOf(layout[i]);
+        if (at + n * valueSize_ > values.size()) throw Error("internal error: the layout holds more entries than the values given");
+        head_.layout.push_back(layout[i++]);
+        head_.values.insert(head_.values.end(), values.begin() + long(at), values.begin() + long(at + n * valueSize_));
+        at += size_t(n * valueSize_);
+        entries_ += n;
+    }
+    while (i < layout.size()) {
         // A brick instance belongs to the window its first entry falls in.
         const uint64_t window = entries_ / kValueWindowEntries;
         if (pending_.empty() || window != windows_ - 1) {
+            if (window != windows_) throw Error("internal error: a predicted window skipped");
             if (pending_.size() == parallel_) codePending();  // every pending window is full
             pending_.emplace_back();
+            pending_.back().values.reserve(size_t((kValueWindowEntries + 64) * valueSize_));  // untouched until filled: never copied
             ++windows_;
         }
         Window& w = pending_.back();
@@ -95,6 +118,49 @@ void PredictedWindowWriter::codePending() {
         directory_.push_back({stored[i].size(), rawBytes[i], pending_[i].entries});
     }
     pending_.clear();
+}
+
+ShareWindows PredictedWindowWriter::finishShare() {
+    if (!share_) throw Error("internal error: finishShare without beginShare");
+    ShareWindows out;
+    // The last window is whole here when the next share's first brick
+    // starts past it, or this share ends the layer.
+    if (!pending_.empty() && !endsLayer_ && entries_ < windows_ * kValueWindowEntries) {
+        out.tail.window = windows_ - 1;
+        out.tail.values = std::move(pending_.back().values);
+        out.tail.layout = std::move(pending_.back().layout);
+        pending_.pop_back();
+    }
+    codePending();
+    out.firstWindow = headEnd_ / kValueWindowEntries;
+    for (const Directory& d : directory_) out.directory.push_back({d.stored, d.raw, d.entries});
+    out.coded = std::move(payload_);
+    out.head = std::move(head_);
+    directory_.clear();
+    return out;
+}
+
+void PredictedWindowWriter::addShare(const ShareWindows& share) {
+    add(share.head.values, share.head.layout);
+    uint64_t at = 0;
+    for (size_t j = 0; j < share.directory.size(); ++j) {
+        const ShareWindows::Coded& c = share.directory[j];
+        if (c.stored > share.coded.size() - at) throw Error("internal error: a process's coded windows are cut short");
+        addCoded(share.firstWindow + j, c, std::span<const uint8_t>(share.coded).subspan(size_t(at), size_t(c.stored)));
+        at += c.stored;
+    }
+    add(share.tail.values, share.tail.layout);
+}
+
+void PredictedWindowWriter::addCoded(uint64_t window, const ShareWindows::Coded& coded, std::span<const uint8_t> bytes) {
+    if (entries_ / kValueWindowEntries != window || windows_ > window || bytes.size() != coded.stored)
+        throw Error("internal error: a coded window out of place");
+    codePending();
+    if (spill_) spill_->append(bytes.data(), bytes.size());
+    else payload_.insert(payload_.end(), bytes.begin(), bytes.end());
+    directory_.push_back({coded.stored, coded.raw, coded.entries});
+    entries_ += coded.entries;
+    windows_ = window + 1;
 }
 
 ValueWindowsPayload PredictedWindowWriter::finish() {

@@ -44,6 +44,12 @@ public:
     void add(std::span<const uint8_t> values, std::span<const uint64_t> layout);
     ValueWindowsPayload finish();  // its `predicted` is set
     uint64_t entries() const { return entries_; }
+    // Share mode and assembly, as ValueWindowWriter's (the loose parts
+    // carry their bricks' layout).
+    void beginShare(uint64_t firstEntry, bool endsLayer);
+    ShareWindows finishShare();
+    void addCoded(uint64_t window, const ShareWindows::Coded& coded, std::span<const uint8_t> bytes);
+    void addShare(const ShareWindows& share);
 
 private:
     struct Window {
@@ -60,6 +66,9 @@ private:
     std::shared_ptr<ScratchFile> spill_;
     struct Directory { uint64_t stored, raw, entries; };
     std::vector<Directory> directory_;
+    bool share_ = false, endsLayer_ = true;
+    uint64_t headEnd_ = 0;
+    ShareWindows::Loose head_;
 };
 
 // All at once.

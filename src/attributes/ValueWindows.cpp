@@ -49,14 +49,30 @@ ValueWindowWriter::ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntrie
     payload_.resize(kHeaderBytes);
 }
 
+void ValueWindowWriter::beginShare(uint64_t firstEntry, bool endsLayer) {
+    if (entries_ || !pending_.empty() || !directory_.empty() || spill_) throw Error("internal error: a share begins before the first entry");
+    share_ = true;
+    endsLayer_ = endsLayer;
+    entries_ = firstEntry;
+    headEnd_ = (firstEntry + kValueWindowEntries - 1) / kValueWindowEntries * kValueWindowEntries;
+    head_.window = firstEntry / kValueWindowEntries;
+    payload_.clear();  // coded windows only: process 0 writes the header
+}
+
 void ValueWindowWriter::add(std::span<const uint8_t> values) {
     if (values.size() % valueSize_) throw Error("internal error: values are not whole entries");
+    if (share_ && entries_ < headEnd_ && !values.empty()) {  // the window this share starts inside
+        const size_t take = size_t(std::min<uint64_t>(headEnd_ - entries_, values.size() / valueSize_) * valueSize_);
+        head_.values.insert(head_.values.end(), values.begin(), values.begin() + long(take));
+        entries_ += take / valueSize_;
+        values = values.subspan(take);
+    }
     const uint64_t windowBytes = kValueWindowEntries * valueSize_;
     while (!values.empty()) {
         if (pending_.empty() || pending_.back().size() == windowBytes) {
             if (pending_.size() == parallel_) codePending();  // every pending window is full
             pending_.emplace_back();
-            pending_.back().reserve(size_t(std::min<uint64_t>(windowBytes, std::max<uint64_t>(values.size(), 1u << 16))));
+            pending_.back().reserve(size_t(windowBytes));  // untouched until filled: never copied while it grows
         }
         std::vector<uint8_t>& w = pending_.back();
         const size_t take = size_t(std::min<uint64_t>(windowBytes - w.size(), values.size()));
@@ -74,6 +90,7 @@ void ValueWindowWriter::codePending() {
     std::vector<Coded> coded(pending_.size());
     // Each window on its own core (compressPalette parallelises inside a
     // window too); the result is the same for any number of threads.
+    for (const std::vector<uint8_t>& w : pending_) codedEntries_.push_back(w.size() / valueSize_);
     tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
         std::vector<uint8_t> raw = serializePalette(compressPalette(pending_[i], valueSize_));
         std::vector<uint8_t>().swap(pending_[i]);
@@ -118,6 +135,92 @@ ValueWindowsPayload ValueWindowWriter::finish() {
     payload_.insert(payload_.end(), dir.bytes().begin(), dir.bytes().end());
     out.bytes = std::move(payload_);
     return out;
+}
+
+ShareWindows ValueWindowWriter::finishShare() {
+    if (!share_) throw Error("internal error: finishShare without beginShare");
+    ShareWindows out;
+    const uint64_t windowBytes = kValueWindowEntries * valueSize_;
+    // The last window is whole here when it is full or ends the layer.
+    if (!pending_.empty() && !endsLayer_ && pending_.back().size() != windowBytes) {
+        out.tail.window = (entries_ - pending_.back().size() / valueSize_) / kValueWindowEntries;
+        out.tail.values = std::move(pending_.back());
+        pending_.pop_back();
+    }
+    codePending();
+    out.firstWindow = headEnd_ / kValueWindowEntries;
+    for (size_t i = 0; i < directory_.size(); ++i) out.directory.push_back({directory_[i].first, directory_[i].second, codedEntries_[i]});
+    out.coded = std::move(payload_);
+    out.head = std::move(head_);
+    directory_.clear();
+    return out;
+}
+
+void ValueWindowWriter::addShare(const ShareWindows& share) {
+    add(share.head.values);
+    uint64_t at = 0;
+    for (size_t j = 0; j < share.directory.size(); ++j) {
+        const ShareWindows::Coded& c = share.directory[j];
+        if (c.stored > share.coded.size() - at) throw Error("internal error: a process's coded windows are cut short");
+        addCoded(share.firstWindow + j, c, std::span<const uint8_t>(share.coded).subspan(size_t(at), size_t(c.stored)));
+        at += c.stored;
+    }
+    add(share.tail.values);
+}
+
+void ValueWindowWriter::addCoded(uint64_t window, const ShareWindows::Coded& coded, std::span<const uint8_t> bytes) {
+    const uint64_t windowBytes = kValueWindowEntries * valueSize_;
+    if (entries_ != window * kValueWindowEntries || (!pending_.empty() && pending_.back().size() != windowBytes) || bytes.size() != coded.stored)
+        throw Error("internal error: a coded window out of place");
+    codePending();
+    if (spill_) spill_->append(bytes.data(), bytes.size());
+    else payload_.insert(payload_.end(), bytes.begin(), bytes.end());
+    directory_.push_back({coded.stored, coded.raw});
+    codedEntries_.push_back(coded.entries);
+    entries_ += coded.entries;
+}
+
+std::vector<uint8_t> ShareWindows::serialize() const {
+    format::ByteWriter w;
+    w.put<uint64_t>(firstWindow);
+    w.put<uint64_t>(directory.size());
+    for (const Coded& c : directory) {
+        w.put<uint64_t>(c.stored);
+        w.put<uint64_t>(c.raw);
+        w.put<uint64_t>(c.entries);
+    }
+    w.put<uint64_t>(coded.size());
+    w.putBytes(coded);
+    for (const Loose* l : {&head, &tail}) {
+        w.put<uint64_t>(l->window);
+        w.put<uint64_t>(l->values.size());
+        w.putBytes(l->values);
+        w.put<uint64_t>(l->layout.size());
+        for (uint64_t m : l->layout) w.put<uint64_t>(m);
+    }
+    return w.take();
+}
+
+ShareWindows ShareWindows::deserialize(std::span<const uint8_t> bytes) {
+    format::ByteReader r(bytes, "a process's value windows");
+    ShareWindows s;
+    s.firstWindow = r.get<uint64_t>();
+    const uint64_t n = r.get<uint64_t>();
+    if (n > r.remaining() / 24) r.fail("directory runs past the end");
+    s.directory.resize(size_t(n));
+    for (Coded& c : s.directory) {
+        c.stored = r.get<uint64_t>();
+        c.raw = r.get<uint64_t>();
+        c.entries = r.get<uint64_t>();
+    }
+    s.coded = r.getArray<uint8_t>(r.get<uint64_t>());
+    for (Loose* l : {&s.head, &s.tail}) {
+        l->window = r.get<uint64_t>();
+        l->values = r.getArray<uint8_t>(r.get<uint64_t>());
+        l->layout = r.getArray<uint64_t>(r.get<uint64_t>());
+    }
+    r.expectEnd();
+    return s;
 }
 
 std::vector<uint8_t> encodeValueWindows(std::span<const uint8_t> values, uint32_t valueSize, uint64_t* estimate) {

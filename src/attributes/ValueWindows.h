@@ -47,6 +47,29 @@ struct ValueWindowsPayload {
     std::vector<uint8_t> load() const;  // the bytes, read back when spilled
 };
 
+// One process's share of a layer (several processes, pipeline/CubeTeam.h):
+// the windows wholly inside it, coded, and the entries of the windows it
+// shares with its neighbours (the head before its first window, the tail
+// after its last), raw, for process 0 to complete. Any process codes a
+// window to the same bytes, so the file does not depend on the split.
+struct ShareWindows {
+    uint64_t firstWindow = 0;  // index of the first coded window
+    struct Coded {
+        uint64_t stored = 0, raw = 0, entries = 0;
+    };
+    std::vector<Coded> directory;  // per coded window
+    std::vector<uint8_t> coded;    // the coded windows back to back
+    struct Loose {
+        uint64_t window = 0;            // the window they belong to
+        std::vector<uint8_t> values;    // entries
+        std::vector<uint64_t> layout;   // their brick instances (predicted windows)
+        bool empty() const { return values.empty(); }
+    };
+    Loose head, tail;
+    std::vector<uint8_t> serialize() const;
+    static ShareWindows deserialize(std::span<const uint8_t> bytes);
+};
+
 // Takes the entries in order (any number per call) and codes every full
 // window; at most `parallel` windows (0: one per core) wait to be coded
 // together, so memory holds about that many windows.
@@ -61,6 +84,16 @@ public:
     void add(std::span<const uint8_t> values);
     // The section payload. The writer is spent afterwards.
     ValueWindowsPayload finish();
+    // Share mode (before the first add): the entries start at `firstEntry`
+    // of the layer and end it when `endsLayer`; finishShare() instead of
+    // finish(). (No spilling in share mode.)
+    void beginShare(uint64_t firstEntry, bool endsLayer);
+    ShareWindows finishShare();
+    // On the writer that assembles the shares: a window another process
+    // coded, in its place (`entries()` must be where it starts).
+    void addCoded(uint64_t window, const ShareWindows::Coded& coded, std::span<const uint8_t> bytes);
+    // ... and a whole share: its head, coded windows and tail, in order.
+    void addShare(const ShareWindows& share);
     // A fast-zstd estimate of the payload (the sum of the windows'
     // zstd level-1 sizes), the yardstick GridCodec compares other codings
     // with; valid after finish().
@@ -76,6 +109,10 @@ private:
     std::vector<uint8_t> payload_;               // header placeholder, then the coded windows
     std::shared_ptr<ScratchFile> spill_;         // ... or there
     std::vector<std::pair<uint64_t, uint64_t>> directory_;  // stored, raw bytes per window
+    bool share_ = false, endsLayer_ = true;
+    uint64_t headEnd_ = 0;  // share mode: the first window boundary at or after the first entry
+    ShareWindows::Loose head_;
+    std::vector<uint64_t> codedEntries_;  // entries per coded window
 };
 
 // All of `values` at once.

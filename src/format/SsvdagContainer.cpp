@@ -101,9 +101,10 @@ std::string describe(size_t index, uint32_t kind, uint32_t grid) {
     return text;
 }
 
-std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string& name) {
+// `bytes`: the file, or (readContainerFile) at least its header, table and
+// table checksum; `size`: the file's size.
+std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string& name, uint64_t size) {
     auto fail = [&](const std::string& why) { throw Error(name + ": " + why); };
-    const uint64_t size = bytes.size();
     if (size < sizeof(kMagic)) {
         // A prefix of the magic is a truncated file; anything else is not ours.
         if (size == 0 || std::memcmp(bytes.data(), kMagic, size) == 0)  // (no memcmp on a null pointer)
@@ -320,14 +321,14 @@ uint64_t writeContainerTo(std::vector<Section>&& sections, std::ostream& out, co
 
 std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, const std::string& sourceName) {
     std::vector<SectionSummary> out;
-    const std::vector<Entry> entries = parseTable(bytes, sourceName);
+    const std::vector<Entry> entries = parseTable(bytes, sourceName, bytes.size());
     out.reserve(entries.size());
     for (const Entry& e : entries) out.push_back({SectionKind(e.kind), e.grid, e.codec == kCodecZstd, e.stored, e.raw});
     return out;
 }
 
 std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName, bool unknownKinds) {
-    const std::vector<Entry> entries = parseTable(bytes, sourceName);
+    const std::vector<Entry> entries = parseTable(bytes, sourceName, bytes.size());
     std::vector<Section> sections;
     sections.reserve(entries.size());
     for (size_t i = 0; i < entries.size(); ++i) {
@@ -340,6 +341,81 @@ std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::st
             continue;
         }
         sections.push_back({SectionKind(e.kind), e.grid, restore(e, bytes.subspan(e.offset, e.stored), what)});
+    }
+    return sections;
+}
+
+namespace {
+
+// An open regular file (O_NONBLOCK: opening a FIFO must not block; it is
+// refused), closed when done.
+struct InputFile {
+    int fd = -1;
+    uint64_t size = 0;
+    explicit InputFile(const std::string& path) {
+        auto fail = [&](const std::string& why, int err) { throw Error(path + ": " + why + " (" + std::strerror(err) + ")"); };
+        fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+        if (fd < 0) {
+            const int err = errno;
+            if (err == ENOENT || err == ENOTDIR) throw Error(path + ": no such file");
+            fail("cannot be opened for reading", err);
+        }
+        struct stat st{};
+        if (::fstat(fd, &st) != 0) {
+            const int err = errno;
+            ::close(fd);
+            fail("cannot be read", err);
+        }
+        if (!S_ISREG(st.st_mode)) {
+            ::close(fd);
+            throw Error(path + ": is " + fileKindName(st.st_mode) + ", not an .ssvdag file");  // a device could be read forever, a FIFO block
+        }
+        size = uint64_t(st.st_size);
+    }
+    ~InputFile() { ::close(fd); }
+    InputFile(const InputFile&) = delete;
+    InputFile& operator=(const InputFile&) = delete;
+    // Up to `n` bytes at `offset` (fewer when the file shrank meanwhile).
+    std::vector<uint8_t> read(uint64_t offset, uint64_t n, const std::string& path) const {
+        std::vector<uint8_t> bytes(static_cast<size_t>(n));
+        size_t done = 0;
+        while (done < bytes.size()) {
+            const ssize_t got = ::pread(fd, bytes.data() + done, bytes.size() - done, off_t(offset + done));
+            if (got < 0) {
+                if (errno == EINTR) continue;
+                throw Error(path + ": read error (" + std::string(std::strerror(errno)) + ")");
+            }
+            if (got == 0) break;
+            done += size_t(got);
+        }
+        bytes.resize(done);
+        return bytes;
+    }
+};
+
+} // namespace
+
+std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds) {
+    const InputFile file(path);
+    // The header first, for the table's size, then header and table together.
+    std::vector<uint8_t> head = file.read(0, std::min<uint64_t>(file.size, kHeaderBytes), path);
+    if (head.size() == kHeaderBytes && std::memcmp(head.data(), kMagic, sizeof(kMagic)) == 0) {
+        uint32_t count;
+        std::memcpy(&count, head.data() + 12, 4);
+        head = file.read(0, std::min<uint64_t>(file.size, kHeaderBytes + uint64_t(count) * kEntryBytes + kChecksumBytes), path);
+    }
+    const std::vector<Entry> entries = parseTable(head, path, file.size);
+    std::vector<Section> sections;
+    sections.reserve(entries.size());
+    for (size_t i = 0; i < entries.size(); ++i) {
+        const Entry& e = entries[i];
+        const std::string what = path + ": " + describe(i, e.kind, e.grid);
+        std::vector<uint8_t> stored = file.read(e.offset, e.stored, path);
+        if (stored.size() != e.stored) throw Error(what + ": the file was cut short while it was read");
+        if (XXH3_64bits(stored.data(), stored.size()) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
+        if (!unknownKinds && std::strcmp(sectionKindName(SectionKind(e.kind)), "unknown") == 0) continue;  // checked, never inflated
+        if (e.codec == kCodecRaw) sections.push_back({SectionKind(e.kind), e.grid, std::move(stored)});  // no copy
+        else sections.push_back({SectionKind(e.kind), e.grid, zstdInflateFrame(stored, e.raw, what)});
     }
     return sections;
 }

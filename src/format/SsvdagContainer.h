@@ -93,5 +93,8 @@ std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, c
 // Reads a whole file into memory (throws Error naming the file if missing or
 // unreadable).
 std::vector<uint8_t> readFileBytes(const std::string& path);
+// readContainer of the file at `path`, read section by section: memory
+// holds the sections, never the file as well.
+std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds = true);
 
 } // namespace vdbdag::format

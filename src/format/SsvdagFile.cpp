@@ -409,12 +409,7 @@ SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceN
 SsvdagScene readSceneFile(const std::string& path) { return readSceneFile(path, ReadOptions{}); }
 
 SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
-    std::vector<Section> sections;
-    {
-        const std::vector<uint8_t> bytes = readFileBytes(path);  // released before the sections are parsed
-        sections = readContainer(bytes, path, /*unknownKinds=*/false);
-    }
-    return sectionsToScene(std::move(sections), path, options);
+    return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false), path, options);
 }
 
 } // namespace vdbdag::format

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <functional>
 #include <optional>
+#include <type_traits>
 
 #include <tbb/info.h>
 #include <tbb/parallel_pipeline.h>
@@ -217,7 +218,11 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
     const uint64_t endEntry = end < subtrees.size() ? subtrees[end].firstEntry : entries;
     // This process's entries, [firstEntry, endEntry); process 0 of a solo
     // team fills the whole array directly (unless it streams them).
-    if (stream && team.size() != 1) throw Error("internal error: streamed values need a single process");
+    // Several processes streaming: each codes the windows of its share.
+    if (stream && team.size() != 1) {
+        if (stream->predicted) stream->predicted->beginShare(firstEntry, endEntry == entries);
+        else stream->palette->beginShare(firstEntry, endEntry == entries);
+    }
     std::vector<uint8_t> attributes(stream ? 0 : (endEntry - firstEntry) * vs);
     auto entriesOf = [&](size_t i) { return (i + 1 < subtrees.size() ? subtrees[i + 1].firstEntry : entries) - subtrees[i].firstEntry; };
     GridTopology largeTopology;
@@ -258,7 +263,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
             if (progress) progress(piece.index + 1 - begin, end - begin);
         });
     source.endPass();
-    if (team.size() == 1) return attributes;
+    if (team.size() == 1 || stream) return attributes;
     const std::vector<std::vector<uint8_t>> all = team.gather(attributes);
     if (!team.isRoot()) return {};
     std::vector<uint8_t> whole;
@@ -317,28 +322,44 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan, team);
     // Lossless values (no tolerance or colour quantisation, which need the
     // whole channel) stream from the gather into the value windows: never
-    // held whole. Several processes gather them to process 0 instead.
-    const bool streamValues = team.size() == 1 && vs > 0 && options.tolerance.mode == attributes::ScalarTolerance::Mode::Exact &&
-                              !isColourGrid(source.header(), options);
+    // held whole. With several processes each codes the windows of its
+    // share and process 0 puts them together (completing the windows that
+    // straddle two shares).
+    const bool streamValues = vs > 0 && options.tolerance.mode == attributes::ScalarTolerance::Mode::Exact && !isColourGrid(source.header(), options);
     const bool predicted = usesPredictedWindows(source.header().valueType, options);
-    // Gathers the layer into windows.
+    // Gathers the layer into windows (on process 0: all of them).
     auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries) {
         const unsigned inFlight = valueWindowsInFlight(budget, vs);
+        const uint64_t expected = encoding::decodedSize(dag).attributeEntries;
         ValueStream stream;
-        if (predicted) {
-            attributes::PredictedWindowWriter writer(vs, inFlight, budget.spillNear);
-            stream.predicted = &writer;
+        auto run = [&](auto& writer) -> attributes::ValueWindowsPayload {
             gatherLayer(source, layer, layerPlan, dag, vs, budget, team, options.onStepProgress, &stream);
             if (layer == Layer::Active) step("coding the last value windows");
-            entries = writer.entries();
-            return writer.finish();
+            if (team.size() == 1) {
+                entries = writer.entries();
+                return writer.finish();
+            }
+            const std::vector<std::vector<uint8_t>> shares = team.gather(writer.finishShare().serialize());
+            if (!team.isRoot()) return {};
+            std::decay_t<decltype(writer)> whole = [&] {
+                if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::PredictedWindowWriter>)
+                    return attributes::PredictedWindowWriter(vs, inFlight, budget.spillNear);
+                else
+                    return attributes::ValueWindowWriter(vs, expected, inFlight, budget.spillNear);
+            }();
+            for (const std::vector<uint8_t>& bytes : shares) whole.addShare(attributes::ShareWindows::deserialize(bytes));
+            entries = whole.entries();
+            if (entries != expected) throw Error("internal error: the processes' values do not add up to the DAG's entries");
+            return whole.finish();
+        };
+        if (predicted) {
+            attributes::PredictedWindowWriter writer(vs, inFlight, team.size() == 1 ? budget.spillNear : "");
+            stream.predicted = &writer;
+            return run(writer);
         }
-        attributes::ValueWindowWriter writer(vs, encoding::decodedSize(dag).attributeEntries, inFlight, budget.spillNear);
+        attributes::ValueWindowWriter writer(vs, team.size() == 1 ? expected : 0, inFlight, team.size() == 1 ? budget.spillNear : "");
         stream.palette = &writer;
-        gatherLayer(source, layer, layerPlan, dag, vs, budget, team, options.onStepProgress, &stream);
-        if (layer == Layer::Active) step("coding the last value windows");
-        entries = writer.entries();
-        return writer.finish();
+        return run(writer);
     };
     if (streamValues) {
         step("ordering and coding values");
@@ -360,7 +381,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     if (!inactive.empty()) {
         LayerPlan inactivePlan;
         out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, inactivePlan, team);
-        if (team.size() == 1 && vs > 0) {  // streamed, as the active values above
+        if (vs > 0) {  // streamed, as the active values above
             uint64_t entries = 0;
             out.inactiveValueWindows = streamLayer(Layer::Inactive, inactivePlan, out.inactiveDag, entries);
         } else {

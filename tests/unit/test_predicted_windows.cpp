@@ -6,6 +6,7 @@
 // in one line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <random>
@@ -162,4 +163,36 @@ TEST(PredictedWindows, DamagedPayloadsAreRefused) {
     refused(flipped, "a damaged frame", c.layout);
     const std::vector<uint64_t> shorter(c.layout.begin(), c.layout.end() - 1);
     refused(good, "a DAG with a brick fewer", shorter);
+}
+
+// Several processes (pipeline/CubeTeam.h): each codes the windows of its
+// share and process 0 completes those that straddle shares. Shares cut at
+// brick boundaries anywhere (inside a window, on a window boundary, a share
+// inside one window, an empty share) give the single writer's bytes.
+TEST(PredictedWindows, SharesPutTogetherGiveTheSingleWritersBytes) {
+    const Channel c = makeChannel(kValueWindowEntries * 3 + 777, kValueWindowEntries * 2, 7);
+    const std::vector<uint8_t> whole = attributes::encodePredictedWindows(c.values, 4, c.layout);
+    // Brick index -> first entry.
+    std::vector<uint64_t> first(c.layout.size() + 1, 0);
+    for (size_t b = 0; b < c.layout.size(); ++b) first[b + 1] = first[b] + (c.layout[b] ? std::popcount(c.layout[b]) : 1);
+    auto brickAt = [&](uint64_t entry) { return size_t(std::lower_bound(first.begin(), first.end(), entry) - first.begin()); };
+    const std::vector<std::vector<size_t>> splits{
+        {brickAt(kValueWindowEntries / 2), brickAt(kValueWindowEntries * 2 + 5)},
+        {brickAt(kValueWindowEntries), brickAt(kValueWindowEntries) + 1, brickAt(kValueWindowEntries + 100)},
+        {0, brickAt(kValueWindowEntries * 3 - 10)},
+        {brickAt(10), brickAt(20), brickAt(30), c.layout.size()}};
+    for (const auto& cuts : splits) {
+        std::vector<size_t> bounds{0};
+        bounds.insert(bounds.end(), cuts.begin(), cuts.end());
+        bounds.push_back(c.layout.size());
+        attributes::PredictedWindowWriter root(4, 2);
+        for (size_t s = 0; s + 1 < bounds.size(); ++s) {
+            attributes::PredictedWindowWriter share(4, 2);
+            share.beginShare(first[bounds[s]], bounds[s + 1] == c.layout.size());
+            share.add(std::span<const uint8_t>(c.values).subspan(size_t(first[bounds[s]] * 4), size_t((first[bounds[s + 1]] - first[bounds[s]]) * 4)),
+                      std::span<const uint64_t>(c.layout).subspan(bounds[s], bounds[s + 1] - bounds[s]));
+            root.addShare(attributes::ShareWindows::deserialize(share.finishShare().serialize()));
+        }
+        EXPECT_TRUE(root.finish().bytes == whole) << "shares cut at " << ::testing::PrintToString(cuts);
+    }
 }

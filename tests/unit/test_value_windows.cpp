@@ -112,3 +112,28 @@ TEST(ValueWindows, DamagedPayloadsAreRefused) {
     flipped[40] ^= 0x5A;  // inside the first window's zstd frame
     refused(flipped, "a damaged frame");
 }
+
+// Several processes: shares cut anywhere give the single writer's bytes
+// (PredictedWindows' test has the brick-aligned case).
+TEST(ValueWindows, SharesPutTogetherGiveTheSingleWritersBytes) {
+    const uint64_t n = kValueWindowEntries * 3 + 999;
+    const std::vector<uint8_t> values = mixedFloats(n, 8);
+    const std::vector<uint8_t> whole = attributes::encodeValueWindows(values, 4);
+    const std::vector<std::vector<uint64_t>> splits{{kValueWindowEntries / 3, kValueWindowEntries * 2 + 1},
+                                                    {kValueWindowEntries, kValueWindowEntries + 1, kValueWindowEntries + 2},
+                                                    {0, n - 5},
+                                                    {7, 8, 9, n}};
+    for (const auto& cuts : splits) {
+        std::vector<uint64_t> bounds{0};
+        bounds.insert(bounds.end(), cuts.begin(), cuts.end());
+        bounds.push_back(n);
+        attributes::ValueWindowWriter root(4, n, 2);
+        for (size_t s = 0; s + 1 < bounds.size(); ++s) {
+            attributes::ValueWindowWriter share(4, 0, 2);
+            share.beginShare(bounds[s], bounds[s + 1] == n);
+            share.add(std::span<const uint8_t>(values).subspan(size_t(bounds[s] * 4), size_t((bounds[s + 1] - bounds[s]) * 4)));
+            root.addShare(attributes::ShareWindows::deserialize(share.finishShare().serialize()));
+        }
+        EXPECT_TRUE(root.finish().bytes == whole) << "shares cut at " << ::testing::PrintToString(cuts);
+    }
+}
