@@ -137,15 +137,13 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
                 throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
                                          "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
-            // Cube by cube (region by region from the file) with
-            // --memory-limit, under mpirun, or when the whole grid would not
-            // fit in memory (about 10x the file, against half the physical
-            // memory); otherwise whole, through OpenVDB's strictest reader.
-            // The same bytes either way; --normals needs the whole grid.
-            std::error_code sizeError;
-            const uintmax_t fileBytes = std::filesystem::file_size(opt->input, sizeError);
-            const bool large = !sizeError && fileBytes > defaultMemoryLimit() / 10;
-            if ((opt->memoryLimit || cubeTeam().size() > 1 || large) && !importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
+            // Cube by cube (region by region from the file) whenever the
+            // file allows it (grid offsets): less memory than the whole grid
+            // and faster too (the cubes' values are gathered in parallel,
+            // each through a small index). Whole, through OpenVDB's
+            // strictest reader, for a stream and for --normals (the
+            // gradient reads across cubes). The same bytes either way.
+            if (!importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
                 const std::string scratchNear =
                     opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
                 cubeInput = bridge::openVdbCubes(opt->input, importOptions, scratchNear);

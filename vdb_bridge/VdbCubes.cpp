@@ -57,7 +57,20 @@ class VdbGridCubes final : public CubeSource {
 public:
     VdbGridCubes(std::string path, std::string uniqueName, GridRecord header, typename GridT::Ptr grid, std::shared_ptr<ScratchFile> scratch)
         : path_(std::move(path)), uniqueName_(std::move(uniqueName)), header_(std::move(header)), scratch_(std::move(scratch)) {
-        summarise(*grid);
+        // OpenVDB's delayed loading (LeafBuffer::doLoad) leaves a leaf whose
+        // values ran out of memory while they were read flagged out-of-core
+        // over its value array; destroying that leaf then frees a FileInfo
+        // that is not one ("free(): invalid pointer"). The encode fails
+        // anyway, so after a failure the grid is never destroyed: the holder
+        // is allocated before anything can fail, and leaked.
+        auto holder = std::make_unique<typename GridT::Ptr>();
+        try {
+            summarise(*grid);
+        } catch (...) {
+            *holder = std::move(grid);
+            (void)holder.release();
+            throw;
+        }
         grid.reset();
         releaseFreedMemory();
     }

@@ -113,8 +113,7 @@ void PredictedWindowWriter::codePending() {
         if (stored[i].empty()) stored[i] = std::move(raw);
     });
     for (size_t i = 0; i < pending_.size(); ++i) {
-        if (spill_) spill_->append(stored[i].data(), stored[i].size());
-        else payload_.insert(payload_.end(), stored[i].begin(), stored[i].end());
+        appendWindow(payload_, spill_.get(), stored[i]);
         directory_.push_back({stored[i].size(), rawBytes[i], pending_[i].entries});
     }
     pending_.clear();
@@ -156,8 +155,7 @@ void PredictedWindowWriter::addCoded(uint64_t window, const ShareWindows::Coded&
     if (entries_ / kValueWindowEntries != window || windows_ > window || bytes.size() != coded.stored)
         throw Error("internal error: a coded window out of place");
     codePending();
-    if (spill_) spill_->append(bytes.data(), bytes.size());
-    else payload_.insert(payload_.end(), bytes.begin(), bytes.end());
+    appendWindow(payload_, spill_.get(), bytes);
     directory_.push_back({coded.stored, coded.raw, coded.entries});
     entries_ += coded.entries;
     windows_ = window + 1;
@@ -177,17 +175,8 @@ ValueWindowsPayload PredictedWindowWriter::finish() {
         dir.put<uint64_t>(d.entries);
     }
     directory_.clear();
-    ValueWindowsPayload out;
+    ValueWindowsPayload out = sealWindows(std::move(payload_), std::move(spill_), head.bytes(), dir.bytes());
     out.predicted = true;
-    if (spill_) {
-        spill_->overwrite(0, head.bytes().data(), kHeaderBytes);
-        spill_->append(dir.bytes().data(), dir.bytes().size());
-        out.file = std::move(spill_);
-        return out;
-    }
-    std::memcpy(payload_.data(), head.bytes().data(), kHeaderBytes);
-    payload_.insert(payload_.end(), dir.bytes().begin(), dir.bytes().end());
-    out.bytes = std::move(payload_);
     return out;
 }
 

@@ -102,8 +102,7 @@ void ValueWindowWriter::codePending() {
     });
     pending_.clear();
     for (Coded& c : coded) {
-        if (spill_) spill_->append(c.stored.data(), c.stored.size());
-        else payload_.insert(payload_.end(), c.stored.begin(), c.stored.end());
+        appendWindow(payload_, spill_.get(), c.stored);
         directory_.push_back({c.stored.size(), c.rawBytes});
         estimate_ += c.estimate;
         std::vector<uint8_t>().swap(c.stored);
@@ -124,16 +123,27 @@ ValueWindowsPayload ValueWindowWriter::finish() {
     }
     estimate_ += kHeaderBytes + dir.bytes().size();
     directory_.clear();
+    return sealWindows(std::move(payload_), std::move(spill_), head.bytes(), dir.bytes());
+}
+
+void appendWindow(std::vector<uint8_t>& payload, ScratchFile* spill, std::span<const uint8_t> bytes) {
+    if (spill) spill->append(bytes.data(), bytes.size());
+    else payload.insert(payload.end(), bytes.begin(), bytes.end());
+}
+
+ValueWindowsPayload sealWindows(std::vector<uint8_t>&& payload, std::shared_ptr<ScratchFile>&& spill, std::span<const uint8_t> header,
+                                std::span<const uint8_t> directory) {
     ValueWindowsPayload out;
-    if (spill_) {
-        spill_->overwrite(0, head.bytes().data(), kHeaderBytes);
-        spill_->append(dir.bytes().data(), dir.bytes().size());
-        out.file = std::move(spill_);
+    if (spill) {
+        spill->overwrite(0, header.data(), header.size());
+        spill->append(directory.data(), directory.size());
+        out.file = std::move(spill);
         return out;
     }
-    std::memcpy(payload_.data(), head.bytes().data(), kHeaderBytes);
-    payload_.insert(payload_.end(), dir.bytes().begin(), dir.bytes().end());
-    out.bytes = std::move(payload_);
+    if (payload.size() < header.size()) throw Error("internal error: a window payload without its header placeholder");
+    std::memcpy(payload.data(), header.data(), header.size());
+    payload.insert(payload.end(), directory.begin(), directory.end());
+    out.bytes = std::move(payload);
     return out;
 }
 
@@ -173,8 +183,7 @@ void ValueWindowWriter::addCoded(uint64_t window, const ShareWindows::Coded& cod
     if (entries_ != window * kValueWindowEntries || (!pending_.empty() && pending_.back().size() != windowBytes) || bytes.size() != coded.stored)
         throw Error("internal error: a coded window out of place");
     codePending();
-    if (spill_) spill_->append(bytes.data(), bytes.size());
-    else payload_.insert(payload_.end(), bytes.begin(), bytes.end());
+    appendWindow(payload_, spill_.get(), bytes);
     directory_.push_back({coded.stored, coded.raw});
     codedEntries_.push_back(coded.entries);
     entries_ += coded.entries;

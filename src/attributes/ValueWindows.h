@@ -115,6 +115,14 @@ private:
     std::vector<uint64_t> codedEntries_;  // entries per coded window
 };
 
+// For the window writers (this one and PredictedWindows.h): a coded window
+// appended to the payload in memory or in the scratch file, and the
+// payload sealed: the header over its placeholder at the start, the
+// directory at the end.
+void appendWindow(std::vector<uint8_t>& payload, ScratchFile* spill, std::span<const uint8_t> bytes);
+ValueWindowsPayload sealWindows(std::vector<uint8_t>&& payload, std::shared_ptr<ScratchFile>&& spill, std::span<const uint8_t> header,
+                                std::span<const uint8_t> directory);
+
 // All of `values` at once.
 std::vector<uint8_t> encodeValueWindows(std::span<const uint8_t> values, uint32_t valueSize, uint64_t* estimate = nullptr);
 

@@ -41,7 +41,11 @@ void checkOutputPath(const std::string& output, const std::vector<std::string>& 
     struct stat out{};
     if (::lstat(output.c_str(), &out) != 0) {
         if (errno != ENOENT && errno != ENOTDIR) throw Error(output + ": cannot be checked (" + std::strerror(errno) + ")");
-        return;  // the folder is checked by the atomic writer
+        // Its folder, before any work (and any scratch file beside it).
+        const std::string dir = std::filesystem::path(output).parent_path().empty() ? "." : std::filesystem::path(output).parent_path().string();
+        struct stat folder{};
+        if (::stat(dir.c_str(), &folder) != 0 && (errno == ENOENT || errno == ENOTDIR)) throw Error(output + ": the folder " + dir + " does not exist");
+        return;  // the rest of the folder's checks are the atomic writer's
     }
     if (S_ISLNK(out.st_mode)) throw Error(output + ": is a symbolic link; not writing through it (give the path it points to)");
     if (S_ISDIR(out.st_mode)) throw Error(output + ": is a directory");
