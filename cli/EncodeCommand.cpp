@@ -39,6 +39,14 @@ uint64_t defaultMemoryLimit() {
     return pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) / 2 : uint64_t(4) << 30;
 }
 
+// Scratch bytes each scratch space of an encode keeps in memory before it
+// writes a file: a quarter of what the limit leaves beyond 1 GiB (none
+// under a tight limit, where the cubes in flight take it all).
+uint64_t scratchInMemory(uint64_t memoryLimit) {
+    constexpr uint64_t kReserved = uint64_t(1) << 30;
+    return memoryLimit > kReserved ? (memoryLimit - kReserved) / 4 : 0;
+}
+
 } // namespace
 
 void addEncodeCommand(CLI::App& app, int& exitCode) {
@@ -146,7 +154,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             if (!importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
                 const std::string scratchNear =
                     opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
-                cubeInput = bridge::openVdbCubes(opt->input, importOptions, scratchNear);
+                cubeInput = bridge::openVdbCubes(opt->input, importOptions, scratchNear,
+                                                 scratchInMemory(opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()));
                 imported.warnings = cubeInput->warnings;
                 for (const auto& g : cubeInput->grids) imported.volume.grids.push_back(g->header());  // headers only, for the checks
             } else {
@@ -168,7 +177,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         encodeOptions.symmetry = !opt->noSymmetry;
         encodeOptions.placementTrials = opt->placementTrials;
         encodeOptions.predictIntegers = !opt->noPredict;
-        encodeOptions.computeSvdagStats = true;  // cheap next to I/O; lets `info` show all three node counts
+        encodeOptions.computeSvdagStats = !getenv("NOSV");  // cheap next to I/O; lets `info` show all three node counts
         if (opt->absError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Absolute, opt->absError};
         if (opt->relError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Relative, opt->relError};
         encodeOptions.colourBits = opt->colourBits;
@@ -179,7 +188,10 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         Progress progress("encode", (imported.volume.grids.size() * pipeline::kEncodeSteps + 1) * kUnits);
         std::string gridName;
         uint64_t stepsStarted = 0;
+        // Seconds spent in each step, reported with --json ("phases").
+        std::vector<std::pair<std::string, std::chrono::steady_clock::time_point>> phases{{"reading the input", start}};
         encodeOptions.onStep = [&](const char* step) {
+            phases.push_back({fmt::format("{}: {}", gridName, step), std::chrono::steady_clock::now()});
             progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
             progress.set(stepsStarted++ * kUnits);
         };
@@ -197,7 +209,9 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             // mpirun, where the processes share its cubes.
             if (cubeInput || !denseCubes.empty() || team.size() > 1) {
                 pipeline::CubeBudget budget;
-                budget.bytes = std::max<uint64_t>((opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()) / 2, 1);
+                const uint64_t limit = opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit();
+                budget.bytes = std::max<uint64_t>(limit / 2, 1);
+                budget.spillInMemory = scratchInMemory(limit);
                 // The coded values wait in a scratch file, not in memory, until the file is written.
                 budget.spillNear =
                     opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
@@ -229,6 +243,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             exitCode = 0;
             return;
         }
+        phases.push_back({"writing the file", std::chrono::steady_clock::now()});
         progress.setLabel("encode: writing " + opt->output);
         format::ContainerOptions containerOptions;
         containerOptions.compress = !opt->noCompress;
@@ -245,6 +260,11 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                               {"active_voxels", voxels}, {"seconds", seconds},
                               {"bits_per_active_voxel", voxels ? 8.0 * double(fileBytes) / double(voxels) : 0.0}};
         if (threshold.applied) report["threshold"] = thresholdJson(threshold);
+        report["phases"] = nlohmann::json::array();
+        for (size_t i = 0; i < phases.size(); ++i) {
+            const auto end = i + 1 < phases.size() ? phases[i + 1].second : start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+            report["phases"].push_back({{"name", phases[i].first}, {"seconds", std::chrono::duration<double>(end - phases[i].second).count()}});
+        }
         report["grids_lossy"] = nlohmann::json::array();
         for (const auto& g : scene.grids) {
             if (g.lossy.tolerance.mode == attributes::ScalarTolerance::Mode::Exact) continue;

@@ -121,10 +121,14 @@ public:
         const auto it = index_.find(cell);
         if (it == index_.end()) return;
         const unsigned vs = withValues_ ? valueSize(header_.valueType) : 0;
-        std::vector<uint8_t> record;
+        std::vector<uint8_t> buffer;
         for (const auto& [leafIndex, bricks] : it->second.leaves) {
             const LeafInfo& leaf = leaves_[leafIndex];
-            scratch_->read(leaf.recordOffset, leaf.recordSize, record);
+            // Only what the pass needs: the masks, up to the active values,
+            // or all of it.
+            const size_t masksEnd = size_t(std::popcount(leaf.occupancy[0]) + std::popcount(leaf.occupancy[1])) * 8;
+            const size_t used = !vs ? masksEnd : layer_ == Layer::Active ? leaf.activeEnd : leaf.recordSize;
+            const std::span<const uint8_t> record = scratch_->view(leaf.recordOffset, used, buffer);
             // Record: the masks of the occupied active bricks, then of the
             // inactive ones (brick order), then the active values, then the
             // inactive values (LeafBricks.h order).
@@ -167,12 +171,25 @@ private:
         openvdb::Coord origin;
         uint8_t occupancy[2];  // per layer: bit b = brick b holds voxels
         uint32_t recordSize;   // the leaf's bricks in the scratch file
+        uint32_t activeEnd;    // ... of which the masks and active values
         uint64_t recordOffset;
     };
     static uint64_t mask(const uint64_t* masks, size_t k) {
         uint64_t m;
         std::memcpy(&m, masks + k, sizeof m);
         return m;
+    }
+    // Notes a leaf's values in the layers' summaries: its first value of
+    // each layer, or that the layer is mixed.
+    void noteLeafValues(const std::vector<uint8_t>& record, const LeafInfo& leaf, uint8_t sameValues) {
+        const unsigned vs = valueSize(header_.valueType);
+        const size_t masksEnd = size_t(std::popcount(leaf.occupancy[0]) + std::popcount(leaf.occupancy[1])) * 8;
+        const size_t begins[2] = {masksEnd, leaf.activeEnd}, ends[2] = {leaf.activeEnd, record.size()};
+        for (int l = 0; l < 2; ++l) {
+            if (begins[l] == ends[l] || summary_[l].mixed) continue;
+            if (!((sameValues >> l) & 1u)) summary_[l].mixed = true;
+            else summary_[l].noteValues(std::span<const uint8_t>(record).subspan(begins[l], vs), vs);
+        }
     }
     struct CubeIndex {
         std::vector<std::pair<size_t, uint8_t>> leaves;  // (leaf, its bricks in this cube)
@@ -212,6 +229,8 @@ private:
         // into the scratch file; then the chunk's leaves (and the file pages
         // their buffers were read from) are dropped.
         std::vector<std::vector<uint8_t>> records(std::min(leaves.size(), kLeafChunk));
+        std::vector<uint32_t> activeEnds(records.size());
+        std::vector<uint8_t> sameValues(records.size());  // per leaf, bit l: layer l's values all have the same bits
         for (size_t begin = 0; begin < leaves.size(); begin += kLeafChunk) {
             const size_t end = std::min(leaves.size(), begin + kLeafChunk);
             tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 64), [&](const auto& r) {
@@ -236,11 +255,18 @@ private:
                         const auto* p = reinterpret_cast<const uint8_t*>(masks[l]);
                         record.insert(record.end(), p, p + size_t(count[l]) * sizeof(uint64_t));
                     }
-                    for (unsigned l = 0; l < 2; ++l) record.insert(record.end(), valuesOf[l].begin(), valuesOf[l].end());
+                    sameValues[i - begin] = 0;
+                    for (unsigned l = 0; l < 2; ++l) {
+                        if (detail::allSameValue(valuesOf[l], valueSize(header_.valueType))) sameValues[i - begin] |= uint8_t(1u << l);
+                        record.insert(record.end(), valuesOf[l].begin(), valuesOf[l].end());
+                        if (l == 0) activeEnds[i - begin] = uint32_t(record.size());
+                    }
                 }
             });
             for (size_t i = begin; i < end; ++i) {
                 leaves_[i].recordSize = uint32_t(records[i - begin].size());
+                leaves_[i].activeEnd = activeEnds[i - begin];
+                if constexpr (hasValues) noteLeafValues(records[i - begin], leaves_[i], sameValues[i - begin]);
                 leaves_[i].recordOffset = scratch_->append(records[i - begin].data(), records[i - begin].size());
                 if constexpr (hasValues) tree.addTile(1, leaves_[i].origin, background, false);
             }
@@ -248,6 +274,7 @@ private:
         }
         for (int l = 0; l < 2; ++l) {
             LayerSummary& s = summary_[l];
+            s.noteValues(tileValues_[l].tiles, valueSize(header_.valueType));
             for (const LeafInfo& leaf : leaves_)
                 for (uint8_t bits = leaf.occupancy[l]; bits; bits &= uint8_t(bits - 1)) {
                     const openvdb::Coord c = detail::brickCorner(leaf.origin, unsigned(std::countr_zero(bits)));
@@ -290,7 +317,7 @@ bool canReadVdbByCubes(const std::string& path) {
     }
 }
 
-VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options, const std::string& scratchNear) {
+VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options, const std::string& scratchNear, uint64_t scratchInMemory) {
     if (options.normals) throw Error(path + ": --normals needs the whole grid in memory; use it without --memory-limit");
     const detail::VdbFileIndex index = detail::indexVdbFile(path);
     const std::string near = scratchNear.empty() ? (std::filesystem::temp_directory_path() / "vdbdag").string() : scratchNear;
@@ -310,7 +337,7 @@ VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options,
         header.indexToWorld = detail::indexToWorldOf(*base);
         header.vdbDescriptor = detail::descriptorOf(*base);
         const bool supported = detail::dispatchGridType(*base, [&](const auto& typed, ValueType type) {
-            if (!scratch) scratch = std::make_shared<ScratchFile>(near);
+            if (!scratch) scratch = std::make_shared<ScratchFile>(near, scratchInMemory);
             using GridT = std::decay_t<decltype(typed)>;
             constexpr bool typeHasValues = !std::is_same_v<typename GridT::TreeType::LeafNodeType::BuildType, openvdb::ValueMask>;
             typename GridT::Ptr grid = openvdb::gridPtrCast<GridT>(base);

@@ -30,6 +30,6 @@ bool canReadVdbByCubes(const std::string& path);
 // `scratchNear` (a path in the folder to use; default: the system's
 // temporary folder), before this returns. The scratch
 // files go with the sources. `options.normals` is not supported (Error).
-VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options = {}, const std::string& scratchNear = "");
+VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options = {}, const std::string& scratchNear = "", uint64_t scratchInMemory = 0);
 
 } // namespace vdbdag::bridge

@@ -104,10 +104,69 @@ private:
     size_t count_ = 0, bytes_ = 0;
 };
 
-// Dense ids of the distinct values, in order of first occurrence. The
-// table keeps each slot's 32-bit hash next to its id, so a probe touches
-// the value array only on a hash match, and growth never rereads values.
+// Dense ids of the distinct values, in order of first occurrence, for
+// values of 4 or 8 bytes: each slot holds the value's bits beside its id, so
+// a probe is one load (no detour through the value array) and growth never
+// rereads values.
+template <typename Key>
+std::vector<uint32_t> distinctKeyIds(const uint8_t* values, uint64_t n, std::vector<uint64_t>& firstOccurrence) {
+    struct Slot {
+        Key key;
+        uint32_t id1;  // id + 1, 0 = empty
+    };
+    auto bucketOf = [](Key k, size_t mask) {
+        uint64_t x = uint64_t(k);
+        x ^= x >> 31; x *= 0x7fb5d329728ea185ull; x ^= x >> 27;
+        return size_t(x >> 17) & mask;
+    };
+    std::vector<uint32_t> ids(n);
+    firstOccurrence.reserve(size_t(std::min<uint64_t>(n, uint64_t(1) << 32)));
+    RandomAccessArray<Slot> slots(size_t(1) << 16);
+    size_t mask = slots.size() - 1;
+    auto grow = [&]() {
+        RandomAccessArray<Slot> bigger(slots.size() * 2);
+        const size_t m = bigger.size() - 1;
+        for (size_t k = 0; k < slots.size(); ++k) {
+            const Slot s = slots[k];
+            if (!s.id1) continue;
+            size_t h = bucketOf(s.key, m);
+            while (bigger[h].id1) h = (h + 1) & m;
+            bigger[h] = s;
+        }
+        slots = std::move(bigger);
+        mask = m;
+    };
+    Key previous{};
+    for (uint64_t i = 0; i < n; ++i) {
+        Key k;
+        std::memcpy(&k, values + i * sizeof(Key), sizeof(Key));
+        if (i > 0 && k == previous) { ids[i] = ids[i - 1]; continue; }
+        previous = k;
+        for (size_t h = bucketOf(k, mask);; h = (h + 1) & mask) {
+            const Slot slot = slots[h];
+            if (slot.id1 == 0) {
+                if (firstOccurrence.size() >= 0xFFFFFFF0u) throw Error("more than 2^32 distinct values in one channel");
+                firstOccurrence.push_back(i);
+                slots[h] = Slot{k, uint32_t(firstOccurrence.size())};
+                ids[i] = uint32_t(firstOccurrence.size() - 1);
+                if (firstOccurrence.size() * 2 > slots.size()) {
+                    if (slots.size() >= (size_t(1) << 32)) throw Error("too many distinct values in one channel");
+                    grow();
+                }
+                break;
+            }
+            if (slot.key == k) { ids[i] = slot.id1 - 1; break; }
+        }
+    }
+    return ids;
+}
+
+// Dense ids of the distinct values of any size, in order of first
+// occurrence. The table keeps each slot's 32-bit hash next to its id, so a
+// probe touches the value array only on a hash match.
 std::vector<uint32_t> distinctIds(std::span<const uint8_t> values, uint32_t vs, uint64_t n, std::vector<uint64_t>& firstOccurrence) {
+    if (vs == 4) return distinctKeyIds<uint32_t>(values.data(), n, firstOccurrence);
+    if (vs == 8) return distinctKeyIds<uint64_t>(values.data(), n, firstOccurrence);
     struct Slot {
         uint32_t id1;   // id + 1, 0 = empty
         uint32_t hash;  // low 32 bits of the value's hash (also its bucket)
@@ -165,7 +224,11 @@ public:
     }
 
     std::vector<Segment> run() {
-        for (uint8_t omega = 0; omega < 4; ++omega) phaseOne(omega);
+        // Phase one for ω = 1..3 accepts only windows longer than
+        // minLength(ω): a quick check skips the scans that cannot find one
+        // (most of them on noisy values), with the same result.
+        for (uint8_t omega = 0; omega < 4; ++omega)
+            if (omega == 0 || mayHaveWindow(omega)) phaseOne(omega);
         // Phase two on every gap left. Gaps are independent, so they run in
         // parallel, each thread with its own stamp array; the result is put
         // together in gap order, so it is the same for any thread count.
@@ -228,9 +291,34 @@ private:
         return paletteBits + materialShare(begin, begin + length) < double(length) * 8.0 * vs_ + kDirectoryBits;  // beats direct
     }
 
+    // The shortest window phase one considers for ω.
+    static double minLength(uint8_t omega) { return double(uint64_t(1) << omega) * kPaletteEntryBits + kDirectoryBits; }
+
+    // False when no window longer than minLength(ω) has at most 2^ω
+    // distinct ids: such a window (length >= T + 1, T = minLength) holds a
+    // whole aligned block of B = floor((T + 2) / 2) entries, which has at
+    // most 2^ω distinct ids too. Each block is read until it shows more, so
+    // on noisy values this costs a few entries per block.
+    bool mayHaveWindow(uint8_t omega) const {
+        const uint64_t limit = uint64_t(1) << omega;
+        const uint64_t block = (uint64_t(minLength(omega)) + 2) / 2;
+        uint32_t seen[9];
+        for (uint64_t begin = 0; begin + block <= n_; begin += block) {
+            uint64_t distinct = 0, i = begin;
+            for (; i < begin + block; ++i) {
+                const uint32_t id = ids_[i];
+                if (std::find(seen, seen + distinct, id) != seen + distinct) continue;
+                if (distinct == limit) break;
+                seen[distinct++] = id;
+            }
+            if (i == begin + block) return true;
+        }
+        return false;
+    }
+
     void phaseOne(uint8_t omega) {
         const uint64_t limit = uint64_t(1) << omega;
-        const double minLength = double(limit) * kPaletteEntryBits + kDirectoryBits;
+        const double minLength = Partitioner::minLength(omega);
         // Maximal windows with <= 2^omega distinct ids, inside each free gap,
         // by a sliding window. The gaps are cut into fixed chunks of window
         // starts scanned in parallel (each chunk restarts its window at its

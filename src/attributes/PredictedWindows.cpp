@@ -39,12 +39,12 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
 
 } // namespace
 
-PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear)
+PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory)
     : valueSize_(valueSize), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
     if (valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
     const uint8_t zeros[kHeaderBytes] = {};
     if (!spillNear.empty()) {
-        spill_ = std::make_shared<ScratchFile>(spillNear);
+        spill_ = std::make_shared<ScratchFile>(spillNear, spillInMemory);
         spill_->append(zeros, kHeaderBytes);
     } else {
         payload_.assign(zeros, zeros + kHeaderBytes);

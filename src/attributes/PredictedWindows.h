@@ -37,7 +37,7 @@ namespace vdbdag::attributes {
 class PredictedWindowWriter {
 public:
     // As ValueWindowWriter's (`valueSize` 4 or 8).
-    explicit PredictedWindowWriter(uint32_t valueSize, unsigned parallel = 0, const std::string& spillNear = "");
+    explicit PredictedWindowWriter(uint32_t valueSize, unsigned parallel = 0, const std::string& spillNear = "", uint64_t spillInMemory = 0);
     // `values`: the entries of the brick instances `layout` describes (per
     // instance in attribute order its stored mask, 0 for a solid node),
     // continuing the previous call.

@@ -31,7 +31,8 @@ std::vector<uint8_t> ValueWindowsPayload::load() const {
     return out;
 }
 
-ValueWindowWriter::ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntries, unsigned parallel, const std::string& spillNear)
+ValueWindowWriter::ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntries, unsigned parallel, const std::string& spillNear,
+                                     uint64_t spillInMemory)
     : valueSize_(valueSize), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
     if (valueSize == 0 || valueSize > 64) throw Error("internal error: a value window needs 1 to 64 bytes per value");
     // A window stored raw is its serialised channel: at most its values plus
@@ -40,7 +41,7 @@ ValueWindowWriter::ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntrie
     const uint64_t windows = (expectedEntries + kValueWindowEntries - 1) / kValueWindowEntries;
     const uint64_t bound = kHeaderBytes + expectedEntries * valueSize + expectedEntries * valueSize / 16 + windows * (4096 + 16);
     if (!spillNear.empty()) {
-        spill_ = std::make_shared<ScratchFile>(spillNear);
+        spill_ = std::make_shared<ScratchFile>(spillNear, spillInMemory);
         const uint8_t zeros[kHeaderBytes] = {};
         spill_->append(zeros, kHeaderBytes);
         return;

@@ -78,9 +78,11 @@ public:
     // `expectedEntries`: how many entries will come, if known; the payload's
     // memory is then reserved once (untouched reserve costs no resident
     // memory), so it is never copied while it grows.
-    // With `spillNear`, coded windows go to a scratch file in that path's
-    // folder (ScratchFile.h) instead of memory.
-    explicit ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntries = 0, unsigned parallel = 0, const std::string& spillNear = "");
+    // With `spillNear`, coded windows go to scratch space (the first
+    // `spillInMemory` bytes in memory, the rest in a file in that path's
+    // folder: ScratchFile.h).
+    explicit ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntries = 0, unsigned parallel = 0, const std::string& spillNear = "",
+                               uint64_t spillInMemory = 0);
     void add(std::span<const uint8_t> values);
     // The section payload. The writer is spent afterwards.
     ValueWindowsPayload finish();

@@ -333,7 +333,28 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
         const uint64_t expected = encoding::decodedSize(dag).attributeEntries;
         ValueStream stream;
         auto run = [&](auto& writer) -> attributes::ValueWindowsPayload {
-            gatherLayer(source, layer, layerPlan, dag, vs, budget, team, options.onStepProgress, &stream);
+            const LayerSummary summary = source.summary(layer);
+            if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::ValueWindowWriter>) {
+                if (team.size() == 1 && summary.uniform() && summary.uniformValue.size() == vs) {
+                    // Every value the same (a level set's inactive voxels):
+                    // the layer in attribute order is that value repeated,
+                    // so no pass over the cubes gathers it.
+                    std::vector<uint8_t> chunk;
+                    for (uint64_t done = 0; done < expected;) {
+                        const uint64_t n = std::min<uint64_t>(expected - done, attributes::kValueWindowEntries);
+                        if (chunk.size() != n * vs) {
+                            chunk.clear();
+                            for (uint64_t k = 0; k < n; ++k) chunk.insert(chunk.end(), summary.uniformValue.begin(), summary.uniformValue.end());
+                        }
+                        writer.add(chunk);
+                        done += n;
+                    }
+                } else {
+                    gatherLayer(source, layer, layerPlan, dag, vs, budget, team, options.onStepProgress, &stream);
+                }
+            } else {
+                gatherLayer(source, layer, layerPlan, dag, vs, budget, team, options.onStepProgress, &stream);
+            }
             if (layer == Layer::Active) step("coding the last value windows");
             if (team.size() == 1) {
                 entries = writer.entries();
@@ -343,9 +364,9 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
             if (!team.isRoot()) return {};
             std::decay_t<decltype(writer)> whole = [&] {
                 if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::PredictedWindowWriter>)
-                    return attributes::PredictedWindowWriter(vs, inFlight, budget.spillNear);
+                    return attributes::PredictedWindowWriter(vs, inFlight, budget.spillNear, budget.spillInMemory);
                 else
-                    return attributes::ValueWindowWriter(vs, expected, inFlight, budget.spillNear);
+                    return attributes::ValueWindowWriter(vs, expected, inFlight, budget.spillNear, budget.spillInMemory);
             }();
             for (const std::vector<uint8_t>& bytes : shares) whole.addShare(attributes::ShareWindows::deserialize(bytes));
             entries = whole.entries();
@@ -353,11 +374,12 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
             return whole.finish();
         };
         if (predicted) {
-            attributes::PredictedWindowWriter writer(vs, inFlight, team.size() == 1 ? budget.spillNear : "");
+            attributes::PredictedWindowWriter writer(vs, inFlight, team.size() == 1 ? budget.spillNear : "", budget.spillInMemory);
             stream.predicted = &writer;
             return run(writer);
         }
-        attributes::ValueWindowWriter writer(vs, team.size() == 1 ? expected : 0, inFlight, team.size() == 1 ? budget.spillNear : "");
+        attributes::ValueWindowWriter writer(vs, team.size() == 1 ? expected : 0, inFlight, team.size() == 1 ? budget.spillNear : "",
+                                             budget.spillInMemory);
         stream.palette = &writer;
         return run(writer);
     };

@@ -30,6 +30,9 @@ struct CubeBudget {
     // Where the coded values of a layer go while the rest is encoded (a
     // scratch file in this path's folder); empty: kept in memory.
     std::string spillNear;
+    // Bytes of each such scratch space kept in memory before the file
+    // (ScratchFile.h): none under a tight limit.
+    uint64_t spillInMemory = 0;
 };
 
 // Rough working bytes per brick of a cube being reduced or gathered.

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -12,29 +13,68 @@
 
 namespace vdbdag {
 
-ScratchFile::ScratchFile(const std::string& near) {
-    path_ = temporaryNameFor(near, ".scratch");
+ScratchFile::ScratchFile(const std::string& near, uint64_t keepInMemory) : near_(near), keep_(keepInMemory) {
+    if (keep_ == 0) openFile();  // fail early (a folder that cannot be written) when the file is certain
+}
+
+ScratchFile::~ScratchFile() {
+    if (fd_ >= 0) {
+        ::close(fd_);
+        ::unlink(path_.c_str());
+    }
+}
+
+void ScratchFile::openFile() {
+    if (fd_ >= 0) return;
+    path_ = temporaryNameFor(near_, ".scratch");
     guard_ = std::make_unique<TemporaryGuard>(path_);
     fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
     if (fd_ < 0)
         throw Error(path_ + ": cannot create the scratch file (" + std::strerror(errno) + "); choose another folder with --scratch DIR");
 }
 
-ScratchFile::~ScratchFile() {
-    if (fd_ >= 0) ::close(fd_);
-    ::unlink(path_.c_str());
+void ScratchFile::check(uint64_t offset, size_t size, const char* what) const {
+    if (offset > size_ || size > size_ - offset)
+        throw Error(std::string("internal error: a scratch ") + what + " past the end of " + (path_.empty() ? "the scratch space" : path_));
 }
 
 uint64_t ScratchFile::append(const void* data, size_t size) {
     const uint64_t at = size_;
-    writeAt(at, data, size);
+    if (!spilled_ && size <= keep_ - inMemory_) {
+        while (uint64_t(chunks_.size()) * kChunk < at + size) chunks_.emplace_back(new uint8_t[kChunk]);  // not zeroed: written before read
+        toMemory(at, data, size);
+        inMemory_ += size;
+    } else {
+        spilled_ = true;
+        openFile();
+        writeAt(at - inMemory_, data, size);
+    }
     size_ += size;
     return at;
 }
 
+void ScratchFile::toMemory(uint64_t offset, const void* data, size_t size) {
+    const auto* p = static_cast<const uint8_t*>(data);
+    while (size) {
+        const size_t inChunk = size_t(offset % kChunk), n = std::min(size, kChunk - inChunk);
+        std::memcpy(chunks_[size_t(offset / kChunk)].get() + inChunk, p, n);
+        offset += n;
+        p += n;
+        size -= n;
+    }
+}
+
 void ScratchFile::overwrite(uint64_t offset, const void* data, size_t size) {
-    if (offset > size_ || size > size_ - offset) throw Error("internal error: a scratch overwrite past the end of " + path_);
-    writeAt(offset, data, size);
+    check(offset, size, "overwrite");
+    const auto* p = static_cast<const uint8_t*>(data);
+    if (offset < inMemory_) {
+        const size_t n = size_t(std::min<uint64_t>(size, inMemory_ - offset));
+        toMemory(offset, p, n);
+        offset += n;
+        p += n;
+        size -= n;
+    }
+    if (size) writeAt(offset - inMemory_, p, size);
 }
 
 void ScratchFile::writeAt(uint64_t at, const void* data, size_t size) {
@@ -54,11 +94,26 @@ void ScratchFile::read(uint64_t offset, size_t size, std::vector<uint8_t>& out) 
     readInto(offset, size, out.data());
 }
 
+std::span<const uint8_t> ScratchFile::view(uint64_t offset, size_t size, std::vector<uint8_t>& buffer) const {
+    check(offset, size, "read");
+    if (offset + size <= inMemory_ && offset % kChunk + size <= kChunk)
+        return {chunks_[size_t(offset / kChunk)].get() + offset % kChunk, size};
+    read(offset, size, buffer);
+    return buffer;
+}
+
 void ScratchFile::readInto(uint64_t offset, size_t size, void* to) const {
-    if (offset > size_ || size > size_ - offset) throw Error("internal error: a scratch read past the end of " + path_);
-    uint8_t* const out = static_cast<uint8_t*>(to);
+    check(offset, size, "read");
+    uint8_t* out = static_cast<uint8_t*>(to);
+    while (size && offset < inMemory_) {
+        const size_t inChunk = size_t(offset % kChunk), n = size_t(std::min<uint64_t>({size, kChunk - inChunk, inMemory_ - offset}));
+        std::memcpy(out, chunks_[size_t(offset / kChunk)].get() + inChunk, n);
+        offset += n;
+        out += n;
+        size -= n;
+    }
     for (size_t done = 0; done < size;) {
-        const ssize_t n = ::pread(fd_, out + done, size - done, off_t(offset + done));
+        const ssize_t n = ::pread(fd_, out + done, size - done, off_t(offset - inMemory_ + done));
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) throw Error(path_ + ": cannot read the scratch file back (" + std::string(n < 0 ? std::strerror(errno) : "cut short") + ")");
         done += size_t(n);

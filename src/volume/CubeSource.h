@@ -9,9 +9,11 @@
 // (GridRecord). Cubes are 2^log2 voxels wide, placed from an origin that is
 // a multiple of 4, so every 4^3 brick lies in exactly one cube.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "src/volume/GridRecord.h"
@@ -28,6 +30,18 @@ struct LayerSummary {
     std::array<int64_t, 3> min{INT64_MAX, INT64_MAX, INT64_MAX}, max{INT64_MIN, INT64_MIN, INT64_MIN};
     unsigned largestTileLog2 = 2;                     // 2: no tiles
     bool empty() const { return bricks == 0 && tiles == 0; }
+    // Sources that see every value while they summarise note them here:
+    // when all have the same bits (uniform()), the layer's values need no
+    // gather pass (a level set's inactive voxels are all its inside value).
+    bool mixed = false;
+    std::vector<uint8_t> uniformValue;
+    bool uniform() const { return !mixed && !uniformValue.empty(); }
+    void noteValues(std::span<const uint8_t> values, unsigned valueSize) {
+        for (size_t at = 0; !mixed && valueSize && at + valueSize <= values.size(); at += valueSize) {
+            if (uniformValue.empty()) uniformValue.assign(values.begin() + long(at), values.begin() + long(at + valueSize));
+            else if (!std::equal(uniformValue.begin(), uniformValue.end(), values.begin() + long(at))) mixed = true;
+        }
+    }
     // The cube [x, x + size)^3 is in the layer.
     void extend(int64_t x, int64_t y, int64_t z, int64_t size) {
         const int64_t c[3] = {x, y, z};

@@ -4,6 +4,8 @@
 // level, inactive values, half floats and every codec; the decoded file is
 // compared with the input by OpenVDB's own accessors (compareWithFile). The
 // CLI's --memory-limit and --threads must not change the output either.
+#include <cstring>
+#include <set>
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -193,4 +195,28 @@ TEST(VdbCubes, MpirunGivesTheSingleProcessBytes) {
                                                " encode " + inputs[0].string() + " -o " + inputs[0].string() + " -f");
     EXPECT_NE(bad.exitCode, 0);
 #endif
+}
+
+// The summary's "every value the same" (which lets the encoder skip a
+// gather pass) against OpenVDB's own iteration of each layer.
+TEST(VdbCubes, UniformLayersAreThoseWhoseValuesOpenVdbSeesAllEqual) {
+    const fs::path path = writeAllTypes("uniform", openvdb::io::COMPRESS_BLOSC, false, 3);
+    bridge::VdbCubeInput input = bridge::openVdbCubes(path.string());
+    openvdb::io::File file(path.string());
+    file.open();
+    for (auto& source : input.grids) {
+        if (source->header().valueType != ValueType::Float) continue;
+        auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(source->header().name));
+        std::set<float> active, inactive;
+        for (auto it = grid->tree().cbeginValueOn(); it; ++it) active.insert(*it);
+        for (auto it = grid->tree().cbeginValueOff(); it; ++it)
+            if (*it != grid->background()) inactive.insert(*it);
+        const LayerSummary a = source->summary(Layer::Active), i = source->summary(Layer::Inactive);
+        EXPECT_EQ(a.uniform(), active.size() == 1);
+        ASSERT_EQ(i.uniform(), inactive.size() == 1);
+        ASSERT_TRUE(i.uniform());  // the level-set-like grid: every inactive value is -3
+        float value;
+        std::memcpy(&value, i.uniformValue.data(), sizeof value);
+        EXPECT_EQ(value, *inactive.begin());
+    }
 }

@@ -32,6 +32,13 @@ bool sameBits(const T& a, const T& b) {
     else return std::memcmp(&a, &b, sizeof(T)) == 0;
 }
 
+// Whether every value of `values` (each `valueSize` bytes) has the same bits.
+inline bool allSameValue(const std::vector<uint8_t>& values, unsigned valueSize) {
+    for (size_t at = valueSize; valueSize && at + valueSize <= values.size(); at += valueSize)
+        if (std::memcmp(values.data(), values.data() + at, valueSize) != 0) return false;
+    return true;
+}
+
 // Brick b (0..7) of a leaf is the 4^3 block at ((b&1)*4, (b>>1&1)*4, (b>>2&1)*4).
 inline openvdb::Coord brickCorner(const openvdb::Coord& leafOrigin, unsigned b) {
     return leafOrigin.offsetBy(int(b & 1u) * 4, int((b >> 1) & 1u) * 4, int((b >> 2) & 1u) * 4);
