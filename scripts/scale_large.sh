@@ -5,9 +5,8 @@
 #  - sphere_d4096 (vdb_tool -sphere d=4096 r=1.0 w=3, 315M voxels) at
 #    --memory-limit 1G, then `vdbdag diff` against the input (0 = exact),
 #    beside vdb_tool's read + blosc write of the same file;
-#  - a 16-bit CT-like scan XxYxZ at --memory-limit 4G, written slab by slab
-#    by scripts/make_large_scan.py (vdbdag_make_ct_phantom holds the whole
-#    volume as floats: 16 GB at 2048x2048x1024); with --decode also decoded
+#  - the CT phantom XxYxZ (vdbdag_make_ct_phantom --dims X Y Z, written
+#    slab by slab) at --memory-limit 4G; with --decode also decoded
 #    to .nhdr (cube by cube from the DAG) and its raw file compared (cmp)
 #    with the input's;
 #  - with --d8192, the d=8192 sphere (about 1.26G voxels) at 4G.
@@ -40,9 +39,9 @@ run() {  # run NAME CMD...: "seconds peak_kb" in $OUT/NAME.time
 }
 secs() { cut -d' ' -f1 "$OUT/$1.time"; }
 peak() { awk '{printf "%.0f", $2/1024}' "$OUT/$1.time"; }
-voxels() { $V info "$1" --json | python3 -c "import json,sys;print(sum(g['active_voxels'] for g in json.load(sys.stdin)['grids']))"; }
+voxels() { $V info "$1" --json | /usr/bin/python3 -c "import json,sys;print(sum(g['active_voxels'] for g in json.load(sys.stdin)['grids']))"; }
 row() {  # row INPUT VOXELS RUN KEY [CHECK]
-  python3 -c "print(f'| $1 | {$2:,} | $3 | {$(secs $4):.1f} | {$2/1e6/$(secs $4):.2f} | $(peak $4) | ${5:-—} |')" >> "$tmp"
+  /usr/bin/python3 -c "print(f'| $1 | {$2:,} | $3 | {$(secs $4):.1f} | {$2/1e6/$(secs $4):.2f} | $(peak $4) | ${5:-—} |')" >> "$tmp"
 }
 
 {
@@ -61,8 +60,11 @@ for d in "${spheres[@]+"${spheres[@]}"}"; do
   [ -f "$f" ] || vdb_tool -sphere d=$d r=1.0 w=3 -write "$f" >/dev/null
   limit=1G; [ $d = 8192 ] && limit=4G
   run "d$d.limited" $V encode "$f" -o "$OUT/d$d.limited.ssvdag" -f --memory-limit $limit
-  same="NO"
-  run "d$d.diff" $V diff "$f" "$OUT/d$d.limited.ssvdag" && same="exact (\`vdbdag diff\`, $(secs d$d.diff) s, $(peak d$d.diff) MB)"
+  same="not checked (\`vdbdag diff\` holds both grids: too large here)"
+  if [ $d != 8192 ]; then
+    same="NO"
+    run "d$d.diff" $V diff "$f" "$OUT/d$d.limited.ssvdag" && same="exact (\`vdbdag diff\`, $(secs d$d.diff) s, $(peak d$d.diff) MB)"
+  fi
   n=$(voxels "$OUT/d$d.limited.ssvdag")
   row "sphere_d$d" "$n" "encode --memory-limit $limit" "d$d.limited" "$same"
   run "d$d.vdbtool" vdb_tool -read "$f" -write "$OUT/sphere_d$d.blosc.vdb" codec=blosc
@@ -70,8 +72,8 @@ for d in "${spheres[@]+"${spheres[@]}"}"; do
   rm -f "$OUT/sphere_d$d.blosc.vdb"
 done
 
-p="scan_${phantom[0]}x${phantom[1]}x${phantom[2]}"
-[ -f "$OUT/$p.nhdr" ] || /usr/bin/python3 scripts/make_large_scan.py "$OUT/$p" "${phantom[@]}"
+p="phantom_${phantom[0]}x${phantom[1]}x${phantom[2]}"
+[ -f "$OUT/$p.nhdr" ] || build/vdbdag_make_ct_phantom "$OUT/$p" --dims "${phantom[@]}" >/dev/null
 run "$p.limited" $V encode "$OUT/$p.nhdr" -o "$OUT/$p.limited.ssvdag" -f --memory-limit 4G
 check="not checked (run with --decode)"
 if [ $decode = 1 ]; then
@@ -79,7 +81,7 @@ if [ $decode = 1 ]; then
   raw=$(awk -F': ' '/^data file/ {print $2}' "$OUT/$p.nhdr")
   cmp -s "$OUT/$raw" "$OUT/$p.decoded.raw" && check="exact (decode to .nhdr + cmp of the raw, $(secs $p.decode) s, $(peak $p.decode) MB)" || check=NO
 fi
-row "$p (16-bit CT-like)" "$(voxels "$OUT/$p.limited.ssvdag")" "encode --memory-limit 4G" "$p.limited" "$check"
+row "$p (vdbdag_make_ct_phantom, 12-bit in uint16)" "$(voxels "$OUT/$p.limited.ssvdag")" "encode --memory-limit 4G" "$p.limited" "$check"
 
 mv "$tmp" "$report"
 cat "$report"
