@@ -224,7 +224,6 @@ private:
         for (auto it = tree.beginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
         leaves_.resize(leaves.size());
         std::vector<uint64_t> inactiveVoxels(leaves.size(), 0);
-        const MappedPages mapped(path_);
         // Chunk by chunk: each leaf's bricks of both layers, with values,
         // into the scratch file; then the chunk's leaves (and the file pages
         // their buffers were read from) are dropped.
@@ -270,7 +269,7 @@ private:
                 leaves_[i].recordOffset = scratch_->append(records[i - begin].data(), records[i - begin].size());
                 if constexpr (hasValues) tree.addTile(1, leaves_[i].origin, background, false);
             }
-            if constexpr (hasValues) mapped.release();
+            if constexpr (hasValues) releaseMappedPages(path_);
         }
         for (int l = 0; l < 2; ++l) {
             LayerSummary& s = summary_[l];

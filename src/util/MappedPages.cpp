@@ -7,14 +7,17 @@
 
 #include <cinttypes>
 #include <cstdio>
+#include <utility>
+#include <vector>
 
 namespace vdbdag {
 
-MappedPages::MappedPages(const std::string& path) {
+size_t releaseMappedPages(const std::string& path) {
     struct stat st {};
-    if (::stat(path.c_str(), &st) != 0) return;
+    if (::stat(path.c_str(), &st) != 0) return 0;
     FILE* maps = std::fopen("/proc/self/maps", "r");
-    if (!maps) return;
+    if (!maps) return 0;
+    std::vector<std::pair<void*, size_t>> ranges;
     char line[4096];
     while (std::fgets(line, sizeof line, maps)) {
         uintptr_t begin = 0, end = 0;
@@ -22,14 +25,14 @@ MappedPages::MappedPages(const std::string& path) {
         unsigned long long offset = 0, inode = 0;
         unsigned devMajor = 0, devMinor = 0;
         if (std::sscanf(line, "%" SCNxPTR "-%" SCNxPTR " %7s %llx %x:%x %llu", &begin, &end, perms, &offset, &devMajor, &devMinor, &inode) != 7) continue;
-        if (inode != st.st_ino || makedev(devMajor, devMinor) != st.st_dev || perms[1] == 'w') continue;
-        ranges_.push_back({reinterpret_cast<void*>(begin), size_t(end - begin)});
+        if (inode == 0 || inode != st.st_ino || makedev(devMajor, devMinor) != st.st_dev || perms[1] == 'w') continue;
+        ranges.push_back({reinterpret_cast<void*>(begin), size_t(end - begin)});
     }
     std::fclose(maps);
-}
-
-void MappedPages::release() const {
-    for (const auto& [address, length] : ranges_) ::madvise(address, length, MADV_DONTNEED);
+    // Still this process's mapping of the file: nothing here unmaps it
+    // between the lookup and the advice (the caller's thread holds the grid).
+    for (const auto& [address, length] : ranges) ::madvise(address, length, MADV_DONTNEED);
+    return ranges.size();
 }
 
 } // namespace vdbdag
