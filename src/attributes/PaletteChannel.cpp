@@ -104,6 +104,23 @@ private:
     size_t count_ = 0, bytes_ = 0;
 };
 
+// Doubles an open-addressing table of slots (id1 == 0: empty), placing each
+// slot at bucketOf(slot, new mask) with linear probing.
+template <typename Slot, typename Bucket>
+void growTable(RandomAccessArray<Slot>& slots, size_t& mask, Bucket&& bucketOf) {
+    RandomAccessArray<Slot> bigger(slots.size() * 2);
+    const size_t m = bigger.size() - 1;
+    for (size_t k = 0; k < slots.size(); ++k) {
+        const Slot s = slots[k];
+        if (!s.id1) continue;
+        size_t h = bucketOf(s, m);
+        while (bigger[h].id1) h = (h + 1) & m;
+        bigger[h] = s;
+    }
+    slots = std::move(bigger);
+    mask = m;
+}
+
 // Dense ids of the distinct values, in order of first occurrence, for
 // values of 4 or 8 bytes: each slot holds the value's bits beside its id, so
 // a probe is one load (no detour through the value array) and growth never
@@ -123,19 +140,7 @@ std::vector<uint32_t> distinctKeyIds(const uint8_t* values, uint64_t n, std::vec
     firstOccurrence.reserve(size_t(std::min<uint64_t>(n, uint64_t(1) << 32)));
     RandomAccessArray<Slot> slots(size_t(1) << 16);
     size_t mask = slots.size() - 1;
-    auto grow = [&]() {
-        RandomAccessArray<Slot> bigger(slots.size() * 2);
-        const size_t m = bigger.size() - 1;
-        for (size_t k = 0; k < slots.size(); ++k) {
-            const Slot s = slots[k];
-            if (!s.id1) continue;
-            size_t h = bucketOf(s.key, m);
-            while (bigger[h].id1) h = (h + 1) & m;
-            bigger[h] = s;
-        }
-        slots = std::move(bigger);
-        mask = m;
-    };
+    auto grow = [&]() { growTable(slots, mask, [&](const Slot& s, size_t m) { return bucketOf(s.key, m); }); };
     Key previous{};
     for (uint64_t i = 0; i < n; ++i) {
         Key k;
@@ -177,19 +182,7 @@ std::vector<uint32_t> distinctIds(std::span<const uint8_t> values, uint32_t vs, 
     firstOccurrence.reserve(size_t(std::min<uint64_t>(n, uint64_t(1) << 32)));
     RandomAccessArray<Slot> slots(size_t(1) << 16);
     size_t mask = slots.size() - 1;
-    auto grow = [&]() {
-        RandomAccessArray<Slot> bigger(slots.size() * 2);
-        const size_t m = bigger.size() - 1;
-        for (size_t k = 0; k < slots.size(); ++k) {
-            const Slot s = slots[k];
-            if (!s.id1) continue;
-            size_t h = s.hash & m;
-            while (bigger[h].id1) h = (h + 1) & m;
-            bigger[h] = s;
-        }
-        slots = std::move(bigger);
-        mask = m;
-    };
+    auto grow = [&]() { growTable(slots, mask, [](const Slot& s, size_t m) { return size_t(s.hash) & m; }); };
     for (uint64_t i = 0; i < n; ++i) {
         const uint8_t* v = values.data() + i * vs;
         if (i > 0 && sameValue(v, v - vs, vs)) { ids[i] = ids[i - 1]; continue; }
