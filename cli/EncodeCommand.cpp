@@ -4,8 +4,6 @@
 // `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]`
 // Dense scans (.raw, .nrrd, .nhdr, .mhd, .mha, by extension) are read by
 // vdb_bridge/DenseImport.h instead, with the raw layout and threshold options.
-#include <unistd.h>
-
 #include <chrono>
 #include <filesystem>
 #include <optional>
@@ -19,6 +17,7 @@
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "cli/DenseInputOptions.h"
+#include "cli/MemoryBudget.h"
 #include "cli/FiniteNumber.h"
 #include "src/pipeline/CubeEncoder.h"
 #include "src/pipeline/GridCodec.h"
@@ -31,24 +30,6 @@
 #include "vdb_bridge/VdbImport.h"
 
 namespace vdbdag::cli {
-namespace {
-
-// Without --memory-limit: half of the physical memory.
-uint64_t defaultMemoryLimit() {
-    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
-    return pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) / 2 : uint64_t(4) << 30;
-}
-
-// Scratch bytes each scratch space of an encode keeps in memory before it
-// writes a file: a quarter of what the limit leaves beyond 1 GiB (none
-// under a tight limit, where the cubes in flight take it all).
-uint64_t scratchInMemory(uint64_t memoryLimit) {
-    constexpr uint64_t kReserved = uint64_t(1) << 30;
-    return memoryLimit > kReserved ? (memoryLimit - kReserved) / 4 : 0;
-}
-
-} // namespace
-
 void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::vector<std::string> inputs;
@@ -112,6 +93,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         if (opt->colourBits && opt->topologyOnly) throw Error("--colour-bits and --topology-only exclude each other: a topology-only file has no colours");
         const bool dense = bridge::denseFormatOf(opt->input) != bridge::DenseFormat::None;
         checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".ssvdag"}, "encode", opt->force});
+        // Scratch files are named after the output, in its folder or in --scratch.
+        const std::string scratchNear = opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
         bridge::ImportResult imported;
         std::optional<bridge::VdbCubeInput> cubeInput;  // --memory-limit on a .vdb: read region by region
         std::vector<std::unique_ptr<CubeSource>> denseCubes;  // ... on a scalar scan: its samples in a scratch file
@@ -125,8 +108,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             // default limit); the same bytes either way.
             if (!opt->topologyOnly) {
                 if (opt->memoryLimit || cubeTeam().size() > 1 || bridge::describeDense(opt->input, denseOptions).sampleCount() > defaultMemoryLimit() / 12)
-                    denseOptions.cubesNear = opt->scratch.empty() ? opt->output
-                                                                  : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
+                    denseOptions.cubesNear = scratchNear;
             }
             bridge::DenseImportResult dense = bridge::importDense(opt->input, denseOptions);
             threshold = dense.threshold;
@@ -152,8 +134,6 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             // strictest reader, for a stream and for --normals (the
             // gradient reads across cubes). The same bytes either way.
             if (!importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
-                const std::string scratchNear =
-                    opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
                 cubeInput = bridge::openVdbCubes(opt->input, importOptions, scratchNear,
                                                  scratchInMemory(opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()));
                 imported.warnings = cubeInput->warnings;
@@ -208,13 +188,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             // in memory, which costs least (the same bytes), except under
             // mpirun, where the processes share its cubes.
             if (cubeInput || !denseCubes.empty() || team.size() > 1) {
-                pipeline::CubeBudget budget;
-                const uint64_t limit = opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit();
-                budget.bytes = std::max<uint64_t>(limit / 2, 1);
-                budget.spillInMemory = scratchInMemory(limit);
-                // The coded values wait in a scratch file, not in memory, until the file is written.
-                budget.spillNear =
-                    opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
+                const pipeline::CubeBudget budget = cubeBudget(opt->memoryLimit, scratchNear);
                 std::vector<std::unique_ptr<CubeSource>> sources;
                 if (!denseCubes.empty()) {
                     sources = std::move(denseCubes);

@@ -1,38 +1,150 @@
-// `vdbdag verify IN.vdb [--json]`: encode, write the container in memory,
-// read it back, decode, and compare with the original file using OpenVDB
-// alone (vdb_bridge/VdbCompare): headers, topology, every active value and
-// every stored inactive value, bit for bit. Exit 0 only if identical.
+// `vdbdag verify IN.vdb [--json] [--memory-limit SIZE] [--scratch DIR]`:
+// encode, write the .ssvdag, read it back, decode, and compare with the
+// original file using OpenVDB alone: headers, topology, every active value
+// and every stored inactive value, bit for bit. Exit 0 only if identical.
+//
+// A .vdb with grid offsets goes the way `encode` takes it (region by
+// region, within --memory-limit) into a temporary file in the scratch
+// folder, and is compared cube by cube (vdb_bridge/VdbStreamCompare.h):
+// neither side is ever a whole grid. An OpenVDB stream is read, encoded
+// and compared whole, in memory (vdb_bridge/VdbCompare.h).
+#include <filesystem>
+#include <fstream>
+
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/MemoryBudget.h"
 #include "cli/RunContext.h"
+#include "src/pipeline/CubeEncoder.h"
 #include "src/pipeline/GridCodec.h"
+#include "src/util/Error.h"
+#include "src/util/Progress.h"
+#include "src/util/TemporaryFiles.h"
 #include "vdb_bridge/VdbCompare.h"
+#include "vdb_bridge/VdbCubes.h"
 #include "vdb_bridge/VdbImport.h"
+#include "vdb_bridge/VdbStreamCompare.h"
 
 namespace vdbdag::cli {
+namespace {
+
+struct VerifyOptions {
+    std::string input, scratch, encoded;
+    bool json = false, noSymmetry = false, topologyOnly = false;
+    uint64_t memoryLimit = 0;
+};
+
+struct Verified {
+    bridge::CompareResult result;
+    uint64_t bytes = 0;  // the .ssvdag file's size
+    size_t grids = 0;
+};
+
+// Removes a file when it goes out of scope (and, through the guard, on an interrupt).
+struct RemovedAfterwards {
+    explicit RemovedAfterwards(std::string p) : path(std::move(p)), guard(path) {}
+    ~RemovedAfterwards() {
+        std::error_code ignored;
+        std::filesystem::remove(path, ignored);
+    }
+    std::string path;
+    TemporaryGuard guard;
+};
+
+// An .ssvdag file against the input, cube by cube.
+void compareByCubes(const VerifyOptions& opt, const std::string& encoded, Progress& progress, uint64_t from, uint64_t units, Verified& out) {
+    format::ReadOptions readOptions;
+    readOptions.rebuildPalettes = false;
+    readOptions.keepValueWindows = true;
+    const format::SsvdagScene scene = format::readSceneFile(encoded, readOptions);
+    out.grids = scene.grids.size();
+    std::string step;
+    out.result = bridge::compareSceneWithFile(opt.input, scene, !opt.topologyOnly, [&](const std::string& s, uint64_t done, uint64_t total) {
+        if (s != step) progress.setLabel("verify: " + (step = s));
+        if (total) progress.set(from + std::min(done, total) * (units - 1) / total);
+    });
+}
+
+// The file `encode` wrote (--encoded).
+Verified verifyEncoded(const VerifyOptions& opt) {
+    if (!bridge::canReadVdbByCubes(opt.input)) throw Error(opt.input + ": --encoded needs a .vdb file with grid offsets (not an OpenVDB stream)");
+    Progress progress("verify", 1000);
+    Verified out;
+    compareByCubes(opt, opt.encoded, progress, 0, 1000, out);
+    out.bytes = std::filesystem::file_size(opt.encoded);
+    progress.finish();
+    return out;
+}
+
+// Region by region, through a temporary .ssvdag file.
+Verified verifyByCubes(const VerifyOptions& opt) {
+    const std::filesystem::path folder = opt.scratch.empty() ? std::filesystem::temp_directory_path() : std::filesystem::path(opt.scratch);
+    const RemovedAfterwards encoded(temporaryNameFor((folder / std::filesystem::path(opt.input).filename()).string(), ".ssvdag"));
+    constexpr uint64_t kUnits = 1000;  // encode, then compare
+    Progress progress("verify: encode", 2 * kUnits);
+    Verified out;
+    {
+        bridge::ImportOptions importOptions;
+        importOptions.topologyOnly = opt.topologyOnly;
+        bridge::VdbCubeInput input = bridge::openVdbCubes(opt.input, importOptions, encoded.path, scratchInMemory(opt.memoryLimit ? opt.memoryLimit : defaultMemoryLimit()));
+        pipeline::EncodeOptions options;
+        options.symmetry = !opt.noSymmetry;
+        options.computeSvdagStats = true;  // as `encode` does: the same file, byte for byte
+        const size_t steps = std::max<size_t>(1, input.grids.size() * pipeline::kEncodeSteps);
+        size_t stepsStarted = 0;
+        options.onStep = [&](const char*) { progress.set(stepsStarted++ * kUnits / steps); };
+        options.onStepProgress = [&](uint64_t done, uint64_t total) {
+            if (stepsStarted && total) progress.set(((stepsStarted - 1) * kUnits + std::min(done, total) * kUnits / total) / steps);
+        };
+        format::SsvdagScene scene = pipeline::encodeSourcesByCubes(std::move(input.grids), input.fileMetadata, options, cubeBudget(opt.memoryLimit, encoded.path));
+        std::ofstream file(encoded.path, std::ios::binary | std::ios::trunc);
+        if (!file) throw Error(encoded.path + ": cannot be created (the verify's temporary file; choose another folder with --scratch)");
+        out.bytes = format::writeSceneReleasing(scene, file);
+        file.close();
+        if (!file) throw Error(encoded.path + ": could not be written (the verify's temporary file; is the disk full?)");
+    }
+    compareByCubes(opt, encoded.path, progress, kUnits, kUnits, out);
+    progress.finish();
+    return out;
+}
+
+// Whole, in memory (an OpenVDB stream has no offsets to read regions by).
+Verified verifyWhole(const VerifyOptions& opt) {
+    bridge::ImportOptions importOptions;
+    importOptions.topologyOnly = opt.topologyOnly;
+    const bridge::ImportResult imported = bridge::importVdb(opt.input, importOptions);
+    pipeline::EncodeOptions options;
+    options.symmetry = !opt.noSymmetry;
+    const std::vector<uint8_t> bytes = format::writeScene(pipeline::encodeVolume(imported.volume, options));
+    const Volume decoded = pipeline::decodeScene(format::readScene(bytes, opt.input + " (in memory)"));
+    return {bridge::compareWithFile(opt.input, decoded, !opt.topologyOnly), bytes.size(), decoded.grids.size()};
+}
+
+} // namespace
 
 void addVerifyCommand(CLI::App& app, int& exitCode) {
-    struct Options { std::string input; std::vector<std::string> grids; bool json = false, noSymmetry = false, topologyOnly = false; };
-    auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("verify", "Round-trip a .vdb file through the .ssvdag format in memory and compare");
+    auto opt = std::make_shared<VerifyOptions>();
+    CLI::App* cmd = app.add_subcommand("verify", "Check that a .vdb file survives the round trip through .ssvdag bit for bit (or that an .ssvdag file holds it), region by region");
     cmd->add_option("input", opt->input, "input .vdb file")->required();
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "verify the plain SVDAG encoding");
     cmd->add_flag("--topology-only", opt->topologyOnly, "verify the geometry-only encoding (topology and headers)");
+    cmd->add_option("--encoded", opt->encoded, "compare this .ssvdag file (e.g. what `encode` wrote) with the input, instead of encoding one")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--memory-limit", opt->memoryLimit, "working memory of the encode, as for `encode` (default: half the physical memory)")
+        ->transform(CLI::AsSizeValue(false));
+    cmd->add_option("--scratch", opt->scratch, "folder for the encoded file and the scratch files while verifying (default: the system's temporary folder)")
+        ->check(CLI::ExistingDirectory);
     cmd->add_flag("--json", opt->json, "print JSON");
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "verifying");
-        bridge::ImportOptions importOptions;
-        importOptions.topologyOnly = opt->topologyOnly;
-        const bridge::ImportResult imported = bridge::importVdb(opt->input, importOptions);
-        pipeline::EncodeOptions options;
-        options.symmetry = !opt->noSymmetry;
-        const std::vector<uint8_t> bytes = format::writeScene(pipeline::encodeVolume(imported.volume, options));
-        const Volume decoded = pipeline::decodeScene(format::readScene(bytes, opt->input + " (in memory)"));
-        const bridge::CompareResult result = bridge::compareWithFile(opt->input, decoded, !opt->topologyOnly);
-
-        nlohmann::json report{{"input", opt->input}, {"identical", result.identical}, {"ssvdag_bytes", bytes.size()},
+        if (opt->json) setQuiet(true);
+        const Verified verified = !opt->encoded.empty()                   ? verifyEncoded(*opt)
+                                  : bridge::canReadVdbByCubes(opt->input) ? verifyByCubes(*opt)
+                                                                          : verifyWhole(*opt);
+        const bridge::CompareResult& result = verified.result;
+        nlohmann::json report{{"input", opt->input}, {"identical", result.identical}, {"ssvdag_bytes", verified.bytes},
                               {"header_differences", result.headerDifferences}, {"grids", nlohmann::json::array()}};
         for (const auto& d : result.topology)
             report["grids"].push_back({{"index", d.gridIndex}, {"name", d.gridName}, {"only_in_original", d.onlyInA},
@@ -44,7 +156,7 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
         if (opt->json) {
             fmt::print("{}\n", report.dump(2));
         } else if (result.identical) {
-            fmt::print("{}: identical after the round trip ({} grid(s), {} bytes encoded)\n", opt->input, decoded.grids.size(), bytes.size());
+            fmt::print("{}: identical after the round trip ({} grid(s), {} bytes encoded)\n", opt->input, verified.grids, verified.bytes);
         } else {
             fmt::print("{}: DIFFERS after the round trip\n", opt->input);
             for (const auto& h : result.headerDifferences) fmt::print("  {}\n", h);

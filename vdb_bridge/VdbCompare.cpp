@@ -5,35 +5,21 @@
 #include "vdb_bridge/VdbCompare.h"
 
 #include <cstring>
-#include <set>
-#include <sstream>
 #include <type_traits>
 
 #include "src/util/Error.h"
 #include "vdb_bridge/detail/GridBuilder.h"
+#include "vdb_bridge/detail/HeaderCompare.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/VdbFile.h"
 
 namespace vdbdag::bridge {
 namespace {
 
-// Metadata OpenVDB's writer recomputes on every write (grid statistics and the
-// compression it used): not part of what a round trip must keep.
-const std::set<std::string> kWriterMetadata = {"file_bbox_min", "file_bbox_max", "file_mem_bytes", "file_voxel_count",
-                                               "file_compression", "file_delayed_load"};
-
 template <typename T>
 bool sameBits(const T& a, const T& b) {
     if constexpr (std::is_same_v<T, bool>) return a == b;
     else return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
-
-template <typename T>
-std::string show(const T& v) {
-    std::ostringstream s;
-    s.precision(9);
-    s << v;
-    return s.str();
 }
 
 template <typename GridT>
@@ -46,7 +32,7 @@ void compareValues(const GridT& a, const GridT& b, ValueDifference& d) {
         (active ? d.activeValues : d.inactiveValues)++;
         if (d.examples.size() < 8)
             d.examples.push_back(std::string(active ? "active" : "inactive") + " value at (" + std::to_string(c.x()) + "," + std::to_string(c.y()) + "," +
-                                 std::to_string(c.z()) + "): " + show(va) + " vs " + show(vb));
+                                 std::to_string(c.z()) + "): " + detail::showValue(va) + " vs " + detail::showValue(vb));
     };
     // Leaves of A against B (B's leaf, or the tile/background covering it).
     for (auto leaf = ta.cbeginLeaf(); leaf; ++leaf) {
@@ -100,24 +86,6 @@ std::string describeBox(const openvdb::CoordBBox& box) {
     return "tile of " + std::to_string(box.dim().x()) + "^3 at (" + std::to_string(a.x()) + "," + std::to_string(a.y()) + "," + std::to_string(a.z()) + ")";
 }
 
-void compareHeaders(size_t index, const openvdb::GridBase& a, const openvdb::GridBase& b, std::vector<std::string>& out) {
-    const std::string prefix = "grid " + std::to_string(index) + " '" + a.getName() + "': ";
-    if (a.getName() != b.getName()) out.push_back(prefix + "name differs ('" + a.getName() + "' vs '" + b.getName() + "')");
-    if (a.getGridClass() != b.getGridClass())
-        out.push_back(prefix + "class differs (" + openvdb::GridBase::gridClassToString(a.getGridClass()) + " vs " +
-                      openvdb::GridBase::gridClassToString(b.getGridClass()) + ")");
-    if (a.transform() != b.transform()) out.push_back(prefix + "transform differs");
-    std::set<std::string> names;
-    for (auto it = a.beginMeta(); it != a.endMeta(); ++it) names.insert(it->first);
-    for (auto it = b.beginMeta(); it != b.endMeta(); ++it) names.insert(it->first);
-    for (const std::string& name : names) {
-        if (kWriterMetadata.count(name)) continue;
-        const auto ma = a[name], mb = b[name];
-        if (!ma || !mb) out.push_back(prefix + "metadata '" + name + "' only in " + (ma ? "the first" : "the second"));
-        else if (!(*ma == *mb)) out.push_back(prefix + "metadata '" + name + "' differs (" + ma->str() + " vs " + mb->str() + ")");
-    }
-}
-
 TopologyDifference compareTrees(size_t index, const std::string& name, const openvdb::MaskTree& a, const openvdb::MaskTree& b) {
     TopologyDifference d;
     d.gridIndex = index;
@@ -163,7 +131,7 @@ CompareResult compareGridLists(const openvdb::GridPtrVec& a, const openvdb::Grid
     if (a.size() != b.size())
         result.headerDifferences.push_back("grid count differs (" + std::to_string(a.size()) + " vs " + std::to_string(b.size()) + ")");
     for (size_t g = 0; g < std::min(a.size(), b.size()); ++g) {
-        compareHeaders(g, *a[g], *b[g], result.headerDifferences);
+        detail::compareHeaders(g, *a[g], *b[g], result.headerDifferences);
         const auto ta = topologyTree(*a[g]), tb = topologyTree(*b[g]);
         if (!ta || !tb) {
             result.headerDifferences.push_back("grid " + std::to_string(g) + " '" + a[g]->getName() + "': unsupported type '" +
@@ -178,19 +146,6 @@ CompareResult compareGridLists(const openvdb::GridPtrVec& a, const openvdb::Grid
     return result;
 }
 
-// File-level metadata, entry by entry.
-void compareFileMetadata(const openvdb::MetaMap& a, const openvdb::MetaMap& b, std::vector<std::string>& out) {
-    std::set<std::string> names;
-    for (auto it = a.beginMeta(); it != a.endMeta(); ++it) names.insert(it->first);
-    for (auto it = b.beginMeta(); it != b.endMeta(); ++it) names.insert(it->first);
-    for (const std::string& name : names) {
-        const auto ma = a[name], mb = b[name];
-        if (!ma || !mb) out.push_back("file metadata '" + name + "' only in " + (ma ? "the first" : "the second"));
-        else if (ma->typeName() != mb->typeName() || !(*ma == *mb))
-            out.push_back("file metadata '" + name + "' differs (" + ma->str() + " vs " + mb->str() + ")");
-    }
-}
-
 void finish(CompareResult& result) {
     result.identical = result.headerDifferences.empty() && result.topology.empty() && result.values.empty();
 }
@@ -203,7 +158,7 @@ CompareResult compareWithFile(const std::string& originalPath, const Volume& dec
     for (size_t g = 0; g < decoded.grids.size(); ++g)
         rebuilt.push_back(detail::buildGrid(decoded.grids[g], originalPath + " (decoded grid " + std::to_string(g) + ")"));
     CompareResult result = compareGridLists(original.grids, rebuilt, values);
-    compareFileMetadata(*original.metadata, *detail::parseMetadata(decoded.fileMetadata, originalPath + " (decoded)"), result.headerDifferences);
+    detail::compareFileMetadata(*original.metadata, *detail::parseMetadata(decoded.fileMetadata, originalPath + " (decoded)"), result.headerDifferences);
     finish(result);
     return result;
 }
@@ -211,7 +166,7 @@ CompareResult compareWithFile(const std::string& originalPath, const Volume& dec
 CompareResult compareFiles(const std::string& pathA, const std::string& pathB, bool values) {
     const detail::VdbFileContents a = detail::readVdbFile(pathA), b = detail::readVdbFile(pathB);
     CompareResult result = compareGridLists(a.grids, b.grids, values);
-    compareFileMetadata(*a.metadata, *b.metadata, result.headerDifferences);
+    detail::compareFileMetadata(*a.metadata, *b.metadata, result.headerDifferences);
     finish(result);
     return result;
 }
