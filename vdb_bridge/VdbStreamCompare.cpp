@@ -137,9 +137,8 @@ private:
             auto found = pending_.find(node.origin());
             if (whole || found == pending_.end()) expected_ += storedInactive(node);  // first met
             for (openvdb::Index n = 0; n < LeafT::SIZE; ++n) {
-                if (node.isValueOn(n)) continue;
                 const ValueT& v = node.getValue(n);
-                if (detail::sameBits(v, background_)) continue;
+                if (!inLayer(node.isValueOn(n), v)) continue;
                 const openvdb::Coord c = node.offsetToGlobalCoord(n);
                 if (whole || region.isInside(c)) meet(c, v);
             }
@@ -217,7 +216,7 @@ private:
     uint64_t storedInactive(const LeafT& node) const {
         uint64_t n = 0;
         for (openvdb::Index i = 0; i < LeafT::SIZE; ++i)
-            if (!node.isValueOn(i) && !detail::sameBits(ValueT(node.getValue(i)), background_)) ++n;
+            if (inLayer(node.isValueOn(i), node.getValue(i))) ++n;
         return n;
     }
 

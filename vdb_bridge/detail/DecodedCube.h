@@ -17,18 +17,6 @@
 
 namespace vdbdag::bridge::detail {
 
-// A decoded value as the decoder's grid builder reads it (GridBuilder.cpp).
-template <typename T>
-T valueFromBytes(const uint8_t* p) {
-    if constexpr (std::is_same_v<T, bool>) {
-        return *p != 0;
-    } else {
-        T v;
-        std::memcpy(&v, p, sizeof(T));
-        return v;
-    }
-}
-
 // Cubes of up to 2^log2 voxels a side (the layer's cut), `valueSize` bytes a value.
 class DecodedCube {
 public:

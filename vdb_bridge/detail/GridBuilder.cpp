@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstring>
 
+#include "vdb_bridge/detail/LeafBricks.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 
 namespace vdbdag::bridge::detail {
@@ -11,13 +12,7 @@ namespace {
 
 template <typename T>
 T valueAt(const std::vector<uint8_t>& bytes, size_t index) {
-    if constexpr (std::is_same_v<T, bool>) {
-        return bytes[index] != 0;
-    } else {
-        T value;
-        std::memcpy(&value, &bytes[index * sizeof(T)], sizeof(T));
-        return value;
-    }
+    return valueFromBytes<T>(&bytes[index * (std::is_same_v<T, bool> ? 1 : sizeof(T))]);
 }
 
 template <typename GridT>

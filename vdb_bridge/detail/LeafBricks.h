@@ -26,6 +26,18 @@ void appendValue(std::vector<uint8_t>& out, const T& value) {
     }
 }
 
+// The inverse of appendValue: the value whose raw bytes start at `p`.
+template <typename T>
+T valueFromBytes(const uint8_t* p) {
+    if constexpr (std::is_same_v<T, bool>) {
+        return *p != 0;
+    } else {
+        T v;
+        std::memcpy(&v, p, sizeof(T));
+        return v;
+    }
+}
+
 template <typename T>
 bool sameBits(const T& a, const T& b) {
     if constexpr (std::is_same_v<T, bool>) return a == b;
