@@ -47,6 +47,22 @@ std::vector<std::vector<uint8_t>> MpiTeam::gather(const std::vector<uint8_t>& mi
     return all;
 }
 
+void MpiTeam::gatherEach(std::vector<uint8_t> mine, const std::function<void(std::vector<uint8_t>&&)>& take) {
+    uint64_t mySize = mine.size();
+    std::vector<uint64_t> sizes(size_);
+    MPI_Gather(&mySize, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+    if (rank_ != 0) {
+        sendAll(mine.data(), mySize, 0);
+        return;
+    }
+    take(std::move(mine));
+    for (unsigned r = 1; r < size_; ++r) {
+        std::vector<uint8_t> bytes(sizes[r]);
+        receiveAll(bytes.data(), sizes[r], int(r));
+        take(std::move(bytes));
+    }
+}
+
 std::vector<uint8_t> MpiTeam::broadcast(const std::vector<uint8_t>& bytes) {
     uint64_t size = bytes.size();
     MPI_Bcast(&size, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);

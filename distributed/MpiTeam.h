@@ -12,6 +12,7 @@ public:
     unsigned rank() const override { return rank_; }
     unsigned size() const override { return size_; }
     std::vector<std::vector<uint8_t>> gather(const std::vector<uint8_t>& mine) override;
+    void gatherEach(std::vector<uint8_t> mine, const std::function<void(std::vector<uint8_t>&&)>& take) override;
     std::vector<uint8_t> broadcast(const std::vector<uint8_t>& bytes) override;
 
 private:

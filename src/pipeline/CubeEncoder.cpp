@@ -360,18 +360,24 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
                 entries = writer.entries();
                 return writer.finish();
             }
-            const std::vector<std::vector<uint8_t>> shares = team.gather(writer.finishShare().serialize());
-            if (!team.isRoot()) return {};
-            std::decay_t<decltype(writer)> whole = [&] {
+            // Process 0 puts the shares together one at a time (each into
+            // its scratch space as it comes), never holding them all.
+            std::optional<std::decay_t<decltype(writer)>> whole;
+            if (team.isRoot()) {
                 if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::PredictedWindowWriter>)
-                    return attributes::PredictedWindowWriter(vs, inFlight, budget.spillNear, budget.spillInMemory);
+                    whole.emplace(vs, inFlight, budget.spillNear, budget.spillInMemory);
                 else
-                    return attributes::ValueWindowWriter(vs, expected, inFlight, budget.spillNear, budget.spillInMemory);
-            }();
-            for (const std::vector<uint8_t>& bytes : shares) whole.addShare(attributes::ShareWindows::deserialize(bytes));
-            entries = whole.entries();
+                    whole.emplace(vs, expected, inFlight, budget.spillNear, budget.spillInMemory);
+            }
+            team.gatherEach(writer.finishShare().serialize(), [&](std::vector<uint8_t>&& bytes) {
+                const attributes::ShareWindows share = attributes::ShareWindows::deserialize(bytes);
+                std::vector<uint8_t>().swap(bytes);
+                whole->addShare(share);
+            });
+            if (!team.isRoot()) return {};
+            entries = whole->entries();
             if (entries != expected) throw Error("internal error: the processes' values do not add up to the DAG's entries");
-            return whole.finish();
+            return whole->finish();
         };
         if (predicted) {
             attributes::PredictedWindowWriter writer(vs, inFlight, team.size() == 1 ? budget.spillNear : "", budget.spillInMemory);

@@ -7,6 +7,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace vdbdag::pipeline {
@@ -18,6 +19,11 @@ public:
     virtual unsigned size() const = 0;
     // Every process's bytes on process 0, in rank order; elsewhere empty.
     virtual std::vector<std::vector<uint8_t>> gather(const std::vector<uint8_t>& mine) = 0;
+    // The same, handed to `take` on process 0 one process's bytes at a time,
+    // in rank order, so process 0 need not hold them all at once.
+    virtual void gatherEach(std::vector<uint8_t> mine, const std::function<void(std::vector<uint8_t>&&)>& take) {
+        for (std::vector<uint8_t>& bytes : gather(mine)) take(std::move(bytes));
+    }
     // Process 0's bytes on every process (`bytes` is ignored elsewhere).
     virtual std::vector<uint8_t> broadcast(const std::vector<uint8_t>& bytes) = 0;
     bool isRoot() const { return rank() == 0; }
