@@ -1,67 +1,22 @@
-// OpenImageIO writer; see ImageWriter.h.
+// See ImageWriter.h: the frame is written by libvdbdag_images.so.
 #include "vdb_bridge/ImageWriter.h"
 
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
-
-#include <OpenImageIO/imageio.h>
 
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
+#include "vdb_bridge/detail/ImageModuleLoader.h"
 
 namespace vdbdag::bridge {
-namespace {
-
-float linearToSrgb(float c) {
-    c = std::clamp(std::isfinite(c) ? c : 0.f, 0.f, 1.f);
-    return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1 / 2.4f) - 0.055f;
-}
-
-std::string lowerExtension(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext;
-}
-
-} // namespace
 
 void writeImage(const std::string& path, const trace::Image& image) {
-    namespace fs = std::filesystem;
-    const std::string ext = lowerExtension(path);
+    const std::string ext = std::filesystem::path(path).extension().string();
     if (ext.empty()) throw Error(path + ": no file extension (use .png or .exr)");
-    const size_t pixels = size_t(image.width) * size_t(image.height);
+    const detail::ImageModule& module = detail::imageModule(path);
     // The temporary keeps the extension, so OpenImageIO picks the format.
     writeViaTemporary(path, [&](const std::string& temp) {
-        auto out = OIIO::ImageOutput::create(temp);
-        if (!out) throw Error(path + ": OpenImageIO cannot write '" + ext + "' files: " + OIIO::geterror());
-        bool ok = false;
-        if (ext == ".exr") {
-            OIIO::ImageSpec spec(image.width, image.height, 8, OIIO::TypeDesc::FLOAT);
-            spec.channelnames = {"R", "G", "B", "A", "Z", "N.x", "N.y", "N.z"};
-            spec.alpha_channel = 3;
-            spec.z_channel = 4;
-            spec.attribute("compression", "zip");
-            std::vector<float> data(pixels * 8);
-            for (size_t i = 0; i < pixels; ++i) {
-                float* p = &data[8 * i];
-                for (int c = 0; c < 3; ++c) p[c] = image.rgb[3 * i + c];
-                p[3] = image.alpha[i];
-                p[4] = image.depth[i];
-                for (int c = 0; c < 3; ++c) p[5 + c] = image.normal[3 * i + c];
-            }
-            ok = out->open(temp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, data.data()) && out->close();
-        } else {
-            OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-            spec.attribute("oiio:ColorSpace", "sRGB");
-            std::vector<uint8_t> data(pixels * 3);
-            for (size_t i = 0; i < pixels * 3; ++i) data[i] = uint8_t(std::lround(linearToSrgb(image.rgb[i]) * 255.f));
-            ok = out->open(temp, spec) && out->write_image(OIIO::TypeDesc::UINT8, data.data()) && out->close();
-        }
-        if (!ok) {
-            const std::string error = out->geterror();
-            throw Error(path + ": cannot write the image: " + (error.empty() ? std::string("unknown error") : error));
-        }
+        std::string error;
+        if (!module.writeFrame(temp.c_str(), image, error)) throw Error(path + ": " + error);
     }, ext);
 }
 

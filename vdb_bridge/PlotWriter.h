@@ -1,6 +1,7 @@
 // Scatter plots for `vdbdag bench` (error against size, error against time),
-// drawn with OpenImageIO's ImageBufAlgo and written as PNG: log-log axes,
-// one colour per family of points, the Pareto front circled and joined.
+// drawn with OpenImageIO's ImageBufAlgo (in libvdbdag_images.so) and written
+// as PNG: log-log axes, one colour per family of points, the Pareto front
+// circled and joined.
 #pragma once
 #include <array>
 #include <string>

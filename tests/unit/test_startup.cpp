@@ -1,0 +1,84 @@
+// What a call costs before it does anything: OpenImageIO (and the two
+// hundred libraries it brings) is loaded only by the commands that write a
+// picture, from libvdbdag_images.so beside the program. The dynamic
+// linker's own trace (LD_DEBUG=files) is the independent witness of what a
+// process loaded.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <vector>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetSphere.h>
+
+#include "tests/unit/CliRunner.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using vdbdag::testing::CommandResult;
+using vdbdag::testing::runCli;
+using vdbdag::testing::runShell;
+
+fs::path workDir() {
+    static const fs::path dir = [] {
+        fs::path d = fs::temp_directory_path() / ("vdbdag_startup_" + std::to_string(getpid()));
+        fs::remove_all(d);
+        fs::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+fs::path encodedBall() {
+    const fs::path vdb = workDir() / "ball.vdb", encoded = workDir() / "ball.ssvdag";
+    if (!fs::exists(encoded)) {
+        openvdb::initialize();
+        auto g = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(12.0f, openvdb::Vec3f(0.0f), 1.0f, 3.0f);
+        g->setName("ball");
+        openvdb::io::File(vdb.string()).write({g});
+        const CommandResult r = runCli("encode " + vdb.string() + " -o " + encoded.string());
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+    }
+    return encoded;
+}
+
+bool loadedOpenImageIO(const std::string& linkerTrace) { return linkerTrace.find("libOpenImageIO.so") != std::string::npos; }
+
+} // namespace
+
+TEST(Startup, OnlyCommandsThatWriteAPictureLoadOpenImageIO) {
+    const fs::path encoded = encodedBall();
+    for (const std::string& args : std::vector<std::string>{"--version", "info " + encoded.string(), "verify " + (workDir() / "ball.vdb").string() + " --encoded " + encoded.string(),
+                                   "decode " + encoded.string() + " -o " + (workDir() / "back.vdb").string() + " -f"}) {
+        const CommandResult r = runCli(args, "env LD_DEBUG=files ");
+        EXPECT_EQ(r.exitCode, 0) << args << "\n" << r.err.substr(0, 2000);
+        EXPECT_NE(r.err.find("calling init"), std::string::npos) << "no linker trace: the check would prove nothing";
+        EXPECT_FALSE(loadedOpenImageIO(r.err)) << args;
+    }
+    const fs::path png = workDir() / "ball.png";
+    const CommandResult r = runCli("render " + encoded.string() + " -o " + png.string() + " --backend cpu --width 32 --height 24", "env LD_DEBUG=files ");
+    ASSERT_EQ(r.exitCode, 0) << r.err.substr(0, 2000);
+    EXPECT_TRUE(loadedOpenImageIO(r.err));
+    EXPECT_TRUE(fs::exists(png));
+}
+
+TEST(Startup, RenderWithoutTheImageModuleIsAOneLineErrorAndWritesNothing) {
+    const fs::path encoded = encodedBall();
+    const fs::path alone = workDir() / "alone";
+    fs::create_directories(alone);
+    fs::copy_file(VDBDAG_BINARY, alone / "vdbdag", fs::copy_options::overwrite_existing);
+    const fs::path png = workDir() / "nothing.png";
+    const auto before = std::distance(fs::directory_iterator(workDir()), fs::directory_iterator());
+    const CommandResult r = runShell((alone / "vdbdag").string() + " render " + encoded.string() + " -o " + png.string() + " --backend cpu --width 16 --height 16");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(png.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("libvdbdag_images.so"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(png));
+    EXPECT_EQ(std::distance(fs::directory_iterator(workDir()), fs::directory_iterator()), before) << "a temporary was left behind";
+}
