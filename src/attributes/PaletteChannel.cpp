@@ -544,7 +544,33 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
     const std::vector<uint32_t> ids = distinctIds(values, valueSize, n, first);
     const std::vector<Segment> segments = Partitioner(ids, first.size(), valueSize).run();
 
+    // Material indices in value order (the values as little-endian unsigned
+    // integers): serializePalette stores the sorted material array as small
+    // differences, and neighbouring voxels, which have close values, get
+    // close indices.
     std::vector<uint32_t> material(first.size(), UINT32_MAX);  // id -> material index
+    {
+        std::vector<uint8_t> used(first.size(), 0);
+        for (const Segment& s : segments)
+            if (s.omega != PaletteBlock::kDirect)
+                for (uint64_t i = s.start; i < s.start + s.length; ++i) used[ids[i]] = 1;
+        std::vector<uint32_t> order;
+        for (uint32_t id = 0; id < used.size(); ++id)
+            if (used[id]) order.push_back(id);
+        const uint8_t* base = values.data();
+        std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+            const uint8_t* x = base + first[a] * valueSize;
+            const uint8_t* y = base + first[b] * valueSize;
+            for (uint32_t k = valueSize; k-- > 0;)
+                if (x[k] != y[k]) return x[k] < y[k];
+            return false;
+        });
+        out.materials.resize(order.size() * valueSize);
+        for (uint32_t m = 0; m < order.size(); ++m) {
+            material[order[m]] = m;
+            std::memcpy(&out.materials[size_t(m) * valueSize], base + first[order[m]] * valueSize, valueSize);
+        }
+    }
     PaletteTable paletteAt;                                        // shared palettes
     std::vector<uint32_t> local(first.size(), 0);
     std::vector<uint32_t> seen(first.size(), UINT32_MAX);  // block index that last listed this id
@@ -557,15 +583,7 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
             block.indexBits = uint8_t(bits);
             block.dataOffset = bitCursor;
             reserveBits(out.indexBits, bitCursor + s.length * bits);
-            for (uint64_t i = s.start; i < s.start + s.length; ++i, bitCursor += bits) {
-                uint32_t& m = material[ids[i]];
-                if (m == UINT32_MAX) {
-                    m = uint32_t(out.materials.size() / valueSize);
-                    out.materials.insert(out.materials.end(), values.begin() + long(first[ids[i]] * valueSize),
-                                         values.begin() + long((first[ids[i]] + 1) * valueSize));
-                }
-                putBits(out.indexBits, bitCursor, m, bits);
-            }
+            for (uint64_t i = s.start; i < s.start + s.length; ++i, bitCursor += bits) putBits(out.indexBits, bitCursor, material[ids[i]], bits);
         } else if (s.omega == PaletteBlock::kDirect) {
             block.dataOffset = out.direct.size();
             out.direct.insert(out.direct.end(), values.begin() + long(s.start * valueSize), values.begin() + long((s.start + s.length) * valueSize));
@@ -575,13 +593,7 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
             for (uint64_t i = s.start; i < s.start + s.length; ++i) {
                 if (seen[ids[i]] == blockIndex) continue;
                 seen[ids[i]] = blockIndex;
-                uint32_t& m = material[ids[i]];
-                if (m == UINT32_MAX) {
-                    m = uint32_t(out.materials.size() / valueSize);
-                    out.materials.insert(out.materials.end(), values.begin() + long(first[ids[i]] * valueSize),
-                                         values.begin() + long((first[ids[i]] + 1) * valueSize));
-                }
-                palette.push_back(m);
+                palette.push_back(material[ids[i]]);
             }
             std::sort(palette.begin(), palette.end());  // at most 256 distinct entries
             const unsigned bits = palette.size() <= 1 ? 0 : unsigned(std::bit_width(palette.size() - 1));
@@ -661,26 +673,72 @@ std::vector<uint8_t> unshuffle(const std::vector<uint8_t>& p, uint32_t vs) {
     return out;
 }
 
+// Differences of consecutive little-endian unsigned values of `vs` bytes
+// (vs = 1, 2, 4 or 8; modulo 2^(8 vs)), in place, and back. Other sizes
+// are left as they are.
+bool deltaCodable(uint32_t vs) { return vs == 1 || vs == 2 || vs == 4 || vs == 8; }
+uint64_t loadUnsigned(const uint8_t* p, uint32_t vs) {
+    uint64_t v = 0;
+    std::memcpy(&v, p, vs);
+    return v;
+}
+void storeUnsigned(uint8_t* p, uint64_t v, uint32_t vs) { std::memcpy(p, &v, vs); }
+std::vector<uint8_t> toDifferences(std::vector<uint8_t> v, uint32_t vs) {
+    if (!deltaCodable(vs)) return v;
+    uint64_t previous = 0;
+    for (size_t at = 0; at + vs <= v.size(); at += vs) {
+        const uint64_t x = loadUnsigned(&v[at], vs);
+        storeUnsigned(&v[at], x - previous, vs);
+        previous = x;
+    }
+    return v;
+}
+std::vector<uint8_t> fromDifferences(std::vector<uint8_t> v, uint32_t vs) {
+    if (!deltaCodable(vs)) return v;
+    uint64_t sum = 0;
+    for (size_t at = 0; at + vs <= v.size(); at += vs) {
+        sum += loadUnsigned(&v[at], vs);
+        storeUnsigned(&v[at], sum, vs);
+    }
+    return v;
+}
+std::vector<uint8_t> bytesOf(const std::vector<uint32_t>& v) {
+    std::vector<uint8_t> out(v.size() * 4);
+    if (!v.empty()) std::memcpy(out.data(), v.data(), out.size());
+    return out;
+}
+
+// The first u32 of a serialised channel: the value size (1..64), with this
+// bit set in the layout below (files before it hold the value size alone).
+constexpr uint32_t kColumnLayout = 0x80000000u;
+
 } // namespace
 
-// Layout: u32 valueSize, u64 entries, u64 materials bytes + bytes (shuffled),
-// u64 palette count + u32[], u64 blocks + (u64 first, u64 data, u32 palette, u8 ω)[],
-// u64 index words + u64[], u64 direct bytes + bytes (shuffled).
+// Layout (FORMAT.md §7): u32 valueSize | kColumnLayout, u64 entries,
+// u64 materials bytes + bytes (sorted; differences, then byte planes),
+// u64 palette count + u32[] (differences, byte planes),
+// u64 blocks + the directory by columns: u64 first entries (differences),
+// u64 data offsets, u32 palette offsets, u8 ω,
+// u64 index words + u64[], u64 direct bytes + bytes (byte planes).
+// The older layout (no kColumnLayout bit) held the materials and direct
+// values in byte planes, the palettes as they are and the directory by rows.
 std::vector<uint8_t> serializePalette(const PaletteChannel& c) {
     format::ByteWriter w;
-    w.put<uint32_t>(c.valueSize);
+    w.put<uint32_t>(c.valueSize | kColumnLayout);
     w.put<uint64_t>(c.entryCount);
     w.put<uint64_t>(c.materials.size());
-    w.putBytes(shuffle(c.materials, c.valueSize));
+    w.putBytes(shuffle(toDifferences(c.materials, c.valueSize), c.valueSize));
     w.put<uint64_t>(c.palettes.size());
-    w.putArray<uint32_t>(c.palettes);
+    w.putBytes(shuffle(toDifferences(bytesOf(c.palettes), 4), 4));
     w.put<uint64_t>(c.blocks.size());
+    uint64_t previous = 0;
     for (const PaletteBlock& b : c.blocks) {
-        w.put<uint64_t>(b.firstEntry);
-        w.put<uint64_t>(b.dataOffset);
-        w.put<uint32_t>(b.paletteOffset);
-        w.put<uint8_t>(b.indexBits);
+        w.put<uint64_t>(b.firstEntry - previous);
+        previous = b.firstEntry;
     }
+    for (const PaletteBlock& b : c.blocks) w.put<uint64_t>(b.dataOffset);
+    for (const PaletteBlock& b : c.blocks) w.put<uint32_t>(b.paletteOffset);
+    for (const PaletteBlock& b : c.blocks) w.put<uint8_t>(b.indexBits);
     w.put<uint64_t>(c.indexBits.size());
     w.putArray<uint64_t>(c.indexBits);
     w.put<uint64_t>(c.direct.size());
@@ -691,21 +749,44 @@ std::vector<uint8_t> serializePalette(const PaletteChannel& c) {
 PaletteChannel deserializePalette(std::span<const uint8_t> bytes, const std::string& what) {
     format::ByteReader r(bytes, what);
     PaletteChannel c;
-    c.valueSize = r.get<uint32_t>();
+    const uint32_t head = r.get<uint32_t>();
+    const bool columns = (head & kColumnLayout) != 0;
+    c.valueSize = head & ~kColumnLayout;
     if (c.valueSize == 0 || c.valueSize > 64) r.fail("bad value size");
     c.entryCount = r.get<uint64_t>();
     const uint64_t materialBytes = r.get<uint64_t>();
     if (materialBytes % c.valueSize) r.fail("material array is not a whole number of values");
     c.materials = unshuffle(r.getArray<uint8_t>(materialBytes), c.valueSize);
-    c.palettes = r.getArray<uint32_t>(r.get<uint64_t>());
+    if (columns) c.materials = fromDifferences(std::move(c.materials), c.valueSize);
+    const uint64_t paletteCount = r.get<uint64_t>();
+    if (columns) {
+        if (paletteCount > r.remaining() / 4) r.fail("palettes run past the end");
+        const std::vector<uint8_t> planes = fromDifferences(unshuffle(r.getArray<uint8_t>(paletteCount * 4), 4), 4);
+        c.palettes.resize(paletteCount);
+        if (paletteCount) std::memcpy(c.palettes.data(), planes.data(), planes.size());
+    } else {
+        c.palettes = r.getArray<uint32_t>(paletteCount);
+    }
     const uint64_t blockCount = r.get<uint64_t>();
     if (blockCount > r.remaining() / 21) r.fail("block directory runs past the end");
     c.blocks.resize(blockCount);
-    for (PaletteBlock& b : c.blocks) {
-        b.firstEntry = r.get<uint64_t>();
-        b.dataOffset = r.get<uint64_t>();
-        b.paletteOffset = r.get<uint32_t>();
-        b.indexBits = r.get<uint8_t>();
+    if (columns) {
+        uint64_t sum = 0;
+        for (PaletteBlock& b : c.blocks) {
+            const uint64_t step = r.get<uint64_t>();
+            if (step > c.entryCount - std::min(sum, c.entryCount)) r.fail("block directory runs past the entries");
+            b.firstEntry = sum += step;
+        }
+        for (PaletteBlock& b : c.blocks) b.dataOffset = r.get<uint64_t>();
+        for (PaletteBlock& b : c.blocks) b.paletteOffset = r.get<uint32_t>();
+        for (PaletteBlock& b : c.blocks) b.indexBits = r.get<uint8_t>();
+    } else {
+        for (PaletteBlock& b : c.blocks) {
+            b.firstEntry = r.get<uint64_t>();
+            b.dataOffset = r.get<uint64_t>();
+            b.paletteOffset = r.get<uint32_t>();
+            b.indexBits = r.get<uint8_t>();
+        }
     }
     c.indexBits = r.getArray<uint64_t>(r.get<uint64_t>());
     const uint64_t directBytes = r.get<uint64_t>();
