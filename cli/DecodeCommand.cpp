@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 
 #include "cli/Commands.h"
+#include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/pipeline/LayerScatter.h"
@@ -68,6 +69,7 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string input, output, grid;
         bool force = false;
+        ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("decode", "Decode an .ssvdag file back into a .vdb file, or a dense grid into a scan file");
@@ -75,6 +77,7 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("-o,--output", opt->output, "output .vdb, or .nrrd/.nhdr/.mha/.mhd/.nii/.nii.gz/.raw for a dense scan")->required();
     cmd->add_option("--grid", opt->grid, "scan output: the grid to write (default: the file's only grid)");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
+    opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "decoding");
         const bool dense = bridge::isDenseOutput(opt->output);
@@ -90,6 +93,8 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         format::ReadOptions readOptions;
         readOptions.rebuildPalettes = false;  // only the values are needed
         readOptions.keepValueWindows = dense;  // a scan is written window by window when it can be
+        // A .vdb decode builds OpenVDB's grid beside the decoded values: one more copy of each.
+        readOptions.limits = opt->limits.limits(dense ? 0 : 1);
         Volume volume;
         {
             const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);

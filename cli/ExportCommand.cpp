@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
@@ -43,6 +44,7 @@ void addExportCommand(CLI::App& app, int& exitCode) {
         std::vector<std::string> grids;
         bool structure = false, uniqueNodes = false, json = false, force = false;
         uint64_t maxCells = 20'000'000, maxBytes = uint64_t(256) << 20, maxInstances = 4'000'000;
+        ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("export", "Write VTK XML for ParaView: active voxels (.vtu), a dense region (.vti), several grids (.vtm), "
@@ -59,6 +61,7 @@ void addExportCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--unique-nodes", opt->uniqueNodes, "--structure: one cell per unique node (at its first instance) with its instance count");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
+    opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "exporting");
         if (opt->json) setQuiet(true);
@@ -71,6 +74,7 @@ void addExportCommand(CLI::App& app, int& exitCode) {
             options.maxInstances = opt->maxInstances;
             options.uniqueNodes = opt->uniqueNodes;
             options.compressor = opt->compressor;
+            options.limits = opt->limits.limits(0);
             const bridge::StructureExportReport r = bridge::exportStructure(opt->input, opt->output, options);
             report["bytes"] = r.bytes;
             report["grids"] = nlohmann::json::array();
@@ -99,6 +103,7 @@ void addExportCommand(CLI::App& app, int& exitCode) {
         options.maxCells = opt->maxCells;
         options.maxImageBytes = opt->maxBytes;
         options.compressor = opt->compressor;
+        options.limits = opt->limits.limits(2);  // OpenVDB's grid and VTK's arrays beside the decoded values
         const bridge::VtkExportReport r = bridge::exportVtk(opt->input, opt->output, options);
         report["bytes"] = r.bytes;
         report["blocks"] = nlohmann::json::array();

@@ -9,6 +9,7 @@
 
 #include "cli/Commands.h"
 #include "cli/DenseInputOptions.h"
+#include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "src/pipeline/GridCodec.h"
@@ -105,12 +106,18 @@ std::string formatScanHeaderReport(const nlohmann::json& r) {
 } // namespace
 
 void addInfoCommand(CLI::App& app, int& exitCode) {
-    struct Options { std::vector<std::string> inputs; std::string input; bool json = false; bool noSymmetry = false; };
+    struct Options {
+        std::vector<std::string> inputs;
+        std::string input;
+        bool json = false, noSymmetry = false;
+        ReadLimitOptions limits;
+    };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("info", "Print per-grid DAG statistics and section sizes of a .ssvdag or .vdb file (or a scan's header, or the series of DICOM input)");
     cmd->add_option("input", opt->inputs, ".ssvdag or .vdb file, a scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
     cmd->add_flag("--json", opt->json, "print JSON");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "for .vdb input: report the plain SVDAG encoding");
+    opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         DenseInputOptions dicomInputs;
         opt->input = dicomInputs.takeInputs(opt->inputs);
@@ -134,7 +141,9 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
         std::vector<uint8_t> bytes = format::readFileBytes(opt->input);
         format::SsvdagScene scene;
         if (!isVdbFile(bytes)) {
-            scene = format::readScene(bytes, opt->input);
+            format::ReadOptions readOptions;
+            readOptions.limits = opt->limits.limits(0);
+            scene = format::readScene(bytes, opt->input, readOptions);
         } else {
             const bridge::ImportResult imported = bridge::importVdb(opt->input);
             pipeline::EncodeOptions options;

@@ -11,6 +11,7 @@
 #include "cli/Commands.h"
 #include "cli/RunContext.h"
 #include "cli/FiniteNumber.h"
+#include "cli/ReadLimitOptions.h"
 #include "cli/RenderBackend.h"
 #include "src/format/SsvdagFile.h"
 #include "src/trace/Camera.h"
@@ -48,6 +49,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
         bool shadows = false, json = false, force = false;
+        ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("render", "Trace an .ssvdag file without decompressing it and write an image");
@@ -66,10 +68,13 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--frames", opt->frames, "render this many frames and report the median time")->check(CLI::Range(1, 1000));
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");
+    opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "rendering");
         checkOutputPath(opt->output, {opt->input}, {{".png", ".exr"}, "render", opt->force});
-        const format::SsvdagScene scene = format::readSceneFile(opt->input);
+        format::ReadOptions readOptions;
+        readOptions.limits = opt->limits.limits(0);  // traced where it lies, compressed
+        const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);
         const format::EncodedGrid* chosen = nullptr;
         for (const format::EncodedGrid& g : scene.grids)
             if (opt->grid.empty() || g.record.name == opt->grid) { chosen = &g; break; }

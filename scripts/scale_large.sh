@@ -41,7 +41,7 @@ run() {  # run NAME CMD...: "seconds peak_kb" in $OUT/NAME.time
 }
 secs() { cut -d' ' -f1 "$OUT/$1.time"; }
 peak() { awk '{printf "%.0f", $2/1024}' "$OUT/$1.time"; }
-voxels() { $V info "$1" --json | /usr/bin/python3 -c "import json,sys;print(sum(g['active_voxels'] for g in json.load(sys.stdin)['grids']))"; }
+voxels() { /usr/bin/python3 -c "import json;print(json.load(open('$OUT/$1.out'))['active_voxels'])"; }  # from encode --json
 row() {  # row INPUT VOXELS RUN KEY [CHECK]
   /usr/bin/python3 -c "print(f'| $1 | {$2:,} | $3 | {$(secs $4):.1f} | {$2/1e6/$(secs $4):.2f} | $(peak $4) | ${5:-—} |')" >> "$tmp"
 }
@@ -61,10 +61,10 @@ for d in "${spheres[@]+"${spheres[@]}"}"; do
   f="$OUT/sphere_d$d.vdb"
   [ -f "$f" ] || vdb_tool -sphere d=$d r=1.0 w=3 -write "$f" >/dev/null
   limit=1G; [ $d = 8192 ] && limit=4G
-  run "d$d.limited" $V encode "$f" -o "$OUT/d$d.limited.ssvdag" -f --memory-limit $limit
+  run "d$d.limited" $V encode "$f" -o "$OUT/d$d.limited.ssvdag" -f --memory-limit $limit --json
   same="NO"
   run "d$d.verify" $V verify "$f" --encoded "$OUT/d$d.limited.ssvdag" && same="exact (\`vdbdag verify --encoded\`, $(secs d$d.verify) s, $(peak d$d.verify) MB)"
-  n=$(voxels "$OUT/d$d.limited.ssvdag")
+  n=$(voxels "d$d.limited")
   row "sphere_d$d" "$n" "encode --memory-limit $limit" "d$d.limited" "$same"
   run "d$d.vdbtool" vdb_tool -read "$f" -write "$OUT/sphere_d$d.blosc.vdb" codec=blosc
   row "sphere_d$d" "$n" "vdb_tool -read -write codec=blosc (baseline)" "d$d.vdbtool"
@@ -73,14 +73,14 @@ done
 
 p="phantom_${phantom[0]}x${phantom[1]}x${phantom[2]}"
 [ -f "$OUT/$p.nhdr" ] || build/vdbdag_make_ct_phantom "$OUT/$p" --dims "${phantom[@]}" >/dev/null
-run "$p.limited" $V encode "$OUT/$p.nhdr" -o "$OUT/$p.limited.ssvdag" -f --memory-limit 4G
+run "$p.limited" $V encode "$OUT/$p.nhdr" -o "$OUT/$p.limited.ssvdag" -f --memory-limit 4G --json
 check="not checked (run with --decode)"
 if [ $decode = 1 ]; then
   run "$p.decode" $V decode "$OUT/$p.limited.ssvdag" -o "$OUT/$p.decoded.nhdr" -f
   raw=$(awk -F': ' '/^data file/ {print $2}' "$OUT/$p.nhdr")
   cmp -s "$OUT/$raw" "$OUT/$p.decoded.raw" && check="exact (decode to .nhdr + cmp of the raw, $(secs $p.decode) s, $(peak $p.decode) MB)" || check=NO
 fi
-row "$p (vdbdag_make_ct_phantom, 12-bit in uint16)" "$(voxels "$OUT/$p.limited.ssvdag")" "encode --memory-limit 4G" "$p.limited" "$check"
+row "$p (vdbdag_make_ct_phantom, 12-bit in uint16)" "$(voxels "$p.limited")" "encode --memory-limit 4G" "$p.limited" "$check"
 
 mv "$tmp" "$report"
 cat "$report"

@@ -225,7 +225,7 @@ VtkExportReport exportVtk(const std::string& input, const std::string& output, c
         const auto& b = *options.bbox;
         if (b[0] > b[3] || b[1] > b[4] || b[2] > b[5]) throw Error("--bbox: each minimum must not exceed its maximum (X0,Y0,Z0,X1,Y1,Z1)");
     }
-    const std::vector<LoadedGrid> grids = detail::loadGrids(input, options.grids);
+    const std::vector<LoadedGrid> grids = detail::loadGrids(input, options.grids, options.limits);
     if (grids.empty()) throw Error(input + ": holds no grids to export");
     if (ext != ".vtm" && grids.size() > 1)
         throw Error(fmt::format("{}: {} grids selected but a {} holds one: pick one with --grid NAME or write a .vtm", input, grids.size(), ext));

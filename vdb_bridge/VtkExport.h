@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "src/format/ReadLimits.h"
+
 namespace vdbdag::bridge {
 
 struct VtkExportOptions {
@@ -21,6 +23,7 @@ struct VtkExportOptions {
     uint64_t maxCells = 20'000'000;                 // per unstructured block
     uint64_t maxImageBytes = uint64_t(256) << 20;    // per image block (values + active flags)
     std::string compressor = "zlib";                // or "lz4"
+    format::ReadLimits limits;                      // for an .ssvdag input
 };
 
 struct VtkBlockReport {

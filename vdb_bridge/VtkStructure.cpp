@@ -99,7 +99,9 @@ StructureExportReport exportStructure(const std::string& input, const std::strin
     const detail::Compressor compressor = detail::parseCompressor(options.compressor);
     format::SsvdagScene scene;
     if (detail::isSsvdagPath(input)) {
-        scene = format::readSceneFile(input);
+        format::ReadOptions readOptions;
+        readOptions.limits = options.limits;
+        scene = format::readSceneFile(input, readOptions);
     } else {
         ImportOptions importOptions;
         importOptions.onlyGrids = options.grids;

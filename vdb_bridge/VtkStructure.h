@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "src/format/ReadLimits.h"
+
 namespace vdbdag::bridge {
 
 struct StructureExportOptions {
@@ -20,6 +22,7 @@ struct StructureExportOptions {
     uint64_t maxInstances = 4'000'000;  // per grid, all levels together
     bool uniqueNodes = false;
     std::string compressor = "zlib";
+    format::ReadLimits limits;  // for an .ssvdag input
 };
 
 struct StructureLevelReport {

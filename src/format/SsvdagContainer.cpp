@@ -174,6 +174,17 @@ std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string&
     return entries;
 }
 
+bool isUnknownKind(uint32_t kind) { return std::strcmp(sectionKindName(SectionKind(kind)), "unknown") == 0; }
+
+// What the sections to be kept claim to inflate to, against --max-memory,
+// before any is inflated (a zstd frame inflates to exactly its declared size).
+void checkInflatedSize(const std::vector<Entry>& entries, bool unknownKinds, const ReadLimits& limits, const std::string& sourceName) {
+    uint64_t total = 0;
+    for (const Entry& e : entries)
+        if (unknownKinds || !isUnknownKind(e.kind)) total = saturatingAdd(total, e.raw);
+    checkMemory(limits, total, sourceName, "its sections, inflated,");
+}
+
 std::vector<uint8_t> restore(const Entry& e, std::span<const uint8_t> stored, const std::string& what) {
     if (XXH3_64bits(stored.data(), stored.size()) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
     if (e.codec == kCodecRaw) return std::vector<uint8_t>(stored.begin(), stored.end());
@@ -327,14 +338,15 @@ std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, c
     return out;
 }
 
-std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName, bool unknownKinds) {
+std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName, bool unknownKinds, const ReadLimits& limits) {
     const std::vector<Entry> entries = parseTable(bytes, sourceName, bytes.size());
+    checkInflatedSize(entries, unknownKinds, limits, sourceName);
     std::vector<Section> sections;
     sections.reserve(entries.size());
     for (size_t i = 0; i < entries.size(); ++i) {
         const Entry& e = entries[i];
         const std::string what = sourceName + ": " + describe(i, e.kind, e.grid);
-        if (!unknownKinds && std::strcmp(sectionKindName(SectionKind(e.kind)), "unknown") == 0) {
+        if (!unknownKinds && isUnknownKind(e.kind)) {
             // Checked (its stored bytes), never inflated: a reader that does
             // not know the kind has no use for it, whatever it claims to hold.
             if (XXH3_64bits(bytes.data() + e.offset, e.stored) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
@@ -395,7 +407,7 @@ struct InputFile {
 
 } // namespace
 
-std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds) {
+std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds, const ReadLimits& limits) {
     const InputFile file(path);
     // The header first, for the table's size, then header and table together.
     std::vector<uint8_t> head = file.read(0, std::min<uint64_t>(file.size, kHeaderBytes), path);
@@ -405,6 +417,7 @@ std::vector<Section> readContainerFile(const std::string& path, bool unknownKind
         head = file.read(0, std::min<uint64_t>(file.size, kHeaderBytes + uint64_t(count) * kEntryBytes + kChecksumBytes), path);
     }
     const std::vector<Entry> entries = parseTable(head, path, file.size);
+    checkInflatedSize(entries, unknownKinds, limits, path);
     std::vector<Section> sections;
     sections.reserve(entries.size());
     for (size_t i = 0; i < entries.size(); ++i) {
@@ -413,7 +426,7 @@ std::vector<Section> readContainerFile(const std::string& path, bool unknownKind
         std::vector<uint8_t> stored = file.read(e.offset, e.stored, path);
         if (stored.size() != e.stored) throw Error(what + ": the file was cut short while it was read");
         if (XXH3_64bits(stored.data(), stored.size()) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
-        if (!unknownKinds && std::strcmp(sectionKindName(SectionKind(e.kind)), "unknown") == 0) continue;  // checked, never inflated
+        if (!unknownKinds && isUnknownKind(e.kind)) continue;  // checked, never inflated
         if (e.codec == kCodecRaw) sections.push_back({SectionKind(e.kind), e.grid, std::move(stored)});  // no copy
         else sections.push_back({SectionKind(e.kind), e.grid, zstdInflateFrame(stored, e.raw, what)});
     }

@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "src/format/ReadLimits.h"
 #include "src/util/ScratchFile.h"
 
 namespace vdbdag::format {
@@ -83,8 +84,11 @@ uint64_t writeContainerTo(std::vector<Section>&& sections, std::ostream& out, co
 // message starting with `sourceName` on any truncation, corruption, checksum
 // mismatch or implausible size. With `unknownKinds` false, sections of kinds
 // this reader does not know are checksum-checked and dropped, never inflated
-// (what the scene readers do: such a section may claim gigabytes).
-std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName, bool unknownKinds = true);
+// (what the scene readers do: such a section may claim gigabytes). The
+// sections' declared raw sizes together must lie within limits.maxMemory,
+// checked before any is inflated.
+std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::string& sourceName, bool unknownKinds = true,
+                                   const ReadLimits& limits = {});
 
 // Validates the header and table only (no payload decompression) and returns
 // the section summaries.
@@ -95,6 +99,6 @@ std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, c
 std::vector<uint8_t> readFileBytes(const std::string& path);
 // readContainer of the file at `path`, read section by section: memory
 // holds the sections, never the file as well.
-std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds = true);
+std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds = true, const ReadLimits& limits = {});
 
 } // namespace vdbdag::format

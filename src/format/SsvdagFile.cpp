@@ -243,6 +243,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
 
     SsvdagScene scene;
     if (fileMetadata) scene.fileMetadata = std::move(fileMetadata->data);
+    uint64_t expanded = 0;  // bytes the sections and what is decoded from them take
+    for (const Section& s : sections) expanded = saturatingAdd(expanded, s.data.size());
     scene.grids.resize(gridCount);
     for (uint32_t g = 0; g < gridCount; ++g) {
         EncodedGrid& grid = scene.grids[g];
@@ -265,9 +267,10 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         }
         grid.record.vdbDescriptor = std::move(find(g, SectionKind::VdbDescriptor, true)->data);
         const unsigned vs = valueSize(grid.record.valueType);
-        auto readLayer = [&](const LayerKinds& kinds, encoding::CompactDag& dag, std::vector<uint8_t>& attributes,
-                             attributes::PaletteChannel& channel, std::vector<uint8_t>& predicted, attributes::ValueWindowsPayload& windows,
-                             uint64_t expectedVoxels, const std::string& layer) {
+        // A layer's DAG first (both layers' before any value), so what the
+        // values will take is weighed before any is decoded.
+        auto readLayerDag = [&](const LayerKinds& kinds, encoding::CompactDag& dag, uint64_t expectedVoxels,
+                                const std::string& layer) -> encoding::DecodedSize {
             uint64_t innerWords = 0, leafCount = 0;
             {
                 ByteReader r(find(g, kinds.levels, true)->data, what + " " + layer + " levels");
@@ -294,6 +297,20 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             if (size.activeVoxels != expectedVoxels)
                 throw Error(what + ": the " + layer + " DAG holds " + std::to_string(size.activeVoxels) + " voxels but the header says " +
                             std::to_string(expectedVoxels) + "; the file is corrupted");
+            // What this layer will take at least, before any value is
+            // decoded: its entries (each voxel of a brick, each tile once)
+            // as decoded values, unless they stay in windows, and as the
+            // command's own copies.
+            checkVoxels(options.limits, size.attributeEntries, what + " " + layer + " layer");
+            const bool decodesValues = vs && !dag.empty() && !options.keepValueWindows;
+            expanded = saturatingAdd(expanded, saturatingMul(size.attributeEntries, decodesValues ? uint64_t(vs) : 0));
+            expanded = saturatingAdd(expanded, saturatingMul(size.attributeEntries, uint64_t(std::max(vs, 1u)) * options.limits.valueCopies));
+            checkMemory(options.limits, expanded, what, "its sections and decoded values");
+            return size;
+        };
+        auto readLayerValues = [&](const LayerKinds& kinds, const encoding::CompactDag& dag, const encoding::DecodedSize& size,
+                                   std::vector<uint8_t>& attributes, attributes::PaletteChannel& channel, std::vector<uint8_t>& predicted,
+                                   attributes::ValueWindowsPayload& windows, const std::string& layer) {
             Section* predictedSection = find(g, kinds.predicted, false);
             Section* windowSection = find(g, kinds.windows, false);
             Section* paletteSection = find(g, kinds.values, false);
@@ -338,10 +355,14 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 attributes = channel.decodeAll();
             }
         };
-        readLayer(kActive, grid.dag, grid.attributes, grid.values, grid.predictedValues, grid.valueWindows, grid.activeVoxels, "active");
-        if (grid.inactiveVoxels || find(g, kInactive.levels, false))
-            readLayer(kInactive, grid.inactiveDag, grid.inactiveAttributes, grid.inactiveValues, grid.inactivePredictedValues, grid.inactiveValueWindows,
-                      grid.inactiveVoxels, "inactive");
+        const encoding::DecodedSize activeSize = readLayerDag(kActive, grid.dag, grid.activeVoxels, "active");
+        const bool inactiveLayer = grid.inactiveVoxels || find(g, kInactive.levels, false);
+        const encoding::DecodedSize inactiveSize = inactiveLayer ? readLayerDag(kInactive, grid.inactiveDag, grid.inactiveVoxels, "inactive")
+                                                                 : encoding::DecodedSize{};
+        readLayerValues(kActive, grid.dag, activeSize, grid.attributes, grid.values, grid.predictedValues, grid.valueWindows, "active");
+        if (inactiveLayer)
+            readLayerValues(kInactive, grid.inactiveDag, inactiveSize, grid.inactiveAttributes, grid.inactiveValues, grid.inactivePredictedValues,
+                            grid.inactiveValueWindows, "inactive");
         if (Section* e = find(g, SectionKind::ValueErrors, false)) {
             ByteReader r(e->data, what + " ValueErrors");
             auto& l = grid.lossy;
@@ -402,14 +423,16 @@ std::vector<uint8_t> writeScene(const SsvdagScene& scene, const ContainerOptions
     return writeContainer(sceneToSections(scene), options);
 }
 
-SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName) {
-    return sectionsToScene(readContainer(bytes, sourceName, /*unknownKinds=*/false), sourceName);
+SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName) { return readScene(bytes, sourceName, ReadOptions{}); }
+
+SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName, const ReadOptions& options) {
+    return sectionsToScene(readContainer(bytes, sourceName, /*unknownKinds=*/false, options.limits), sourceName, options);
 }
 
 SsvdagScene readSceneFile(const std::string& path) { return readSceneFile(path, ReadOptions{}); }
 
 SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
-    return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false), path, options);
+    return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false, options.limits), path, options);
 }
 
 } // namespace vdbdag::format

@@ -81,6 +81,8 @@ struct ReadOptions {
     // array or channel: for readers that stream a layer window by window
     // (pipeline/LayerScatter.h). Only the directory is checked here.
     bool keepValueWindows = false;
+    // Refuse what would expand past these (ReadLimits.h) before expanding it.
+    ReadLimits limits;
 };
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options);
 
@@ -91,6 +93,7 @@ std::vector<uint8_t> writeScene(const SsvdagScene& scene, const ContainerOptions
 // the bytes written.
 uint64_t writeSceneReleasing(SsvdagScene& scene, std::ostream& out, const ContainerOptions& options = {});
 SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName);
+SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName, const ReadOptions& options);
 SsvdagScene readSceneFile(const std::string& path);
 SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options);
 

@@ -247,3 +247,35 @@ TEST(Cli, RenderWithOnvNormalsOnVulkanAndCpuGivesTheSamePng) {
     EXPECT_EQ(slurp(cpuPng), slurp(vulkanPng)) << "the Vulkan and CPU renders with ONV normals differ";
     EXPECT_NE(slurp(cpuPng), slurp(plainPng)) << "the stored normals changed nothing";
 }
+
+// --max-voxels and --max-memory on every command that expands a file: a
+// one-line error naming the file and the limit, exit 1, nothing written.
+// The ball's entries (active voxels, a closed form of OpenVDB's count here)
+// are the threshold: one less is refused, the count itself passes.
+TEST(Cli, ReadLimitsRefuseAFileBeforeExpandingIt) {
+    const fs::path encoded = workDir() / "limits_ball.ssvdag";
+    ASSERT_EQ(runCli("encode " + sphereFile().string() + " -o " + encoded.string()).exitCode, 0);
+    openvdb::io::File file(sphereFile().string());
+    file.open();
+    const uint64_t active = file.readGrid("ball")->activeVoxelCount();
+    file.close();
+    const fs::path dir = workDir() / "limits";
+    fs::create_directories(dir);
+    const std::string in = encoded.string();
+    const std::vector<std::string> commands{"decode " + in + " -o " + (dir / "o.vdb").string(), "export " + in + " -o " + (dir / "o.vtu").string(),
+                                            "render " + in + " -o " + (dir / "o.png").string() + " --backend cpu --width 8 --height 8",
+                                            "info " + in};
+    for (const std::string& c : commands) {
+        for (const std::string& limit : {"--max-voxels " + std::to_string(active - 1), std::string("--max-memory 2K")}) {
+            const CommandResult r = runCli(c + " " + limit);
+            EXPECT_EQ(r.exitCode, 1) << c << " " << limit;
+            EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+            EXPECT_NE(r.err.find(in), std::string::npos) << r.err;
+            EXPECT_NE(r.err.find(limit.substr(0, limit.find(' '))), std::string::npos) << r.err;
+            EXPECT_TRUE(fs::is_empty(dir)) << c << " " << limit << " left output";
+        }
+        const CommandResult ok = runCli(c + " --max-voxels " + std::to_string(active));
+        EXPECT_EQ(ok.exitCode, 0) << c << "\n" << ok.err;
+        for (const auto& e : fs::directory_iterator(dir)) fs::remove(e.path());
+    }
+}

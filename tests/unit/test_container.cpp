@@ -668,3 +668,73 @@ TEST(Container, SceneReaderNeverInflatesUnknownSections) {
     bad[load<uint64_t>(bad, entryAt(last) + kOffsetAt)] ^= 1;
     EXPECT_THROW(format::readScene(bad, "corrupt"), Error);
 }
+
+// ---- read limits (--max-memory, --max-voxels) --------------------------------
+
+// A few kilobytes may hold a genuine zstd frame of any size in a known
+// section: what the table declares is weighed against --max-memory before
+// anything is inflated.
+TEST(ReadLimits, DeclaredSectionSizesAreWeighedBeforeAnyIsInflated) {
+    const std::vector<Section> sections{{SectionKind::DagInner, 0, std::vector<uint8_t>(size_t(64) << 20, 0)}};
+    const auto bytes = format::writeContainer(sections);
+    ASSERT_LT(bytes.size(), size_t(64) << 10);
+    format::ReadLimits limits;
+    limits.maxMemory = uint64_t(16) << 20;
+    {
+        AllocationProbe probe;
+        try {
+            format::readContainer(bytes, "bomb.ssvdag", false, limits);
+            ADD_FAILURE() << "a 64 MiB section passed a 16 MiB limit";
+        } catch (const Error& e) {
+            const std::string m = e.what();
+            EXPECT_EQ(m.rfind("bomb.ssvdag: ", 0), 0u) << m;
+            EXPECT_NE(m.find("--max-memory"), std::string::npos) << m;
+            EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        }
+        EXPECT_LT(probe.largest(), size_t(1) << 20) << "inflated before the check";
+    }
+    limits.maxMemory = uint64_t(65) << 20;
+    EXPECT_EQ(format::readContainer(bytes, "bomb.ssvdag", false, limits).front().data.size(), size_t(64) << 20);
+}
+
+// A DAG shares its subtrees, so its file can stand for far more voxels than
+// it holds: a solid 64^3 block of full bricks (262,144 entries, a closed
+// form) is a few hundred bytes. --max-voxels and --max-memory refuse it by
+// the entries the DAG implies, before any is decoded.
+TEST(ReadLimits, AnExpandingDagIsRefusedByItsEntriesBeforeDecoding) {
+    GridRecord record;
+    record.name = "block";
+    record.gridClass = "fog volume";
+    record.vdbDescriptor = {1};
+    for (int z = 0; z < 64; z += 4)
+        for (int y = 0; y < 64; y += 4)
+            for (int x = 0; x < 64; x += 4) record.topology.bricks.push_back({x, y, z, ~uint64_t(0)});
+    format::SsvdagScene scene;
+    scene.grids.push_back(pipeline::encodeGrid(record));
+    const auto bytes = format::writeScene(scene);
+    ASSERT_LT(bytes.size(), size_t(4096));
+    const uint64_t entries = 64 * 64 * 64;
+    auto refusal = [&](const format::ReadOptions& options) -> std::string {
+        try {
+            format::readScene(bytes, "block.ssvdag", options);
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "";
+    };
+    format::ReadOptions options;
+    options.limits.maxVoxels = entries - 1;
+    std::string m = refusal(options);
+    EXPECT_NE(m.find("--max-voxels"), std::string::npos) << m;
+    EXPECT_NE(m.find(std::to_string(entries)), std::string::npos) << m;
+    EXPECT_EQ(m.rfind("block.ssvdag: grid 0", 0), 0u) << m;
+    options.limits.maxVoxels = entries;
+    EXPECT_EQ(refusal(options), "");
+    // Memory: a decode that builds one copy of every (1-byte, topology-only) value needs at least `entries` bytes beyond the sections.
+    options.limits.valueCopies = 1;
+    options.limits.maxMemory = entries - 1;
+    m = refusal(options);
+    EXPECT_NE(m.find("--max-memory"), std::string::npos) << m;
+    options.limits.maxMemory = entries + (uint64_t(1) << 20);
+    EXPECT_EQ(refusal(options), "");
+}

@@ -39,7 +39,7 @@ bool selected(const std::vector<std::string>& wanted, const std::string& name) {
 
 } // namespace
 
-std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std::string>& onlyGrids) {
+std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std::string>& onlyGrids, const format::ReadLimits& limits) {
     initializeOpenVdb();
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error(path + ": no such file");
@@ -55,7 +55,9 @@ std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std
     }
     if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a .vdb or .ssvdag file");
     if (isSsvdagPath(path)) {
-        format::SsvdagScene scene = format::readSceneFile(path);
+        format::ReadOptions readOptions;
+        readOptions.limits = limits;
+        format::SsvdagScene scene = format::readSceneFile(path, readOptions);
         std::vector<std::string> names;
         for (const auto& g : scene.grids) names.push_back(g.record.name);
         checkNames(path, names, onlyGrids);

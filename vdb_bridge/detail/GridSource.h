@@ -8,6 +8,8 @@
 
 #include <openvdb/openvdb.h>
 
+#include "src/format/ReadLimits.h"
+
 namespace vdbdag::bridge::detail {
 
 struct LoadedGrid {
@@ -20,7 +22,8 @@ bool isSsvdagPath(const std::string& path);
 // All grids, or those named in `onlyGrids` (an unknown name is an error that
 // lists the names the file has). Grids of types vdbdag does not convert are
 // an error naming the grid and its type. Throws vdbdag::Error("PATH: ...").
-std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std::string>& onlyGrids);
+// An .ssvdag is read within `limits` (format/ReadLimits.h).
+std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std::string>& onlyGrids, const format::ReadLimits& limits = {});
 
 // "'name'" or "#index" for unnamed grids, for messages and block names.
 std::string gridLabel(const LoadedGrid& grid);
