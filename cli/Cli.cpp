@@ -1,6 +1,7 @@
 // The `vdbdag` command line as a function, for the plain binary (main.cpp)
 // and the MPI one (distributed/main.cpp). Errors are printed as one line
-// "vdbdag: <message>" with a non-zero exit.
+// "vdbdag: <message>" with a non-zero exit; mistakes in the command line
+// itself as one line with exit status 2 (UsageErrors.h).
 #include "cli/Cli.h"
 
 #include <cstdio>
@@ -14,6 +15,7 @@
 
 #include "cli/Commands.h"
 #include "cli/RunContext.h"
+#include "cli/UsageErrors.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::cli {
@@ -31,7 +33,7 @@ int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
     // shared among them, anything else runs on process 0 alone.
     if (!team.isRoot() && (argc < 2 || std::strcmp(argv[1], "encode") != 0)) return 0;
     installFailureHandlers();
-    CLI::App app{"vdbdag: compress OpenVDB volumes into symmetry-aware sparse voxel DAGs (.ssvdag) and back"};
+    CLI::App app{"vdbdag: compress OpenVDB volumes into symmetry-aware sparse voxel DAGs (.ssvdag) and back", "vdbdag"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "vdbdag 0.1.0");
     int exitCode = 0;
@@ -46,23 +48,26 @@ int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
     addDiffCommand(app, exitCode);
     addSelftestCommand(app, exitCode);
     addImportCommand(app, exitCode);
+    app.footer("Exit status: 0 done (diff: the same), 1 failed (diff: they differ), 2 a mistake in the command line (diff: failed).\n"
+               "vdbdag help COMMAND, or vdbdag COMMAND --help, describes a command.");
+    if (const std::optional<int> helped = answerHelpCommand(app, argc, argv)) return *helped;
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        return answerParseError(app, e, argc, argv);
     } catch (const Error& e) {
         std::fprintf(stderr, "vdbdag: %s\n", e.what());
-        return 1;
+        return failureExitCode();
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "vdbdag: %s\n", outOfMemoryMessage().c_str());
-        return 1;
+        return failureExitCode();
     } catch (const std::exception& e) {
         // TBB reports a thread whose stack could not be mapped this way.
         if (std::strstr(e.what(), "pthread_create has failed") != nullptr)
             std::fprintf(stderr, "vdbdag: %s (no memory for a thread's stack)\n", outOfMemoryMessage().c_str());
         else
             std::fprintf(stderr, "vdbdag: %s\n", e.what());
-        return 1;
+        return failureExitCode();
     }
     return exitCode;
 }

@@ -1,6 +1,7 @@
 // `vdbdag diff A B [-o DIFF.vtu|DIFF.vtm] [--only-differences] [--json]`:
 // voxel-by-voxel comparison (vdb_bridge/VtkDiff); prints counts per status,
-// max / mean / RMS error and PSNR; exit 0 only when the grids are the same.
+// max / mean / RMS error and PSNR; exit 0 when the grids are the same, 1
+// when they differ, 2 on an error (as diff and cmp do).
 #include <cmath>
 
 #include <fmt/core.h>
@@ -31,7 +32,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
         uint64_t maxCells = 20'000'000;
     };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("diff", "Compare two volumes voxel by voxel (.vdb, .ssvdag or a dense scan); exit 0 only if they are the same");
+    CLI::App* cmd = app.add_subcommand("diff", "Compare two volumes voxel by voxel (.vdb, .ssvdag or a dense scan); exit 0 if they are the same, 1 if they differ, 2 on an error");
     cmd->add_option("a", opt->a, "first volume (A: the reference)")->required();
     cmd->add_option("b", opt->b, "second volume (B)")->required();
     cmd->add_option("-o,--output", opt->output, "write the cells (a, b, abs_error, rel_error, status) to a .vtu or .vtm");
@@ -42,6 +43,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");
     cmd->callback([opt, &exitCode] {
+        setFailureExitCode(2);  // 1 means "they differ", as for diff and cmp
         setActivity(opt->a, "comparing");
         if (opt->json) setQuiet(true);
         if (!opt->output.empty()) checkOutputPath(opt->output, {opt->a, opt->b}, {{".vtu", ".vtm"}, "diff", opt->force});

@@ -25,6 +25,7 @@ size_t g_length = std::strlen(g_message);
 char g_crash[4096] = "vdbdag: crashed (a library failed on this input, which may be corrupted); nothing was written\n";
 size_t g_crashLength = std::strlen(g_crash);
 std::atomic_flag g_ending = ATOMIC_FLAG_INIT;
+volatile sig_atomic_t g_failureExit = 1;
 
 // A crash inside a library (OpenVDB's delayed loading segfaults or asserts
 // on some corrupted files) ends like any bad input: one line, exit 1, and
@@ -33,7 +34,7 @@ void onCrash(int) {
     if (g_ending.test_and_set()) for (;;) ::pause();
     removeAllTemporaries();
     [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, g_crash, g_crashLength);
-    ::_exit(1);
+    ::_exit(g_failureExit);
 }
 
 void installCrashHandlers() {
@@ -62,17 +63,20 @@ void installCrashHandlers() {
         } catch (const std::exception& e) {
             removeAllTemporaries();
             std::fprintf(stderr, "vdbdag: internal error: %s\n", e.what());
-            ::_exit(1);
+            ::_exit(g_failureExit);
         } catch (...) {
         }
     }
     removeAllTemporaries();
     static const char kLine[] = "vdbdag: internal error: the program terminated\n";
     [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, kLine, sizeof kLine - 1);
-    ::_exit(1);
+    ::_exit(g_failureExit);
 }
 
 } // namespace
+
+void setFailureExitCode(int code) { g_failureExit = code; }
+int failureExitCode() { return g_failureExit; }
 
 void endOutOfMemory() {
     // Several threads may run out at once: the first one speaks and ends the
@@ -80,7 +84,7 @@ void endOutOfMemory() {
     if (g_ending.test_and_set()) for (;;) ::pause();
     removeAllTemporaries();
     [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, g_message, g_length);
-    ::_exit(1);
+    ::_exit(g_failureExit);
 }
 
 namespace {
@@ -120,7 +124,7 @@ extern "C" [[noreturn]] void __assert_fail(const char* assertion, const char* fi
     if (vdbdag::cli::g_ending.test_and_set()) for (;;) ::pause();
     vdbdag::removeAllTemporaries();
     [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, text, std::min(n, sizeof text - 1));
-    ::_exit(1);
+    ::_exit(vdbdag::cli::g_failureExit);
 }
 
 namespace vdbdag::cli {

@@ -23,8 +23,13 @@ void setActivity(const std::string& path, const std::string& activity);
 // The message for an out-of-memory ending ("PATH: out of memory while ...").
 std::string outOfMemoryMessage();
 
+// The exit status of a failure (bad input, out of memory, a crash): 1, but
+// 2 for `diff`, whose 1 means "they differ" (as for diff and cmp).
+void setFailureExitCode(int code);
+int failureExitCode();
+
 // Removes the temporaries, prints the out-of-memory line and ends the
-// process (exit status 1); async-signal-safe.
+// process (exit status failureExitCode()); async-signal-safe.
 [[noreturn]] void endOutOfMemory();
 
 // Installs the new-handler and the interrupt cleanup (once, from main).

@@ -279,3 +279,55 @@ TEST(Cli, ReadLimitsRefuseAFileBeforeExpandingIt) {
         for (const auto& e : fs::directory_iterator(dir)) fs::remove(e.path());
     }
 }
+
+// Mistakes in the command line itself: one line naming the word and what
+// was probably meant, exit status 2; `help` is a command; diff keeps 1 for
+// "they differ" and answers 2 for a failure.
+TEST(Cli, UsageMistakesAreOneLineWithASuggestionAndExitTwo) {
+    struct Case {
+        std::string args, expect;
+    };
+    const std::string ball = sphereFile().string();
+    for (const Case& c : std::vector<Case>{{"encod " + ball, "'encod' is not a command; did you mean 'encode'?"},
+                                            {"", "a command is required"},
+                                            {"encode " + ball + " -o x.ssvdag --abs-eror 0.1", "unknown option '--abs-eror'; did you mean '--abs-error'?"},
+                                            {"render x.ssvdag -o x.png --widht=8", "unknown option '--widht'; did you mean '--width'?"},
+                                            {"encode " + ball, "--output is required"},
+                                            {"help encdoe", "'encdoe' is not a command; did you mean 'encode'?"}}) {
+        const CommandResult r = runCli(c.args);
+        EXPECT_EQ(r.exitCode, 2) << c.args << "\n" << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
+        EXPECT_TRUE(r.out.empty()) << r.out;
+    }
+    CommandResult r = runCli("help");
+    EXPECT_EQ(r.exitCode, 0);
+    EXPECT_NE(r.out.find("Exit status"), std::string::npos) << r.out;
+    r = runCli("help encode");
+    EXPECT_EQ(r.exitCode, 0);
+    EXPECT_NE(r.out.find("--memory-limit"), std::string::npos) << r.out;
+    EXPECT_EQ(runCli("encode --help").out, r.out);
+
+    const fs::path other = workDir() / "usage_other.vdb";
+    {
+        openvdb::initialize();
+        auto g = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(21.0f, openvdb::Vec3f(0.0f), 1.0f, 3.0f);
+        g->setName("ball");
+        openvdb::io::File(other.string()).write({g});
+    }
+    EXPECT_EQ(runCli("diff " + ball + " " + ball).exitCode, 0);
+    EXPECT_EQ(runCli("diff " + ball + " " + other.string()).exitCode, 1);
+    r = runCli("diff " + ball + " " + (workDir() / "missing.vdb").string());
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find("missing.vdb"), std::string::npos) << r.err;
+}
+
+// A suggestion only when one name is close: a typo ("verif"), never a guess
+// for a word like no command at all.
+TEST(Cli, UnknownCommandsGetASuggestionOnlyWhenOneIsClose) {
+    const CommandResult r = runCli("verif x");
+    EXPECT_NE(r.err.find("did you mean 'verify'?"), std::string::npos) << r.err;
+    const CommandResult none = runCli("frobnicate x");
+    EXPECT_EQ(none.err.find("did you mean"), std::string::npos) << none.err;
+    EXPECT_EQ(none.exitCode, 2);
+}
