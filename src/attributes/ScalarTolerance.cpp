@@ -1,23 +1,22 @@
 // See ScalarTolerance.h.
 #include "src/attributes/ScalarTolerance.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
 #include <fmt/core.h>
 
 namespace vdbdag::attributes {
-namespace {
+
+ScalarQuantizer::ScalarQuantizer(ValueType type, const ScalarTolerance& tolerance) : type_(type) { report_.tolerance = tolerance; }
 
 template <typename T>
-ToleranceReport quantise(std::vector<uint8_t>& bytes, const ScalarTolerance& tol) {
-    ToleranceReport report;
-    report.tolerance = tol;
+void ScalarQuantizer::quantise(std::span<uint8_t> bytes) {
+    const ScalarTolerance& tol = report_.tolerance;
     const size_t n = bytes.size() / sizeof(T);
-    report.entries = n;
     const double absStep = 2.0 * tol.bound;
     const double logStep = 2.0 * std::log2(1.0 + tol.bound);
-    double sumAbs = 0, sumSq = 0;
     for (size_t i = 0; i < n; ++i) {
         T v;
         std::memcpy(&v, &bytes[i * sizeof(T)], sizeof(T));
@@ -36,35 +35,40 @@ ToleranceReport quantise(std::vector<uint8_t>& bytes, const ScalarTolerance& tol
         const double err = std::fabs(double(stored) - d);
         const double limit = tol.mode == ScalarTolerance::Mode::Absolute ? tol.bound : tol.bound * std::fabs(d);
         if (!std::isfinite(double(stored)) || !(err <= limit)) {
-            ++report.keptExact;  // rounding would break the bound (or the sign of zero): keep it
+            ++report_.keptExact;  // rounding would break the bound (or the sign of zero): keep it
             continue;
         }
         if (std::memcmp(&stored, &v, sizeof(T)) != 0) {
-            ++report.changed;
+            ++report_.changed;
             std::memcpy(&bytes[i * sizeof(T)], &stored, sizeof(T));
         }
-        report.maxAbsError = std::max(report.maxAbsError, err);
-        report.maxRelError = std::max(report.maxRelError, err / std::fabs(d));
-        sumAbs += err;
-        sumSq += err * err;
+        report_.maxAbsError = std::max(report_.maxAbsError, err);
+        report_.maxRelError = std::max(report_.maxRelError, err / std::fabs(d));
+        sumAbs_ += err;
+        sumSq_ += err * err;
     }
-    if (n) {
-        report.meanAbsError = sumAbs / double(n);
-        report.rmsError = std::sqrt(sumSq / double(n));
+}
+
+void ScalarQuantizer::apply(std::span<uint8_t> values) {
+    report_.entries += values.size() / std::max(1u, valueSize(type_));
+    if (report_.tolerance.mode == ScalarTolerance::Mode::Exact) return;
+    if (type_ == ValueType::Float) quantise<float>(values);
+    else if (type_ == ValueType::Double) quantise<double>(values);
+}
+
+ToleranceReport ScalarQuantizer::finish() const {
+    ToleranceReport report = report_;
+    if (report.entries && (type_ == ValueType::Float || type_ == ValueType::Double) && report.tolerance.mode != ScalarTolerance::Mode::Exact) {
+        report.meanAbsError = sumAbs_ / double(report.entries);
+        report.rmsError = std::sqrt(sumSq_ / double(report.entries));
     }
     return report;
 }
 
-} // namespace
-
 ToleranceReport applyScalarTolerance(std::vector<uint8_t>& values, ValueType type, const ScalarTolerance& tolerance) {
-    if (tolerance.mode == ScalarTolerance::Mode::Exact) return {tolerance, values.size() / std::max(1u, valueSize(type))};
-    if (type == ValueType::Float) return quantise<float>(values, tolerance);
-    if (type == ValueType::Double) return quantise<double>(values, tolerance);
-    ToleranceReport untouched;
-    untouched.tolerance = tolerance;
-    untouched.entries = values.size() / std::max(1u, valueSize(type));
-    return untouched;
+    ScalarQuantizer quantizer(type, tolerance);
+    quantizer.apply(values);
+    return quantizer.finish();
 }
 
 std::string describe(const ScalarTolerance& t) {

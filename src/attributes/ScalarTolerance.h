@@ -8,6 +8,7 @@
 // distinct values is what the palette compressor then turns into bits.
 #pragma once
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,8 +30,26 @@ struct ToleranceReport {
     double maxAbsError = 0, meanAbsError = 0, rmsError = 0, maxRelError = 0;
 };
 
-// Quantises float or double values (raw bytes, attribute order) in place;
-// other types are left untouched (the report then says 0 changed).
+// Quantises float or double values (raw bytes, attribute order) in place,
+// chunk after chunk in attribute order, so an encoder in bounded memory
+// quantises each cube's values as they are gathered; the report (its sums
+// taken in the same order) is the same however the values were cut. Other
+// types are left untouched (the report then says 0 changed).
+class ScalarQuantizer {
+public:
+    ScalarQuantizer(ValueType type, const ScalarTolerance& tolerance);
+    void apply(std::span<uint8_t> values);
+    ToleranceReport finish() const;
+
+private:
+    template <typename T>
+    void quantise(std::span<uint8_t> bytes);
+    ValueType type_;
+    ToleranceReport report_;
+    double sumAbs_ = 0, sumSq_ = 0;
+};
+
+// All the values at once.
 ToleranceReport applyScalarTolerance(std::vector<uint8_t>& values, ValueType type, const ScalarTolerance& tolerance);
 
 std::string describe(const ScalarTolerance& tolerance);

@@ -10,6 +10,7 @@
 #include <tbb/parallel_pipeline.h>
 
 #include "src/attributes/PredictedWindows.h"
+#include "src/attributes/ScalarTolerance.h"
 #include "src/attributes/ValueWindows.h"
 #include "src/dag/ReducedDagBytes.h"
 #include "src/dag/SubDagMerge.h"
@@ -197,6 +198,7 @@ dag::ReducedDag buildLayer(CubeSource& source, Layer layer, const LayerPlan& pla
 struct ValueStream {
     attributes::ValueWindowWriter* palette = nullptr;
     attributes::PredictedWindowWriter* predicted = nullptr;
+    attributes::ScalarQuantizer* quantizer = nullptr;  // lossy: each subtree's values quantised in attribute order
 };
 
 // The layer's values in attribute order, cube by cube. With several
@@ -256,6 +258,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
             piece.values = {};
         },
         [&](Piece& piece) {
+            if (stream && stream->quantizer) stream->quantizer->apply(piece.gathered);
             if (stream && stream->predicted) stream->predicted->add(piece.gathered, piece.layout);
             else if (stream) stream->palette->add(piece.gathered);
             piece.gathered = {};
@@ -320,22 +323,26 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     step("reducing the DAG");
     LayerPlan plan;
     if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan, team);
-    // Lossless values (no tolerance or colour quantisation, which need the
-    // whole channel) stream from the gather into the value windows: never
-    // held whole. With several processes each codes the windows of its
-    // share and process 0 puts them together (completing the windows that
-    // straddle two shares).
-    const bool streamValues = vs > 0 && options.tolerance.mode == attributes::ScalarTolerance::Mode::Exact && !isColourGrid(source.header(), options);
+    // Values stream from the gather into the value windows, never held
+    // whole: lossless ones, and lossy ones quantised on the way (one value
+    // at a time, in attribute order) by one process. With several processes
+    // each codes the windows of its share and process 0 puts them together
+    // (completing the windows that straddle two shares); their lossy values,
+    // like colours (clustered over the whole channel), are gathered whole.
+    const bool lossy = options.tolerance.mode != attributes::ScalarTolerance::Mode::Exact;
+    const bool streamValues = vs > 0 && !isColourGrid(source.header(), options) && (!lossy || team.size() == 1);
+    attributes::ScalarQuantizer quantizer(source.header().valueType, options.tolerance);
     const bool predicted = usesPredictedWindows(source.header().valueType, options);
     // Gathers the layer into windows (on process 0: all of them).
     auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries) {
         const unsigned inFlight = valueWindowsInFlight(budget, vs);
         const uint64_t expected = encoding::decodedSize(dag).attributeEntries;
         ValueStream stream;
+        if (lossy && layer == Layer::Active) stream.quantizer = &quantizer;
         auto run = [&](auto& writer) -> attributes::ValueWindowsPayload {
             const LayerSummary summary = source.summary(layer);
             if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::ValueWindowWriter>) {
-                if (team.size() == 1 && summary.uniform() && summary.uniformValue.size() == vs) {
+                if (team.size() == 1 && summary.uniform() && summary.uniformValue.size() == vs && !stream.quantizer) {
                     // Every value the same (a level set's inactive voxels):
                     // the layer in attribute order is that value repeated,
                     // so no pass over the cubes gathers it.
@@ -395,7 +402,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
         if (!active.empty()) {
             uint64_t entries = 0;
             out.valueWindows = streamLayer(Layer::Active, plan, out.dag, entries);
-            out.lossy = {options.tolerance, entries};
+            out.lossy = lossy ? quantizer.finish() : attributes::ToleranceReport{options.tolerance, entries};
         }
     } else {
         step("ordering values");

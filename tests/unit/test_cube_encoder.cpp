@@ -110,6 +110,9 @@ TEST(CubeEncoder, LossyAndIntegerCodingsAreByteIdentical) {
     lossy.tolerance.mode = attributes::ScalarTolerance::Mode::Absolute;
     lossy.tolerance.bound = 0.01;
     expectSameFileForAllCubeSizes(shell, lossy, "shell, tolerance 0.01");
+    lossy.tolerance.mode = attributes::ScalarTolerance::Mode::Relative;
+    lossy.tolerance.bound = 0.05;
+    expectSameFileForAllCubeSizes(shell, lossy, "shell, relative tolerance 0.05");
     expectSameFileForAllCubeSizes(intGrid(rng), {}, "int32 labels");
 }
 
