@@ -48,6 +48,8 @@ safety_init() {
     # Private copies: a rebuild during the run must not swap the binaries.
     mkdir -p "$WORK/bin"
     cp "$VDBDAG" "$PROBE" "$WORK/bin/"
+    # The image writers live beside the binary (vdb_bridge/image_module), loaded by render.
+    [ -f "$BUILD/libvdbdag_images.so" ] && cp "$BUILD/libvdbdag_images.so" "$WORK/bin/"
     VDBDAG=$WORK/bin/vdbdag
     PROBE=$WORK/bin/vdbdag_vdb_probe
     if [ -x "$PHANTOM" ]; then
