@@ -331,3 +331,36 @@ TEST(Cli, UnknownCommandsGetASuggestionOnlyWhenOneIsClose) {
     EXPECT_EQ(none.err.find("did you mean"), std::string::npos) << none.err;
     EXPECT_EQ(none.exitCode, 2);
 }
+
+// A .vdb whose transform OpenVDB reads but cannot use (its scale forged to
+// zero in the file's bytes): every command that reads it names the file and
+// the grid, in one line, instead of OpenVDB's bare "ArithmeticError".
+TEST(Cli, AnUnusableTransformIsAnErrorNamingTheFile) {
+    const fs::path good = workDir() / "zero_scale_src.vdb", bad = workDir() / "zero_scale.vdb";
+    {
+        openvdb::initialize();
+        auto g = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(20.0f, openvdb::Vec3f(0.0f), 0.5f, 3.0f);
+        g->setName("ball");
+        openvdb::io::File(good.string()).write({g});
+    }
+    std::ifstream in(good, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    const std::string map = "UniformScaleMap";
+    const size_t at = bytes.find(map);
+    ASSERT_NE(at, std::string::npos) << "OpenVDB wrote another map type";
+    double scale = 0;
+    std::memcpy(&scale, bytes.data() + at + map.size(), 8);
+    ASSERT_DOUBLE_EQ(scale, 0.5) << "not the scale where expected";
+    std::fill(bytes.begin() + long(at + map.size()), bytes.begin() + long(at + map.size() + 48), '\0');  // scale and voxel size
+    std::ofstream(bad, std::ios::binary) << bytes;
+    const std::string f = bad.string(), out = (workDir() / "zero_scale_out").string();
+    for (const std::string& c : {"info " + f, "encode " + f + " -o " + out + ".ssvdag", "encode " + f + " -o " + out + ".ssvdag --memory-limit 64M",
+                                 "export " + f + " -o " + out + ".vtu", "verify " + f}) {
+        const CommandResult r = runCli(c);
+        EXPECT_EQ(r.exitCode, 1) << c;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find(f + ": grid 0 'ball' has an unusable transform"), std::string::npos) << c << "\n" << r.err;
+    }
+    EXPECT_FALSE(fs::exists(out + ".ssvdag"));
+    EXPECT_FALSE(fs::exists(out + ".vtu"));
+}

@@ -85,6 +85,13 @@ void checkGridAgainstFile(const std::string& path, size_t index, const openvdb::
     // simply absent); its writer's own voxel count gives it away.
     const std::string which = path + ": grid " + std::to_string(index) + " '" + g.getName() + "'";
     if (!g.baseTreePtr()) throw Error(which + " could not be read");
+    // A transform OpenVDB reads but cannot use (a zero scale, a singular
+    // matrix) throws later from wherever it is first used, without a name.
+    try {
+        (void)g.transform().baseMap()->getAffineMap();
+    } catch (const std::exception& e) {
+        throw Error(which + " has an unusable transform (" + oneLine(e.what()) + ")");
+    }
     const uint64_t voxels = g.activeVoxelCount();
     if (const auto count = g.getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
         if (uint64_t(count->value()) != voxels)
