@@ -7,7 +7,8 @@
 #                         section parsers, DAG validation and a DAG walk
 #   fuzz_ssvdag_sections  section payloads and DAG validation behind the checksums
 #   fuzz_scan_headers     NRRD, MetaImage, NIfTI (libnifti) and DICOM (GDCM)
-#                         headers, then their samples, seeded from ../shared/data
+#                         headers and raw file names, then their samples,
+#                         seeded from ../shared/data
 # Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
 # Crash inputs are written to build-fuzz/artifacts/; the corpus grows in
 # build-fuzz/corpus_*. Exit status is non-zero if any target found a bug.
@@ -37,6 +38,9 @@ for f in "$DATA"/medical/nifti/*.nii.gz; do
   [ -f "$f" ] && { printf '\002'; zcat "$f" | head -c 65000 || true; } > "build-fuzz/corpus_scan_headers/seed_2_$(basename "$f" .gz)"
 done
 for f in $(ls "$DATA"/medical/dicom/rsna_2/PET 2>/dev/null | head -3); do seed 4 "$DATA/medical/dicom/rsna_2/PET/$f"; done
+# Raw: format byte 5, the file name (its layout), a NUL, the samples.
+{ printf '\005vol_4x4x4_uint16le\000'; head -c 128 /dev/urandom; } > build-fuzz/corpus_scan_headers/seed_5_raw_u16
+{ printf '\005ct_8x2x2_float32\000'; head -c 128 /dev/urandom; } > build-fuzz/corpus_scan_headers/seed_5_raw_f32
 
 status=0
 for target in "${TARGETS[@]}"; do

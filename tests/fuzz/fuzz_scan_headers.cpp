@@ -1,6 +1,7 @@
 // libFuzzer target for the dense-scan readers: the first input byte picks
-// the format (NRRD, MetaImage, NIfTI, gzip NIfTI, DICOM), the rest is the
-// file. It is written to a private temporary file and read as vdbdag reads
+// the format (NRRD, MetaImage, NIfTI, gzip NIfTI, DICOM, raw), the rest is
+// the file; for raw, the file's name (its layout, "NAME_XxYxZ_TYPE.raw")
+// up to a NUL, then its samples. It is written to a private temporary file and read as vdbdag reads
 // a scan: the header (NrrdHeader, MetaImageHeader, libnifti through
 // NiftiHeader, GDCM through DicomSeries), then, when the header validates
 // and describes at most 16 MiB of samples, every slice through
@@ -23,6 +24,7 @@
 #include "vdb_bridge/MetaImageHeader.h"
 #include "vdb_bridge/NiftiHeader.h"
 #include "vdb_bridge/NrrdHeader.h"
+#include "vdb_bridge/RawVolume.h"
 
 namespace {
 
@@ -51,11 +53,21 @@ void readAll(const DenseVolume& v) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size < 1) return 0;
-    static const char* const names[] = {"scan.nrrd", "scan.mha", "scan.nii", "scan.nii.gz", "scan.dcm"};
-    const unsigned kind = data[0] % 5;
-    const std::string path = (folder() / names[kind]).string();
+    static const char* const names[] = {"scan.nrrd", "scan.mha", "scan.nii", "scan.nii.gz", "scan.dcm", ""};
+    const unsigned kind = data[0] % 6;
+    size_t start = 1;
+    std::string name = names[kind];
+    if (kind == 5) {  // raw: the name is the header
+        while (start < size && data[start] != 0 && name.size() < 200) {
+            const char c = char(data[start++]);
+            name += (c == '/' || c == '\0') ? '_' : c;
+        }
+        if (start < size && data[start] == 0) ++start;
+        name = "r_" + name + ".raw";
+    }
+    const std::string path = (folder() / name).string();
     if (std::FILE* f = std::fopen(path.c_str(), "wb")) {
-        std::fwrite(data + 1, 1, size - 1, f);
+        std::fwrite(data + start, 1, size - start, f);
         std::fclose(f);
     } else {
         return 0;
@@ -71,6 +83,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                 if (!scan.series.empty()) readAll(describeDicomSeries(path, "1"));
                 break;
             }
+            case 5: readAll(describeRaw(path, RawLayout{})); break;
         }
     } catch (const Error&) {
     }
