@@ -37,6 +37,17 @@ inline CommandResult runShell(const std::string& command) {
     return r;
 }
 
+// A folder of its own for a test file's outputs ("vdbdag_TAG_PID" in the
+// temporary directory), emptied once per process: a finished process with
+// the same PID may have left one behind.
+inline std::filesystem::path testFolder(const std::string& tag) {
+    namespace fs = std::filesystem;
+    const fs::path d = fs::temp_directory_path() / ("vdbdag_" + tag + "_" + std::to_string(getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
 // `vdbdag ARGS`; `envPrefix`: e.g. "env VAR=value " before the binary.
 inline CommandResult runCli(const std::string& args, const std::string& envPrefix = "") {
     return runShell(envPrefix + std::string(VDBDAG_BINARY) + " " + args);

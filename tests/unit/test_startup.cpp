@@ -25,12 +25,7 @@ using vdbdag::testing::runCli;
 using vdbdag::testing::runShell;
 
 fs::path workDir() {
-    static const fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() / ("vdbdag_startup_" + std::to_string(getpid()));
-        fs::remove_all(d);
-        fs::create_directories(d);
-        return d;
-    }();
+    static const fs::path dir = vdbdag::testing::testFolder("startup");
     return dir;
 }
 
