@@ -10,6 +10,9 @@
 #                         headers and raw file names, then their samples,
 #                         seeded from ../shared/data
 # Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
+# With FUZZ_RUNS=N each target instead runs N inputs from a fixed random seed
+# and a fresh seed corpus: the same inputs on every machine, so the short run
+# that scripts/test.sh makes passes or fails alike here and in CI.
 # Crash inputs are written to build-fuzz/artifacts/; the corpus grows in
 # build-fuzz/corpus_*. Exit status is non-zero if any target found a bug.
 set -euo pipefail
@@ -22,6 +25,7 @@ JOBS=${JOBS:-2}
 
 CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVDBDAG_BUILD_FUZZERS=ON -DVDBDAG_BUILD_TESTS=OFF >/dev/null
 cmake --build build-fuzz -j"$JOBS" --target "${TARGETS[@]}" make_seed_corpus
+[ -n "${FUZZ_RUNS:-}" ] && rm -rf build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/corpus_scan_headers
 mkdir -p build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/artifacts
 build-fuzz/make_seed_corpus build-fuzz/corpus_reader build-fuzz/corpus_sections
 # Scan seeds: a format byte (0 NRRD, 1 MetaImage, 2 NIfTI, 3 gzip NIfTI, 4
@@ -39,15 +43,17 @@ for f in "$DATA"/medical/nifti/*.nii.gz; do
 done
 for f in $(ls "$DATA"/medical/dicom/rsna_2/PET 2>/dev/null | head -3); do seed 4 "$DATA/medical/dicom/rsna_2/PET/$f"; done
 # Raw: format byte 5, the file name (its layout), a NUL, the samples.
-{ printf '\005vol_4x4x4_uint16le\000'; head -c 128 /dev/urandom; } > build-fuzz/corpus_scan_headers/seed_5_raw_u16
-{ printf '\005ct_8x2x2_float32\000'; head -c 128 /dev/urandom; } > build-fuzz/corpus_scan_headers/seed_5_raw_f32
+{ printf '\005vol_4x4x4_uint16le\000'; printf '%0128d' 7; } > build-fuzz/corpus_scan_headers/seed_5_raw_u16
+{ printf '\005ct_8x2x2_float32\000'; printf '%0128d' 3; } > build-fuzz/corpus_scan_headers/seed_5_raw_f32
 
 status=0
 for target in "${TARGETS[@]}"; do
   corpus=build-fuzz/corpus_${target#fuzz_ssvdag_}
   [ "$target" = fuzz_scan_headers ] && corpus=build-fuzz/corpus_scan_headers
-  echo "== $target: ${SECONDS_TO_RUN}s from $(ls "$corpus" | wc -l) corpus files"
-  if ! build-fuzz/"$target" -max_total_time="$SECONDS_TO_RUN" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
+  limit=(-max_total_time="$SECONDS_TO_RUN")
+  [ -n "${FUZZ_RUNS:-}" ] && limit=(-runs="$FUZZ_RUNS" -seed=1)
+  echo "== $target: ${limit[*]} from $(ls "$corpus" | wc -l) corpus files"
+  if ! build-fuzz/"$target" "${limit[@]}" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
         -print_final_stats=1 -artifact_prefix=build-fuzz/artifacts/"$target"- "$corpus" > build-fuzz/"$target".log 2>&1; then
     status=1
     echo "!! $target found a problem; see build-fuzz/$target.log and build-fuzz/artifacts/"

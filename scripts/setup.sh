@@ -18,6 +18,7 @@ PACKAGES=(
   libnifti2-dev python3-nibabel
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils zlib1g-dev
   libzfp-dev
+  clang libclang-rt-14-dev
 )
 
 missing=()

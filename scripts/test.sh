@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Set up (install missing packages, build) and run the whole test suite
-# (GoogleTest under ctest). Tests that need ../shared/data skip cleanly when
-# it is absent.
+# (GoogleTest and the safety scripts under ctest), then short fuzz runs.
+# Tests that need ../shared/data skip cleanly when it is absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-cd build
-ctest --output-on-failure --timeout 900 -j"$(nproc)"
+(cd build && ctest --output-on-failure --timeout 900 -j"$(nproc)")
+# Short fuzz runs of every parser (libFuzzer, ASan + UBSan, a clang build in
+# build-fuzz): a fixed seed and number of inputs, so they find here what
+# they find in CI. Longer runs: scripts/fuzz.sh SECONDS.
+FUZZ_RUNS=${FUZZ_RUNS:-50000} scripts/fuzz.sh

@@ -265,7 +265,11 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
         // (02 00 00 00, E0 7F 10 00: found by fuzz_scan_headers).
         if (size > 0 && size < 8) return fmt::format("the file ({} bytes) ends inside its first element", size);
         if (!readAt(0, h, 6)) return "";
-        const uint16_t group = uint16_t(h[0] | h[1] << 8);
+        uint16_t group = uint16_t(h[0] | h[1] << 8);
+        if (group == 0x0200 || group == 0x0800) {  // big-endian: GDCM reads it so (and asserts on a cut-off element)
+            bigEndian = true;
+            group = uint16_t(h[0] << 8 | h[1]);
+        }
         if (group != 0x0002 && group != 0x0008) return "";
         explicitVr = std::isupper(h[4]) && std::isupper(h[5]);
         declaredImplicit = !explicitVr;

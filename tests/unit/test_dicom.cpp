@@ -553,18 +553,24 @@ TEST(DicomSeries, BadInputsGiveOneLineNamingTheFile) {
     EXPECT_TRUE(oneLine(empty)) << empty;
 }
 
-// Files of four bytes that start like a DICOM element (found by
+// Files that end inside their first DICOM element (found by
 // fuzz_scan_headers): GDCM asserts on them (abort), so the element walk
-// refuses them first. In-process, so an assert would end this test.
+// refuses them first, little- or big-endian. In-process, so an assert would end this test.
 TEST(DicomSeries, AFileEndingInsideItsFirstElementIsRefusedBeforeGdcm) {
     const fs::path dir = freshDir("tiny");
     const fs::path tiny = dir / "tiny.dcm";
-    for (const char* bytes : {"\x02\x00\x00\x00", "\xe0\x7f\x10\x00"}) {
-        std::ofstream(tiny, std::ios::binary).write(bytes, 4);
+    struct Case {
+        std::string bytes, expect;
+    };
+    for (const Case& c : std::vector<Case>{{std::string("\x02\x00\x00\x00", 4), "ends inside its first element"},
+                                           {std::string("\xe0\x7f\x10\x00", 4), "ends inside its first element"},
+                                           // big-endian, an explicit UN element whose 4-byte length is cut off
+                                           {std::string("\x00\x08\x00\x0cUN\x00\x00\xc0\x00\x00", 11), "element (0008,000C) at byte 0 is cut off"}}) {
+        std::ofstream(tiny, std::ios::binary).write(c.bytes.data(), std::streamsize(c.bytes.size()));
         const std::string m = errorOf([&] { scanDicom(tiny.string()); describeDicomSeries(tiny.string(), ""); });
         EXPECT_TRUE(oneLine(m)) << m;
         EXPECT_EQ(m.rfind(tiny.string() + ": ", 0), 0u) << m;
-        EXPECT_NE(m.find("ends inside its first element"), std::string::npos) << m;
+        EXPECT_NE(m.find(c.expect), std::string::npos) << m;
     }
 }
 
