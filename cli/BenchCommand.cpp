@@ -20,6 +20,7 @@
 
 #include "cli/BenchReport.h"
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "src/bench/ImageMetrics.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/trace/CpuRenderer.h"
@@ -364,7 +365,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
         run.seconds = msSince(start) / 1000.0;
         writeBenchReport(run, opt->output);
         if (opt->json) {
-            fmt::print("{}\n", benchToJson(run).dump(2));
+            printJson(benchToJson(run));
         } else {
             fmt::print("bench: {} points on {} grid(s) in {:.0f} s -> {}/report.md\n", run.points.size(), chosen.size(), run.seconds, opt->output);
         }

@@ -1,6 +1,8 @@
 // Report files of `vdbdag bench`; see BenchReport.h.
 #include "cli/BenchReport.h"
 
+#include "cli/JsonReport.h"
+
 #include <cmath>
 #include <limits>
 #include <filesystem>
@@ -159,8 +161,10 @@ nlohmann::json benchToJson(const BenchRun& run) {
                           {"trace", timingJson(p.trace)},
                           {"rays_per_second", numberOrNull(p.raysPerSecond)},
                           {"note", p.note}});
-    return {{"input", run.input},   {"sweep", run.sweep},     {"repeats", run.repeats}, {"time_budget_s", run.budgetSeconds}, {"render_width", run.renderWidth},
+    nlohmann::json report{{"input", run.input},   {"sweep", run.sweep},     {"repeats", run.repeats}, {"time_budget_s", run.budgetSeconds}, {"render_width", run.renderWidth},
             {"render_height", run.renderHeight}, {"seconds", run.seconds}, {"machine", run.machine}, {"points", points}};
+    addVersions(report);
+    return report;
 }
 
 void writeBenchReport(const BenchRun& run, const std::string& directory) {

@@ -14,8 +14,10 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/Commands.h"
+#include "cli/GlobalOptions.h"
 #include "cli/RunContext.h"
 #include "cli/UsageErrors.h"
+#include "cli/JsonReport.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::cli {
@@ -35,7 +37,8 @@ int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
     installFailureHandlers();
     CLI::App app{"vdbdag: compress OpenVDB volumes into symmetry-aware sparse voxel DAGs (.ssvdag) and back", "vdbdag"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "vdbdag 0.1.0");
+    app.set_version_flag("--version", std::string("vdbdag ") + kToolVersion);
+    addGlobalOptions(app);
     int exitCode = 0;
     addEncodeCommand(app, exitCode);
     addDecodeCommand(app, exitCode);
@@ -53,6 +56,7 @@ int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
     if (const std::optional<int> helped = answerHelpCommand(app, argc, argv)) return *helped;
     try {
         app.parse(argc, argv);
+        for (const CLI::App* sub : app.get_subcommands()) reportVerbose(sub->get_name());
     } catch (const CLI::ParseError& e) {
         return answerParseError(app, e, argc, argv);
     } catch (const Error& e) {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "gpu/DeviceInfo.h"
 #include "src/util/Error.h"
 
@@ -76,7 +77,7 @@ void addDevicesCommand(CLI::App& app, int& exitCode) {
             for (const gpu::DeviceInfo& d : devices) report.push_back(toJson(d, chosen && *chosen == d.index));
             report = nlohmann::json{{"devices", report}};
             if (chosen) report[opt->device ? "selected" : "default"] = *chosen;
-            fmt::print("{}\n", report.dump(2));
+            printJson(report);
         } else {
             for (const gpu::DeviceInfo& d : devices) {
                 fmt::print("{}: {} [{}]{}\n", d.index, d.name, d.type, chosen && *chosen == d.index ? mark : "");

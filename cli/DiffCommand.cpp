@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "cli/RunContext.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
@@ -54,7 +55,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
         options.compressor = opt->compressor;
         const bridge::DiffReport r = bridge::diffVolumes(opt->a, opt->b, opt->output, options);
         static const char* kStatus[4] = {"same", "value_differs", "only_in_a", "only_in_b"};
-        nlohmann::json report{{"a", opt->a}, {"b", opt->b}, {"identical", r.identical}, {"header_differences", r.headerDifferences},
+        nlohmann::json report{{"inputs", {opt->a, opt->b}}, {"a", opt->a}, {"b", opt->b}, {"identical", r.identical}, {"header_differences", r.headerDifferences},
                               {"peak", "value range (max - min) of A's active values; vector magnitudes"}, {"grids", nlohmann::json::array()}};
         if (!opt->output.empty()) { report["output"] = opt->output; report["bytes"] = r.bytes; }
         for (const auto& g : r.grids) {
@@ -68,7 +69,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
                                                           {"rms_error", g.ofA.rmsError}, {"psnr_db", number(g.ofA.psnr)}}}});
         }
         if (opt->json) {
-            fmt::print("{}\n", report.dump(2));
+            printJson(report);
         } else {
             fmt::print("{} vs {}: {}\n", opt->a, opt->b, r.identical ? "same" : "DIFFER");
             for (const auto& h : r.headerDifferences) fmt::print("  {}\n", h);

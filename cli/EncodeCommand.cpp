@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "cli/DenseInputOptions.h"
@@ -55,7 +56,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "plain SVDAG: merge identical subtrees only");
     cmd->add_flag("--no-compress", opt->noCompress, "store sections without zstd");
     cmd->add_flag("--no-predict", opt->noPredict, "integer values: always palettes, never the brick predictor");
-    cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the smallest (1-64)")->check(CLI::Range(1, 64));
+    cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the one whose geometry takes the fewest bytes in the file (1-64)")->check(CLI::Range(1, 64));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
     auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error")->check(finiteNumber())->check(CLI::PositiveNumber);
@@ -230,8 +231,13 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
 
         uint64_t voxels = 0;
         for (const auto& g : scene.grids) voxels += g.activeVoxels;
-        nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"bytes", fileBytes}, {"grids", scene.grids.size()},
-                              {"active_voxels", voxels}, {"seconds", seconds},
+        nlohmann::json grids = nlohmann::json::array();
+        for (size_t g = 0; g < scene.grids.size(); ++g)
+            grids.push_back({{"index", g}, {"name", scene.grids[g].record.name}, {"class", scene.grids[g].record.gridClass},
+                             {"value_type", valueTypeName(scene.grids[g].record.valueType)}, {"active_voxels", scene.grids[g].activeVoxels}});
+        // "bytes": the file written, as "ssvdag_bytes" (kept for scripts written before the common keys).
+        nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"ssvdag_bytes", fileBytes}, {"bytes", fileBytes},
+                              {"grid_count", scene.grids.size()}, {"grids", grids}, {"active_voxels", voxels}, {"seconds", seconds},
                               {"bits_per_active_voxel", voxels ? 8.0 * double(fileBytes) / double(voxels) : 0.0}};
         if (threshold.applied) report["threshold"] = thresholdJson(threshold);
         report["phases"] = nlohmann::json::array();
@@ -254,7 +260,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             if (g.normals) report["grids_normals"].push_back(normalsJson(g));
         }
         if (opt->json) {
-            fmt::print("{}\n", report.dump(2));
+            printJson(report);
         } else {
             fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output,
                        scene.grids.size(), voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "src/util/Error.h"
@@ -85,7 +86,7 @@ void addExportCommand(CLI::App& app, int& exitCode) {
                 report["grids"].push_back(j);
             }
             if (opt->json) {
-                fmt::print("{}\n", report.dump(2));
+                printJson(report);
             } else {
                 fmt::print("{} -> {} ({} bytes)\n", opt->input, opt->output, r.bytes);
                 for (const auto& g : r.grids) {
@@ -114,7 +115,7 @@ void addExportCommand(CLI::App& app, int& exitCode) {
             report["blocks"].push_back(j);
         }
         if (opt->json) {
-            fmt::print("{}\n", report.dump(2));
+            printJson(report);
         } else {
             fmt::print("{} -> {} ({} bytes)\n", opt->input, opt->output, r.bytes);
             for (const auto& b : r.blocks)

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "cli/RunContext.h"
 #include "cli/DenseInputOptions.h"
 #include "src/util/Error.h"
@@ -57,7 +58,7 @@ void addImportCommand(CLI::App& app, int& exitCode) {
                               {"seconds", seconds},
                               {"threshold", thresholdJson(imported.threshold)}};
         if (opt->json) {
-            fmt::print("{}\n", report.dump(2));
+            printJson(report);
         } else {
             fmt::print("{}: {}x{}x{} {} samples -> {} grid '{}', {} active voxels in {:.2f} s\n", opt->output, d[0], d[1], d[2],
                        bridge::sampleTypeName(imported.source.type), valueTypeName(g.valueType), g.name, g.topology.activeVoxelCount(), seconds);

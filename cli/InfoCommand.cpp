@@ -1,9 +1,14 @@
-// `vdbdag info FILE [--json]` for .ssvdag files and for .vdb files (which
-// are encoded in memory, with the plain-SVDAG reduction run too so all three
-// node counts show). For DICOM input (a folder, a .dcm file, a DICOMDIR):
+// `vdbdag info FILE [--json]` for .ssvdag files (reading only what it prints:
+// header, DAG, section table, the value windows' range) and for .vdb files
+// (OpenVDB's own figures, then the encoding in memory, with the plain-SVDAG
+// reduction run too so all three node counts show). Both show what
+// `vdb_print -l -m` shows: voxel size, index and world bounding box, value
+// range, transform, class, background, grid and file metadata. For DICOM input (a folder, a .dcm file, a DICOMDIR):
 // the series found (what `encode --series N|UID` picks from) and the files
 // skipped.
 #include <cmath>
+
+#include "src/util/Error.h"
 
 #include <fmt/core.h>
 
@@ -12,11 +17,13 @@
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
+#include "cli/JsonReport.h"
 #include "src/pipeline/GridCodec.h"
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/DicomSeries.h"
 #include "vdb_bridge/NiftiHeader.h"
 #include "vdb_bridge/VdbImport.h"
+#include "vdb_bridge/VdbSummary.h"
 
 namespace vdbdag::cli {
 
@@ -109,7 +116,7 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::vector<std::string> inputs;
         std::string input;
-        bool json = false, noSymmetry = false;
+        bool json = false, noSymmetry = false, values = false;
         ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
@@ -117,43 +124,76 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("input", opt->inputs, ".ssvdag or .vdb file, a scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
     cmd->add_flag("--json", opt->json, "print JSON");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "for .vdb input: report the plain SVDAG encoding");
+    cmd->add_flag("--values", opt->values,
+                  "for .ssvdag input: also each value channel's statistics (entries, distinct values, palette blocks) and the size traceable in "
+                  "memory; decodes every value (slower)");
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         DenseInputOptions dicomInputs;
         opt->input = dicomInputs.takeInputs(opt->inputs);
         setActivity(opt->input, "reading");
         if (bridge::denseFormatOf(opt->input) == bridge::DenseFormat::Dicom) {
-            const nlohmann::json report = dicomReport(bridge::dicomInputName(opt->inputs), bridge::scanDicom(opt->inputs));
+            nlohmann::json report = dicomReport(bridge::dicomInputName(opt->inputs), bridge::scanDicom(opt->inputs));
             // Descriptions may be Latin-1 (Specific Character Set): never throw on them.
-            if (opt->json) fmt::print("{}\n", report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
+            if (opt->json) printJson(report);
             else fmt::print("{}", formatDicomReport(report));
             exitCode = 0;
             return;
         }
         if (const bridge::DenseFormat f = bridge::denseFormatOf(opt->input); f != bridge::DenseFormat::None && f != bridge::DenseFormat::Raw) {
             // describeDense describes a 4-D NIfTI file by its first volume.
-            const nlohmann::json report = scanHeaderReport(opt->input, bridge::describeDense(opt->input, bridge::DenseImportOptions{}));
-            if (opt->json) fmt::print("{}\n", report.dump(2));
+            nlohmann::json report = scanHeaderReport(opt->input, bridge::describeDense(opt->input, bridge::DenseImportOptions{}));
+            if (opt->json) printJson(report);
             else fmt::print("{}", formatScanHeaderReport(report));
             exitCode = 0;
             return;
         }
         std::vector<uint8_t> bytes = format::readFileBytes(opt->input);
-        format::SsvdagScene scene;
+        nlohmann::json report;
         if (!isVdbFile(bytes)) {
+            // Nothing decoded but what is printed: value windows stay as
+            // they are in the file (their range is read window by window)
+            // unless --values asks for the channels' statistics.
             format::ReadOptions readOptions;
             readOptions.limits = opt->limits.limits(0);
-            scene = format::readScene(bytes, opt->input, readOptions);
+            readOptions.keepValueWindows = !opt->values;
+            readOptions.rebuildPalettes = opt->values;
+            const format::SsvdagScene scene = format::readScene(bytes, opt->input, readOptions);
+            report = sceneReport(scene, bytes, opt->input, opt->values);
+            report["format"] = "ssvdag";
+            report["input_bytes"] = bytes.size();
+            for (size_t g = 0; g < scene.grids.size(); ++g) {
+                const format::EncodedGrid& grid = scene.grids[g];
+                const std::string what = opt->input + " grid " + std::to_string(g);
+                const format::GridSummary summary = format::summarizeGrid(grid);
+                addGridHeader(report["grids"][g], grid.record, bridge::gridHeaderFacts(grid.record, summary.indexBox, what), summary, false);
+            }
+            report["file_metadata"] = metadataJson(bridge::fileMetadataEntries(scene.fileMetadata, opt->input + " file metadata"));
         } else {
+            // OpenVDB's own figures (the reference vdb_print shows), then the
+            // DAG figures of its encoding in memory.
+            const uint64_t fileBytes = bytes.size();
+            bytes = {};
+            const bridge::VdbFileFacts facts = bridge::vdbFileFacts(opt->input);
             const bridge::ImportResult imported = bridge::importVdb(opt->input);
             pipeline::EncodeOptions options;
             options.symmetry = !opt->noSymmetry;
             options.computeSvdagStats = true;
-            scene = pipeline::encodeVolume(imported.volume, options);
-            bytes = format::writeScene(scene);
+            const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, options);
+            const std::vector<uint8_t> encoded = format::writeScene(scene);
+            report = sceneReport(scene, encoded, opt->input, true);
+            report["format"] = "vdb";
+            report["input_bytes"] = fileBytes;
+            if (facts.grids.size() != scene.grids.size()) throw Error(opt->input + ": internal error: grids read twice differ in number");
+            for (size_t g = 0; g < facts.grids.size(); ++g) {
+                const bridge::VdbGridFacts& f = facts.grids[g];
+                GridRecord header = f.header;
+                header.background = scene.grids[g].record.background;
+                addGridHeader(report["grids"][g], header, f.facts, f.summary, true);
+            }
+            report["file_metadata"] = metadataJson(facts.fileMetadata);
         }
-        const nlohmann::json report = sceneReport(scene, bytes, opt->input);
-        if (opt->json) fmt::print("{}\n", report.dump(2));
+        if (opt->json) printJson(report);
         else fmt::print("{}", formatSceneReport(report));
         exitCode = 0;
     });

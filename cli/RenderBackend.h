@@ -19,8 +19,9 @@ public:
                                 trace::RenderStats& stats) = 0;
 };
 
-// "cpu", "vulkan", or "auto" (Vulkan when a device exists, else the CPU with
-// a one-line note on stderr); `device` >= 0 picks a Vulkan device (--device N).
+// "cpu", "vulkan", or "auto" (a Vulkan GPU when one exists, else the CPU
+// tracer with a one-line note on stderr: a software Vulkan device is used
+// only when asked for); `device` >= 0 picks a Vulkan device (--device N).
 std::unique_ptr<RenderBackend> makeRenderBackend(const std::string& kind, int device);
 
 } // namespace vdbdag::cli

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "cli/RunContext.h"
 #include "cli/FiniteNumber.h"
 #include "cli/ReadLimitOptions.h"
@@ -60,7 +61,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--height", opt->height, "image height")->check(CLI::Range(1, 16384));
     cmd->add_option("--camera", opt->camera, "EYE,TARGET,UP as 9 comma-separated world coordinates (default: frame the grid)");
     cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(finiteNumber())->check(CLI::Range(1.0, 170.0));
-    cmd->add_option("--backend", opt->backend, "vulkan, cpu, or auto (Vulkan when a device exists)")->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
+    cmd->add_option("--backend", opt->backend, "vulkan, cpu, or auto (a Vulkan GPU when there is one, else the CPU tracer; a software Vulkan device such as lavapipe only with --backend vulkan)")->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
     cmd->add_option("--device", opt->device, "Vulkan device index (see `vdbdag devices`)");
     cmd->add_option("--lod-pixels", opt->lodPixels, "stop descending where a node projects smaller than this many pixels (0: off)")->check(finiteNumber())->check(CLI::Range(0.0, 1e6));
     cmd->add_flag("--shadows", opt->shadows, "cast a shadow ray towards the light");
@@ -114,7 +115,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                              {"frames", opt->frames},      {"ms_per_frame", ms},            {"ms_min", times.front()},
                              {"ms_max", times.back()},     {"primary_rays", stats.primaryRays}, {"secondary_rays", stats.secondaryRays},
                              {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows}};
-            fmt::print("{}\n", j.dump(2));
+            printJson(j);
         } else {
             fmt::print("render '{}' ({}x{}) on {} ({}): {:.1f} ms per frame (median of {}), {:.2f} M rays/s ({} primary, {} shadow) -> {}\n",
                        chosen->record.name, opt->width, opt->height, backend->name(), backend->device(), ms, opt->frames, raysPerSecond / 1e6,

@@ -44,10 +44,79 @@ std::string formatNormals(const nlohmann::json& n) {
                        n["one_sided"].get<uint64_t>(), n["mean_angle_degrees"].get<double>(), n["max_angle_degrees"].get<double>());
 }
 
-nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> fileBytes, const std::string& name) {
+nlohmann::json metadataJson(const std::vector<bridge::MetadataEntry>& entries) {
+    nlohmann::json out = nlohmann::json::object();
+    for (const auto& e : entries) out[e.name] = {{"type", e.type}, {"value", e.value}};
+    return out;
+}
+
+void addGridHeader(nlohmann::json& j, const GridRecord& header, const bridge::GridHeaderFacts& facts, const format::GridSummary& summary, bool fromVdb) {
+    using nlohmann::json;
+    const ValueType type = header.valueType;
+    j["tree_type"] = facts.treeType;
+    j["voxel_size"] = facts.voxelSize;
+    j["transform"] = facts.transform;
+    j["index_to_world"] = header.indexToWorld;
+    j[fromVdb ? "active_tiles" : "solid_nodes"] = summary.solidNodes;
+    if (summary.indexBox) {
+        const auto& b = *summary.indexBox;
+        j["index_bbox"] = {{"min", b.min}, {"max", b.max}};
+    } else {
+        j["index_bbox"] = nullptr;
+    }
+    if (facts.worldBox) {
+        const auto& w = *facts.worldBox;
+        j["world_bbox"] = {{"min", {w[0], w[1], w[2]}}, {"max", {w[3], w[4], w[5]}}};
+    } else {
+        j["world_bbox"] = nullptr;
+    }
+    auto value = [&](std::span<const uint8_t> v) {
+        const std::vector<double> n = format::valueNumbers(type, v);
+        return n.size() == 1 ? json(n[0]) : json(n);
+    };
+    auto text = [&](std::span<const uint8_t> v) { return format::formatValue(type, v); };
+    if (!header.background.empty()) {
+        j["background"] = value(header.background);
+        j["background_text"] = text(header.background);
+    }
+    if (!summary.activeRange.min.empty())
+        j["value_range"] = {{"min", value(summary.activeRange.min)}, {"max", value(summary.activeRange.max)},
+                            {"min_text", text(summary.activeRange.min)}, {"max_text", text(summary.activeRange.max)}};
+    else
+        j["value_range"] = nullptr;
+    j["metadata"] = metadataJson(facts.metadata);
+}
+
+std::string formatGridHeader(const nlohmann::json& g) {
+    std::string out = fmt::format("  tree {}, voxel size {:.6g} x {:.6g} x {:.6g} ({})\n", g["tree_type"].get<std::string>(), g["voxel_size"][0].get<double>(),
+                                  g["voxel_size"][1].get<double>(), g["voxel_size"][2].get<double>(), g["transform"].get<std::string>());
+    if (!g["index_bbox"].is_null()) {
+        const auto& b = g["index_bbox"];
+        auto c = [&](const char* k, int a) { return b[k][a].get<int64_t>(); };
+        out += fmt::format("  index bbox [{}, {}, {}] -> [{}, {}, {}] ({} x {} x {})\n", c("min", 0), c("min", 1), c("min", 2), c("max", 0), c("max", 1),
+                           c("max", 2), c("max", 0) - c("min", 0) + 1, c("max", 1) - c("min", 1) + 1, c("max", 2) - c("min", 2) + 1);
+    }
+    if (!g["world_bbox"].is_null()) {
+        const auto& w = g["world_bbox"];
+        out += fmt::format("  world bbox [{:.6g}, {:.6g}, {:.6g}] -> [{:.6g}, {:.6g}, {:.6g}]\n", w["min"][0].get<double>(), w["min"][1].get<double>(),
+                           w["min"][2].get<double>(), w["max"][0].get<double>(), w["max"][1].get<double>(), w["max"][2].get<double>());
+    }
+    if (g.contains("background_text")) out += fmt::format("  background {}\n", g["background_text"].get<std::string>());
+    if (!g["value_range"].is_null())
+        out += fmt::format("  active values from {} to {}\n", g["value_range"]["min_text"].get<std::string>(), g["value_range"]["max_text"].get<std::string>());
+    const auto& m = g["index_to_world"];
+    out += "  index to world";
+    for (int r = 0; r < 4; ++r)
+        out += fmt::format(" [{:.6g}, {:.6g}, {:.6g}, {:.6g}]", m[4 * r].get<double>(), m[4 * r + 1].get<double>(), m[4 * r + 2].get<double>(), m[4 * r + 3].get<double>());
+    out += "\n";
+    for (const auto& [name, e] : g["metadata"].items()) out += fmt::format("  metadata {}: {}\n", name, e["value"].get<std::string>());
+    return out;
+}
+
+nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> fileBytes, const std::string& name, bool valueStats) {
     using nlohmann::json;
     const auto sections = format::summarizeContainer(fileBytes, name);
-    json report{{"file", name}, {"bytes", fileBytes.size()}, {"grids", json::array()}};
+    json report{{"input", name}, {"ssvdag_bytes", fileBytes.size()}, {"grid_count", scene.grids.size()}, {"grids", json::array()}};
     uint64_t fileLevelBytes = fileBytes.size();
     for (size_t g = 0; g < scene.grids.size(); ++g) {
         const format::EncodedGrid& grid = scene.grids[g];
@@ -82,7 +151,7 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
         uint64_t traceable = grid.dag.byteSize() + grid.inactiveDag.byteSize();
         for (const auto& [layer, raw, inactive] : {std::tuple{"active", &grid.attributes, false},
                                                    std::tuple{"inactive", &grid.inactiveAttributes, true}}) {
-            if (!vs || raw->empty()) continue;
+            if (!valueStats || !vs || raw->empty()) continue;
             const attributes::PaletteChannel channel = format::traceableValues(grid, inactive);
             const attributes::ChannelStats cs = attributes::channelStats(*raw, vs, channel);
             traceable += channel.byteSize();
@@ -95,12 +164,11 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
             j["normals"] = normalsJson(grid);
         }
         if (grid.colour) j["colour"] = colourJson(grid);
-        j["traceable_bytes"] = traceable;
+        if (valueStats) j["traceable_bytes"] = traceable;
         if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
             j["lossy"] = {{"tolerance", attributes::describe(grid.lossy.tolerance)}, {"changed", grid.lossy.changed},
                           {"max_abs_error", grid.lossy.maxAbsError}, {"mean_abs_error", grid.lossy.meanAbsError},
                           {"rms_error", grid.lossy.rmsError}, {"max_rel_error", grid.lossy.maxRelError}};
-        j["bits_per_active_voxel"] = grid.activeVoxels ? 8.0 * double(gridBytes) / double(grid.activeVoxels) : 0.0;
         if (const auto scan = bridge::scanProvenanceOf(grid.record)) {
             json sj{{"source_file", scan->sourceFile}, {"format", scan->format}, {"sample_type", scan->sampleType},
                     {"dims", {scan->dims[0], scan->dims[1], scan->dims[2]}}, {"space", scan->space}};
@@ -116,11 +184,23 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
         report["grids"].push_back(j);
     }
     report["container_overhead_bytes"] = fileLevelBytes;
+    // The one bits-per-voxel figure of a file, as `encode` prints it: the
+    // whole file over every grid's active voxels.
+    uint64_t voxels = 0;
+    for (const format::EncodedGrid& grid : scene.grids) voxels += grid.activeVoxels;
+    report["active_voxels"] = voxels;
+    report["bits_per_active_voxel"] = voxels ? 8.0 * double(fileBytes.size()) / double(voxels) : 0.0;
     return report;
 }
 
 std::string formatSceneReport(const nlohmann::json& r) {
-    std::string out = fmt::format("{}: {} bytes, {} grid(s)\n", r["file"].get<std::string>(), r["bytes"].get<uint64_t>(), r["grids"].size());
+    const bool vdb = r.value("format", "ssvdag") == "vdb";
+    std::string out = vdb ? fmt::format("{}: OpenVDB file, {} bytes, {} grid(s); encoded in memory as .ssvdag: {} bytes\n", r["input"].get<std::string>(),
+                                        r["input_bytes"].get<uint64_t>(), r["grids"].size(), r["ssvdag_bytes"].get<uint64_t>())
+                          : fmt::format("{}: .ssvdag file (format {}), {} bytes, {} grid(s)\n", r["input"].get<std::string>(),
+                                        r.value("format_version", 0u), r["ssvdag_bytes"].get<uint64_t>(), r["grids"].size());
+    if (r.contains("file_metadata"))
+        for (const auto& [name, e] : r["file_metadata"].items()) out += fmt::format("file metadata {}: {}\n", name, e["value"].get<std::string>());
     for (const auto& g : r["grids"]) {
         const std::string root = g["root_log2_size"].get<int>() == 0
                                      ? std::string("empty")
@@ -129,6 +209,7 @@ std::string formatSceneReport(const nlohmann::json& r) {
         out += fmt::format("grid {} '{}' ({}, {}): {} active voxels, {}, {}\n", g["index"].get<size_t>(), g["name"].get<std::string>(),
                            g["value_type"].get<std::string>(), g["class"].get<std::string>(), g["active_voxels"].get<uint64_t>(),
                            g["encoding"].get<std::string>(), root);
+        if (g.contains("tree_type")) out += formatGridHeader(g);
         if (!g["levels"].empty()) {
             out += fmt::format("  {:>10} {:>12} {:>12} {:>12}\n", "node size", "SVO nodes", "SVDAG nodes", g["encoding"].get<std::string>() + " nodes");
             for (size_t i = g["levels"].size(); i-- > 0;) {
@@ -139,7 +220,7 @@ std::string formatSceneReport(const nlohmann::json& r) {
             }
         }
         for (const auto& s : g["sections"])
-            out += fmt::format("  section {:<14} {:>12} bytes{}\n", s["kind"].get<std::string>(), s["stored_bytes"].get<uint64_t>(),
+            out += fmt::format("  section {:<22} {:>12} bytes{}\n", s["kind"].get<std::string>(), s["stored_bytes"].get<uint64_t>(),
                                s["compressed"].get<bool>() ? fmt::format(" (zstd, {} raw)", s["raw_bytes"].get<uint64_t>()) : std::string());
         for (const auto& c : g["channels"])
             out += fmt::format("  {} values: {} entries, {} unique; raw {} B, material+index {} B, palette-compressed {} B ({} palette / {} direct blocks, {} palettes)\n",
@@ -167,9 +248,12 @@ std::string formatSceneReport(const nlohmann::json& r) {
         }
         if (g.contains("colour")) out += "  " + formatColour(g["colour"]) + "\n";
         if (g.contains("normals")) out += "  " + formatNormals(g["normals"]) + "\n";
-        out += fmt::format("  total {} bytes in file ({:.4f} bits/active voxel), {} bytes traceable in memory\n", g["stored_bytes"].get<uint64_t>(),
-                           g["bits_per_active_voxel"].get<double>(), g["traceable_bytes"].get<uint64_t>());
+        out += fmt::format("  its sections: {} bytes in the {}{}\n", g["stored_bytes"].get<uint64_t>(), vdb ? ".ssvdag" : "file",
+                           g.contains("traceable_bytes") ? fmt::format(", {} bytes traceable in memory", g["traceable_bytes"].get<uint64_t>())
+                                                         : std::string(" (--values: value statistics and traceable size)"));
     }
+    out += fmt::format("{} active voxels in {} bytes{}: {:.3f} bits/active voxel\n", r["active_voxels"].get<uint64_t>(), r["ssvdag_bytes"].get<uint64_t>(),
+                       vdb ? " of .ssvdag" : "", r["bits_per_active_voxel"].get<double>());
     return out;
 }
 

@@ -1,7 +1,7 @@
-// Builds the `info` report (text and JSON) of an encoded scene: per grid the
-// per-level node counts (SVO, SVDAG, stored DAG), bytes per section and bits
-// per active voxel. Shared by `info` on .ssvdag files and on .vdb files
-// (which are encoded in memory first).
+// Builds the `info` report (text and JSON) of an encoded scene: per grid its
+// header (what vdb_print shows), the per-level node counts (SVO, SVDAG,
+// stored DAG), bytes per section and bits per active voxel. Shared by `info`
+// on .ssvdag files and on .vdb files (which are encoded in memory first).
 #pragma once
 #include <cstdint>
 #include <span>
@@ -9,12 +9,24 @@
 
 #include <nlohmann/json.hpp>
 
+#include "src/format/GridSummary.h"
 #include "src/format/SsvdagFile.h"
+#include "vdb_bridge/VdbSummary.h"
 
 namespace vdbdag::cli {
 
-nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> fileBytes, const std::string& name);
+// `encodedBytes`: the scene as a .ssvdag (the file read, or the encoding of
+// a .vdb). With `valueStats`, each value channel's statistics (Dado et al.'s
+// Table 1) and the traceable size, which decode every value and rebuild the
+// palettes; without, nothing is decoded but the value windows' range.
+nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> encodedBytes, const std::string& name, bool valueStats);
 std::string formatSceneReport(const nlohmann::json& report);
+
+// What `vdb_print -l -m` shows of a grid (see vdb_bridge/VdbSummary.h), as
+// JSON keys of the grid's report, and as text.
+void addGridHeader(nlohmann::json& grid, const GridRecord& header, const bridge::GridHeaderFacts& facts, const format::GridSummary& summary, bool fromVdb);
+std::string formatGridHeader(const nlohmann::json& grid);
+nlohmann::json metadataJson(const std::vector<bridge::MetadataEntry>& entries);
 
 // The colour (--colour-bits) and normal (--normals) parts of a grid's
 // report, shared by `encode` and `info`; `grid` must have them.

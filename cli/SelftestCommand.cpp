@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "src/selftest/Selftest.h"
 #include "src/util/Error.h"
 #include "src/util/Progress.h"
@@ -44,7 +45,7 @@ void addSelftestCommand(CLI::App& app, int& exitCode) {
                     if (opt->json) list.push_back({{"group", c.group}, {"name", c.name}, {"limit", c.limit}, {"bound", c.bound}});
                     else fmt::print("{}  {}\n    {}\n", c.id(), c.limit, c.bound);
                 }
-            if (opt->json) fmt::print("{}\n", list.dump(2));
+            if (opt->json) printJson(list);
             exitCode = 0;
             return;
         }
@@ -64,7 +65,7 @@ void addSelftestCommand(CLI::App& app, int& exitCode) {
                 cases.push_back({{"group", r.group}, {"name", r.name}, {"limit", r.limit}, {"bound", r.bound}, {"value", r.value},
                                  {"measured", r.measured}, {"passed", r.passed}, {"seconds", r.seconds}});
             const nlohmann::json report{{"cases", cases}, {"total", results.size()}, {"passed", results.size() - failed}, {"failed", failed}, {"seconds", seconds}};
-            fmt::print("{}\n", report.dump(2));
+            printJson(report);
         } else {
             // One table line per case (group/name, bound, measured, PASS|FAIL), then
             // the full figures indented below it; with --verbose the full bound too.

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "cli/MemoryBudget.h"
 #include "cli/RunContext.h"
 #include "src/pipeline/CubeEncoder.h"
@@ -154,7 +155,7 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
             report["values"].push_back({{"index", d.gridIndex}, {"name", d.gridName}, {"active_values_differing", d.activeValues},
                                         {"inactive_values_differing", d.inactiveValues}, {"examples", d.examples}});
         if (opt->json) {
-            fmt::print("{}\n", report.dump(2));
+            printJson(report);
         } else if (result.identical) {
             fmt::print("{}: identical after the round trip ({} grid(s), {} bytes encoded)\n", opt->input, verified.grids, verified.bytes);
         } else {

@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages vdbdag needs (only what is missing) and
 # configures + builds the project in ./build. Safe to run repeatedly.
+#
+# VDBDAG_BUILD_TARGETS="vdbdag vdbdag_make_samples" builds only those CMake
+# targets (what scripts/demo.sh needs first). Unset (the default, and what
+# CI uses): every target, tests and benchmarks included.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -38,4 +42,10 @@ BUILD_TYPE=${BUILD_TYPE:-Release}
 if ! cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE" > build.configure.log 2>&1; then
   cat build.configure.log; exit 1
 fi
-cmake --build build -j"$(nproc)"
+TARGETS=${VDBDAG_BUILD_TARGETS:-}
+if [ -n "$TARGETS" ]; then
+  read -r -a target_list <<< "$TARGETS"
+  cmake --build build -j"$(nproc)" --target "${target_list[@]}"
+else
+  cmake --build build -j"$(nproc)"
+fi

@@ -37,7 +37,7 @@ for f in "${inputs[@]}"; do
   start=$(date +%s.%N)
   build/vdbdag encode "$f" -o "$OUT/$name.values.ssvdag" -f >/dev/null
   end=$(date +%s.%N)
-  build/vdbdag info "$OUT/$name.values.ssvdag" --json > "$OUT/$name.values.json"
+  build/vdbdag info "$OUT/$name.values.ssvdag" --values --json > "$OUT/$name.values.json"
   v=$(stat -c %s "$f"); n=$(stat -c %s "$OUT/$name.nvdb"); s=$(stat -c %s "$OUT/$name.values.ssvdag")
   t=$(python3 -c "import json;print(sum(g['traceable_bytes'] for g in json.load(open('$OUT/$name.values.json'))['grids']))")
   python3 -c "print(f'| $name | {$v:,} | {$n:,} | {$s:,} | {$s/$v:.3f} | {$t:,} | {$t/$n:.3f} | {$end-$start:.2f} |')"

@@ -68,7 +68,6 @@ namespace vdbdag::format {
 namespace {
 
 constexpr uint8_t kMagic[8] = {0x89, 'S', 'S', 'V', 'D', 'A', 'G', '\n'};
-constexpr uint32_t kFormatVersion = 1;
 constexpr uint64_t kHeaderBytes = 16;
 constexpr uint64_t kEntryBytes = 48;
 constexpr uint64_t kChecksumBytes = 8;
@@ -198,6 +197,12 @@ std::vector<uint8_t> compressSection(std::span<const uint8_t> data, const Contai
 }
 
 } // namespace
+
+uint64_t storedSectionBytes(std::span<const uint8_t> raw, const ContainerOptions& options) {
+    if (!options.compress || raw.size() < kMinBytesToCompress) return raw.size();
+    const std::vector<uint8_t> frame = compressSection(raw, options);
+    return frame.empty() ? raw.size() : frame.size();
+}
 
 const char* sectionKindName(SectionKind kind) {
     switch (kind) {

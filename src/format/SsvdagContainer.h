@@ -17,6 +17,9 @@
 
 namespace vdbdag::format {
 
+// The container version this build writes and reads (the u32 after the magic).
+inline constexpr uint32_t kFormatVersion = 1;
+
 // Section kinds. A file holds a section only when the scene needs it
 // (../shared/DESIGN.md invariant 3). Unknown kinds are rejected by readers that need
 // them and skipped by those that do not.
@@ -71,6 +74,10 @@ struct ContainerOptions {
     bool compress = true;  // zstd each section; kept raw if zstd does not shrink it
     int zstdLevel = 9;
 };
+
+// Bytes a section of `raw` payload takes in the file (its zstd frame as the
+// writer makes it, or the raw bytes when zstd does not shrink them).
+uint64_t storedSectionBytes(std::span<const uint8_t> raw, const ContainerOptions& options = {});
 
 // Serialises sections into the container bytes.
 std::vector<uint8_t> writeContainer(const std::vector<Section>& sections, const ContainerOptions& options = {});

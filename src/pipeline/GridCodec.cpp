@@ -2,6 +2,8 @@
 // root-placement search and the statistics `info` reports.
 #include "src/pipeline/GridCodec.h"
 
+#include "src/format/SsvdagContainer.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -91,15 +93,33 @@ encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptio
 
 } // namespace
 
+namespace {
+
+// The inner and leaf sections of `dag` as the file stores them.
+uint64_t storedGeometryBytes(const encoding::CompactDag& dag) {
+    const std::span<const uint8_t> inner(reinterpret_cast<const uint8_t*>(dag.inner.data()), dag.inner.size() * sizeof(uint16_t));
+    const std::span<const uint8_t> leaves(reinterpret_cast<const uint8_t*>(dag.leaves.data()), dag.leaves.size() * sizeof(uint64_t));
+    return format::storedSectionBytes(inner) + format::storedSectionBytes(leaves);
+}
+
+} // namespace
+
 encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t alignment, const EncodeOptions& options, bool withOffsets,
                                            format::DagStats* stats, const PlacedBuild& build, std::array<int64_t, 3>* keptOrigin) {
     bool first = true;
     std::array<int64_t, 3> kept{0, 0, 0};
     encoding::CompactDag best;
-    for (const auto& origin : placementCandidates(box, alignment, std::max(1, options.placementTrials))) {
+    uint64_t bestStored = 0;
+    const auto candidates = placementCandidates(box, alignment, std::max(1, options.placementTrials));
+    for (const auto& origin : candidates) {
         const dag::ReducedDag reduced = build(origin, options.symmetry);
         encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
-        if (first || compact.byteSize() < best.byteSize()) {
+        // The candidate whose geometry takes the fewest bytes in the file:
+        // its inner and leaf sections as the writer compresses them (the
+        // uncompressed size can rank them the other way).
+        const uint64_t stored = candidates.size() == 1 ? 0 : storedGeometryBytes(compact);
+        if (first || stored < bestStored || (stored == bestStored && compact.byteSize() < best.byteSize())) {
+            bestStored = stored;
             best = std::move(compact);
             if (stats) *stats = statsOf(reduced);
             kept = origin;

@@ -12,8 +12,9 @@ namespace vdbdag::pipeline {
 struct EncodeOptions {
     bool symmetry = true;            // SSVDAG; false = plain SVDAG (same compact encoding)
     bool computeSvdagStats = false;  // also reduce without symmetry, for `info`
-    // Try this many root placements (DESIGN.md invariant 1) and keep the
-    // smallest encoding; 1 = the bounding box's aligned minimum only.
+    // Try this many root placements (DESIGN.md invariant 1) and keep the one
+    // whose geometry sections are smallest in the file (compressed as the
+    // writer stores them); 1 = the bounding box's aligned minimum only.
     int placementTrials = 1;
     // 16-bit pointers where offsets fit (SSVDAG paper §4.3); false: all 32-bit.
     bool compactPointers = true;

@@ -81,6 +81,12 @@ TEST(Cli, EncodeDecodeVerifyInfoOnASphere) {
     const auto info = nlohmann::json::parse(r.out);
     EXPECT_EQ(info["grids"][0]["name"], "ball");
     EXPECT_EQ(info["grids"][0]["active_voxels"].get<uint64_t>(), voxels);
+    // One bits-per-voxel figure per file, encode's; sizes labelled as what they are; versions.
+    EXPECT_EQ(info["bits_per_active_voxel"].get<double>(), report["bits_per_active_voxel"].get<double>());
+    EXPECT_EQ(info["input_bytes"].get<uint64_t>(), fs::file_size(encoded));
+    EXPECT_EQ(info["ssvdag_bytes"].get<uint64_t>(), fs::file_size(encoded));
+    EXPECT_EQ(info["tool"], "vdbdag");
+    EXPECT_EQ(info["format_version"].get<uint32_t>(), 1u);
     uint64_t sectionBytes = 0;
     for (const auto& s : info["grids"][0]["sections"]) sectionBytes += s["stored_bytes"].get<uint64_t>();
     EXPECT_LT(sectionBytes, fs::file_size(encoded));
@@ -194,8 +200,15 @@ TEST(Cli, RenderOnVulkanAndCpuGivesTheSamePngAndAutoFallsBackWithoutADevice) {
     r = runCli("render " + encoded.string() + " -o " + fallbackPng.string() + " --width 96 --height 64 --json", noDriver);
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["backend"], "cpu");
-    EXPECT_TRUE(r.err.starts_with("note: no Vulkan device")) << r.err;
+    EXPECT_TRUE(r.err.starts_with("vdbdag: note: no Vulkan device")) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    // --quiet (before or after the command's name) drops the note, not the result.
+    for (const std::string& quiet : {"-q render ", "render --quiet "}) {
+        r = runCli(quiet + encoded.string() + " -o " + fallbackPng.string() + " -f --width 96 --height 64 --json", noDriver);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_EQ(nlohmann::json::parse(r.out)["backend"], "cpu");
+        EXPECT_EQ(r.err, "") << quiet;
+    }
     r = runCli("render " + encoded.string() + " -o " + vulkanPng.string() + " --backend vulkan", noDriver);
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_TRUE(r.err.starts_with("vdbdag: no Vulkan device found")) << r.err;
@@ -363,4 +376,60 @@ TEST(Cli, AnUnusableTransformIsAnErrorNamingTheFile) {
     }
     EXPECT_FALSE(fs::exists(out + ".ssvdag"));
     EXPECT_FALSE(fs::exists(out + ".vtu"));
+}
+
+// Options every command takes, before or after its name: --threads N (the
+// same output), -v (a last line with time and peak memory), and their
+// mistakes as usage errors (exit 2).
+TEST(Cli, GlobalOptionsWorkBeforeAndAfterTheCommand) {
+    const fs::path in = sphereFile(), encoded = workDir() / "global.ssvdag", one = workDir() / "global_1.vdb", all = workDir() / "global_n.vdb";
+    ASSERT_EQ(runCli("--threads 1 encode " + in.string() + " -o " + encoded.string()).exitCode, 0);
+    ASSERT_EQ(runCli("decode " + encoded.string() + " -o " + one.string() + " --threads 1").exitCode, 0);
+    ASSERT_EQ(runCli("decode " + encoded.string() + " -o " + all.string()).exitCode, 0);
+    auto bytesOf = [](const fs::path& p) {
+        std::ifstream f(p, std::ios::binary);
+        std::string s{std::istreambuf_iterator<char>(f), {}};
+        if (s.size() > 57) s.replace(21, 36, 36, '0');  // the random file UUID OpenVDB writes after the 21-byte header
+        return s;
+    };
+    EXPECT_EQ(bytesOf(one), bytesOf(all)) << "--threads changed the decoded file";
+    for (const std::string& args : {"-v info " + encoded.string(), "info " + encoded.string() + " --verbose"}) {
+        const CommandResult r = runCli(args);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_TRUE(r.err.starts_with("vdbdag: info took ")) << args << ": " << r.err;
+        EXPECT_NE(r.err.find("peak resident memory"), std::string::npos) << r.err;
+    }
+    EXPECT_EQ(runCli("--threads 0 info " + encoded.string()).exitCode, 2);
+    EXPECT_EQ(runCli("info " + encoded.string() + " --threads x").exitCode, 2);
+}
+
+// Every command's JSON report parses, carries the tool and format versions,
+// and names its input the same way ("input"; "inputs" for diff) and the
+// .ssvdag's size as "ssvdag_bytes" (the size of the file on disk).
+TEST(Cli, EveryJsonReportCarriesTheVersionsAndTheCommonKeys) {
+    const fs::path in = sphereFile(), ss = workDir() / "keys.ssvdag", vtu = workDir() / "keys.vtu", png = workDir() / "keys.png";
+    const std::string i = in.string(), s = ss.string();
+    const std::vector<std::pair<std::string, std::string>> commands{
+        {"encode " + i + " -o " + s + " -f --json", "input"},
+        {"info " + s + " --json", "input"},
+        {"info " + i + " --json", "input"},
+        {"verify " + i + " --json", "input"},
+        {"render " + s + " -o " + png.string() + " -f --backend cpu --width 16 --height 16 --json", "input"},
+        {"export " + s + " -o " + vtu.string() + " -f --json", "input"},
+        {"diff " + i + " " + s + " --json", "inputs"},
+    };
+    for (const auto& [args, inputKey] : commands) {
+        const CommandResult r = runCli(args);
+        ASSERT_EQ(r.exitCode, 0) << args << ": " << r.err;
+        const nlohmann::json j = nlohmann::json::parse(r.out);
+        EXPECT_EQ(j["tool"], "vdbdag") << args;
+        EXPECT_TRUE(j["tool_version"].is_string()) << args;
+        EXPECT_EQ(j["format_version"].get<uint32_t>(), 1u) << args;
+        EXPECT_TRUE(j.contains(inputKey)) << args;
+        if (j.contains("ssvdag_bytes") && (args.starts_with("encode") || args.starts_with("info " + s)))
+            EXPECT_EQ(j["ssvdag_bytes"].get<uint64_t>(), fs::file_size(ss)) << args;
+    }
+    const CommandResult version = runCli("--version");
+    const CommandResult info = runCli("info " + s + " --json");
+    EXPECT_EQ(version.out, "vdbdag " + nlohmann::json::parse(info.out)["tool_version"].get<std::string>() + "\n");
 }

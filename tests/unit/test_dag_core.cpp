@@ -4,6 +4,7 @@
 // set on random sparse topologies with tiles and int32-extreme coordinates.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <random>
 #include <set>
@@ -303,4 +304,39 @@ TEST(SsvdagFile, SceneRoundTripsThroughSections) {
     EXPECT_EQ(decoded.values.bricks.size(), record.values.bricks.size());
     EXPECT_TRUE(back.grids[1].dag.empty());
     EXPECT_EQ(back.grids[1].record.name, "");
+}
+
+// --placement-trials N keeps the candidate whose geometry is smallest in the
+// file: the candidates for N are those for N-1 and one more, so the stored
+// DagInner + DagLeaves bytes (read back from the container's section table)
+// can never grow with N, and the kept file is never larger than the default.
+TEST(DagBuilder, MorePlacementTrialsNeverEnlargeTheStoredGeometry) {
+    for (const double tilt : {0.3, 0.7}) {
+        std::set<Voxel> voxels;  // a torus (R 30, r 4) tilted about the x axis
+        const double c = std::cos(tilt), s = std::sin(tilt);
+        for (int64_t z = -40; z <= 40; ++z)
+            for (int64_t y = -40; y <= 40; ++y)
+                for (int64_t x = -40; x <= 40; ++x) {
+                    const double yy = c * double(y) - s * double(z), zz = s * double(y) + c * double(z);
+                    const double q = std::sqrt(double(x * x) + yy * yy) - 30.0;
+                    if (std::abs(std::sqrt(q * q + zz * zz) - 4.0) < 1.0) voxels.insert({x, y, z});
+                }
+        GridRecord record;
+        record.name = "torus";
+        record.topology = topologyFromVoxels(voxels);
+        uint64_t previous = 0;
+        for (int trials = 1; trials <= 8; ++trials) {
+            pipeline::EncodeOptions options;
+            options.placementTrials = trials;
+            format::SsvdagScene scene;
+            scene.grids.push_back(pipeline::encodeGrid(record, options));
+            const std::vector<uint8_t> bytes = format::writeScene(scene);
+            uint64_t geometry = 0;
+            for (const auto& section : format::summarizeContainer(bytes, "torus"))
+                if (section.kind == format::SectionKind::DagInner || section.kind == format::SectionKind::DagLeaves) geometry += section.storedBytes;
+            if (trials > 1) EXPECT_LE(geometry, previous) << "tilt " << tilt << ", " << trials << " trials";
+            previous = geometry;
+            EXPECT_EQ(voxelsOf(pipeline::decodeGrid(scene.grids[0]).topology), voxels);
+        }
+    }
 }

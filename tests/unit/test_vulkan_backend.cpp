@@ -317,3 +317,29 @@ TEST(VulkanBackend, DevicesCommandListsWhatVulkaninfoSees) {
     EXPECT_EQ(names.size(), report["devices"].size());
     for (const auto& d : report["devices"]) EXPECT_TRUE(names.count(d["name"].get<std::string>())) << d["name"];
 }
+
+// `render --backend auto` takes a GPU when vulkaninfo (the independent
+// reference) lists one, and the CPU tracer when every device is a software
+// emulation (lavapipe); `--backend vulkan` still takes the software device.
+TEST(VulkanBackend, RenderAutoUsesTheCpuTracerUnlessThereIsAGpu) {
+    const CommandResult vi = runShell("vulkaninfo --summary");
+    if (vi.exitCode != 0) GTEST_SKIP() << "vulkaninfo unavailable";
+    bool gpu = false, any = false;
+    for (size_t pos = 0; (pos = vi.out.find("deviceType", pos)) != std::string::npos; ++pos) {
+        const size_t eq = vi.out.find("= ", pos), end = vi.out.find('\n', pos);
+        const std::string type = vi.out.substr(eq + 2, end - eq - 2);
+        any = true;
+        gpu |= type.find("PHYSICAL_DEVICE_TYPE_CPU") == std::string::npos;
+    }
+    const std::filesystem::path dir = vdbdag::testing::testFolder("render_auto");
+    const std::string ss = (dir / "torus.ssvdag").string(), png = (dir / "torus.png").string();
+    ASSERT_EQ(runShell(std::string(VDBDAG_SAMPLES_TOOL) + " " + dir.string() + " >/dev/null").exitCode, 0);
+    ASSERT_EQ(runShell(std::string(VDBDAG_BINARY) + " encode " + (dir / "torus_ls.vdb").string() + " -o " + ss).exitCode, 0);
+    const CommandResult r = runShell(std::string(VDBDAG_BINARY) + " render " + ss + " -o " + png + " --width 32 --height 32 --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["backend"], gpu ? "vulkan" : "cpu") << vi.out;
+    if (!any) return;
+    const CommandResult v = runShell(std::string(VDBDAG_BINARY) + " render " + ss + " -o " + png + " -f --width 32 --height 32 --json --backend vulkan");
+    ASSERT_EQ(v.exitCode, 0) << v.err;
+    EXPECT_EQ(nlohmann::json::parse(v.out)["backend"], "vulkan");
+}
