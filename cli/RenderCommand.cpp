@@ -46,7 +46,7 @@ std::vector<double> parseNumbers(const std::string& text, size_t count, const st
 
 void addRenderCommand(CLI::App& app, int& exitCode) {
     struct Options {
-        std::string input, output, grid, camera, backend = "auto";
+        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto";
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
         bool shadows = false, json = false, force = false;
@@ -60,6 +60,17 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--width", opt->width, "image width")->check(CLI::Range(1, 16384));
     cmd->add_option("--height", opt->height, "image height")->check(CLI::Range(1, 16384));
     cmd->add_option("--camera", opt->camera, "EYE,TARGET,UP as 9 comma-separated world coordinates (default: frame the grid)");
+    cmd->add_option("--up", opt->up, "the world's up axis for the default camera: x, y or z (scans and CAD models are often z-up)")
+        ->check(CLI::IsMember({"x", "y", "z"}))
+        ->capture_default_str();
+    cmd->add_option("--view", opt->view, "where the default camera looks from: iso (front-right-above), front, side or top")
+        ->check(CLI::IsMember({"iso", "front", "side", "top"}))
+        ->capture_default_str();
+    cmd->add_option("--shading", opt->shading,
+                    "auto (level sets as surfaces; fog volumes, by class or by content (densities >= 0, background 0), as fog; else voxels coloured by "
+                    "value), fog, surface or values")
+        ->check(CLI::IsMember({"auto", "fog", "surface", "values"}))
+        ->capture_default_str();
     cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(finiteNumber())->check(CLI::Range(1.0, 170.0));
     cmd->add_option("--backend", opt->backend, "vulkan, cpu, or auto (a Vulkan GPU when there is one, else the CPU tracer; a software Vulkan device such as lavapipe only with --backend vulkan)")->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
     cmd->add_option("--device", opt->device, "Vulkan device index (see `vdbdag devices`)");
@@ -70,7 +81,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");
     opt->limits.add(*cmd);
-    cmd->callback([opt, &exitCode] {
+    cmd->callback([opt, cmd, &exitCode] {
+        const bool cmdDensityScaleGiven = cmd->count("--density-scale") > 0, cmdUpGiven = cmd->count("--up") > 0, cmdViewGiven = cmd->count("--view") > 0;
         setActivity(opt->input, "rendering");
         checkOutputPath(opt->output, {opt->input}, {{".png", ".exr"}, "render", opt->force});
         format::ReadOptions readOptions;
@@ -81,9 +93,19 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             if (opt->grid.empty() || g.record.name == opt->grid) { chosen = &g; break; }
         if (!chosen) throw Error(opt->input + ": no grid named '" + opt->grid + "'");
         if (chosen->dag.empty()) throw Error(opt->input + ": grid '" + chosen->record.name + "' is empty: nothing to render");
-        const trace::RenderGrid grid = trace::makeRenderGrid(*chosen);
+        const trace::Shading shading = opt->shading == "fog"       ? trace::Shading::Fog
+                                       : opt->shading == "surface" ? trace::Shading::Surface
+                                       : opt->shading == "values"  ? trace::Shading::Values
+                                                                   : trace::Shading::Auto;
+        const trace::RenderGrid grid = trace::makeRenderGrid(*chosen, shading);
+        // Every option takes effect or is refused.
+        if (cmdDensityScaleGiven && !grid.fog)
+            throw Error(opt->input + ": --density-scale applies to fog shading, and grid '" + chosen->record.name + "' is shown as " +
+                        trace::shadingOf(grid) + " (use --shading fog)");
+        if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");
         const trace::GridFrame frame(grid.indexToWorld);
-        trace::Camera camera = trace::frameBounds(frame, grid.cellLo, grid.cellHi, opt->width, opt->height, opt->fov);
+        trace::Camera camera = trace::frameBounds(frame, grid.cellLo, grid.cellHi, opt->width, opt->height, opt->fov,
+                                                  {trace::parseUpAxis(opt->up), trace::parseView(opt->view)});
         if (!opt->camera.empty()) {
             const auto v = parseNumbers(opt->camera, 9, "--camera");
             camera.eye = {v[0], v[1], v[2]};
@@ -114,7 +136,10 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                              {"backend", backend->name()}, {"device", backend->device()}, {"width", opt->width},           {"height", opt->height},
                              {"frames", opt->frames},      {"ms_per_frame", ms},            {"ms_min", times.front()},
                              {"ms_max", times.back()},     {"primary_rays", stats.primaryRays}, {"secondary_rays", stats.secondaryRays},
-                             {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows}};
+                             {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows},
+                             {"shading", trace::shadingOf(grid)},
+                             {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}, {"target", {camera.target.x, camera.target.y, camera.target.z}},
+                                         {"up", {camera.up.x, camera.up.y, camera.up.z}}}}};
             printJson(j);
         } else {
             fmt::print("render '{}' ({}x{}) on {} ({}): {:.1f} ms per frame (median of {}), {:.2f} M rays/s ({} primary, {} shadow) -> {}\n",

@@ -51,8 +51,23 @@ glm::dvec3 GridFrame::normalToWorld(const glm::dvec3& n) const {
     return len > 0 ? w / len : glm::dvec3(0, 0, 1);
 }
 
+int parseUpAxis(const std::string& text) {
+    if (text == "x") return 0;
+    if (text == "y") return 1;
+    if (text == "z") return 2;
+    throw Error("--up: '" + text + "' is not x, y or z");
+}
+
+View parseView(const std::string& text) {
+    if (text == "iso") return View::Iso;
+    if (text == "front") return View::Front;
+    if (text == "side") return View::Side;
+    if (text == "top") return View::Top;
+    throw Error("--view: '" + text + "' is not iso, front, side or top");
+}
+
 Camera frameBounds(const GridFrame& frame, const std::array<double, 3>& lo, const std::array<double, 3>& hi, int width, int height,
-                   double fovDegrees) {
+                   double fovDegrees, const ViewSpec& view) {
     glm::dvec3 wlo(1e300), whi(-1e300);
     for (int c = 0; c < 8; ++c) {
         const glm::dvec3 corner{(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]};
@@ -68,8 +83,22 @@ Camera frameBounds(const GridFrame& frame, const std::array<double, 3>& lo, cons
     const double radius = std::max(glm::length(whi - wlo) * 0.5, 1e-9);
     const double aspect = std::min(1.0, double(width) / double(height));
     const double distance = radius / std::sin(glm::radians(fovDegrees) / 2 * aspect) * 1.02;
-    camera.eye = camera.target + distance * glm::normalize(glm::dvec3(0.45, 0.35, 1.0));
-    camera.up = {0, 1, 0};
+    // The world's up axis u, the right-hand axis r and the axis towards the
+    // viewer t, for the chosen up.
+    glm::dvec3 u(0), r(0), t(0);
+    u[view.up] = 1;
+    if (view.up == 1) { r = {1, 0, 0}; t = {0, 0, 1}; }
+    else if (view.up == 2) { r = {1, 0, 0}; t = {0, -1, 0}; }
+    else { r = {0, 1, 0}; t = {0, 0, 1}; }
+    glm::dvec3 from = 0.45 * r + 0.35 * u + 1.0 * t;
+    camera.up = u;
+    switch (view.view) {
+    case View::Iso: break;
+    case View::Front: from = t; break;
+    case View::Side: from = r; break;
+    case View::Top: from = u; camera.up = -t; break;
+    }
+    camera.eye = camera.target + distance * glm::normalize(from);
     return camera;
 }
 

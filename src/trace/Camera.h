@@ -6,6 +6,7 @@
 // for both, whatever the grid's voxel size.
 #pragma once
 #include <array>
+#include <string>
 
 #include <glm/glm.hpp>
 
@@ -42,9 +43,23 @@ private:
     double voxelSize_ = 1;
 };
 
+// Where the default camera looks from, in a world whose up axis is `up`
+// (0 x, 1 y, 2 z). With up y, "front" looks from +z, "side" from +x, "top"
+// from +y (with -z up in the image) and "iso" from front-right-above; with
+// up z (scans, CAD), front is -y and side +x; with up x, front is +z and
+// side +y.
+enum class View { Iso, Front, Side, Top };
+struct ViewSpec {
+    int up = 1;
+    View view = View::Iso;
+};
+// Parses "x"/"y"/"z" and "iso"/"front"/"side"/"top" (Error otherwise).
+int parseUpAxis(const std::string& text);
+View parseView(const std::string& text);
+
 // A camera looking at the world-space box of the index-space cell bounds
-// [lo, hi) from the front-right-above, the whole box in view.
+// [lo, hi) from `view`, the whole box in view.
 Camera frameBounds(const GridFrame& frame, const std::array<double, 3>& cellLo, const std::array<double, 3>& cellHi, int width, int height,
-                   double fovDegrees = 35);
+                   double fovDegrees = 35, const ViewSpec& view = {});
 
 } // namespace vdbdag::trace

@@ -2,6 +2,7 @@
 #include "src/trace/RenderGrid.h"
 
 #include "src/trace/DagTracer.h"
+#include "src/util/Error.h"
 
 #include <algorithm>
 #include <cctype>
@@ -35,19 +36,62 @@ std::array<double, 3> decodeValue(ValueType type, const uint8_t* bytes) {
 
 } // namespace
 
-RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
+const char* shadingName(Shading shading) {
+    switch (shading) {
+    case Shading::Auto: return "auto";
+    case Shading::Fog: return "fog";
+    case Shading::Surface: return "surface";
+    case Shading::Values: return "values";
+    }
+    return "auto";
+}
+
+const char* shadingOf(const RenderGrid& grid) { return grid.fog ? "fog" : grid.levelSet ? "surface" : "values"; }
+
+RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
     RenderGrid out;
     out.dag = &grid.dag;
     out.valueType = grid.record.valueType;
     out.indexToWorld = grid.record.indexToWorld;
     const bool scalarFloat = out.valueType == ValueType::Float || out.valueType == ValueType::Double;
-    out.levelSet = grid.record.gridClass == "level set" && scalarFloat;
-    out.fog = grid.record.gridClass == "fog volume" && scalarFloat;
     if (valueSize(out.valueType) > 0 && grid.values.entryCount > 0) {
         out.values = &grid.values;
     } else if (valueSize(out.valueType) > 0 && (!grid.valueWindows.empty() || !grid.attributes.empty())) {
         out.ownValues = std::make_shared<const attributes::PaletteChannel>(format::traceableValues(grid));
         if (out.ownValues->entryCount > 0) out.values = out.ownValues.get();
+    }
+    // The range of the stored values: the material array and the directly
+    // stored values hold every one of them.
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    if (out.values) {
+        const unsigned vs = out.values->valueSize;
+        auto take = [&](const uint8_t* bytes) {
+            const double v = decodeValue(out.valueType, bytes)[0];
+            if (std::isfinite(v)) { lo = std::min(lo, v); hi = std::max(hi, v); }
+        };
+        for (size_t i = 0; i + vs <= out.values->materials.size(); i += vs) take(&out.values->materials[i]);
+        for (size_t i = 0; i + vs <= out.values->direct.size(); i += vs) take(&out.values->direct[i]);
+    }
+    const double background = grid.record.background.size() >= valueSize(out.valueType) && valueSize(out.valueType)
+                                  ? decodeValue(out.valueType, grid.record.background.data())[0]
+                                  : 0.0;
+    const bool isLevelSetClass = grid.record.gridClass == "level set";
+    switch (shading) {
+    case Shading::Auto:
+        out.levelSet = isLevelSetClass && scalarFloat;
+        out.fog = scalarFloat && !isLevelSetClass &&
+                  (grid.record.gridClass == "fog volume" || (out.values && lo >= 0 && background == 0));
+        break;
+    case Shading::Fog:
+        if (!scalarFloat)
+            throw Error("grid '" + grid.record.name + "' holds " + valueTypeName(out.valueType) + " values: fog shading needs float or double densities");
+        out.fog = true;
+        break;
+    case Shading::Surface:
+        // A level set by class, or by content (a sign change, outside positive).
+        out.levelSet = scalarFloat && out.values && (isLevelSetClass || (lo < 0 && background > 0));
+        break;
+    case Shading::Values: break;
     }
     if (grid.normals && grid.normals->entryCount() > 0) out.normals = &*grid.normals;
     if (out.levelSet && out.values) out.inside = std::make_shared<const InsideBits>(insideBitsOf(*out.values, out.valueType));
@@ -58,27 +102,15 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid) {
     case ValueType::Float:
     case ValueType::Double:
     case ValueType::Int32:
-    case ValueType::Int64: out.colouring = out.levelSet ? ValueColouring::None : ValueColouring::Scalar; break;
+    case ValueType::Int64: out.colouring = out.levelSet || shading == Shading::Surface ? ValueColouring::None : ValueColouring::Scalar; break;
     default: out.colouring = ValueColouring::None;
     }
     if (!out.values) out.colouring = ValueColouring::None;
-    if (out.values && out.colouring == ValueColouring::Scalar) {
-        // Range over the material array and the directly stored values.
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        const unsigned vs = out.values->valueSize;
-        auto take = [&](const uint8_t* bytes) {
-            const double v = decodeValue(out.valueType, bytes)[0];
-            if (std::isfinite(v)) { lo = std::min(lo, v); hi = std::max(hi, v); }
-        };
-        for (size_t i = 0; i + vs <= out.values->materials.size(); i += vs) take(&out.values->materials[i]);
-        for (size_t i = 0; i + vs <= out.values->direct.size(); i += vs) take(&out.values->direct[i]);
-        if (lo <= hi) { out.valueMin = lo; out.valueMax = hi > lo ? hi : lo + 1; }
+    if (out.values && out.colouring == ValueColouring::Scalar && lo <= hi) {
+        out.valueMin = lo;
+        out.valueMax = hi > lo ? hi : lo + 1;
     }
     if (out.fog && out.values) {
-        double hi = 0;
-        const unsigned vs = out.values->valueSize;
-        for (size_t i = 0; i + vs <= out.values->materials.size(); i += vs) hi = std::max(hi, decodeValue(out.valueType, &out.values->materials[i])[0]);
-        for (size_t i = 0; i + vs <= out.values->direct.size(); i += vs) hi = std::max(hi, decodeValue(out.valueType, &out.values->direct[i])[0]);
         out.valueMax = std::isfinite(hi) && hi > 0 ? hi : 1;
         out.valueMin = 0;
     }

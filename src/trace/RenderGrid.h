@@ -43,10 +43,21 @@ struct RenderGrid {
     std::array<double, 3> cellLo{0, 0, 0}, cellHi{1, 1, 1};  // occupied cells, [lo, hi)
 };
 
-// Chooses the shading from the grid's class, type and name (colour grids
-// are vec3 grids named like Cd, color, colour, rgb, or any vec3i grid).
-// `grid` must outlive the result.
-RenderGrid makeRenderGrid(const format::EncodedGrid& grid);
+// How a grid is shown. Auto: a level set (class "level set") as its zero
+// surface; a fog volume as emission-absorption, by class or, for a float
+// grid of another class, by content: every stored value >= 0 and a
+// background of 0 (no level-set sign), as nanovdb_convert's "unknown" fogs;
+// anything else as voxel blocks coloured by value. The others force one
+// (Fog needs float or double values: Error otherwise).
+enum class Shading { Auto, Fog, Surface, Values };
+const char* shadingName(Shading shading);
+
+// Chooses the shading (see Shading) from the grid's class, type, name and
+// values (colour grids are vec3 grids named like Cd, color, colour, rgb, or
+// any vec3i grid). `grid` must outlive the result.
+RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading = Shading::Auto);
+// What the grid is shown as: "fog", "surface" (level set), or "values".
+const char* shadingOf(const RenderGrid& grid);
 
 // A stored value as up to three doubles (scalars in [0]).
 std::array<double, 3> valueAsDoubles(const RenderGrid& grid, uint64_t attribute);

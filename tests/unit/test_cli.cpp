@@ -3,7 +3,9 @@
 // agree with OpenVDB's own counts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
+#include <openvdb/tools/LevelSetUtil.h>
 
 #include "tests/unit/CliRunner.h"
 #include "vdb_bridge/VdbCompare.h"
@@ -432,4 +435,89 @@ TEST(Cli, EveryJsonReportCarriesTheVersionsAndTheCommonKeys) {
     const CommandResult version = runCli("--version");
     const CommandResult info = runCli("info " + s + " --json");
     EXPECT_EQ(version.out, "vdbdag " + nlohmann::json::parse(info.out)["tool_version"].get<std::string>() + "\n");
+}
+
+namespace {
+
+// A fog sphere (OpenVDB's level set turned into densities) with `cls` as its class.
+fs::path fogSphere(const std::string& name, openvdb::GridClass cls) {
+    const fs::path p = workDir() / (name + ".vdb");
+    openvdb::initialize();
+    auto g = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(16.0f, openvdb::Vec3f(0.0f), 1.0f, 3.0f);
+    openvdb::tools::sdfToFogVolume(*g);
+    g->setName("density");
+    g->setGridClass(cls);
+    openvdb::io::File f(p.string());
+    f.write({g});
+    f.close();
+    return p;
+}
+
+std::string fileBytes(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(f), {}};
+}
+
+} // namespace
+
+// A fog whose class is "unknown" (as nanovdb_convert writes it) is shown as
+// fog, like the same grid of class "fog volume": the same picture; options
+// that would have no effect are refused.
+TEST(Cli, AFogOfUnknownClassRendersAsFogAndEveryRenderOptionTakesEffect) {
+    const fs::path fog = fogSphere("fog_class", openvdb::GRID_FOG_VOLUME), unknown = fogSphere("fog_unknown", openvdb::GRID_UNKNOWN);
+    const fs::path a = workDir() / "fog_class.ssvdag", b = workDir() / "fog_unknown.ssvdag";
+    ASSERT_EQ(runCli("encode " + fog.string() + " -o " + a.string()).exitCode, 0);
+    ASSERT_EQ(runCli("encode " + unknown.string() + " -o " + b.string()).exitCode, 0);
+    const fs::path pa = workDir() / "fog_class.png", pb = workDir() / "fog_unknown.png", pv = workDir() / "fog_values.png";
+    const std::string size = " --backend cpu --width 48 --height 40 --json";
+    CommandResult r = runCli("render " + a.string() + " -o " + pa.string() + size);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["shading"], "fog");
+    r = runCli("render " + b.string() + " -o " + pb.string() + size + " --density-scale 0.08");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["shading"], "fog");
+    EXPECT_EQ(fileBytes(pa), fileBytes(pb)) << "the class-unknown fog must render as the fog volume does";
+    r = runCli("render " + b.string() + " -o " + pv.string() + size + " --shading values");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["shading"], "values");
+    EXPECT_NE(fileBytes(pv), fileBytes(pb));
+    // A level set is a surface: --density-scale has no effect there and is refused, in one line.
+    const fs::path ls = sphereFile(), lss = workDir() / "ls_render.ssvdag";
+    ASSERT_EQ(runCli("encode " + ls.string() + " -o " + lss.string() + " -f").exitCode, 0);
+    r = runCli("render " + lss.string() + " -o " + (workDir() / "ls_ds.png").string() + size + " --density-scale 0.5");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("--density-scale applies to fog shading"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(workDir() / "ls_ds.png"));
+    // --camera and --view together: refused.
+    r = runCli("render " + lss.string() + " -o " + (workDir() / "ls_cv.png").string() + size + " --view top --camera 0,0,90,0,0,0,0,1,0");
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+}
+
+// --up and --view place the default camera: its up is the world axis asked
+// for, and it looks along the documented axis at the middle of the grid.
+TEST(Cli, UpAndViewPlaceTheDefaultCamera) {
+    const fs::path ls = sphereFile(), ss = workDir() / "views.ssvdag";
+    ASSERT_EQ(runCli("encode " + ls.string() + " -o " + ss.string() + " -f").exitCode, 0);
+    struct Case {
+        std::string args;
+        std::array<double, 3> up, from;  // from: unit direction target -> eye
+    };
+    for (const Case& c : {Case{"--up z --view front", {0, 0, 1}, {0, -1, 0}}, Case{"--up z --view side", {0, 0, 1}, {1, 0, 0}},
+                          Case{"--up z --view top", {0, 1, 0}, {0, 0, 1}}, Case{"--view front", {0, 1, 0}, {0, 0, 1}},
+                          Case{"--up x --view side", {1, 0, 0}, {0, 1, 0}}}) {
+        const CommandResult r = runCli("render " + ss.string() + " -o " + (workDir() / "view.png").string() + " -f --backend cpu --width 16 --height 16 --json " + c.args);
+        ASSERT_EQ(r.exitCode, 0) << c.args << ": " << r.err;
+        const auto cam = nlohmann::json::parse(r.out)["camera"];
+        std::array<double, 3> d{};
+        double len = 0;
+        for (int i = 0; i < 3; ++i) {
+            d[i] = cam["eye"][i].get<double>() - cam["target"][i].get<double>();
+            len += d[i] * d[i];
+        }
+        for (int i = 0; i < 3; ++i) {
+            EXPECT_NEAR(cam["up"][i].get<double>(), c.up[i], 1e-12) << c.args;
+            EXPECT_NEAR(d[i] / std::sqrt(len), c.from[i], 1e-12) << c.args;
+        }
+    }
 }
