@@ -23,6 +23,7 @@ PACKAGES=(
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils zlib1g-dev
   libzfp-dev
   clang libclang-rt-14-dev
+  help2man
 )
 
 missing=()

@@ -521,3 +521,15 @@ TEST(Cli, UpAndViewPlaceTheDefaultCamera) {
         }
     }
 }
+
+// The man page the build writes (help2man, when installed) describes every
+// command, the global options and the exit status.
+TEST(Cli, TheManPageDescribesEveryCommand) {
+    const fs::path page = fs::path(VDBDAG_BINARY).parent_path() / "vdbdag.1";
+    if (!fs::exists(page)) GTEST_SKIP() << "no man page: help2man is not installed";
+    const std::string text = fileBytes(page);
+    for (const char* c : {"encode", "decode", "info", "verify", "render", "devices", "export", "diff", "import", "bench", "selftest"})
+        EXPECT_NE(text.find(std::string(".SS ") + c + "\n"), std::string::npos) << c;
+    for (const char* s : {"EXIT STATUS", "quiet", "threads", "--memory-limit"})
+        EXPECT_NE(text.find(s), std::string::npos) << s;
+}
