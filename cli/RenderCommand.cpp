@@ -63,8 +63,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--up", opt->up, "the world's up axis for the default camera: x, y or z (scans and CAD models are often z-up)")
         ->check(CLI::IsMember({"x", "y", "z"}))
         ->capture_default_str();
-    cmd->add_option("--view", opt->view, "where the default camera looks from: iso (front-right-above), front, side or top")
-        ->check(CLI::IsMember({"iso", "front", "side", "top"}))
+    cmd->add_option("--view", opt->view, "where the default camera looks from: iso (front-right-above), front, back, side or top")
+        ->check(CLI::IsMember({"iso", "front", "back", "side", "top"}))
         ->capture_default_str();
     cmd->add_option("--shading", opt->shading,
                     "auto (level sets as surfaces; fog volumes, by class or by content (densities >= 0, background 0), as fog; else voxels coloured by "

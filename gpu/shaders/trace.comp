@@ -81,6 +81,7 @@ void traceOneRay(uint i) {
 // ---- shading (Shading.cpp, CpuRenderer.cpp) ----------------------------------
 
 const double kAmbient = 0.2lf;
+const double kShadowNormalOffset = 1.5lf;  // Shading.h
 const dvec3 kMaterial = dvec3(0.80lf, 0.78lf, 0.74lf);
 
 double dot3(dvec3 a, dvec3 b) {
@@ -222,11 +223,13 @@ void renderPixel(uint i) {
             dvec3 normal;
             dvec3 g;
             bool oriented = false;  // outward already: not flipped towards the viewer
+            bool haveGradient = false;  // a level set's gradient in g (index space)
             if (storedNormal(hit.entry, normal)) {
                 oriented = gNormalsOriented;  // world space already (CpuRenderer.cpp storedNormal)
             } else if (LEVEL_SET && hit.lodLevel == 0u && levelSetGradient(hit, g)) {
                 normal = normalToWorld(g);
                 oriented = true;
+                haveGradient = true;
             } else if (hit.faceAxis >= 0) {
                 dvec3 n = dvec3(0.0lf);
                 n[hit.faceAxis] = double(hit.faceSign);
@@ -242,7 +245,13 @@ void renderPixel(uint i) {
                 const dvec3 sd = vec3At(P.lightCell);
                 const int f = hit.faceAxis;
                 so[f] = double(hit.faceSign < 0 ? hit.voxel[f] : hit.voxel[f] + 1l);
-                if ((sd[f] > 0.0lf) == (hit.faceSign > 0) && sd[f] != 0.0lf) {
+                if (haveGradient) {
+                    // CpuRenderer.cpp: off the surface along the gradient.
+                    const dvec3 n = g / sqrt(dot3(g, g));
+                    so = so + kShadowNormalOffset * n;
+                    atomicAdd(U32Array(pc.counter).v[0], 1u);
+                    if (firstSurfaceHit(so, sd, 0.0lf, infinity(), P.shadowBias, 0.0lf).hit) lambert = 0.0lf;
+                } else if ((sd[f] > 0.0lf) == (hit.faceSign > 0) && sd[f] != 0.0lf) {
                     atomicAdd(U32Array(pc.counter).v[0], 1u);
                     if (firstSurfaceHit(so, sd, 0.0lf, infinity(), LEVEL_SET ? P.shadowBias : 0.0lf, 0.0lf).hit) lambert = 0.0lf;
                 }

@@ -61,9 +61,10 @@ int parseUpAxis(const std::string& text) {
 View parseView(const std::string& text) {
     if (text == "iso") return View::Iso;
     if (text == "front") return View::Front;
+    if (text == "back") return View::Back;
     if (text == "side") return View::Side;
     if (text == "top") return View::Top;
-    throw Error("--view: '" + text + "' is not iso, front, side or top");
+    throw Error("--view: '" + text + "' is not iso, front, back, side or top");
 }
 
 Camera frameBounds(const GridFrame& frame, const std::array<double, 3>& lo, const std::array<double, 3>& hi, int width, int height,
@@ -95,6 +96,7 @@ Camera frameBounds(const GridFrame& frame, const std::array<double, 3>& lo, cons
     switch (view.view) {
     case View::Iso: break;
     case View::Front: from = t; break;
+    case View::Back: from = -t; break;
     case View::Side: from = r; break;
     case View::Top: from = u; camera.up = -t; break;
     }

@@ -47,13 +47,14 @@ private:
 // (0 x, 1 y, 2 z). With up y, "front" looks from +z, "side" from +x, "top"
 // from +y (with -z up in the image) and "iso" from front-right-above; with
 // up z (scans, CAD), front is -y and side +x; with up x, front is +z and
-// side +y.
-enum class View { Iso, Front, Side, Top };
+// side +y. "back" looks from the opposite of front (models facing -z, such
+// as the Stanford Armadillo).
+enum class View { Iso, Front, Back, Side, Top };
 struct ViewSpec {
     int up = 1;
     View view = View::Iso;
 };
-// Parses "x"/"y"/"z" and "iso"/"front"/"side"/"top" (Error otherwise).
+// Parses "x"/"y"/"z" and "iso"/"front"/"back"/"side"/"top" (Error otherwise).
 int parseUpAxis(const std::string& text);
 View parseView(const std::string& text);
 

@@ -87,12 +87,14 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
                     const RayHit hit = firstSurfaceHit(grid, tracer, ray, 0);
                     if (hit.hit) {
                         glm::dvec3 normal;
+                        std::optional<glm::dvec3> surfaceNormal;  // a level set's gradient (index space)
                         bool oriented = false;  // outward already: not flipped towards the viewer
                         if (const std::optional<glm::dvec3> stored = storedNormal(grid, hit, oriented)) {
                             normal = *stored;  // world space already
                         } else if (const std::optional<glm::dvec3> gradient =
                                        grid.levelSet && hit.lodLevel == 0 ? levelSetGradient(grid, tracer, hit, hit.attribute) : std::nullopt) {
                             normal = frame.normalToWorld(*gradient);
+                            surfaceNormal = *gradient;
                             oriented = true;
                         } else if (hit.faceAxis >= 0) {
                             glm::dvec3 n(0);
@@ -112,10 +114,18 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
                             }
                             const int f = hit.faceAxis;
                             shadow.origin[f] = double(hit.faceSign < 0 ? hit.voxel[f] : hit.voxel[f] + 1);
-                            if ((shadow.direction[f] > 0) == (hit.faceSign > 0) && shadow.direction[f] != 0) {
+                            if (surfaceNormal) {
+                                // A level set: start off the surface, kShadowNormalOffset
+                                // voxels along its gradient, so the staircase of the
+                                // narrow band does not shadow its own smooth surface.
+                                const glm::dvec3 n = *surfaceNormal / std::sqrt(glm::dot(*surfaceNormal, *surfaceNormal));  // as trace.comp
+                                for (int a = 0; a < 3; ++a) shadow.origin[a] = shadow.origin[a] + kShadowNormalOffset * n[a];
+                                ++localSecondary;
+                                if (firstSurfaceHit(grid, shadowTracer, shadow, kShadowBias * frame.voxelSize()).hit) lambert = 0;
+                            } else if ((shadow.direction[f] > 0) == (hit.faceSign > 0) && shadow.direction[f] != 0) {
                                 ++localSecondary;
                                 if (firstSurfaceHit(grid, shadowTracer, shadow, grid.levelSet ? kShadowBias * frame.voxelSize() : 0).hit) lambert = 0;
-                            }  // else the light leaves through another face: no shadow test (a gradient normal may still face it)
+                            }  // else the light leaves through another face: no shadow test
                         }
                         colour = baseColour(grid, hit.attribute) * (kAmbient + (1 - kAmbient) * lambert);
                         image.alpha[pixel] = 1;

@@ -19,6 +19,8 @@ inline constexpr double kAmbient = 0.2;
 // Level-set shadow rays skip voxels within this many voxel lengths of their
 // start: the narrow band's staircase would otherwise shadow its own surface.
 inline constexpr double kShadowBias = 3.0;
+// ... and start this many voxels off the surface along its gradient.
+inline constexpr double kShadowNormalOffset = 1.5;
 inline const glm::dvec3 kMaterial{0.80, 0.78, 0.74};
 inline const glm::dvec3 kFogEmission{0.92, 0.92, 0.95};
 

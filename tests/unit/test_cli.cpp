@@ -505,6 +505,7 @@ TEST(Cli, UpAndViewPlaceTheDefaultCamera) {
     };
     for (const Case& c : {Case{"--up z --view front", {0, 0, 1}, {0, -1, 0}}, Case{"--up z --view side", {0, 0, 1}, {1, 0, 0}},
                           Case{"--up z --view top", {0, 1, 0}, {0, 0, 1}}, Case{"--view front", {0, 1, 0}, {0, 0, 1}},
+                          Case{"--view back", {0, 1, 0}, {0, 0, -1}}, Case{"--up z --view back", {0, 0, 1}, {0, 1, 0}},
                           Case{"--up x --view side", {1, 0, 0}, {0, 1, 0}}}) {
         const CommandResult r = runCli("render " + ss.string() + " -o " + (workDir() / "view.png").string() + " -f --backend cpu --width 16 --height 16 --json " + c.args);
         ASSERT_EQ(r.exitCode, 0) << c.args << ": " << r.err;
