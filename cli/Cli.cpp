@@ -38,6 +38,8 @@ int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
     CLI::App app{"vdbdag: compress OpenVDB volumes into symmetry-aware sparse voxel DAGs (.ssvdag) and back", "vdbdag"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("vdbdag ") + kToolVersion);
+    // Every option's --help shows its default value.
+    app.option_defaults()->always_capture_default();
     addGlobalOptions(app);
     int exitCode = 0;
     addEncodeCommand(app, exitCode);
@@ -51,6 +53,22 @@ int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
     addDiffCommand(app, exitCode);
     addSelftestCommand(app, exitCode);
     addImportCommand(app, exitCode);
+    // An example per command, under its --help.
+    const std::pair<const char*, const char*> examples[] = {
+        {"encode", "vdbdag encode smoke.vdb -o smoke.ssvdag --memory-limit 4G\n  vdbdag encode ct_series/ -o ct.ssvdag --background-below -900"},
+        {"decode", "vdbdag decode smoke.ssvdag -o smoke.vdb\n  vdbdag decode ct.ssvdag -o ct.nii.gz"},
+        {"info", "vdbdag info smoke.ssvdag --json\n  vdbdag info ct_series/"},
+        {"verify", "vdbdag verify smoke.vdb\n  vdbdag verify smoke.vdb --encoded smoke.ssvdag"},
+        {"render", "vdbdag render smoke.ssvdag -o smoke.png --shadows\n  vdbdag render scan.ssvdag -o scan.exr --up z --view front"},
+        {"devices", "vdbdag devices --json"},
+        {"export", "vdbdag export smoke.ssvdag -o smoke.vtu\n  vdbdag export smoke.ssvdag -o box.vti --bbox 0,0,0,63,63,63"},
+        {"diff", "vdbdag diff smoke.vdb lossy.ssvdag -o diff.vtu"},
+        {"import", "vdbdag import ct_512x512x300_int16le.raw -o ct.vdb"},
+        {"bench", "vdbdag bench smoke.vdb -o report/ --sweep quick"},
+        {"selftest", "vdbdag selftest --list"},
+    };
+    for (const auto& [name, example] : examples)
+        for (CLI::App* sub : app.get_subcommands([&](CLI::App* s) { return s->get_name() == name; })) sub->footer(std::string("Example:\n  ") + example);
     app.footer("Exit status: 0 done (diff: the same), 1 failed (diff: they differ), 2 a mistake in the command line (diff: failed).\n"
                "vdbdag help COMMAND, or vdbdag COMMAND --help, describes a command.");
     if (const std::optional<int> helped = answerHelpCommand(app, argc, argv)) return *helped;

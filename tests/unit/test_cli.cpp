@@ -534,3 +534,16 @@ TEST(Cli, TheManPageDescribesEveryCommand) {
     for (const char* s : {"EXIT STATUS", "quiet", "threads", "--memory-limit"})
         EXPECT_NE(text.find(s), std::string::npos) << s;
 }
+
+// Each command's --help ends with an example of its use, and shows defaults.
+TEST(Cli, EveryCommandsHelpShowsAnExampleAndItsDefaults) {
+    for (const char* c : {"encode", "decode", "info", "verify", "render", "devices", "export", "diff", "import", "bench", "selftest"}) {
+        const CommandResult r = runCli(std::string(c) + " --help");
+        ASSERT_EQ(r.exitCode, 0) << c;
+        const size_t at = r.out.find("Example:\n  vdbdag " + std::string(c) + " ");
+        EXPECT_NE(at, std::string::npos) << c << ":\n" << r.out;
+    }
+    const CommandResult render = runCli("render --help");
+    EXPECT_NE(render.out.find("--width INT:INT in [1 - 16384]=1024"), std::string::npos) << render.out;
+    EXPECT_NE(render.out.find("--view TEXT:{iso,front,back,side,top}=iso"), std::string::npos) << render.out;
+}
