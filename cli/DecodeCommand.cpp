@@ -96,18 +96,31 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         // A .vdb decode builds OpenVDB's grid beside the decoded values: one more copy of each.
         readOptions.limits = opt->limits.limits(dense ? 0 : 1);
         Volume volume;
+        // Steps of a .vdb decode, in thousandths: reading (50), decoding the
+        // grids (450, by active voxels), building OpenVDB's grids and
+        // writing the file (500, by grid and a last step for the write), so
+        // the ETA moves with the work, not from 0% to 100%.
+        Progress progress("decode: reading " + std::filesystem::path(opt->input).filename().string(), 1000);
         {
             const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);
             if (dense && decodeDenseByCubes(scene, opt->input, opt->output, opt->grid)) {
                 exitCode = 0;
                 return;
             }
-            Progress progress("decode", scene.grids.size());
-            volume = pipeline::decodeScene(scene, [&](size_t i, size_t) { progress.set(i); });
-            progress.finish();
+            progress.set(50);
+            uint64_t voxels = 0, done = 0;
+            for (const auto& g : scene.grids) voxels += g.activeVoxels + g.inactiveVoxels;
+            volume = pipeline::decodeScene(scene, [&](size_t i, size_t) {
+                if (i > 0) done += scene.grids[i - 1].activeVoxels + scene.grids[i - 1].inactiveVoxels;
+                progress.setLabel("decode: grid '" + scene.grids[i].record.name + "'");
+                progress.set(50 + 450 * done / std::max<uint64_t>(voxels, 1));
+            });
+            progress.set(500);
         }  // the scene is released before the output is built
+        progress.setLabel("decode: writing " + std::filesystem::path(opt->output).filename().string());
         if (dense) bridge::exportDense(denseGridOf(volume.grids, opt->input, opt->grid, [](const GridRecord& g) { return g.name; }), opt->output);
-        else bridge::exportVdb(volume, opt->output);
+        else bridge::exportVdb(volume, opt->output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
+        progress.finish();
         exitCode = 0;
     });
 }
