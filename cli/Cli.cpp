@@ -19,10 +19,12 @@
 #include "cli/UsageErrors.h"
 #include "cli/JsonReport.h"
 #include "src/util/Error.h"
+#include "src/util/FullCommand.h"
 
 namespace vdbdag::cli {
 
 int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
+    rememberCommandLine(argc, argv);  // for a call that needs vdbdag-full (src/util/FullCommand.h)
     setCubeTeam(team);
 #ifdef __GLIBC__
     // Blocks of 4 MiB and more (value windows, cubes, DAG levels) from and

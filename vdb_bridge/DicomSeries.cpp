@@ -242,7 +242,7 @@ std::string checkNativeLength(const std::string& path, uint32_t length, bool big
 // truncated slice, which the series check names).
 // `pixelLength`: set to the Pixel Data element's declared length when it is
 // that element that runs past the end.
-std::string elementLengthProblem(const std::string& path, bool beforePixels = false, uint64_t* pixelLength = nullptr) {
+std::string walkElementLengths(const std::string& path, bool beforePixels, uint64_t* pixelLength, bool& unknownStart) {
     std::FILE* file = std::fopen(path.c_str(), "rb");
     if (!file) return "";
     struct Closer {
@@ -259,6 +259,7 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
     char magic[4];
     if (readAt(128, magic, 4) && std::memcmp(magic, "DICM", 4) == 0) pos = 132;
     bool explicitVr = true, bigEndian = false, metaGroup = pos == 132, declaredImplicit = false;
+    unknownStart = false;
     if (pos == 0) {  // no preamble: walk only what starts like a DICOM dataset (else GDCM refuses it as not DICOM)
         uint8_t h[6];
         // GDCM asserts (aborts) on a file shorter than one element header
@@ -270,9 +271,13 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
             bigEndian = true;
             group = uint16_t(h[0] << 8 | h[1]);
         }
-        if (group != 0x0002 && group != 0x0008) return "";
+        // Neither a file meta group nor a dataset's first group: GDCM still
+        // parses it as a dataset (and allocated 1.8 GB for a 107-byte file
+        // whose bytes read as a 1.8 GB element: found by fuzz_scan_headers),
+        // so it is walked the same way, its VRs taken as they come.
+        unknownStart = group != 0x0002 && group != 0x0008;
         explicitVr = std::isupper(h[4]) && std::isupper(h[5]);
-        declaredImplicit = !explicitVr;
+        declaredImplicit = !explicitVr && !unknownStart;
         metaGroup = group == 0x0002;
     }
     auto u16 = [&](const uint8_t* b) { return bigEndian ? uint16_t(b[0] << 8 | b[1]) : uint16_t(b[0] | b[1] << 8); };
@@ -350,11 +355,20 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels = fa
     return "";
 }
 
+std::string elementLengthProblem(const std::string& path, bool beforePixels = false, uint64_t* pixelLength = nullptr) {
+    bool unknownStart = false;
+    const std::string problem = walkElementLengths(path, beforePixels, pixelLength, unknownStart);
+    // What starts like no DICOM and does not walk as one is not DICOM.
+    if (!problem.empty() && unknownStart) return "not a DICOM file (no DICM preamble, and read as one: " + problem + ")";
+    return problem;
+}
+
 // Reads one file's header into `frames` (one per frame); returns the reason
 // to skip it, or "" when it is an image.
 std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>& frames) {
     quietGdcm();
-    if (const std::string bad = elementLengthProblem(path, true); !bad.empty()) return "corrupt DICOM: " + bad;
+    if (const std::string bad = elementLengthProblem(path, true); !bad.empty())
+        return bad.rfind("not a DICOM file", 0) == 0 ? bad : "corrupt DICOM: " + bad;
     gdcm::Reader reader;
     reader.SetFileName(path.c_str());
     // GDCM reads the element it stops at: the pixel data are skipped, not

@@ -50,6 +50,8 @@ safety_init() {
     cp "$VDBDAG" "$PROBE" "$WORK/bin/"
     # The image writers live beside the binary (vdb_bridge/image_module), loaded by render.
     [ -f "$BUILD/libvdbdag_images.so" ] && cp "$BUILD/libvdbdag_images.so" "$WORK/bin/"
+    # ... and so does vdbdag-full, which vdbdag runs for VTK output and DICOM input (src/util/FullCommand.h).
+    [ -f "$(dirname "$VDBDAG")/vdbdag-full" ] && cp "$(dirname "$VDBDAG")/vdbdag-full" "$WORK/bin/"
     VDBDAG=$WORK/bin/vdbdag
     PROBE=$WORK/bin/vdbdag_vdb_probe
     if [ -x "$PHANTOM" ]; then

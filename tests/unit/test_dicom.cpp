@@ -715,3 +715,20 @@ TEST(DicomCli, AListOfFilesIsOneSet) {
     EXPECT_NE(r.err.find(nrrd.string() + ": not DICOM"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(workDir() / "mixed.ssvdag"));
 }
+
+// A file that starts like no DICOM at all (no preamble, no group 0002 or
+// 0008 first) is walked too: GDCM parses it as a dataset anyway, and
+// allocated 1.8 GB for these 106 bytes (found by fuzz_scan_headers). Under
+// a 1.5 GB address-space cap it is skipped as not DICOM, with the reason.
+TEST(DicomSeries, BytesThatReadAsAHugeElementAreNotDicomAndCostNothing) {
+    const fs::path dir = freshDir("not_dicom_huge");
+    std::ofstream(dir / "junk.bin", std::ios::binary) << std::string("dataOBfile") + std::string(95, '\x17') + "[";
+    const auto r = runShell("ulimit -v 1500000; " + std::string(VDBDAG_BINARY) + " info " + quote(dir) + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json info = nlohmann::json::parse(r.out);
+    EXPECT_EQ(info["series"].size(), 0u);
+    ASSERT_EQ(info["skipped"].size(), 1u);
+    const std::string reason = info["skipped"][0].get<std::string>();
+    EXPECT_EQ(reason.rfind((dir / "junk.bin").string() + ": not a DICOM file (no DICM preamble", 0), 0u) << reason;
+    EXPECT_NE(reason.find("claims"), std::string::npos) << reason;
+}

@@ -77,3 +77,49 @@ TEST(Startup, RenderWithoutTheImageModuleIsAOneLineErrorAndWritesNothing) {
     EXPECT_FALSE(fs::exists(png));
     EXPECT_EQ(std::distance(fs::directory_iterator(workDir()), fs::directory_iterator()), before) << "a temporary was left behind";
 }
+
+namespace {
+
+bool loaded(const std::string& linkerTrace, const std::string& library) { return linkerTrace.find(library) != std::string::npos; }
+
+} // namespace
+
+// `vdbdag` links neither VTK nor GDCM (the linker's trace is the witness);
+// the calls that need them run vdbdag-full with the same command line and
+// do their work: export and diff (VTK), DICOM input (GDCM).
+TEST(Startup, VtkAndDicomLoadOnlyInTheCallsThatNeedThem) {
+    const fs::path encoded = encodedBall();
+    for (const std::string& args : {std::string("--version"), "info " + encoded.string(), "decode " + encoded.string() + " -o " + (workDir() / "b2.vdb").string() + " -f"}) {
+        const CommandResult r = runCli(args, "env LD_DEBUG=files ");
+        ASSERT_EQ(r.exitCode, 0) << args;
+        ASSERT_NE(r.err.find("calling init"), std::string::npos) << "no linker trace: the check would prove nothing";
+        EXPECT_FALSE(loaded(r.err, "libvtkCommonCore")) << args;
+        EXPECT_FALSE(loaded(r.err, "libgdcmMSFF")) << args;
+        EXPECT_FALSE(loaded(r.err, "vdbdag-full")) << args;
+    }
+    const fs::path vtu = workDir() / "ball.vtu";
+    CommandResult r = runCli("export " + encoded.string() + " -o " + vtu.string() + " -f", "env LD_DEBUG=files ");
+    ASSERT_EQ(r.exitCode, 0) << r.err.substr(0, 2000);
+    EXPECT_TRUE(loaded(r.err, "libvtkIOXML")) << "export ran without VTK?";
+    EXPECT_TRUE(fs::exists(vtu) && fs::file_size(vtu) > 0);
+    // diff keeps its exit codes through the helper: 0 the same, 1 they differ, 2 an error.
+    EXPECT_EQ(runCli("diff " + (workDir() / "ball.vdb").string() + " " + encoded.string()).exitCode, 0);
+    EXPECT_EQ(runCli("diff " + (workDir() / "ball.vdb").string() + " " + (workDir() / "missing.vdb").string()).exitCode, 2);
+    const fs::path pet = fs::path(VDBDAG_SHARED_DATA) / "medical/dicom/rsna_2/PET";
+    if (fs::is_directory(pet)) {
+        r = runCli("info " + pet.string() + " --json", "env LD_DEBUG=files ");
+        ASSERT_EQ(r.exitCode, 0);
+        EXPECT_TRUE(loaded(r.err, "libgdcmMSFF"));
+        const std::string json = r.out;
+        EXPECT_NE(json.find("\"format\": \"dicom\""), std::string::npos) << json.substr(0, 400);
+    }
+    // Without vdbdag-full beside it, such a call is a one-line error.
+    const fs::path alone = workDir() / "alone_full";
+    fs::create_directories(alone);
+    fs::copy_file(VDBDAG_BINARY, alone / "vdbdag", fs::copy_options::overwrite_existing);
+    r = runShell((alone / "vdbdag").string() + " export " + encoded.string() + " -o " + (workDir() / "none.vtu").string());
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("vdbdag-full"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(workDir() / "none.vtu"));
+}
