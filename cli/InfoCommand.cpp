@@ -193,6 +193,7 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
             }
             report["file_metadata"] = metadataJson(facts.fileMetadata);
         }
+        addVersions(report);  // the text names the format version too
         if (opt->json) printJson(report);
         else fmt::print("{}", formatSceneReport(report));
         exitCode = 0;

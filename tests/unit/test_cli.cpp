@@ -90,6 +90,8 @@ TEST(Cli, EncodeDecodeVerifyInfoOnASphere) {
     EXPECT_EQ(info["ssvdag_bytes"].get<uint64_t>(), fs::file_size(encoded));
     EXPECT_EQ(info["tool"], "vdbdag");
     EXPECT_EQ(info["format_version"].get<uint32_t>(), 1u);
+    const CommandResult text = runCli("info " + encoded.string());
+    EXPECT_NE(text.out.find(".ssvdag file (format 1), " + std::to_string(fs::file_size(encoded)) + " bytes"), std::string::npos) << text.out;
     uint64_t sectionBytes = 0;
     for (const auto& s : info["grids"][0]["sections"]) sectionBytes += s["stored_bytes"].get<uint64_t>();
     EXPECT_LT(sectionBytes, fs::file_size(encoded));
