@@ -7,6 +7,8 @@
 // the series found (what `encode --series N|UID` picks from) and the files
 // skipped.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "src/util/Error.h"
 
@@ -28,9 +30,15 @@
 namespace vdbdag::cli {
 
 namespace {
-// OpenVDB files start with the int32 magic 0x56444220 ("VDB " read little-endian).
-bool isVdbFile(std::span<const uint8_t> bytes) {
-    return bytes.size() >= 4 && bytes[0] == 0x20 && bytes[1] == 0x42 && bytes[2] == 0x44 && bytes[3] == 0x56;
+// OpenVDB files start with the int32 magic 0x56444220 ("VDB " read
+// little-endian). Only a regular file is opened to look (a FIFO or a device
+// goes on to readFileBytes, which refuses it without blocking).
+bool isVdbFile(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return false;
+    std::ifstream in(path, std::ios::binary);
+    char magic[4] = {};
+    return in.read(magic, 4) && magic[0] == 0x20 && magic[1] == 0x42 && magic[2] == 0x44 && magic[3] == 0x56;
 }
 
 nlohmann::json dicomReport(const std::string& input, const bridge::DicomScan& scan) {
@@ -148,9 +156,9 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
             exitCode = 0;
             return;
         }
-        std::vector<uint8_t> bytes = format::readFileBytes(opt->input);
         nlohmann::json report;
-        if (!isVdbFile(bytes)) {
+        if (!isVdbFile(opt->input)) {
+            const std::vector<uint8_t> bytes = format::readFileBytes(opt->input);
             // Nothing decoded but what is printed: value windows stay as
             // they are in the file (their range is read window by window)
             // unless --values asks for the channels' statistics.
@@ -172,8 +180,7 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
         } else {
             // OpenVDB's own figures (the reference vdb_print shows), then the
             // DAG figures of its encoding in memory.
-            const uint64_t fileBytes = bytes.size();
-            bytes = {};
+            const uint64_t fileBytes = std::filesystem::file_size(opt->input);  // never read whole here: OpenVDB reads it
             const bridge::VdbFileFacts facts = bridge::vdbFileFacts(opt->input);
             const bridge::ImportResult imported = bridge::importVdb(opt->input);
             pipeline::EncodeOptions options;

@@ -93,11 +93,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             if (opt->grid.empty() || g.record.name == opt->grid) { chosen = &g; break; }
         if (!chosen) throw Error(opt->input + ": no grid named '" + opt->grid + "'");
         if (chosen->dag.empty()) throw Error(opt->input + ": grid '" + chosen->record.name + "' is empty: nothing to render");
-        const trace::Shading shading = opt->shading == "fog"       ? trace::Shading::Fog
-                                       : opt->shading == "surface" ? trace::Shading::Surface
-                                       : opt->shading == "values"  ? trace::Shading::Values
-                                                                   : trace::Shading::Auto;
-        const trace::RenderGrid grid = trace::makeRenderGrid(*chosen, shading);
+        const trace::RenderGrid grid = trace::makeRenderGrid(*chosen, trace::parseShading(opt->shading));
         // Every option takes effect or is refused.
         if (cmdDensityScaleGiven && !grid.fog)
             throw Error(opt->input + ": --density-scale applies to fog shading, and grid '" + chosen->record.name + "' is shown as " +

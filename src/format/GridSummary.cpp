@@ -10,6 +10,7 @@
 #include "src/attributes/WindowCursor.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/util/Error.h"
+#include "src/volume/ValueBytes.h"
 
 namespace vdbdag::format {
 namespace {
@@ -225,24 +226,9 @@ GridSummary summarizeGrid(const EncodedGrid& grid) {
 }
 
 std::vector<double> valueNumbers(ValueType type, std::span<const uint8_t> value) {
-    auto get = [&](auto tag, size_t offset) {
-        decltype(tag) v;
-        if (offset + sizeof(v) > value.size()) throw Error("internal error: value too short");
-        std::memcpy(&v, value.data() + offset, sizeof(v));
-        return double(v);
-    };
-    switch (type) {
-    case ValueType::Float: return {get(float{}, 0)};
-    case ValueType::Double: return {get(double{}, 0)};
-    case ValueType::Int32: return {get(int32_t{}, 0)};
-    case ValueType::Int64: return {get(int64_t{}, 0)};
-    case ValueType::Bool: return {value.empty() ? 0.0 : double(value[0] != 0)};
-    case ValueType::Mask: return {};
-    case ValueType::Vec3S: return {get(float{}, 0), get(float{}, 4), get(float{}, 8)};
-    case ValueType::Vec3D: return {get(double{}, 0), get(double{}, 8), get(double{}, 16)};
-    case ValueType::Vec3I: return {get(int32_t{}, 0), get(int32_t{}, 4), get(int32_t{}, 8)};
-    }
-    return {};
+    if (value.size() < valueSize(type)) throw Error("internal error: value too short");
+    const std::array<double, 3> d = valueAsDoubles(type, value.data());
+    return std::vector<double>(d.begin(), d.begin() + valueComponents(type));
 }
 
 std::string formatValue(ValueType type, std::span<const uint8_t> value) {

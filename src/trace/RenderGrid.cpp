@@ -3,6 +3,7 @@
 
 #include "src/trace/DagTracer.h"
 #include "src/util/Error.h"
+#include "src/volume/ValueBytes.h"
 
 #include <algorithm>
 #include <cctype>
@@ -18,32 +19,16 @@ bool looksLikeColour(std::string name) {
     return name == "cd" || name.find("col") != std::string::npos || name.find("rgb") != std::string::npos;
 }
 
-std::array<double, 3> decodeValue(ValueType type, const uint8_t* bytes) {
-    std::array<double, 3> out{0, 0, 0};
-    switch (type) {
-    case ValueType::Float: { float f; std::memcpy(&f, bytes, 4); out[0] = f; break; }
-    case ValueType::Double: std::memcpy(&out[0], bytes, 8); break;
-    case ValueType::Int32: { int32_t i; std::memcpy(&i, bytes, 4); out[0] = i; break; }
-    case ValueType::Int64: { int64_t i; std::memcpy(&i, bytes, 8); out[0] = double(i); break; }
-    case ValueType::Bool: out[0] = bytes[0] ? 1 : 0; break;
-    case ValueType::Mask: break;
-    case ValueType::Vec3S: { float f[3]; std::memcpy(f, bytes, 12); out = {f[0], f[1], f[2]}; break; }
-    case ValueType::Vec3D: std::memcpy(out.data(), bytes, 24); break;
-    case ValueType::Vec3I: { int32_t i[3]; std::memcpy(i, bytes, 12); out = {double(i[0]), double(i[1]), double(i[2])}; break; }
-    }
-    return out;
-}
+std::array<double, 3> decodeValue(ValueType type, const uint8_t* bytes) { return valueAsDoubles(type, bytes); }
 
 } // namespace
 
-const char* shadingName(Shading shading) {
-    switch (shading) {
-    case Shading::Auto: return "auto";
-    case Shading::Fog: return "fog";
-    case Shading::Surface: return "surface";
-    case Shading::Values: return "values";
-    }
-    return "auto";
+Shading parseShading(const std::string& text) {
+    if (text == "auto") return Shading::Auto;
+    if (text == "fog") return Shading::Fog;
+    if (text == "surface") return Shading::Surface;
+    if (text == "values") return Shading::Values;
+    throw Error("--shading: '" + text + "' is not auto, fog, surface or values");
 }
 
 const char* shadingOf(const RenderGrid& grid) { return grid.fog ? "fog" : grid.levelSet ? "surface" : "values"; }

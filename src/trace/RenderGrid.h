@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <memory>
+#include <string>
 #include <optional>
 
 #include "src/attributes/PaletteChannel.h"
@@ -50,7 +51,8 @@ struct RenderGrid {
 // anything else as voxel blocks coloured by value. The others force one
 // (Fog needs float or double values: Error otherwise).
 enum class Shading { Auto, Fog, Surface, Values };
-const char* shadingName(Shading shading);
+// Parses "auto"/"fog"/"surface"/"values" (Error otherwise).
+Shading parseShading(const std::string& text);
 
 // Chooses the shading (see Shading) from the grid's class, type, name and
 // values (colour grids are vec3 grids named like Cd, color, colour, rgb, or
