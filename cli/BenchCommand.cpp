@@ -22,6 +22,7 @@
 #include "cli/Commands.h"
 #include "cli/JsonReport.h"
 #include "src/bench/ImageMetrics.h"
+#include "src/format/TraceableValues.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/trace/CpuRenderer.h"
 #include "src/util/Error.h"
@@ -354,7 +355,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
                 p.bytes = timed.fileBytes;
                 p.encode = timed.encode;
                 p.decode = timed.decode;
-                p.traceableBytes = timed.grid.dag.byteSize() + timed.grid.values.byteSize();
+                p.traceableBytes = timed.grid.dag.byteSize() + format::traceableValues(timed.grid).byteSize();
                 p.exact = timed.grid.lossy.changed == 0;
                 p.maxError = timed.grid.lossy.maxAbsError;
                 p.rmsError = timed.grid.lossy.rmsError;

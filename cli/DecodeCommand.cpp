@@ -91,7 +91,6 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
             checkOutputPath((std::filesystem::path(opt->output).parent_path() / (std::filesystem::path(opt->output).stem().string() + ".raw")).string(),
                             {opt->input}, rules);
         format::ReadOptions readOptions;
-        readOptions.rebuildPalettes = false;  // only the values are needed
         readOptions.keepValueWindows = dense;  // a scan is written window by window when it can be
         // A .vdb decode builds OpenVDB's grid beside the decoded values: one more copy of each.
         readOptions.limits = opt->limits.limits(dense ? 0 : 1);

@@ -57,7 +57,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "plain SVDAG: merge identical subtrees only");
     cmd->add_flag("--no-compress", opt->noCompress, "store sections without zstd");
     cmd->add_flag("--no-predict", opt->noPredict, "integer values: always palettes, never the brick predictor");
-    cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the one whose geometry takes the fewest bytes in the file (1-64)")->check(CLI::Range(1, 64));
+    cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the one whose file is smallest; each codes the values again (1-64)")->check(CLI::Range(1, 64));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
     auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error")->check(finiteNumber())->check(CLI::PositiveNumber);
@@ -232,7 +232,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         // Where the geometry weighs, other root placements may shrink it
         // (a tilted torus: 30%): say that the option exists.
         if (opt->placementTrials == 1 && fileBytes && geometryBytes * 4 > fileBytes)
-            note("the geometry is a large part of this file: --placement-trials 4 tries other root placements and keeps the smallest geometry");
+            note("the geometry is a large part of this file: --placement-trials 4 tries other root placements and keeps the smallest file");
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
         uint64_t voxels = 0;

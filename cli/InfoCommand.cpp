@@ -165,7 +165,6 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
             format::ReadOptions readOptions;
             readOptions.limits = opt->limits.limits(0);
             readOptions.keepValueWindows = !opt->values;
-            readOptions.rebuildPalettes = opt->values;
             const format::SsvdagScene scene = format::readScene(bytes, opt->input, readOptions);
             report = sceneReport(scene, bytes, opt->input, opt->values);
             report["format"] = "ssvdag";

@@ -6,6 +6,8 @@
 
 #include <fmt/core.h>
 
+#include "src/attributes/PaletteCompressor.h"
+#include "src/format/TraceableValues.h"
 #include "vdb_bridge/DenseImport.h"
 
 namespace vdbdag::cli {

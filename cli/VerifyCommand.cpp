@@ -57,7 +57,6 @@ struct RemovedAfterwards {
 // An .ssvdag file against the input, cube by cube.
 void compareByCubes(const VerifyOptions& opt, const std::string& encoded, Progress& progress, uint64_t from, uint64_t units, Verified& out) {
     format::ReadOptions readOptions;
-    readOptions.rebuildPalettes = false;
     readOptions.keepValueWindows = true;
     const format::SsvdagScene scene = format::readSceneFile(encoded, readOptions);
     out.grids = scene.grids.size();

@@ -24,6 +24,7 @@ PACKAGES=(
   libzfp-dev
   clang libclang-rt-14-dev
   help2man
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-openvdb
 )
 
 missing=()

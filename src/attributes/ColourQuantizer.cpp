@@ -244,8 +244,6 @@ void refineColourCentres(const std::vector<Lab>& points, const std::vector<uint6
 
 } // namespace
 
-bool isVec3Type(ValueType type) { return type == ValueType::Vec3S || type == ValueType::Vec3D || type == ValueType::Vec3I; }
-
 bool hasColourGridName(const std::string& name) {
     std::string lower(name);
     for (char& ch : lower) ch = char(std::tolower(static_cast<unsigned char>(ch)));

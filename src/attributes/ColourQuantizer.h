@@ -42,7 +42,7 @@ struct ColourReport {
 };
 
 // True for vec3 value types.
-bool isVec3Type(ValueType type);
+inline bool isVec3Type(ValueType type) { return type == ValueType::Vec3S || type == ValueType::Vec3D || type == ValueType::Vec3I; }
 
 // Default colour-grid names (case-insensitive): Cd, color, colour,
 // colorGrid, colourGrid, rgb.

@@ -23,33 +23,6 @@ std::array<float, 3> NormalChannel::decode(uint64_t entry) const { return decode
 
 bool isSupportedNormalBits(unsigned bits) { return bits == 10 || bits == 12 || bits == 16 || bits == 24 || bits == 32; }
 
-NormalChannel encodeNormals(std::span<const std::array<float, 3>> normals, unsigned bits, NormalReport::Source source, uint64_t oneSided) {
-    if (bits < 4 || bits > 32 || bits % 2) throw Error("internal error: ONV bits must be even, 4..32");
-    NormalChannel channel;
-    channel.bits = bits;
-    channel.report.source = source;
-    channel.report.entries = normals.size();
-    channel.report.oneSided = oneSided;
-    std::vector<uint8_t> codes(normals.size() * 4);
-    double sumAngle = 0;
-    for (size_t i = 0; i < normals.size(); ++i) {
-        bool zero = false;
-        const OctahedralCode c = encodeOctahedral(normals[i], bits, &zero);
-        std::memcpy(&codes[i * 4], &c.bits, 4);
-        if (zero) {
-            ++channel.report.zeroLength;
-            continue;
-        }
-        const double angle = angleDegrees(decodeOctahedral(c, bits), normals[i]);
-        sumAngle += angle;
-        channel.report.maxAngleDegrees = std::max(channel.report.maxAngleDegrees, angle);
-    }
-    const uint64_t measured = channel.report.entries - channel.report.zeroLength;
-    channel.report.meanAngleDegrees = measured ? sumAngle / double(measured) : 0.0;
-    channel.codes = compressPalette(codes, 4);
-    return channel;
-}
-
 std::vector<uint8_t> serializeNormals(const NormalChannel& c) {
     format::ByteWriter w;
     w.put<uint8_t>(uint8_t(c.bits));

@@ -1,12 +1,10 @@
-// See PredictedWindows.h.
+// See PredictedWindows.h: reading the windows (directory, one window, all
+// of them). Writing them: PredictedWindowWriter.cpp.
 #include "src/attributes/PredictedWindows.h"
 
 #include <algorithm>
 #include <bit>
 #include <cstring>
-
-#include <tbb/info.h>
-#include <tbb/parallel_for.h>
 
 #include "src/attributes/PredictedChannel.h"
 #include "src/format/ByteIO.h"
@@ -14,177 +12,6 @@
 #include "src/util/Error.h"
 
 namespace vdbdag::attributes {
-namespace {
-
-constexpr uint64_t kSmallWindowBytes = uint64_t(4) << 20;  // level 9 up to this, then 3 (the container's rule)
-constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;
-constexpr size_t kDirectoryEntryBytes = 24;
-constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1;
-
-inline uint64_t entriesOf(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
-
-// A window's raw bytes: its coding byte, then the smaller (by zstd's fast
-// estimate) of its palettes and its residuals.
-std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, uint32_t vs) {
-    std::vector<uint8_t> palette = serializePalette(compressPalette(values, vs));
-    std::vector<uint8_t> predicted = encodePredicted(values, vs, layout);
-    const bool usePredicted = format::zstdFastSize(predicted) < format::zstdFastSize(palette);
-    std::vector<uint8_t>& chosen = usePredicted ? predicted : palette;
-    std::vector<uint8_t> raw;
-    raw.reserve(chosen.size() + 1);
-    raw.push_back(usePredicted ? kPredictedCoding : kPaletteCoding);
-    raw.insert(raw.end(), chosen.begin(), chosen.end());
-    return raw;
-}
-
-} // namespace
-
-PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory)
-    : valueSize_(valueSize), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
-    if (valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
-    const uint8_t zeros[kHeaderBytes] = {};
-    if (!spillNear.empty()) {
-        spill_ = std::make_shared<ScratchFile>(spillNear, spillInMemory);
-        spill_->append(zeros, kHeaderBytes);
-    } else {
-        payload_.assign(zeros, zeros + kHeaderBytes);
-    }
-}
-
-void PredictedWindowWriter::beginShare(uint64_t firstEntry, bool endsLayer) {
-    if (entries_ || !pending_.empty() || !directory_.empty() || spill_) throw Error("internal error: a share begins before the first entry");
-    share_ = true;
-    endsLayer_ = endsLayer;
-    entries_ = firstEntry;
-    headEnd_ = (firstEntry + kValueWindowEntries - 1) / kValueWindowEntries * kValueWindowEntries;
-    head_.window = firstEntry / kValueWindowEntries;
-    windows_ = headEnd_ / kValueWindowEntries;
-    payload_.clear();  // coded windows only: process 0 writes the header
-}
-
-void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const uint64_t> layout) {
-    size_t at = 0;  // byte position in `values`
-    size_t i = 0;
-    // The bricks that start before this share's first window: its head.
-    while (share_ && i < layout.size() && entries_ < headEnd_) {
-        const uint64_t n = entriesOf(layout[i]);
-        if (at + n * valueSize_ > values.size()) throw Error("internal error: the layout holds more entries than the values given");
-        head_.layout.push_back(layout[i++]);
-        head_.values.insert(head_.values.end(), values.begin() + long(at), values.begin() + long(at + n * valueSize_));
-        at += size_t(n * valueSize_);
-        entries_ += n;
-    }
-    while (i < layout.size()) {
-        // A brick instance belongs to the window its first entry falls in.
-        const uint64_t window = entries_ / kValueWindowEntries;
-        if (pending_.empty() || window != windows_ - 1) {
-            if (window != windows_) throw Error("internal error: a predicted window skipped");
-            if (pending_.size() == parallel_) codePending();  // every pending window is full
-            pending_.emplace_back();
-            pending_.back().values.reserve(size_t((kValueWindowEntries + 64) * valueSize_));  // untouched until filled: never copied
-            ++windows_;
-        }
-        Window& w = pending_.back();
-        // The instances that start in this window.
-        const uint64_t windowEnd = (window + 1) * kValueWindowEntries;
-        size_t j = i;
-        uint64_t n = 0;
-        while (j < layout.size() && entries_ + n < windowEnd) n += entriesOf(layout[j++]);
-        if (at + n * valueSize_ > values.size()) throw Error("internal error: the layout holds more entries than the values given");
-        w.layout.insert(w.layout.end(), layout.begin() + long(i), layout.begin() + long(j));
-        w.values.insert(w.values.end(), values.begin() + long(at), values.begin() + long(at + n * valueSize_));
-        w.entries += n;
-        entries_ += n;
-        at += size_t(n * valueSize_);
-        i = j;
-    }
-    if (at != values.size()) throw Error("internal error: the values given hold more entries than the layout");
-}
-
-void PredictedWindowWriter::codePending() {
-    std::vector<std::vector<uint8_t>> stored(pending_.size());
-    std::vector<uint64_t> rawBytes(pending_.size());
-    tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
-        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, valueSize_);
-        std::vector<uint8_t>().swap(pending_[i].values);
-        std::vector<uint64_t>().swap(pending_[i].layout);
-        rawBytes[i] = raw.size();
-        stored[i] = format::zstdCompressIfSmaller(raw, {raw.size() <= kSmallWindowBytes ? 9 : 3, /*checksum*/ true, 0});
-        if (stored[i].empty()) stored[i] = std::move(raw);
-    });
-    for (size_t i = 0; i < pending_.size(); ++i) {
-        appendWindow(payload_, spill_.get(), stored[i]);
-        directory_.push_back({stored[i].size(), rawBytes[i], pending_[i].entries});
-    }
-    pending_.clear();
-}
-
-ShareWindows PredictedWindowWriter::finishShare() {
-    if (!share_) throw Error("internal error: finishShare without beginShare");
-    ShareWindows out;
-    // The last window is whole here when the next share's first brick
-    // starts past it, or this share ends the layer.
-    if (!pending_.empty() && !endsLayer_ && entries_ < windows_ * kValueWindowEntries) {
-        out.tail.window = windows_ - 1;
-        out.tail.values = std::move(pending_.back().values);
-        out.tail.layout = std::move(pending_.back().layout);
-        pending_.pop_back();
-    }
-    codePending();
-    out.firstWindow = headEnd_ / kValueWindowEntries;
-    for (const Directory& d : directory_) out.directory.push_back({d.stored, d.raw, d.entries});
-    out.coded = std::move(payload_);
-    out.head = std::move(head_);
-    directory_.clear();
-    return out;
-}
-
-void PredictedWindowWriter::addShare(const ShareWindows& share) {
-    add(share.head.values, share.head.layout);
-    uint64_t at = 0;
-    for (size_t j = 0; j < share.directory.size(); ++j) {
-        const ShareWindows::Coded& c = share.directory[j];
-        if (c.stored > share.coded.size() - at) throw Error("internal error: a process's coded windows are cut short");
-        addCoded(share.firstWindow + j, c, std::span<const uint8_t>(share.coded).subspan(size_t(at), size_t(c.stored)));
-        at += c.stored;
-    }
-    add(share.tail.values, share.tail.layout);
-}
-
-void PredictedWindowWriter::addCoded(uint64_t window, const ShareWindows::Coded& coded, std::span<const uint8_t> bytes) {
-    if (entries_ / kValueWindowEntries != window || windows_ > window || bytes.size() != coded.stored)
-        throw Error("internal error: a coded window out of place");
-    codePending();
-    appendWindow(payload_, spill_.get(), bytes);
-    directory_.push_back({coded.stored, coded.raw, coded.entries});
-    entries_ += coded.entries;
-    windows_ = window + 1;
-}
-
-ValueWindowsPayload PredictedWindowWriter::finish() {
-    if (!pending_.empty()) codePending();
-    format::ByteWriter head;
-    head.put<uint32_t>(valueSize_);
-    head.put<uint64_t>(entries_);
-    head.put<uint64_t>(kValueWindowEntries);
-    head.put<uint64_t>(directory_.size());
-    format::ByteWriter dir;
-    for (const Directory& d : directory_) {
-        dir.put<uint64_t>(d.stored);
-        dir.put<uint64_t>(d.raw);
-        dir.put<uint64_t>(d.entries);
-    }
-    directory_.clear();
-    ValueWindowsPayload out = sealWindows(std::move(payload_), std::move(spill_), head.bytes(), dir.bytes());
-    out.predicted = true;
-    return out;
-}
-
-std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout) {
-    PredictedWindowWriter writer(valueSize, 0);
-    writer.add(values, layout);
-    return std::move(writer.finish().bytes);
-}
 
 WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
                                              const std::string& what) {
@@ -194,14 +21,14 @@ WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, u
     if (dir.valueSize != valueSize) r.fail("holds " + std::to_string(dir.valueSize) + "-byte values, expected " + std::to_string(valueSize));
     dir.entries = r.get<uint64_t>();
     uint64_t layoutEntries = 0;
-    for (uint64_t m : layout) layoutEntries += entriesOf(m);
+    for (uint64_t m : layout) layoutEntries += detail::layoutEntries(m);
     if (dir.entries != layoutEntries) r.fail("holds " + std::to_string(dir.entries) + " entries, the DAG " + std::to_string(layoutEntries));
     const uint64_t windowEntries = r.get<uint64_t>();
     if (!std::has_single_bit(windowEntries) || windowEntries < (uint64_t(1) << 10) || windowEntries > (uint64_t(1) << 30))
         r.fail("window of " + std::to_string(windowEntries) + " entries (a power of two from 2^10 to 2^30 is expected)");
     const uint64_t windows = r.get<uint64_t>();
-    if (windows > r.remaining() / kDirectoryEntryBytes) r.fail("window directory runs past the end");
-    const size_t framesBegin = r.position(), directoryBegin = payload.size() - size_t(windows) * kDirectoryEntryBytes;
+    if (windows > r.remaining() / detail::kPredictedDirectoryEntryBytes) r.fail("window directory runs past the end");
+    const size_t framesBegin = r.position(), directoryBegin = payload.size() - size_t(windows) * detail::kPredictedDirectoryEntryBytes;
     format::ByteReader d(payload.subspan(directoryBegin), what + " window directory");
     dir.windows.resize(size_t(windows));
     uint64_t storedTotal = 0, entryTotal = 0;
@@ -225,7 +52,7 @@ WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, u
         // The window's brick instances.
         e.firstBrick = brick;
         uint64_t n = 0;
-        while (brick < layout.size() && n < e.entries) n += entriesOf(layout[brick++]);
+        while (brick < layout.size() && n < e.entries) n += detail::layoutEntries(layout[brick++]);
         e.bricks = brick - e.firstBrick;
         if (n != e.entries) r.fail("window " + std::to_string(k) + "'s " + std::to_string(e.entries) + " entries end inside a brick");
     }
@@ -240,14 +67,14 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
     const std::string where = what + " window " + std::to_string(k);
     const std::vector<uint8_t> raw = windowRawBytes(payload, e, where);
     const std::span<const uint8_t> body = std::span<const uint8_t>(raw).subspan(1);
-    if (raw[0] == kPaletteCoding) {
+    if (raw[0] == detail::kPaletteCoding) {
         const PaletteChannel c = deserializePalette(body, where);
         if (c.valueSize != dir.valueSize || c.entryCount != e.entries)
             throw Error(where + ": holds " + std::to_string(c.entryCount) + " entries of " + std::to_string(c.valueSize) + " bytes, expected " +
                         std::to_string(e.entries) + " of " + std::to_string(dir.valueSize));
         return c.decodeAll();
     }
-    if (raw[0] == kPredictedCoding) return decodePredicted(body, dir.valueSize, layout.subspan(size_t(e.firstBrick), size_t(e.bricks)), where);
+    if (raw[0] == detail::kPredictedCoding) return decodePredicted(body, dir.valueSize, layout.subspan(size_t(e.firstBrick), size_t(e.bricks)), where);
     throw Error(where + ": unknown coding " + std::to_string(raw[0]));
 }
 
@@ -264,3 +91,4 @@ std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, ui
 }
 
 } // namespace vdbdag::attributes
+

@@ -24,6 +24,8 @@
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
+#include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -33,6 +35,13 @@
 #include "src/attributes/ValueWindows.h"
 
 namespace vdbdag::attributes {
+
+namespace detail {  // the layout above, shared by the writer and the reader
+inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
+inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1;
+// Entries of a brick instance of the attribute layout (a solid node: 1).
+inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
+} // namespace detail
 
 class PredictedWindowWriter {
 public:

@@ -13,18 +13,12 @@
 #include <vector>
 
 #include "src/encoding/CompactDag.h"
+#include "src/format/DagBounds.h"
 #include "src/format/SsvdagFile.h"
 #include "src/volume/GridRecord.h"
 
 namespace vdbdag::format {
 
-struct IndexBox {
-    std::array<int64_t, 3> min{}, max{};  // inclusive, as OpenVDB's CoordBBox
-};
-
-// The bounding box of every voxel the DAG holds (bricks and solid nodes);
-// empty for an empty DAG.
-std::optional<IndexBox> dagBounds(const encoding::CompactDag& dag);
 
 // Minimum and maximum of raw values as OpenVDB's tools::minMax finds them:
 // by the value type's `<` (vectors lexicographically, as math::Tuple).

@@ -73,6 +73,35 @@ constexpr LayerKinds kInactive{SectionKind::InactiveLevels,          SectionKind
                                SectionKind::InactiveValues,          SectionKind::InactivePredictedValues, SectionKind::InactiveValueWindows,
                                SectionKind::InactivePredictedWindows};
 
+} // namespace
+
+std::vector<uint8_t> serializeDagLevels(const encoding::CompactDag& dag) {
+    ByteWriter levels;
+    for (int64_t o : dag.origin) levels.put<int64_t>(o);
+    levels.put<uint8_t>(dag.log2Size);
+    levels.put<uint8_t>(dag.rootReflection);
+    levels.put<uint32_t>(uint32_t(dag.levelStart.size()));
+    for (uint64_t s : dag.levelStart) levels.put<uint64_t>(s);
+    for (uint8_t w : dag.offsetWords) levels.put<uint8_t>(w);
+    levels.put<uint64_t>(dag.inner.size());
+    levels.put<uint64_t>(dag.leaves.size());
+    return levels.take();
+}
+
+std::vector<uint8_t> serializeDagStats(const DagStats& st) {
+    ByteWriter stats;
+    stats.put<uint32_t>(uint32_t(st.svoNodes.size()));
+    stats.put<uint8_t>(st.hasSvdag ? 1 : 0);
+    for (size_t i = 0; i < st.svoNodes.size(); ++i) {
+        stats.put<uint64_t>(st.svoNodes[i]);
+        stats.put<uint64_t>(i < st.svdagNodes.size() ? st.svdagNodes[i] : 0);
+        stats.put<uint64_t>(i < st.storedNodes.size() ? st.storedNodes[i] : 0);
+    }
+    return stats.take();
+}
+
+namespace {
+
 // `take`: move (or release) the layer's payloads out of the scene instead of copying them.
 template <typename T>
 std::vector<T> takeOrCopy(std::vector<T>& v, bool take) {
@@ -88,16 +117,7 @@ void releaseIf(std::vector<T>& v, bool take) {
 
 void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, encoding::CompactDag& dag, const attributes::PaletteChannel& channel,
               attributes::ValueWindowsPayload& windows, std::vector<uint8_t>& predicted, unsigned valueSize, bool take) {
-    ByteWriter levels;
-    for (int64_t o : dag.origin) levels.put<int64_t>(o);
-    levels.put<uint8_t>(dag.log2Size);
-    levels.put<uint8_t>(dag.rootReflection);
-    levels.put<uint32_t>(uint32_t(dag.levelStart.size()));
-    for (uint64_t s : dag.levelStart) levels.put<uint64_t>(s);
-    for (uint8_t w : dag.offsetWords) levels.put<uint8_t>(w);
-    levels.put<uint64_t>(dag.inner.size());
-    levels.put<uint64_t>(dag.leaves.size());
-    sections.push_back({kinds.levels, g, levels.take()});
+    sections.push_back({kinds.levels, g, serializeDagLevels(dag)});
     if (!dag.empty()) {
         const SectionKind windowKind = windows.predicted ? kinds.predictedWindows : kinds.windows;
         sections.push_back({kinds.inner, g, rawBytes(dag.inner)});
@@ -113,20 +133,6 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
 
 } // namespace
 
-attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactive) {
-    const attributes::PaletteChannel& values = inactive ? grid.inactiveValues : grid.values;
-    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
-    const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
-    if (values.entryCount || values.valueSize) return values;
-    if (!windows.empty() && windows.predicted && !attributes.empty()) return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
-    if (!windows.empty() && windows.predicted)
-        return attributes::compressPalette(attributes::decodePredictedWindows(windows.load(), valueSize(grid.record.valueType),
-                                                                              encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
-                                                                              "grid '" + grid.record.name + "' predicted windows"),
-                                           valueSize(grid.record.valueType));
-    if (!windows.empty()) return attributes::decodeValueWindows(windows.load(), "grid '" + grid.record.name + "' value windows");
-    return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
-}
 
 namespace {
 
@@ -181,16 +187,7 @@ std::vector<Section> toSections(SsvdagScene& scene, bool take) {
             sections.push_back({SectionKind::ColourErrors, g, e.take()});
         }
         if (grid.normals) sections.push_back({SectionKind::Normals, g, attributes::serializeNormals(*grid.normals)});
-        ByteWriter stats;
-        const DagStats& st = grid.stats;
-        stats.put<uint32_t>(uint32_t(st.svoNodes.size()));
-        stats.put<uint8_t>(st.hasSvdag ? 1 : 0);
-        for (size_t i = 0; i < st.svoNodes.size(); ++i) {
-            stats.put<uint64_t>(st.svoNodes[i]);
-            stats.put<uint64_t>(i < st.svdagNodes.size() ? st.svdagNodes[i] : 0);
-            stats.put<uint64_t>(i < st.storedNodes.size() ? st.storedNodes[i] : 0);
-        }
-        sections.push_back({SectionKind::DagStats, g, stats.take()});
+        sections.push_back({SectionKind::DagStats, g, serializeDagStats(grid.stats)});
     }
     return sections;
 }
@@ -339,7 +336,6 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 if (attributes.size() != size.attributeEntries * vs)
                     throw Error(what + ": " + layer + " predicted values hold " + std::to_string(attributes.size() / vs) + " entries, expected " +
                                 std::to_string(size.attributeEntries));
-                if (options.rebuildPalettes) channel = attributes::compressPalette(attributes, vs);  // the traceable layout, rebuilt
             } else if (vs && !dag.empty() && windowSection && options.keepValueWindows) {
                 windows.bytes = std::move(windowSection->data);
                 const attributes::WindowDirectory d = attributes::readValueWindowDirectory(windows.bytes, what + " " + layer + " value windows");

@@ -64,18 +64,20 @@ struct SsvdagScene {
     std::vector<uint8_t> fileMetadata;  // Volume::fileMetadata (opaque)
 };
 
-// The traceable value channel of a layer as a reader builds it: `values`
-// when set (a scene read from a file), else from the windows or the raw
-// attributes an encoder left (a scene just encoded).
-attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactive = false);
+// The traceable channel of a layer (palettes): format/TraceableValues.h.
 
 std::vector<Section> sceneToSections(const SsvdagScene& scene);
+
+// The raw payloads of a layer's DagLevels (or InactiveLevels) section and of
+// a grid's DagStats section, as the writer stores them (docs/FORMAT.md).
+std::vector<uint8_t> serializeDagLevels(const encoding::CompactDag& dag);
+std::vector<uint8_t> serializeDagStats(const DagStats& stats);
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName);
 // What a reader builds beyond the values themselves.
 struct ReadOptions {
-    // For PredictedValues sections: rebuild the palette channel (the
-    // traceable layout). A plain decode to .vdb needs only the values.
-    bool rebuildPalettes = true;
+    // (Integer channels, stored as predicted windows, are read into
+    // `attributes`; their palettes, the traceable layout, are built where a
+    // tracer needs them: format::traceableValues.)
     // Keep ValueWindows and PredictedWindows payloads as they are, in
     // EncodedGrid::valueWindows / inactiveValueWindows, with no attribute
     // array or channel: for readers that stream a layer window by window

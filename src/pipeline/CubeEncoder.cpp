@@ -2,6 +2,7 @@
 #include "src/pipeline/CubeEncoder.h"
 
 #include <algorithm>
+#include <cstring>
 #include <functional>
 #include <optional>
 #include <type_traits>
@@ -276,9 +277,14 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
     return whole;
 }
 
-// Tries the placements like encodeLayer (GridCodec.cpp) and keeps the smallest.
+// A layer's values coded at one candidate (its DAG and plan); returns their
+// stored bytes (on process 0; elsewhere anything).
+using PlanValues = std::function<uint64_t(const encoding::CompactDag& dag, const LayerPlan& plan)>;
+
+// Tries the placements like encodeLayer (GridCodec.cpp) and keeps the one
+// whose file is smallest, its values coded by `code` and kept by `keep`.
 encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const EncodeOptions& options, const CubeBudget& budget, bool withOffsets,
-                                        format::DagStats* stats, LayerPlan& keptPlan, CubeTeam& team) {
+                                        format::DagStats* stats, CubeTeam& team, const PlanValues& code, const std::function<void()>& keep) {
     const LayerSummary summary = source.summary(layer);
     const int64_t alignment = int64_t(1) << std::max(2u, summary.largestTileLog2);
     const unsigned vs = valueSize(source.header().valueType);
@@ -291,15 +297,24 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
         }
         return last->second;
     };
-    std::array<int64_t, 3> kept{};
-    encoding::CompactDag compact =
-        encodeAtBestPlacement(boxOf(summary), alignment, options, withOffsets, stats,
-                              [&](const std::array<int64_t, 3>& origin, bool symmetry) {
-                                  return buildLayer(source, layer, planAt(origin), symmetry, budget, team, options.onStepProgress);
-                              },
-                              &kept);
-    keptPlan = planAt(kept);
-    return compact;
+    const CandidateValues values{[&](const encoding::CompactDag& dag, const std::array<int64_t, 3>& origin) {
+                                     const uint64_t stored = code(dag, planAt(origin));
+                                     if (team.size() == 1) return stored;
+                                     // Every process keeps the same candidate: process 0's figure decides.
+                                     std::vector<uint8_t> bytes(sizeof stored);
+                                     std::memcpy(bytes.data(), &stored, sizeof stored);
+                                     bytes = team.broadcast(bytes);
+                                     uint64_t agreed = 0;
+                                     std::memcpy(&agreed, bytes.data(), sizeof agreed);
+                                     return agreed;
+                                 },
+                                 keep};
+    return encodeAtBestPlacement(
+        boxOf(summary), alignment, options, withOffsets, stats,
+        [&](const std::array<int64_t, 3>& origin, bool symmetry) {
+            return buildLayer(source, layer, planAt(origin), symmetry, budget, team, options.onStepProgress);
+        },
+        &values);
 }
 
 } // namespace
@@ -321,8 +336,6 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     const LayerSummary active = source.summary(Layer::Active);
     out.activeVoxels = active.voxels;
     step("reducing the DAG");
-    LayerPlan plan;
-    if (!active.empty()) out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, plan, team);
     // Values stream from the gather into the value windows, never held
     // whole: lossless ones, and lossy ones quantised on the way (one value
     // at a time, in attribute order) by one process. With several processes
@@ -331,14 +344,14 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     // like colours (clustered over the whole channel), are gathered whole.
     const bool lossy = options.tolerance.mode != attributes::ScalarTolerance::Mode::Exact;
     const bool streamValues = vs > 0 && !isColourGrid(source.header(), options) && (!lossy || team.size() == 1);
-    attributes::ScalarQuantizer quantizer(source.header().valueType, options.tolerance);
     const bool predicted = usesPredictedWindows(source.header().valueType, options);
     // Gathers the layer into windows (on process 0: all of them).
-    auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries) {
+    auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries,
+                           attributes::ScalarQuantizer* quantizer) {
         const unsigned inFlight = valueWindowsInFlight(budget, vs);
         const uint64_t expected = encoding::decodedSize(dag).attributeEntries;
         ValueStream stream;
-        if (lossy && layer == Layer::Active) stream.quantizer = &quantizer;
+        stream.quantizer = quantizer;
         auto run = [&](auto& writer) -> attributes::ValueWindowsPayload {
             const LayerSummary summary = source.summary(layer);
             if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::ValueWindowWriter>) {
@@ -396,33 +409,50 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
         stream.palette = &writer;
         return run(writer);
     };
-    if (streamValues) {
-        step("ordering and coding values");
-        if (active.empty()) step("coding the last value windows");
-        if (!active.empty()) {
-            uint64_t entries = 0;
-            out.valueWindows = streamLayer(Layer::Active, plan, out.dag, entries);
-            out.lossy = lossy ? quantizer.finish() : attributes::ToleranceReport{options.tolerance, entries};
-        }
+    // Each placement candidate's values are gathered and coded (the
+    // placement orders them); the smallest file's are kept.
+    CodedValues kept, trial;
+    auto keep = [&] { kept = std::move(trial); };
+    if (!active.empty()) {
+        const PlanValues codeActive = [&](const encoding::CompactDag& dag, const LayerPlan& layerPlan) -> uint64_t {
+            trial = {};
+            if (streamValues) {
+                step("ordering and coding values");
+                attributes::ScalarQuantizer quantizer(source.header().valueType, options.tolerance);
+                uint64_t entries = 0;
+                trial.windows = streamLayer(Layer::Active, layerPlan, dag, entries, lossy ? &quantizer : nullptr);
+                trial.lossy = lossy ? quantizer.finish() : attributes::ToleranceReport{options.tolerance, entries};
+            } else {
+                step("ordering values");
+                trial.attributes = gatherLayer(source, Layer::Active, layerPlan, dag, vs, budget, team, options.onStepProgress);
+                step("palette compression");
+                if (team.isRoot()) codeActiveValues(dag, trial, source.header(), options);
+            }
+            return trial.storedBytes();
+        };
+        out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, team, codeActive, keep);
+        storeActiveValues(out, std::move(kept));
     } else {
-        step("ordering values");
-        if (!active.empty()) out.attributes = gatherLayer(source, Layer::Active, plan, out.dag, vs, budget, team, options.onStepProgress);
-        step("palette compression");
-        if (!active.empty() && team.isRoot()) codeActiveValues(out, options);
+        step(streamValues ? "coding the last value windows" : "palette compression");
     }
+    trial = {};
     const LayerSummary inactive = source.summary(Layer::Inactive);
     out.inactiveVoxels = inactive.voxels;
     step("inactive values");
     if (!inactive.empty()) {
-        LayerPlan inactivePlan;
-        out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, inactivePlan, team);
-        if (vs > 0) {  // streamed, as the active values above
-            uint64_t entries = 0;
-            out.inactiveValueWindows = streamLayer(Layer::Inactive, inactivePlan, out.inactiveDag, entries);
-        } else {
-            out.inactiveAttributes = gatherLayer(source, Layer::Inactive, inactivePlan, out.inactiveDag, vs, budget, team, options.onStepProgress);
-            if (team.isRoot()) codeInactiveValues(out, options);
-        }
+        const PlanValues codeInactive = [&](const encoding::CompactDag& dag, const LayerPlan& layerPlan) -> uint64_t {
+            trial = {};
+            if (vs > 0) {  // streamed, as the active values above
+                uint64_t entries = 0;
+                trial.windows = streamLayer(Layer::Inactive, layerPlan, dag, entries, nullptr);
+            } else {
+                trial.attributes = gatherLayer(source, Layer::Inactive, layerPlan, dag, vs, budget, team, options.onStepProgress);
+                if (team.isRoot()) codeInactiveValues(dag, trial, source.header().valueType, options);
+            }
+            return trial.storedBytes();
+        };
+        out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, team, codeInactive, keep);
+        storeInactiveValues(out, std::move(kept));
     }
     return out;
 }

@@ -3,6 +3,7 @@
 #include "src/pipeline/GridCodec.h"
 
 #include "src/format/SsvdagContainer.h"
+#include "src/format/TraceableValues.h"
 
 #include <algorithm>
 #include <cstring>
@@ -81,61 +82,78 @@ attributes::ValueWindowsPayload codeValues(const encoding::CompactDag& dag, cons
 namespace {
 
 // Builds and lays out one layer (active or inactive), trying the placements.
-encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptions& options, bool withOffsets, format::DagStats* stats) {
-    return encodeAtBestPlacement(dag::activeBounds(topology), dag::placementAlignment(topology), options, withOffsets, stats,
-                                 [&](const std::array<int64_t, 3>& origin, bool symmetry) {
-                                     dag::BuildOptions build;
-                                     build.symmetry = symmetry;
-                                     build.origin = origin;
-                                     return dag::buildDag(topology, build);
-                                 });
+encoding::CompactDag encodeLayer(const GridTopology& topology, const EncodeOptions& options, bool withOffsets, format::DagStats* stats,
+                                 const CandidateValues& values) {
+    return encodeAtBestPlacement(
+        dag::activeBounds(topology), dag::placementAlignment(topology), options, withOffsets, stats,
+        [&](const std::array<int64_t, 3>& origin, bool symmetry) {
+            dag::BuildOptions build;
+            build.symmetry = symmetry;
+            build.origin = origin;
+            return dag::buildDag(topology, build);
+        },
+        &values);
 }
 
 } // namespace
 
 namespace {
 
-// The inner and leaf sections of `dag` as the file stores them.
+// The level table, inner and leaf sections of `dag` as the file stores them.
 uint64_t storedGeometryBytes(const encoding::CompactDag& dag) {
     const std::span<const uint8_t> inner(reinterpret_cast<const uint8_t*>(dag.inner.data()), dag.inner.size() * sizeof(uint16_t));
     const std::span<const uint8_t> leaves(reinterpret_cast<const uint8_t*>(dag.leaves.data()), dag.leaves.size() * sizeof(uint64_t));
-    return format::storedSectionBytes(inner) + format::storedSectionBytes(leaves);
+    return format::storedSectionBytes(format::serializeDagLevels(dag)) + format::storedSectionBytes(inner) + format::storedSectionBytes(leaves);
+}
+
+// The plain SVDAG's node counts beside `stats` (options.computeSvdagStats):
+// the same placement without symmetry, so the per-level counts compare.
+void addSvdagStats(format::DagStats& stats, const PlacedBuild& build, const std::array<int64_t, 3>& origin, const EncodeOptions& options) {
+    if (!options.symmetry) {
+        stats.svdagNodes = stats.storedNodes;
+    } else {
+        const dag::ReducedDag plain = build(origin, false);
+        for (unsigned s = 2; s <= plain.log2Size; ++s) stats.svdagNodes.push_back(plain.uniqueNodeCount(s));
+    }
+    stats.hasSvdag = true;
 }
 
 } // namespace
 
 encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t alignment, const EncodeOptions& options, bool withOffsets,
-                                           format::DagStats* stats, const PlacedBuild& build, std::array<int64_t, 3>* keptOrigin) {
+                                           format::DagStats* stats, const PlacedBuild& build, const CandidateValues* values) {
     bool first = true;
     std::array<int64_t, 3> kept{0, 0, 0};
     encoding::CompactDag best;
     uint64_t bestStored = 0;
     const auto candidates = placementCandidates(box, alignment, std::max(1, options.placementTrials));
+    const bool several = candidates.size() > 1;
     for (const auto& origin : candidates) {
         const dag::ReducedDag reduced = build(origin, options.symmetry);
         encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
-        // The candidate whose geometry takes the fewest bytes in the file:
-        // its inner and leaf sections as the writer compresses them (the
-        // uncompressed size can rank them the other way).
-        const uint64_t stored = candidates.size() == 1 ? 0 : storedGeometryBytes(compact);
+        // With several candidates, the one whose file is smallest: every
+        // section the placement changes, as the writer stores it (the
+        // uncompressed sizes can rank them the other way). With one, nothing
+        // is measured.
+        format::DagStats candidateStats;
+        if (stats) candidateStats = statsOf(reduced);
+        uint64_t stored = 0;
+        if (several) {
+            stored = storedGeometryBytes(compact);
+            if (stats && options.computeSvdagStats) addSvdagStats(candidateStats, build, origin, options);
+            if (stats) stored += format::storedSectionBytes(format::serializeDagStats(candidateStats));
+        }
+        if (values) stored += values->code(compact, origin);
         if (first || stored < bestStored || (stored == bestStored && compact.byteSize() < best.byteSize())) {
             bestStored = stored;
             best = std::move(compact);
-            if (stats) *stats = statsOf(reduced);
+            if (stats) *stats = std::move(candidateStats);
             kept = origin;
+            if (values) values->keep();
         }
         first = false;
     }
-    if (stats && options.computeSvdagStats) {
-        if (!options.symmetry) {
-            stats->svdagNodes = stats->storedNodes;
-        } else {
-            const dag::ReducedDag plain = build(kept, false);  // same placement, so the per-level counts compare
-            for (unsigned s = 2; s <= plain.log2Size; ++s) stats->svdagNodes.push_back(plain.uniqueNodeCount(s));
-        }
-        stats->hasSvdag = true;
-    }
-    if (keptOrigin) *keptOrigin = kept;
+    if (stats && options.computeSvdagStats && !several) addSvdagStats(*stats, build, kept, options);
     return best;
 }
 
@@ -152,16 +170,35 @@ format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& o
     return out;
 }
 
-void codeActiveValues(format::EncodedGrid& out, const EncodeOptions& options) {
-    const ValueType type = out.record.valueType;
-    out.lossy = attributes::applyScalarTolerance(out.attributes, type, options.tolerance);
-    if (isColourGrid(out.record, options))
-        out.colour = attributes::quantiseColours(out.attributes, type, options.colourBits, "grid '" + out.record.name + "'");
-    out.valueWindows = codeValues(out.dag, out.attributes, type, options);
+uint64_t CodedValues::storedBytes() const {
+    uint64_t bytes = windows.size();
+    if (normals) bytes += format::storedSectionBytes(attributes::serializeNormals(*normals));
+    return bytes;
 }
 
-void codeInactiveValues(format::EncodedGrid& out, const EncodeOptions& options) {
-    out.inactiveValueWindows = codeValues(out.inactiveDag, out.inactiveAttributes, out.record.valueType, options);
+void codeActiveValues(const encoding::CompactDag& dag, CodedValues& coded, const GridRecord& header, const EncodeOptions& options) {
+    const ValueType type = header.valueType;
+    coded.lossy = attributes::applyScalarTolerance(coded.attributes, type, options.tolerance);
+    if (isColourGrid(header, options))
+        coded.colour = attributes::quantiseColours(coded.attributes, type, options.colourBits, "grid '" + header.name + "'");
+    coded.windows = codeValues(dag, coded.attributes, type, options);
+}
+
+void codeInactiveValues(const encoding::CompactDag& dag, CodedValues& coded, ValueType type, const EncodeOptions& options) {
+    coded.windows = codeValues(dag, coded.attributes, type, options);
+}
+
+void storeActiveValues(format::EncodedGrid& out, CodedValues&& coded) {
+    out.attributes = std::move(coded.attributes);
+    out.valueWindows = std::move(coded.windows);
+    out.lossy = coded.lossy;
+    out.colour = std::move(coded.colour);
+    out.normals = std::move(coded.normals);
+}
+
+void storeInactiveValues(format::EncodedGrid& out, CodedValues&& coded) {
+    out.inactiveAttributes = std::move(coded.attributes);
+    out.inactiveValueWindows = std::move(coded.windows);
 }
 
 bool usesPredictedWindows(ValueType type, const EncodeOptions& options) {
@@ -176,6 +213,16 @@ bool isColourGrid(const GridRecord& grid, const EncodeOptions& options) {
 
 namespace {
 
+// The grid's exact normals (GridRecord::normals) in `dag`'s attribute order, as ONVs.
+attributes::NormalChannel normalsOf(const encoding::CompactDag& dag, const GridRecord& grid, const EncodeOptions& options) {
+    const std::vector<uint8_t> raw = gatherAttributes(dag, grid.topology, grid.normals->vectors, sizeof(std::array<float, 3>));
+    std::vector<std::array<float, 3>> exact(raw.size() / sizeof(std::array<float, 3>));
+    if (!raw.empty()) std::memcpy(exact.data(), raw.data(), raw.size());
+    return attributes::encodeNormals(exact, options.normalBits,
+                                     grid.normals->fromNormalGrid ? attributes::NormalReport::Source::NormalGrid : attributes::NormalReport::Source::Gradient,
+                                     grid.normals->oneSided);
+}
+
 // `release`: the same grid, non-const, whose voxels may be dropped once
 // they are in attribute order (nullptr: keep them).
 format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& options, GridRecord* release) {
@@ -185,32 +232,40 @@ format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& 
     out.activeVoxels = grid.topology.activeVoxelCount();
     step("reducing the DAG");
     const bool withNormals = options.normalBits && grid.normals && !grid.topology.empty();
-    if (!grid.topology.empty()) out.dag = encodeLayer(grid.topology, options, vs > 0 || withNormals, &out.stats);
-    step("ordering values");
+    // Each placement candidate's values are gathered and coded (the
+    // placement orders them); the smallest file's are kept.
+    CodedValues kept, trial;
+    const CandidateValues active{[&](const encoding::CompactDag& dag, const std::array<int64_t, 3>&) {
+                                     trial = {};
+                                     step("ordering values");
+                                     trial.attributes = gatherAttributes(dag, grid.topology, grid.values, vs);
+                                     if (withNormals) trial.normals = normalsOf(dag, grid, options);
+                                     step("palette compression");
+                                     codeActiveValues(dag, trial, grid, options);
+                                     return trial.storedBytes();
+                                 },
+                                 [&] { kept = std::move(trial); }};
     if (!grid.topology.empty()) {
-        out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
+        out.dag = encodeLayer(grid.topology, options, vs > 0 || withNormals, &out.stats, active);
+        storeActiveValues(out, std::move(kept));
+        trial = {};
         if (release) {
             std::vector<uint8_t>().swap(release->values.bricks);
             std::vector<uint8_t>().swap(release->values.tiles);
         }
     }
-    if (withNormals) {
-        const std::vector<uint8_t> raw = gatherAttributes(out.dag, grid.topology, grid.normals->vectors, sizeof(std::array<float, 3>));
-        std::vector<std::array<float, 3>> exact(raw.size() / sizeof(std::array<float, 3>));
-        if (!raw.empty()) std::memcpy(exact.data(), raw.data(), raw.size());
-        out.normals = attributes::encodeNormals(exact, options.normalBits,
-                                                grid.normals->fromNormalGrid ? attributes::NormalReport::Source::NormalGrid
-                                                                             : attributes::NormalReport::Source::Gradient,
-                                                grid.normals->oneSided);
-    }
-    step("palette compression");
-    if (!grid.topology.empty()) codeActiveValues(out, options);
     out.inactiveVoxels = grid.inactiveTopology.activeVoxelCount();
     step("inactive values");
     if (!grid.inactiveTopology.empty()) {
-        out.inactiveDag = encodeLayer(grid.inactiveTopology, options, vs > 0, nullptr);
-        out.inactiveAttributes = gatherAttributes(out.inactiveDag, grid.inactiveTopology, grid.inactiveValues, vs);
-        codeInactiveValues(out, options);
+        const CandidateValues inactive{[&](const encoding::CompactDag& dag, const std::array<int64_t, 3>&) {
+                                           trial = {};
+                                           trial.attributes = gatherAttributes(dag, grid.inactiveTopology, grid.inactiveValues, vs);
+                                           codeInactiveValues(dag, trial, grid.valueType, options);
+                                           return trial.storedBytes();
+                                       },
+                                       [&] { kept = std::move(trial); }};
+        out.inactiveDag = encodeLayer(grid.inactiveTopology, options, vs > 0, nullptr, inactive);
+        storeInactiveValues(out, std::move(kept));
     }
     if (release) *release = GridRecord{};  // everything the scene needs is copied
     return out;

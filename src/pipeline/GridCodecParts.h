@@ -4,6 +4,7 @@
 #pragma once
 #include <array>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "src/dag/DagBuilder.h"
@@ -17,13 +18,39 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const dag::ActiveBounds&
 
 format::DagStats statsOf(const dag::ReducedDag& reduced);
 
-// Builds a layer at each placement candidate and keeps the smallest compact
-// encoding; with `stats`, also the plain SVDAG's node counts at the kept
-// placement when options.computeSvdagStats. `build(origin, symmetry)`
-// builds the layer's DAG with its root at `origin`.
+// A layer's values as the file stores them, coded in the attribute order of
+// one placement candidate.
+struct CodedValues {
+    std::vector<uint8_t> attributes;  // attribute order, after the lossy settings (empty when streamed)
+    attributes::ValueWindowsPayload windows;
+    attributes::ToleranceReport lossy;
+    std::optional<attributes::ColourReport> colour;
+    std::optional<attributes::NormalChannel> normals;
+    // What they take in the file: the windows as they are (the container
+    // stores them precompressed), the normals as the container compresses them.
+    uint64_t storedBytes() const;
+};
+
+// How encodeAtBestPlacement codes a candidate's values: `code(dag, origin)`
+// codes them (into the caller's pending slot) and returns their stored
+// bytes; `keep()` runs right after for a candidate that is the best so far,
+// to keep what was just coded.
+struct CandidateValues {
+    std::function<uint64_t(const encoding::CompactDag& dag, const std::array<int64_t, 3>& origin)> code;
+    std::function<void()> keep;
+};
+
+// Builds a layer at each placement candidate and keeps the one whose file
+// is smallest: its geometry as the writer compresses it plus, with
+// `values`, its values as coded in its attribute order (the placement
+// orders the values, so it changes their coding too). With `values` the
+// kept candidate's values are coded and kept (also with a single
+// candidate, so the caller has one path). With `stats`, also the plain
+// SVDAG's node counts at the kept placement when options.computeSvdagStats.
+// `build(origin, symmetry)` builds the layer's DAG with its root at `origin`.
 using PlacedBuild = std::function<dag::ReducedDag(const std::array<int64_t, 3>& origin, bool symmetry)>;
 encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t alignment, const EncodeOptions& options, bool withOffsets,
-                                           format::DagStats* stats, const PlacedBuild& build, std::array<int64_t, 3>* keptOrigin = nullptr);
+                                           format::DagStats* stats, const PlacedBuild& build, const CandidateValues* values = nullptr);
 
 // An EncodedGrid with `grid`'s header and nothing else.
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options);
@@ -32,9 +59,15 @@ format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& o
 // unless --no-predict) rather than palette windows.
 bool usesPredictedWindows(ValueType type, const EncodeOptions& options);
 
-// From out.attributes / out.inactiveAttributes (attribute order): the lossy
-// settings, then the value windows (predicted windows for integers).
-void codeActiveValues(format::EncodedGrid& out, const EncodeOptions& options);
-void codeInactiveValues(format::EncodedGrid& out, const EncodeOptions& options);
+// From coded.attributes (attribute order of `dag`): the lossy settings
+// (tolerance, colours), then the value windows (predicted windows for
+// integers). `header`: the grid's name, type and class.
+void codeActiveValues(const encoding::CompactDag& dag, CodedValues& coded, const GridRecord& header, const EncodeOptions& options);
+// The same for an inactive layer (never lossy).
+void codeInactiveValues(const encoding::CompactDag& dag, CodedValues& coded, ValueType type, const EncodeOptions& options);
+
+// Moves a layer's coded values into `out`.
+void storeActiveValues(format::EncodedGrid& out, CodedValues&& coded);
+void storeInactiveValues(format::EncodedGrid& out, CodedValues&& coded);
 
 } // namespace vdbdag::pipeline

@@ -1,6 +1,7 @@
 // Shading choices and value access for renderers; see RenderGrid.h.
 #include "src/trace/RenderGrid.h"
 
+#include "src/format/TraceableValues.h"
 #include "src/trace/DagTracer.h"
 #include "src/util/Error.h"
 #include "src/volume/ValueBytes.h"

@@ -13,6 +13,7 @@
 #include <sys/resource.h>
 
 #include "src/attributes/PaletteChannel.h"
+#include "src/attributes/PaletteCompressor.h"
 
 namespace {
 

@@ -10,6 +10,16 @@
 //                                 bit for bit); prints what differs otherwise
 //   vdbdag_vdb_probe read FILE    reads every grid and every leaf buffer; exit 0,
 //                                 or prints the error and exits 1
+//   vdbdag_vdb_probe values FILE GRID
+//                                 for each line "i j k" of stdin prints "A HEX",
+//                                 from OpenVDB's accessor: A is 1 if the voxel
+//                                 is active, HEX the value's bytes in memory
+//                                 order ("-" for a mask grid)
+//   vdbdag_vdb_probe sample FILE GRID N SEED
+//                                 prints N lines "i j k": every other one an
+//                                 active voxel of a leaf drawn at random, the
+//                                 rest uniform in the active bounding box
+//                                 grown by 8 voxels
 //
 // The file_* rule: OpenVDB rewrites the per-grid statistics metadata on every
 // write. file_bbox_min, file_bbox_max and file_voxel_count must be equal when
@@ -26,6 +36,7 @@
 #include <cstring>
 #include <iostream>
 #include <map>
+#include <random>
 #include <set>
 #include <sstream>
 #include <string>
@@ -318,8 +329,80 @@ int cmdRead(const std::string& path) {
 
 } // namespace
 
+struct ValueLookup {
+    template <typename GridT>
+    void operator()(const GridT& grid) const {
+        using V = typename GridT::ValueType;
+        auto acc = grid.getConstAccessor();
+        static const char* kHex = "0123456789abcdef";
+        std::string out;
+        long long i, j, k;
+        while (std::cin >> i >> j >> k) {
+            const openvdb::Coord c{int32_t(i), int32_t(j), int32_t(k)};
+            out += acc.isValueOn(c) ? "1 " : "0 ";
+            if constexpr (std::is_same_v<V, openvdb::ValueMask>) {
+                out += '-';
+            } else {
+                const V v = acc.getValue(c);
+                unsigned char bytes[sizeof(V)];
+                if constexpr (std::is_same_v<V, bool>) bytes[0] = v ? 1 : 0;
+                else std::memcpy(bytes, &v, sizeof(V));
+                for (unsigned n = 0; n < (std::is_same_v<V, bool> ? 1u : unsigned(sizeof(V))); ++n) {
+                    out += kHex[bytes[n] >> 4];
+                    out += kHex[bytes[n] & 15];
+                }
+            }
+            out += '\n';
+        }
+        std::cout << out;
+    }
+};
+
+struct CoordSample {
+    size_t n;
+    uint64_t seed;
+    template <typename GridT>
+    void operator()(const GridT& grid) const {
+        std::vector<openvdb::Coord> active;
+        for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
+            for (auto v = leaf->cbeginValueOn(); v; ++v) active.push_back(v.getCoord());
+        const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+        std::mt19937_64 rng(seed);
+        std::string out;
+        for (size_t i = 0; i < n; ++i) {
+            openvdb::Coord c;
+            if (i % 2 == 0 && !active.empty()) {
+                c = active[rng() % active.size()];
+            } else {
+                for (int a = 0; a < 3; ++a) {
+                    const int64_t lo = int64_t(box.min()[a]) - 8, hi = int64_t(box.max()[a]) + 8;
+                    c[a] = int32_t(lo + int64_t(rng() % uint64_t(hi - lo + 1)));
+                }
+            }
+            out += std::to_string(c[0]) + " " + std::to_string(c[1]) + " " + std::to_string(c[2]) + "\n";
+        }
+        std::cout << out;
+    }
+};
+
+int cmdSample(const std::string& path, const std::string& name, size_t n, uint64_t seed) {
+    openvdb::io::File file(path);
+    file.open(false);
+    const GridBase::Ptr grid = file.readGrid(name);
+    if (!grid->apply<openvdb::GridTypes>(CoordSample{n, seed})) throw std::runtime_error("grid type " + grid->type() + " cannot be sampled");
+    return 0;
+}
+
+int cmdValues(const std::string& path, const std::string& name) {
+    openvdb::io::File file(path);
+    file.open(false);
+    const GridBase::Ptr grid = file.readGrid(name);
+    if (!grid->apply<openvdb::GridTypes>(ValueLookup{})) throw std::runtime_error("grid type " + grid->type() + " cannot be probed");
+    return 0;
+}
+
 int main(int argc, char** argv) {
-    const std::string usage = "usage: vdbdag_vdb_probe meta FILE | same A B | read FILE\n";
+    const std::string usage = "usage: vdbdag_vdb_probe meta FILE | same A B | read FILE | values FILE GRID | sample FILE GRID N SEED\n";
     if (argc < 3) {
         std::cerr << usage;
         return 2;
@@ -330,6 +413,8 @@ int main(int argc, char** argv) {
         if (cmd == "meta" && argc == 3) return cmdMeta(argv[2]);
         if (cmd == "same" && argc == 4) return cmdSame(argv[2], argv[3]);
         if (cmd == "read" && argc == 3) return cmdRead(argv[2]);
+        if (cmd == "values" && argc == 4) return cmdValues(argv[2], argv[3]);
+        if (cmd == "sample" && argc == 6) return cmdSample(argv[2], argv[3], std::stoul(argv[4]), std::stoull(argv[5]));
         std::cerr << usage;
         return 2;
     } catch (const std::exception& e) {

@@ -113,7 +113,15 @@ TEST(CubeEncoder, LossyAndIntegerCodingsAreByteIdentical) {
     lossy.tolerance.mode = attributes::ScalarTolerance::Mode::Relative;
     lossy.tolerance.bound = 0.05;
     expectSameFileForAllCubeSizes(shell, lossy, "shell, relative tolerance 0.05");
-    expectSameFileForAllCubeSizes(intGrid(rng), {}, "int32 labels");
+    const GridRecord labels = intGrid(rng);
+    expectSameFileForAllCubeSizes(labels, {}, "int32 labels");
+    // Several placements: each candidate's values are coded (and, lossy,
+    // quantised afresh) in its own order, in both encoders alike.
+    lossy.placementTrials = 3;
+    expectSameFileForAllCubeSizes(shell, lossy, "shell, relative tolerance 0.05, 3 placements");
+    pipeline::EncodeOptions trials;
+    trials.placementTrials = 3;
+    expectSameFileForAllCubeSizes(labels, trials, "int32 labels, 3 placements");
 }
 
 TEST(CubeEncoder, ChoosesSmallerCubesForASmallerBudget) {

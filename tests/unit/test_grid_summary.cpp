@@ -43,7 +43,6 @@ format::SsvdagScene encodedAndReadBack(const Volume& volume) {
     const std::vector<uint8_t> bytes = format::writeScene(pipeline::encodeVolume(volume, {}));
     format::ReadOptions options;
     options.keepValueWindows = true;
-    options.rebuildPalettes = false;
     return format::readScene(bytes, "test", options);
 }
 

@@ -11,6 +11,7 @@
 #include <tbb/global_control.h>
 
 #include "src/attributes/PaletteChannel.h"
+#include "src/attributes/PaletteCompressor.h"
 #include "src/util/Error.h"
 
 using namespace vdbdag;

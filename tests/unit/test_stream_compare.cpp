@@ -102,7 +102,6 @@ format::SsvdagScene encodedScene(const fs::path& original) {
     const fs::path encoded = tempDir() / (original.stem().string() + ".ssvdag");
     std::ofstream(encoded, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
     format::ReadOptions options;
-    options.rebuildPalettes = false;
     options.keepValueWindows = true;
     return format::readSceneFile(encoded.string(), options);
 }

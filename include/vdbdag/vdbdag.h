@@ -1,0 +1,145 @@
+// vdbdag: the public reader of .ssvdag files (docs/FORMAT.md).
+//
+//   #include <vdbdag/vdbdag.h>
+//   vdbdag::File file = vdbdag::File::open("bunny.ssvdag");  // throws vdbdag::Error
+//   const vdbdag::Grid& g = file.grid(0);                      // or file.grid("ls_bunny")
+//   vdbdag::Accessor a = g.accessor();                         // one per thread
+//   if (a.isActive(i, j, k)) float v = a.value<float>(i, j, k);
+//
+// A file is memory-mapped on open; its DAGs are inflated then, and each
+// value channel is decoded the first time a value of it is asked for. A
+// File, its Grids and their Accessors are used from any number of threads
+// (an Accessor from one at a time); Grids and Accessors refer to the File
+// they came from, which must outlive them.
+//
+// Values are the exact bits the file stores: an active voxel's value; an
+// inactive voxel's own value where the grid stores one (OpenVDB's inactive
+// values that differ from the background); the background elsewhere. Value
+// types and the C++ type value<T> takes:
+//   "float" float, "double" double, "int32" int32_t, "int64" int64_t,
+//   "bool" bool, "mask" bool (the active state), "vec3s" std::array<float, 3>,
+//   "vec3d" std::array<double, 3>, "vec3i" std::array<int32_t, 3>.
+//
+// Built with CMake: find_package(vdbdag CONFIG) and link vdbdag::vdbdag; or
+// pkg-config vdbdag. The library depends on the C++ standard library, zstd
+// and xxHash only.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <type_traits>
+
+#include <vdbdag/Error.h>
+
+namespace vdbdag {
+
+// The library's version, and the newest .ssvdag format version it reads
+// (every older one too).
+inline constexpr int kVersionMajor = 0, kVersionMinor = 1, kVersionPatch = 0;
+VDBDAG_API int readableFormatVersion();
+
+// An inclusive box of index coordinates, as OpenVDB's CoordBBox; empty()
+// when min > max (a grid with no active voxels).
+struct IndexBBox {
+    std::array<int64_t, 3> min{0, 0, 0}, max{-1, -1, -1};
+    bool empty() const { return min[0] > max[0] || min[1] > max[1] || min[2] > max[2]; }
+};
+
+namespace detail {
+struct GridData;
+struct FileData;
+} // namespace detail
+
+// Random access to one grid's voxels. Cheap to make (make one per thread);
+// it remembers the path to the last voxel it found, per layer, and starts
+// the next walk from the deepest node that still holds the new voxel, as
+// NanoVDB's ReadAccessor does, so coherent lookups cost a few steps.
+class VDBDAG_API Accessor {
+public:
+    bool isActive(int64_t i, int64_t j, int64_t k);
+    // The value's bytes (valueSize() of them; none for a mask grid).
+    void valueBytes(int64_t i, int64_t j, int64_t k, void* out);
+    // The value as T, whose size must be the grid's value size (see the
+    // table above; throws vdbdag::Error otherwise).
+    template <typename T>
+    T value(int64_t i, int64_t j, int64_t k) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        if constexpr (std::is_same_v<T, bool>) {
+            if (maskGrid()) return isActive(i, j, k);
+        }
+        checkValueSize(sizeof(T));
+        T out;
+        valueBytes(i, j, k, &out);
+        return out;
+    }
+    unsigned valueSize() const;
+
+    // Where a walk left off, per layer (internal; see Accessor.cpp).
+    struct Path {
+        static constexpr unsigned kMaxDepth = 64;
+        struct Node {
+            uint64_t pos = 0, base = 0;  // header word in the DAG's inner words, first attribute entry
+            unsigned mirror = 0;
+        };
+        Node nodes[kMaxDepth];
+        std::array<int64_t, 3> key{};  // the voxel of the last walk, relative to the root
+        unsigned depth = 0;             // nodes[0 .. depth) hold the last walk's path
+        size_t paletteHint = 0;         // palette block of the last value
+    };
+
+private:
+    friend class Grid;
+    explicit Accessor(const detail::GridData* grid) : grid_(grid) {}
+    bool maskGrid() const;
+    void checkValueSize(size_t size) const;
+    const detail::GridData* grid_;
+    Path active_, inactive_;
+};
+
+class VDBDAG_API Grid {
+public:
+    const std::string& name() const;
+    const std::string& gridClass() const;   // "level set", "fog volume", "staggered", "unknown"
+    std::string valueType() const;          // "float", "double", "int32", "int64", "bool", "mask", "vec3s", "vec3d", "vec3i"
+    unsigned valueSize() const;             // bytes per value (bool 1, mask 0)
+    uint64_t activeVoxelCount() const;      // tiles counted as their voxels
+    uint64_t inactiveVoxelCount() const;    // inactive voxels whose value is stored (not the background)
+    IndexBBox indexBBox() const;            // of the active voxels
+    std::array<double, 16> indexToWorld() const;  // 4x4 row-major, as OpenVDB's Mat4d: world = [i j k 1] * M
+    // The background value's bytes (valueSize() of them).
+    void backgroundBytes(void* out) const;
+    template <typename T>
+    T background() const {
+        static_assert(std::is_trivially_copyable_v<T>);
+        if (sizeof(T) != valueSize()) throw Error("grid '" + name() + "': background asked as a " + std::to_string(sizeof(T)) + "-byte value, the grid holds " + valueType());
+        T out;
+        backgroundBytes(&out);
+        return out;
+    }
+    Accessor accessor() const { return Accessor(data_); }
+
+private:
+    friend struct detail::FileData;
+    explicit Grid(const detail::GridData* data) : data_(data) {}
+    const detail::GridData* data_;
+};
+
+class VDBDAG_API File {
+public:
+    // Maps the file and checks it (format version, checksums, every DAG);
+    // throws vdbdag::Error with a one-line message naming the file.
+    static File open(const std::string& path);
+    size_t gridCount() const;
+    const Grid& grid(size_t index) const;
+    const Grid& grid(const std::string& name) const;  // the first grid of that name
+    uint32_t formatVersion() const;                    // of this file
+    const std::string& path() const;
+
+private:
+    explicit File(std::shared_ptr<const detail::FileData> data) : data_(std::move(data)) {}
+    std::shared_ptr<const detail::FileData> data_;
+};
+
+} // namespace vdbdag

@@ -1,0 +1,159 @@
+// The Python module vdbdag._vdbdag (pybind11): the public reader
+// (include/vdbdag/vdbdag.h) with numpy arrays in and out. The package
+// python/vdbdag/__init__.py re-exports it and adds encode/decode.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <vdbdag/vdbdag.h>
+
+#include <array>
+#include <cstring>
+#include <memory>
+#include <string>
+
+namespace py = pybind11;
+
+namespace {
+
+// A grid with the file that owns it (a Python object may outlive the
+// File object it came from).
+struct PyGrid {
+    std::shared_ptr<const vdbdag::File> file;
+    const vdbdag::Grid* grid;
+};
+
+// numpy's dtype and components per value type.
+struct Layout {
+    py::dtype dtype;
+    unsigned components;
+};
+Layout layoutOf(const std::string& type) {
+    if (type == "float") return {py::dtype::of<float>(), 1};
+    if (type == "double") return {py::dtype::of<double>(), 1};
+    if (type == "int32") return {py::dtype::of<int32_t>(), 1};
+    if (type == "int64") return {py::dtype::of<int64_t>(), 1};
+    if (type == "bool" || type == "mask") return {py::dtype::of<bool>(), 1};
+    if (type == "vec3s") return {py::dtype::of<float>(), 3};
+    if (type == "vec3d") return {py::dtype::of<double>(), 3};
+    if (type == "vec3i") return {py::dtype::of<int32_t>(), 3};
+    throw vdbdag::Error("unknown value type '" + type + "'");
+}
+
+using Coords = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
+
+void checkCoords(const Coords& ijk) {
+    if (ijk.ndim() != 2 || ijk.shape(1) != 3) throw py::value_error("ijk must be an (N, 3) array of integer coordinates");
+}
+
+// Values of a grid at coordinates `ijk`, or (isActive) whether they are active.
+py::array values(const PyGrid& g, const Coords& ijk) {
+    checkCoords(ijk);
+    const Layout layout = layoutOf(g.grid->valueType());
+    const py::ssize_t n = ijk.shape(0);
+    std::vector<py::ssize_t> shape{n};
+    if (layout.components == 3) shape.push_back(3);
+    py::array out(layout.dtype, shape);
+    auto* bytes = static_cast<uint8_t*>(out.mutable_data());
+    const unsigned vs = g.grid->valueSize();
+    const bool mask = vs == 0;
+    const auto c = ijk.unchecked<2>();
+    {
+        py::gil_scoped_release release;
+        vdbdag::Accessor a = g.grid->accessor();
+        for (py::ssize_t i = 0; i < n; ++i) {
+            if (mask) bytes[i] = a.isActive(c(i, 0), c(i, 1), c(i, 2)) ? 1 : 0;
+            else a.valueBytes(c(i, 0), c(i, 1), c(i, 2), bytes + size_t(i) * vs);
+        }
+    }
+    return out;
+}
+
+py::array_t<bool> isActive(const PyGrid& g, const Coords& ijk) {
+    checkCoords(ijk);
+    const py::ssize_t n = ijk.shape(0);
+    py::array_t<bool> out(n);
+    auto* flags = out.mutable_data();
+    const auto c = ijk.unchecked<2>();
+    py::gil_scoped_release release;
+    vdbdag::Accessor a = g.grid->accessor();
+    for (py::ssize_t i = 0; i < n; ++i) flags[i] = a.isActive(c(i, 0), c(i, 1), c(i, 2));
+    return out;
+}
+
+// The values of an inclusive index box ((x0, y0, z0), (x1, y1, z1)) as an
+// array of shape (x1-x0+1, y1-y0+1, z1-z0+1[, 3]): out[i-x0, j-y0, k-z0].
+py::array dense(const PyGrid& g, const std::array<std::array<int64_t, 3>, 2>& box) {
+    const auto& [lo, hi] = box;
+    std::vector<py::ssize_t> shape;
+    uint64_t cells = 1;
+    for (int a = 0; a < 3; ++a) {
+        if (hi[a] < lo[a]) throw py::value_error("dense: the box's maximum is below its minimum on axis " + std::to_string(a));
+        const uint64_t n = uint64_t(hi[a] - lo[a]) + 1;
+        if (n > (uint64_t(1) << 31) || cells > (uint64_t(1) << 40) / n) throw py::value_error("dense: the box is too large");
+        cells *= n;
+        shape.push_back(py::ssize_t(n));
+    }
+    const Layout layout = layoutOf(g.grid->valueType());
+    if (layout.components == 3) shape.push_back(3);
+    const unsigned vs = g.grid->valueSize();
+    py::array out(layout.dtype, shape);
+    auto* bytes = static_cast<uint8_t*>(out.mutable_data());
+    py::gil_scoped_release release;
+    vdbdag::Accessor a = g.grid->accessor();
+    size_t at = 0;
+    for (int64_t i = lo[0]; i <= hi[0]; ++i)
+        for (int64_t j = lo[1]; j <= hi[1]; ++j)
+            for (int64_t k = lo[2]; k <= hi[2]; ++k) {  // k fastest: C order of (i, j, k)
+                if (vs == 0) bytes[at++] = a.isActive(i, j, k) ? 1 : 0;
+                else {
+                    a.valueBytes(i, j, k, bytes + at);
+                    at += vs;
+                }
+            }
+    return out;
+}
+
+} // namespace
+
+PYBIND11_MODULE(_vdbdag, m) {
+    m.doc() = "Reader of .ssvdag files (vdbdag's public reader library)";
+    py::register_exception<vdbdag::Error>(m, "Error", PyExc_RuntimeError);
+    m.attr("format_version") = vdbdag::readableFormatVersion();
+
+    py::class_<PyGrid>(m, "Grid")
+        .def_property_readonly("name", [](const PyGrid& g) { return g.grid->name(); })
+        .def_property_readonly("value_type", [](const PyGrid& g) { return g.grid->valueType(); })
+        .def_property_readonly("grid_class", [](const PyGrid& g) { return g.grid->gridClass(); })
+        .def_property_readonly("active_voxel_count", [](const PyGrid& g) { return g.grid->activeVoxelCount(); })
+        .def_property_readonly("index_bbox",
+                               [](const PyGrid& g) {
+                                   const vdbdag::IndexBBox b = g.grid->indexBBox();
+                                   return py::make_tuple(py::make_tuple(b.min[0], b.min[1], b.min[2]), py::make_tuple(b.max[0], b.max[1], b.max[2]));
+                               })
+        .def_property_readonly("index_to_world",
+                               [](const PyGrid& g) {
+                                   const auto m4 = g.grid->indexToWorld();
+                                   py::array_t<double> out({4, 4});
+                                   std::memcpy(out.mutable_data(), m4.data(), sizeof m4);
+                                   return out;
+                               })
+        .def("values", &values, py::arg("ijk"), "values at an (N, 3) array of index coordinates: (N,) or (N, 3) for vectors, exact")
+        .def("is_active", &isActive, py::arg("ijk"), "whether the voxels at an (N, 3) array of index coordinates are active")
+        .def("dense", &dense, py::arg("bbox"), "values of the inclusive box ((x0, y0, z0), (x1, y1, z1)), indexed [i-x0, j-y0, k-z0]")
+        .def("__repr__", [](const PyGrid& g) { return "<vdbdag.Grid '" + g.grid->name() + "' " + g.grid->valueType() + ">"; });
+
+    py::class_<vdbdag::File, std::shared_ptr<vdbdag::File>>(m, "File")
+        .def_property_readonly("path", &vdbdag::File::path)
+        .def_property_readonly("grids",
+                               [](const std::shared_ptr<vdbdag::File>& f) {
+                                   py::list grids;
+                                   for (size_t i = 0; i < f->gridCount(); ++i) grids.append(PyGrid{f, &f->grid(i)});
+                                   return grids;
+                               })
+        .def("grid", [](const std::shared_ptr<vdbdag::File>& f, const std::string& name) { return PyGrid{f, &f->grid(name)}; }, py::arg("name"))
+        .def("__repr__", [](const vdbdag::File& f) { return "<vdbdag.File '" + f.path() + "'>"; });
+
+    m.def("open", [](const std::string& path) { return std::make_shared<vdbdag::File>(vdbdag::File::open(path)); }, py::arg("path"),
+          "opens a .ssvdag file (raises vdbdag.Error with a one-line message)");
+}

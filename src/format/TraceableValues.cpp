@@ -1,0 +1,26 @@
+// See TraceableValues.h.
+#include "src/format/TraceableValues.h"
+
+#include "src/attributes/PaletteCompressor.h"
+#include "src/attributes/PredictedWindows.h"
+#include "src/attributes/ValueWindows.h"
+#include "src/encoding/AttributeLayout.h"
+
+namespace vdbdag::format {
+
+attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactive) {
+    const attributes::PaletteChannel& values = inactive ? grid.inactiveValues : grid.values;
+    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+    const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
+    if (values.entryCount || values.valueSize) return values;
+    if (!windows.empty() && windows.predicted && !attributes.empty()) return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
+    if (!windows.empty() && windows.predicted)
+        return attributes::compressPalette(attributes::decodePredictedWindows(windows.load(), valueSize(grid.record.valueType),
+                                                                              encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
+                                                                              "grid '" + grid.record.name + "' predicted windows"),
+                                           valueSize(grid.record.valueType));
+    if (!windows.empty()) return attributes::decodeValueWindows(windows.load(), "grid '" + grid.record.name + "' value windows");
+    return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
+}
+
+} // namespace vdbdag::format

@@ -1,0 +1,102 @@
+// vdbdag::Accessor (include/vdbdag/vdbdag.h): a point lookup in the compact
+// DAG. From the root (or the deepest node of the last walk that holds the
+// voxel), each inner node's child is the spatial slot of the voxel's
+// coordinate bits mapped through the node's accumulated mirror mask to its
+// stored slot; the child pointer's own reflection composes with the mask
+// and its attribute offset adds to the entry base (DESIGN.md invariant 2).
+// A solid node holds one entry for its whole cube; in a 4^3 leaf the entry
+// is the base plus the rank of the voxel's stored bit among the brick's set
+// bits. The child pointers are read by encoding::readChild, the one parser
+// of the inner words on the CPU.
+#include <vdbdag/vdbdag.h>
+
+#include <bit>
+#include <cstring>
+
+#include "src/encoding/CompactDag.h"
+#include "src/reader/GridData.h"
+
+namespace vdbdag {
+namespace detail {
+
+bool Layer::find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t& entry) const {
+    const encoding::CompactDag& d = *dag;
+    if (d.empty() || d.innerLevelCount() == 0 || d.log2Size > 62) return false;
+    // Relative to the root's corner; below it wraps to a huge value, so one
+    // unsigned comparison per axis tests the root cube.
+    const uint64_t size = uint64_t(1) << d.log2Size;
+    const std::array<uint64_t, 3> rel{uint64_t(i) - uint64_t(d.origin[0]), uint64_t(j) - uint64_t(d.origin[1]), uint64_t(k) - uint64_t(d.origin[2])};
+    if (rel[0] >= size || rel[1] >= size || rel[2] >= size) return false;
+    unsigned t = 0;
+    if (path.depth == 0) {
+        path.nodes[0] = {d.levelStart[0], 0, d.rootReflection};
+    } else {  // the deepest node of the last walk whose cube holds this voxel too
+        const auto& key = path.key;
+        while (t + 1 < path.depth) {
+            const unsigned s = d.log2Size - (t + 1);
+            if ((rel[0] >> s) != (uint64_t(key[0]) >> s) || (rel[1] >> s) != (uint64_t(key[1]) >> s) || (rel[2] >> s) != (uint64_t(key[2]) >> s)) break;
+            ++t;
+        }
+    }
+    path.key = {int64_t(rel[0]), int64_t(rel[1]), int64_t(rel[2])};
+    for (;; ++t) {
+        path.depth = t + 1;
+        const Accessor::Path::Node& n = path.nodes[t];
+        const uint16_t header = d.inner[n.pos];
+        if (header == 0) {  // solid: one entry for the whole cube
+            entry = n.base;
+            return true;
+        }
+        const unsigned half = d.log2Size - t - 1;  // log2 of a child's size
+        const unsigned spatial = unsigned((rel[0] >> half) & 1u) | unsigned((rel[1] >> half) & 1u) << 1 | unsigned((rel[2] >> half) & 1u) << 2;
+        const unsigned slot = spatial ^ n.mirror;
+        if (((header >> (2 * slot)) & 3u) == 0) return false;
+        const encoding::ChildPointer child = encoding::readChild(d.inner, n.pos, slot, d.offsetWords[t]);
+        const unsigned mirror = n.mirror ^ child.reflection;
+        const uint64_t base = n.base + child.attributeOffset;
+        if (t + 1 == d.innerLevelCount()) {  // the child is a 4^3 leaf
+            const uint64_t stored = d.leaves[child.offset];
+            unsigned x = unsigned(rel[0] & 3u), y = unsigned(rel[1] & 3u), z = unsigned(rel[2] & 3u);
+            if (mirror & 1u) x = 3 - x;
+            if (mirror & 2u) y = 3 - y;
+            if (mirror & 4u) z = 3 - z;
+            const unsigned bit = x + 4 * y + 16 * z;
+            if (((stored >> bit) & 1u) == 0) return false;
+            entry = base + uint64_t(std::popcount(stored & ((uint64_t(1) << bit) - 1)));
+            return true;
+        }
+        if (t + 1 >= Accessor::Path::kMaxDepth) throw Error(what + ": the DAG is deeper than " + std::to_string(Accessor::Path::kMaxDepth) + " levels");
+        path.nodes[t + 1] = {d.levelStart[t + 1] + child.offset, base, mirror};
+    }
+}
+
+} // namespace detail
+
+bool Accessor::isActive(int64_t i, int64_t j, int64_t k) {
+    uint64_t entry = 0;
+    return grid_->active.find(i, j, k, active_, entry);
+}
+
+void Accessor::valueBytes(int64_t i, int64_t j, int64_t k, void* out) {
+    if (grid_->valueSize == 0) return;
+    auto* bytes = static_cast<uint8_t*>(out);
+    uint64_t entry = 0;
+    if (grid_->active.find(i, j, k, active_, entry)) {
+        grid_->active.value(entry, bytes, active_.paletteHint);
+    } else if (grid_->inactive.find(i, j, k, inactive_, entry)) {
+        grid_->inactive.value(entry, bytes, inactive_.paletteHint);
+    } else {
+        std::memcpy(bytes, grid_->grid.record.background.data(), grid_->valueSize);
+    }
+}
+
+unsigned Accessor::valueSize() const { return grid_->valueSize; }
+bool Accessor::maskGrid() const { return grid_->grid.record.valueType == ValueType::Mask; }
+
+void Accessor::checkValueSize(size_t size) const {
+    if (size != grid_->valueSize)
+        throw Error("grid '" + grid_->grid.record.name + "': a " + std::to_string(size) + "-byte value asked of a " +
+                    valueTypeName(grid_->grid.record.valueType) + " grid (" + std::to_string(grid_->valueSize) + " bytes)");
+}
+
+} // namespace vdbdag

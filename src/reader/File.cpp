@@ -1,0 +1,123 @@
+// vdbdag::File and vdbdag::Grid (include/vdbdag/vdbdag.h): a file read with
+// its value windows kept as stored, each channel decoded on first use.
+#include <vdbdag/vdbdag.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "src/attributes/PredictedWindows.h"
+#include "src/attributes/ValueWindows.h"
+#include "src/encoding/AttributeLayout.h"
+#include "src/format/DagBounds.h"
+#include "src/format/SsvdagContainer.h"
+#include "src/reader/GridData.h"
+
+namespace vdbdag {
+
+int readableFormatVersion() { return int(format::kFormatVersion); }
+
+namespace detail {
+
+void Layer::load() const {
+    std::call_once(loaded_, [&] {
+        const unsigned vs = valueSize(grid->record.valueType);
+        const attributes::ValueWindowsPayload& windows = inactive ? grid->inactiveValueWindows : grid->valueWindows;
+        const attributes::PaletteChannel& channel = inactive ? grid->inactiveValues : grid->values;
+        const std::vector<uint8_t>& attributes = inactive ? grid->inactiveAttributes : grid->attributes;
+        if (!windows.empty() && windows.predicted) {
+            flat_ = attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(*dag), what + " predicted windows");
+        } else if (!windows.empty()) {
+            channel_ = attributes::decodeValueWindows(windows.load(), what + " value windows");
+            palette_ = true;
+        } else if (channel.entryCount) {  // an older file's palette section
+            channel_ = channel;
+            palette_ = true;
+        } else {  // an older file's predicted values, decoded as read
+            flat_ = attributes;
+        }
+    });
+}
+
+void Layer::value(uint64_t entry, uint8_t* out, size_t& hint) const {
+    load();
+    const unsigned vs = valueSize(grid->record.valueType);
+    if (palette_) {
+        channel_.lookup(entry, out, hint);
+        return;
+    }
+    if ((entry + 1) * vs > flat_.size()) throw Error(what + ": value entry " + std::to_string(entry) + " is past the channel's end");
+    std::memcpy(out, flat_.data() + entry * vs, vs);
+}
+
+std::shared_ptr<FileData> FileData::read(const std::string& path) {
+    format::ReadOptions options;
+    options.keepValueWindows = true;  // decoded when first asked for
+    format::SsvdagScene scene = format::readSceneFile(path, options);
+    auto file = std::make_shared<FileData>();
+    file->path = path;
+    for (format::EncodedGrid& g : scene.grids) {
+        auto data = std::make_unique<GridData>();
+        data->grid = std::move(g);
+        data->valueSize = valueSize(data->grid.record.valueType);
+        const std::string what = path + ": grid '" + data->grid.record.name + "'";
+        if (data->grid.record.background.size() != data->valueSize)
+            throw Error(what + ": its background holds " + std::to_string(data->grid.record.background.size()) + " bytes, expected " +
+                        std::to_string(data->valueSize));
+        data->active.dag = &data->grid.dag;
+        data->active.grid = &data->grid;
+        data->active.what = what;
+        data->inactive.dag = &data->grid.inactiveDag;
+        data->inactive.grid = &data->grid;
+        data->inactive.inactive = true;
+        data->inactive.what = what + " inactive values";
+        file->grids.push_back(Grid(data.get()));
+        file->data.push_back(std::move(data));
+    }
+    return file;
+}
+
+} // namespace detail
+
+File File::open(const std::string& path) { return File(detail::FileData::read(path)); }
+
+size_t File::gridCount() const { return data_->grids.size(); }
+
+const Grid& File::grid(size_t index) const {
+    if (index >= data_->grids.size())
+        throw Error(data_->path + ": no grid " + std::to_string(index) + " (the file holds " + std::to_string(data_->grids.size()) + ")");
+    return data_->grids[index];
+}
+
+const Grid& File::grid(const std::string& name) const {
+    for (size_t g = 0; g < data_->grids.size(); ++g)
+        if (data_->grids[g].name() == name) return data_->grids[g];
+    throw Error(data_->path + ": no grid named '" + name + "'");
+}
+
+uint32_t File::formatVersion() const { return format::kFormatVersion; }
+const std::string& File::path() const { return data_->path; }
+
+const std::string& Grid::name() const { return data_->grid.record.name; }
+const std::string& Grid::gridClass() const { return data_->grid.record.gridClass; }
+std::string Grid::valueType() const { return valueTypeName(data_->grid.record.valueType); }
+unsigned Grid::valueSize() const { return data_->valueSize; }
+uint64_t Grid::activeVoxelCount() const { return data_->grid.activeVoxels; }
+uint64_t Grid::inactiveVoxelCount() const { return data_->grid.inactiveVoxels; }
+std::array<double, 16> Grid::indexToWorld() const { return data_->grid.record.indexToWorld; }
+
+IndexBBox Grid::indexBBox() const {
+    IndexBBox box;
+    if (const auto b = format::dagBounds(data_->grid.dag)) {
+        box.min = b->min;
+        box.max = b->max;
+    }
+    return box;
+}
+
+void Grid::backgroundBytes(void* out) const {
+    const std::vector<uint8_t>& b = data_->grid.record.background;
+    if (b.size() != data_->valueSize) throw Error("grid '" + name() + "': its background holds " + std::to_string(b.size()) + " bytes");
+    if (!b.empty()) std::memcpy(out, b.data(), b.size());
+}
+
+} // namespace vdbdag

@@ -1,0 +1,164 @@
+"""The Python module against pyopenvdb (Debian's python3-openvdb), an
+independent reader of the same grids: values and active states at random
+active voxels and random points around them, a dense block, the grid facts,
+and encode/decode round trips through the command. Inputs: OpenVDB's own
+level-set and fog generators (pyopenvdb.createLevelSetSphere), and the
+bunny level set from ../shared/data when it is present."""
+import os
+import tempfile
+
+import numpy as np
+import pytest
+
+import vdbdag
+
+openvdb = pytest.importorskip("pyopenvdb")
+SHARED = os.environ.get("VDBDAG_SHARED_DATA", os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "data"))
+
+
+@pytest.fixture(scope="module")
+def work():
+    with tempfile.TemporaryDirectory() as d:
+        yield d
+
+
+def sphere_file(work):
+    path = os.path.join(work, "sphere.vdb")
+    if not os.path.exists(path):
+        ls = openvdb.createLevelSetSphere(radius=30.0, center=(1.5, -2.0, 3.0), voxelSize=0.5, halfWidth=3.0)
+        ls.name = "sphere"
+        fog = openvdb.createLevelSetSphere(radius=20.0, center=(0, 0, 0), voxelSize=1.0, halfWidth=3.0)
+        fog.name = "fog"
+        fog.transform = openvdb.createLinearTransform(voxelSize=1.0)
+        vec = openvdb.Vec3SGrid()
+        vec.name = "velocity"
+        acc = vec.getAccessor()
+        rng = np.random.default_rng(5)
+        for _ in range(3000):
+            ijk = tuple(int(v) for v in rng.integers(-40, 40, 3))
+            acc.setValueOn(ijk, tuple(float(v) for v in rng.normal(size=3)))
+        openvdb.write(path, grids=[ls, fog, vec])
+    return path
+
+
+def encoded(work, vdb, **options):
+    out = os.path.join(work, os.path.basename(vdb) + ".ssvdag")
+    if not os.path.exists(out):
+        vdbdag.encode(vdb, out, **options)
+    return out
+
+
+def reference(grid, ijk):
+    acc = grid.getConstAccessor()
+    values, active = [], []
+    for c in ijk:
+        v, on = acc.probeValue(tuple(int(x) for x in c))
+        values.append(v)
+        active.append(on)
+    return values, np.array(active, dtype=bool)
+
+
+def sample_coords(grid, n, seed):
+    """Half random active voxels (from pyopenvdb's leaf-value iteration), half uniform around them."""
+    rng = np.random.default_rng(seed)
+    (x0, y0, z0), (x1, y1, z1) = grid.evalActiveVoxelBoundingBox()
+    active = [item.min for item in grid.citerOnValues() if item.count == 1]
+    picks = [active[i] for i in rng.integers(0, len(active), n // 2)]
+    lo, hi = np.array([x0, y0, z0]) - 8, np.array([x1, y1, z1]) + 8
+    around = rng.integers(lo, hi + 1, size=(n - len(picks), 3))
+    return np.vstack([np.array(picks, dtype=np.int32).reshape(-1, 3), around.astype(np.int32)])
+
+
+def check_grid(vdb_path, ssvdag_path, name, n, seed=1):
+    ref = openvdb.read(vdb_path, name)
+    g = vdbdag.open(ssvdag_path).grid(name)
+    ijk = sample_coords(ref, n, seed)
+    want_values, want_active = reference(ref, ijk)
+    assert np.array_equal(g.is_active(ijk), want_active)
+    assert want_active.sum() >= n // 2
+    got = g.values(ijk)
+    want = np.array(want_values, dtype=got.dtype)
+    assert got.shape == want.shape
+    assert got.tobytes() == want.tobytes(), "values differ from pyopenvdb's"
+
+
+def test_level_set_fog_and_vectors_equal_pyopenvdb(work):
+    vdb = sphere_file(work)
+    path = encoded(work, vdb)
+    f = vdbdag.open(path)
+    assert [g.name for g in f.grids] == ["sphere", "fog", "velocity"]
+    assert [g.value_type for g in f.grids] == ["float", "float", "vec3s"]
+    for name in ("sphere", "fog", "velocity"):
+        check_grid(vdb, path, name, 20000)
+
+
+def test_grid_facts_equal_pyopenvdb(work):
+    vdb = sphere_file(work)
+    g = vdbdag.open(encoded(work, vdb)).grid("sphere")
+    ref = openvdb.read(vdb, "sphere")
+    assert g.active_voxel_count == ref.activeVoxelCount()
+    assert g.index_bbox == tuple(tuple(c) for c in ref.evalActiveVoxelBoundingBox())
+    assert g.grid_class == "level set"
+    m = g.index_to_world
+    assert m.shape == (4, 4)
+    assert m[0, 0] == pytest.approx(0.5) and m[3, 3] == 1.0
+
+
+def test_dense_block_equals_pyopenvdb_copy_to_array(work):
+    vdb = sphere_file(work)
+    g = vdbdag.open(encoded(work, vdb)).grid("sphere")
+    ref = openvdb.read(vdb, "sphere")
+    lo, hi = (-10, -70, -5), (25, -40, 20)
+    block = g.dense((lo, hi))
+    want = np.zeros(tuple(h - l + 1 for l, h in zip(lo, hi)), dtype=np.float32)
+    ref.copyToArray(want, ijk=lo)
+    assert block.shape == want.shape
+    assert block.tobytes() == want.tobytes()
+
+
+def test_encode_decode_round_trip_is_exact(work):
+    vdb = sphere_file(work)
+    path = encoded(work, vdb)
+    back = os.path.join(work, "back.vdb")
+    vdbdag.decode(path, back)
+    for name in ("sphere", "fog", "velocity"):
+        a, b = openvdb.read(vdb, name), openvdb.read(back, name)
+        ijk = sample_coords(a, 4000, 3)
+        va, aa = reference(a, ijk)
+        vb, ab = reference(b, ijk)
+        assert np.array_equal(aa, ab)
+        assert np.array(va).tobytes() == np.array(vb).tobytes()
+
+
+def test_errors_are_vdbdag_errors(work):
+    with pytest.raises(vdbdag.Error, match="missing.ssvdag"):
+        vdbdag.open(os.path.join(work, "missing.ssvdag"))
+    g = vdbdag.open(encoded(work, sphere_file(work))).grid("sphere")
+    with pytest.raises(ValueError):
+        g.values(np.zeros((4, 2), dtype=np.int32))
+    with pytest.raises(vdbdag.Error):
+        vdbdag.open(encoded(work, sphere_file(work))).grid("no such grid")
+    with pytest.raises(vdbdag.Error):
+        vdbdag.encode(os.path.join(work, "missing.vdb"), os.path.join(work, "x.ssvdag"))
+    assert not os.path.exists(os.path.join(work, "x.ssvdag"))
+
+
+def test_lossy_encode_keeps_its_bound(work):
+    vdb = sphere_file(work)
+    out = os.path.join(work, "lossy.ssvdag")
+    vdbdag.encode(vdb, out, abs_error=0.01, grid=["sphere"])
+    ref = openvdb.read(vdb, "sphere")
+    g = vdbdag.open(out).grid("sphere")
+    ijk = sample_coords(ref, 10000, 9)
+    want, active = reference(ref, ijk)
+    got = g.values(ijk)
+    assert np.array_equal(g.is_active(ijk), active)
+    assert np.max(np.abs(got[active] - np.array(want, dtype=np.float32)[active])) <= 0.01
+
+
+@pytest.mark.skipif(not os.path.exists(os.path.join(SHARED, "levelsets", "bunny_d512_ls.vdb")), reason="../shared/data absent")
+def test_bunny_level_set_100000_lookups(work):
+    vdb = os.path.join(SHARED, "levelsets", "bunny_d512_ls.vdb")
+    path = encoded(work, vdb)
+    name = vdbdag.open(path).grids[0].name
+    check_grid(vdb, path, name, 100000, seed=2)

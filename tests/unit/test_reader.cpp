@@ -1,0 +1,240 @@
+// The public reader (include/vdbdag/vdbdag.h) against the grids that made
+// the file: every lookup of vdbdag::Accessor is compared with a brute-force
+// answer from the synthetic grid's own voxel and tile lists (a map lookup,
+// then a scan of the tiles), which shares no code with the DAG, its
+// attribute order or the value channels. Lookups are made at every stored
+// voxel, at random points in and around the grid, and in a coherent scan
+// (the accessor's cached path), on mirrored (SSVDAG) and plain DAGs, with
+// active tiles, an inactive layer, and every channel coding (palette
+// windows, predicted integer windows, vectors, bool, mask).
+#include <gtest/gtest.h>
+
+#include <vdbdag/vdbdag.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+
+#include <unistd.h>
+
+#include "src/format/SsvdagFile.h"
+#include "src/pipeline/GridCodec.h"
+#include "src/selftest/SyntheticGrid.h"
+
+using namespace vdbdag;
+
+namespace {
+
+// The answer a reader must give, from the synthetic grids alone.
+struct Reference {
+    unsigned vs = 0;
+    std::map<std::array<int64_t, 3>, std::string> active, inactive;
+    std::vector<std::pair<Tile, std::string>> activeTiles, inactiveTiles;
+    std::string background;
+
+    static void add(const selftest::SyntheticGrid& g, unsigned vs, std::map<std::array<int64_t, 3>, std::string>& voxels,
+                    std::vector<std::pair<Tile, std::string>>& tiles) {
+        for (size_t i = 0; i < g.voxels.size(); ++i)
+            voxels[{g.voxels[i][0], g.voxels[i][1], g.voxels[i][2]}] = std::string(reinterpret_cast<const char*>(g.voxelValues.data()) + i * vs, vs);
+        for (size_t i = 0; i < g.tiles.size(); ++i)
+            tiles.push_back({g.tiles[i], std::string(reinterpret_cast<const char*>(g.tileValues.data()) + i * vs, vs)});
+    }
+    static const std::string* in(const std::map<std::array<int64_t, 3>, std::string>& voxels, const std::vector<std::pair<Tile, std::string>>& tiles,
+                                 int64_t x, int64_t y, int64_t z) {
+        if (auto it = voxels.find({x, y, z}); it != voxels.end()) return &it->second;
+        for (const auto& [t, v] : tiles) {
+            const int64_t n = int64_t(1) << t.log2Size;
+            if (x >= t.x && x < t.x + n && y >= t.y && y < t.y + n && z >= t.z && z < t.z + n) return &v;
+        }
+        return nullptr;
+    }
+    bool isActive(int64_t x, int64_t y, int64_t z) const { return in(active, activeTiles, x, y, z) != nullptr; }
+    std::string value(int64_t x, int64_t y, int64_t z) const {
+        if (const std::string* v = in(active, activeTiles, x, y, z)) return *v;
+        if (const std::string* v = in(inactive, inactiveTiles, x, y, z)) return *v;
+        return background;
+    }
+};
+
+std::string lookup(Accessor& a, int64_t x, int64_t y, int64_t z) {
+    std::string out(a.valueSize(), '\0');
+    a.valueBytes(x, y, z, out.data());
+    return out;
+}
+
+struct Case {
+    std::string name;
+    selftest::SyntheticGrid active, inactive;
+};
+
+// A shell of radius 26 (values from `value(d)`), tiles of 8^3 and 32^3, and
+// an inactive inside with a tile.
+template <typename MakeValue>
+Case shell(ValueType type, const std::string& name, std::mt19937& rng, MakeValue&& value) {
+    Case c;
+    c.name = name;
+    c.active.type = c.inactive.type = type;
+    const unsigned vs = valueSize(type);
+    std::vector<uint8_t> v(std::max(1u, vs));
+    for (int z = -30; z <= 30; ++z)
+        for (int y = -30; y <= 30; ++y)
+            for (int x = -30; x <= 30; ++x) {
+                const double d = std::sqrt((x + 0.5) * (x + 0.5) + (y + 0.5) * (y + 0.5) + (z + 0.5) * (z + 0.5)) - 26.0;
+                value(d, rng, v.data());
+                if (std::abs(d) < 1.5) c.active.addVoxel(x, y, z, v.data());
+                else if (d < 0 && (x + 2 * y + z) % 3 != 0) c.inactive.addVoxel(x, y, z, v.data());
+            }
+    value(100.0, rng, v.data());
+    for (int i = 0; i < 3; ++i) c.active.addTile({64 + 8 * i, 0, 0, 3}, v.data());
+    c.active.addTile({128, 128, 0, 5}, v.data());
+    value(-100.0, rng, v.data());
+    c.inactive.addTile({-96, -96, -96, 5}, v.data());
+    return c;
+}
+
+std::filesystem::path writeFile(const std::vector<std::pair<Case*, bool>>& grids, const pipeline::EncodeOptions& options, const std::string& stem) {
+    format::SsvdagScene scene;
+    for (const auto& [c, withInactive] : grids) {
+        GridRecord record = selftest::toRecord(c->active, c->name);
+        if (withInactive && valueSize(c->active.type)) {
+            const GridRecord in = selftest::toRecord(c->inactive, c->name);
+            record.inactiveTopology = in.topology;
+            record.inactiveValues = in.values;
+        }
+        record.indexToWorld = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 1.25, -2, 3, 1};
+        scene.grids.push_back(pipeline::encodeGrid(record, options));
+    }
+    const auto path = std::filesystem::temp_directory_path() / (stem + "_" + std::to_string(::getpid()) + ".ssvdag");
+    const std::vector<uint8_t> bytes = format::writeScene(scene);
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    return path;
+}
+
+void expectSameAnswers(const Grid& grid, const Case& c, bool withInactive, std::mt19937& rng) {
+    Reference ref;
+    ref.vs = valueSize(c.active.type);
+    Reference::add(c.active, ref.vs, ref.active, ref.activeTiles);
+    if (withInactive && ref.vs) Reference::add(c.inactive, ref.vs, ref.inactive, ref.inactiveTiles);
+    ref.background.assign(ref.vs, '\0');
+    Accessor a = grid.accessor();
+    uint64_t checked = 0, failures = 0;
+    auto check = [&](int64_t x, int64_t y, int64_t z) {
+        ++checked;
+        const bool on = a.isActive(x, y, z);
+        const std::string v = lookup(a, x, y, z);
+        if (on != ref.isActive(x, y, z) || v != ref.value(x, y, z)) {
+            if (++failures <= 5)
+                ADD_FAILURE() << c.name << ": voxel (" << x << "," << y << "," << z << ") active " << on << " value " << selftest::hexValue(v)
+                              << ", expected active " << ref.isActive(x, y, z) << " value " << selftest::hexValue(ref.value(x, y, z));
+        }
+    };
+    for (const auto& [p, v] : ref.active) check(p[0], p[1], p[2]);
+    for (const auto& [p, v] : ref.inactive) check(p[0], p[1], p[2]);
+    for (const auto& [t, v] : ref.activeTiles) check(t.x + 3, t.y + 1, t.z + 2);
+    std::uniform_int_distribution<int64_t> around(-140, 200);
+    for (int i = 0; i < 20000; ++i) check(around(rng), around(rng), around(rng));
+    for (int64_t z = -4; z <= 4; ++z)  // coherent: a slab through the shell, x fastest
+        for (int64_t y = -32; y <= 32; ++y)
+            for (int64_t x = -32; x <= 32; ++x) check(x, y, z);
+    for (int64_t far : {int64_t(1) << 40, -(int64_t(1) << 40), int64_t(INT32_MAX), int64_t(INT32_MIN)}) check(far, 0, 0);
+    EXPECT_EQ(failures, 0u) << c.name << ": " << failures << " of " << checked << " lookups differ";
+}
+
+} // namespace
+
+TEST(Reader, AccessorAnswersAsTheGridsThatMadeTheFile) {
+    std::mt19937 rng(11);
+    std::vector<Case> cases;
+    cases.push_back(shell(ValueType::Float, "float", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const float v = (r() % 4 == 0) ? float(r() % 7) : float(d);
+        std::memcpy(out, &v, 4);
+    }));
+    cases.push_back(shell(ValueType::Int32, "int32", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const int32_t v = int32_t(std::floor(d * 3)) + int32_t(r() % 2);
+        std::memcpy(out, &v, 4);
+    }));
+    cases.push_back(shell(ValueType::Vec3S, "vec3s", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const float v[3] = {float(d), float(r() % 5), -0.0f};
+        std::memcpy(out, v, 12);
+    }));
+    cases.push_back(shell(ValueType::Double, "double", rng, [](double d, std::mt19937&, uint8_t* out) { std::memcpy(out, &d, 8); }));
+    cases.push_back(shell(ValueType::Bool, "bool", rng, [](double d, std::mt19937&, uint8_t* out) { out[0] = d > 0.25 ? 1 : 0; }));
+    cases.push_back(shell(ValueType::Mask, "mask", rng, [](double, std::mt19937&, uint8_t*) {}));
+    for (const bool symmetry : {true, false}) {
+        pipeline::EncodeOptions options;
+        options.symmetry = symmetry;
+        std::vector<std::pair<Case*, bool>> grids;
+        for (Case& c : cases) grids.push_back({&c, c.name != "bool"});  // one grid without an inactive layer
+        const auto path = writeFile(grids, options, symmetry ? "reader_ssvdag" : "reader_svdag");
+        const File file = File::open(path.string());
+        ASSERT_EQ(file.gridCount(), cases.size());
+        for (size_t g = 0; g < cases.size(); ++g) {
+            const Grid& grid = file.grid(g);
+            EXPECT_EQ(grid.name(), cases[g].name);
+            EXPECT_EQ(grid.valueType(), cases[g].name);  // the cases are named by their type
+            EXPECT_EQ(&file.grid(cases[g].name), &grid);
+            expectSameAnswers(grid, cases[g], grids[g].second, rng);
+        }
+        std::filesystem::remove(path);
+    }
+}
+
+TEST(Reader, GridFactsAndTypedValues) {
+    std::mt19937 rng(3);
+    Case c = shell(ValueType::Float, "density", rng, [](double d, std::mt19937&, uint8_t* out) {
+        const float v = float(d);
+        std::memcpy(out, &v, 4);
+    });
+    const auto path = writeFile({{&c, true}}, {}, "reader_facts");
+    const File file = File::open(path.string());
+    const Grid& g = file.grid("density");
+    // Brute force: the box and count of the active voxels and tiles.
+    IndexBBox want;
+    want.min = {INT64_MAX, INT64_MAX, INT64_MAX};
+    want.max = {INT64_MIN, INT64_MIN, INT64_MIN};
+    uint64_t count = 0;
+    auto grow = [&](int64_t x, int64_t y, int64_t z, int64_t n) {
+        const int64_t lo[3] = {x, y, z};
+        for (int a = 0; a < 3; ++a) {
+            want.min[a] = std::min(want.min[a], lo[a]);
+            want.max[a] = std::max(want.max[a], lo[a] + n - 1);
+        }
+        count += uint64_t(n * n * n);
+    };
+    for (const auto& v : c.active.voxels) grow(v[0], v[1], v[2], 1);
+    for (const Tile& t : c.active.tiles) grow(t.x, t.y, t.z, int64_t(1) << t.log2Size);
+    EXPECT_EQ(g.indexBBox().min, want.min);
+    EXPECT_EQ(g.indexBBox().max, want.max);
+    EXPECT_EQ(g.activeVoxelCount(), count);
+    EXPECT_EQ(g.inactiveVoxelCount(), c.inactive.voxels.size() + (uint64_t(1) << 15));
+    EXPECT_EQ(g.indexToWorld()[0], 0.5);
+    EXPECT_EQ(g.indexToWorld()[12], 1.25);
+    EXPECT_EQ(g.background<float>(), 0.0f);
+    Accessor a = g.accessor();
+    const auto& p = c.active.voxels[100];
+    float want100;
+    std::memcpy(&want100, c.active.voxelValues.data() + 100 * 4, 4);
+    EXPECT_EQ(a.value<float>(p[0], p[1], p[2]), want100);
+    EXPECT_THROW(a.value<double>(p[0], p[1], p[2]), Error);
+    EXPECT_THROW((void)file.grid("nope"), Error);
+    EXPECT_THROW((void)file.grid(7), Error);
+    EXPECT_EQ(file.formatVersion(), uint32_t(readableFormatVersion()));
+    std::filesystem::remove(path);
+}
+
+TEST(Reader, OpenNamesTheFileInItsError) {
+    const std::string missing = (std::filesystem::temp_directory_path() / "no_such_reader_file.ssvdag").string();
+    try {
+        (void)File::open(missing);
+        FAIL() << "opened a missing file";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+    }
+    const auto junk = std::filesystem::temp_directory_path() / ("reader_junk_" + std::to_string(::getpid()) + ".ssvdag");
+    std::ofstream(junk) << "not a DAG";
+    EXPECT_THROW((void)File::open(junk.string()), Error);
+    std::filesystem::remove(junk);
+}
