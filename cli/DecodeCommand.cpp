@@ -14,6 +14,7 @@
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/DenseExport.h"
+#include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/VdbExport.h"
 
 namespace vdbdag::cli {
@@ -72,19 +73,20 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("decode", "Decode an .ssvdag file back into a .vdb file, or a dense grid into a scan file");
+    CLI::App* cmd = app.add_subcommand("decode", "Decode an .ssvdag file back into a .vdb (or NanoVDB .nvdb) file, or a dense grid into a scan file");
     cmd->add_option("input", opt->input, "input .ssvdag file")->required();
-    cmd->add_option("-o,--output", opt->output, "output .vdb, or .nrrd/.nhdr/.mha/.mhd/.nii/.nii.gz/.raw for a dense scan")->required();
+    cmd->add_option("-o,--output", opt->output, "output .vdb or .nvdb, or .nrrd/.nhdr/.mha/.mhd/.nii/.nii.gz/.raw for a dense scan")->required();
     cmd->add_option("--grid", opt->grid, "scan output: the grid to write (default: the file's only grid)");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "decoding");
         const bool dense = bridge::isDenseOutput(opt->output);
-        if (!dense && lowerExtension(opt->output) != ".vdb")
-            throw Error(opt->output + ": decode writes .vdb, or a dense scan as .nrrd, .nhdr, .mha, .mhd, .nii, .nii.gz or .raw");
-        if (!dense && !opt->grid.empty()) throw Error(opt->output + ": --grid applies to scan outputs (a .vdb file takes every grid)");
-        const OutputRules rules{{".vdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt->force};
+        const bool nano = lowerExtension(opt->output) == ".nvdb";
+        if (!dense && !nano && lowerExtension(opt->output) != ".vdb")
+            throw Error(opt->output + ": decode writes .vdb or .nvdb, or a dense scan as .nrrd, .nhdr, .mha, .mhd, .nii, .nii.gz or .raw");
+        if (!dense && !opt->grid.empty()) throw Error(opt->output + ": --grid applies to scan outputs (a .vdb or .nvdb file takes every grid)");
+        const OutputRules rules{{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt->force};
         checkOutputPath(opt->output, {opt->input}, rules);
         const std::string ext = lowerExtension(opt->output);
         if (ext == ".nhdr" || ext == ".mhd")  // their samples go beside them, as NAME.raw
@@ -118,6 +120,7 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         }  // the scene is released before the output is built
         progress.setLabel("decode: writing " + std::filesystem::path(opt->output).filename().string());
         if (dense) bridge::exportDense(denseGridOf(volume.grids, opt->input, opt->grid, [](const GridRecord& g) { return g.name; }), opt->output);
+        else if (nano) bridge::exportNanoVdb(volume, opt->output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
         else bridge::exportVdb(volume, opt->output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
         progress.finish();
         exitCode = 0;

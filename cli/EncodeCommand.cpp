@@ -28,6 +28,7 @@
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/DenseImport.h"
+#include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/VdbCubes.h"
 #include "vdb_bridge/VdbImport.h"
 
@@ -49,8 +50,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         DenseInputOptions dense;
     };
     auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha/.nii scan, or one DICOM series) into an .ssvdag file");
-    cmd->add_option("input", opt->inputs, "input .vdb file or dense scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
+    CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb or NanoVDB .nvdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha/.nii scan, or one DICOM series) into an .ssvdag file");
+    cmd->add_option("input", opt->inputs, "input .vdb or .nvdb file or dense scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
     cmd->add_option("-o,--output", opt->output, "output .ssvdag file")->required();
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_option("--grid", opt->grids, "encode only grids with this name (repeatable)");
@@ -135,7 +136,9 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             // each through a small index). Whole, through OpenVDB's
             // strictest reader, for a stream and for --normals (the
             // gradient reads across cubes). The same bytes either way.
-            if (!importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
+            if (bridge::isNanoVdbPath(opt->input)) {  // NanoVDB: whole, through NanoVDB's own converter
+                imported = bridge::importNanoVdb(opt->input, importOptions);
+            } else if (!importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
                 cubeInput = bridge::openVdbCubes(opt->input, importOptions, scratchNear,
                                                  scratchInMemory(opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()));
                 imported.warnings = cubeInput->warnings;

@@ -15,6 +15,7 @@
 #include <tbb/parallel_for.h>
 
 #include "src/util/Error.h"
+#include "vdb_bridge/detail/ImportGrids.h"
 #include "vdb_bridge/detail/LeafBricks.h"
 #include "vdb_bridge/detail/NormalEstimation.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
@@ -102,8 +103,13 @@ void addNormals(const GridT& grid, GridRecord& record, const std::string& normal
 
 ImportResult importVdb(const std::string& path, const ImportOptions& options) {
     // Checked and read whole, in file order (detail/VdbFile.h).
-    detail::VdbFileContents contents = detail::readVdbFile(path);
-    const openvdb::GridPtrVec* grids = &contents.grids;
+    const detail::VdbFileContents contents = detail::readVdbFile(path);
+    return detail::importGrids(contents.grids, *contents.metadata, path, options);
+}
+
+ImportResult detail::importGrids(const openvdb::GridPtrVec& fileGrids, const openvdb::MetaMap& metadata, const std::string& path,
+                                 const ImportOptions& options) {
+    const openvdb::GridPtrVec* grids = &fileGrids;
 
     if (!options.onlyGrids.empty()) {
         for (const std::string& wanted : options.onlyGrids) {
@@ -117,7 +123,7 @@ ImportResult importVdb(const std::string& path, const ImportOptions& options) {
     }
 
     ImportResult result;
-    result.volume.fileMetadata = detail::serializeMetadata(*contents.metadata);
+    result.volume.fileMetadata = detail::serializeMetadata(metadata);
     for (size_t index = 0; index < grids->size(); ++index) {
         const openvdb::GridBase::Ptr& base = (*grids)[index];
         if (!options.onlyGrids.empty() &&
