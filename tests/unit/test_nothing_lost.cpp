@@ -668,7 +668,7 @@ TEST(NothingLostExtensions, WrongOutputExtensionsAreRefused) {
     const Inputs in = makeInputs("ext");
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"encode " + q(in.vdb) + " -o " + q(in.dir / "x.vdb"), "encode X.vdb -o x.vdb"},
-        {"decode " + q(in.ssvdag) + " -o " + q(in.dir / "x.nvdb"), "decode a.ssvdag -o x.nvdb"},
+        {"decode " + q(in.ssvdag) + " -o " + q(in.dir / "x.vdbx"), "decode a.ssvdag -o x.vdbx"},
         {"decode " + q(in.ssvdag) + " -o " + q(in.dir / "x.ssvdag"), "decode a.ssvdag -o x.ssvdag"},
     };
     for (const auto& [args, why] : cases) expectRefused(in.dir, args, why);
