@@ -2,9 +2,7 @@
 #include "vdb_bridge/NanoVdb.h"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
-#include <sys/stat.h>
 
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/NanoToOpenVDB.h>
@@ -13,26 +11,16 @@
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 #include "src/util/InputPath.h"
+#include "src/util/OutputPath.h"
 #include "vdb_bridge/detail/GridBuilder.h"
 #include "vdb_bridge/detail/ImportGrids.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 
 namespace vdbdag::bridge {
-namespace {
 
-std::string oneLineOf(const std::exception& e) {
-    std::string s = e.what();
-    std::replace(s.begin(), s.end(), '\n', ' ');
-    return s;
-}
+using detail::oneLine;
 
-} // namespace
-
-bool isNanoVdbPath(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".nvdb";
-}
+bool isNanoVdbPath(const std::string& path) { return lowerExtension(path) == ".nvdb"; }
 
 ImportResult importNanoVdb(const std::string& path, const ImportOptions& options) {
     checkInputFile(path, "a NanoVDB file");
@@ -44,7 +32,7 @@ ImportResult importNanoVdb(const std::string& path, const ImportOptions& options
     try {
         metas = nanovdb::io::readGridMetaData(path);
     } catch (const std::exception& e) {
-        throw Error(path + ": not a NanoVDB file, or a damaged one (" + oneLineOf(e) + ")");
+        throw Error(path + ": not a NanoVDB file, or a damaged one (" + oneLine(e.what()) + ")");
     }
     for (size_t i = 0; i < metas.size(); ++i) {
         const auto& m = metas[i];
@@ -60,7 +48,7 @@ ImportResult importNanoVdb(const std::string& path, const ImportOptions& options
             const nanovdb::GridMetaData* meta = handles[i].gridMetaData();
             try {
                 grids.push_back(nanovdb::nanoToOpenVDB(handles[i]));
-            } catch (const std::exception& e) {
+            } catch (const std::exception&) {
                 const std::string name = meta ? meta->shortGridName() : "";
                 const std::string type = meta ? nanovdb::toStr(meta->gridType()) : "unknown";
                 const std::string message = "grid " + std::to_string(i) + " '" + name + "' has NanoVDB type '" + type + "', which vdbdag does not convert";
@@ -70,7 +58,7 @@ ImportResult importNanoVdb(const std::string& path, const ImportOptions& options
     } catch (const Error&) {
         throw;
     } catch (const std::exception& e) {
-        throw Error(path + ": NanoVDB could not read the file (" + oneLineOf(e) + ")");
+        throw Error(path + ": NanoVDB could not read the file (" + oneLine(e.what()) + ")");
     }
     ImportResult result = detail::importGrids(grids, openvdb::MetaMap(), path, options);
     if (grids.size() < metas.size())
@@ -90,7 +78,7 @@ void exportNanoVdb(const Volume& volume, const std::string& path, const std::fun
         try {
             handles.push_back(nanovdb::openToNanoVDB(grid));
         } catch (const std::exception& e) {
-            throw Error(what + ": NanoVDB could not convert it (" + oneLineOf(e) + ")");
+            throw Error(what + ": NanoVDB could not convert it (" + oneLine(e.what()) + ")");
         }
         if (onStep) onStep(g + 1, steps);
     }
@@ -98,7 +86,7 @@ void exportNanoVdb(const Volume& volume, const std::string& path, const std::fun
         try {
             nanovdb::io::writeGrids(out, handles);
         } catch (const std::exception& e) {
-            throw Error(path + ": NanoVDB could not write the file (" + oneLineOf(e) + ")");
+            throw Error(path + ": NanoVDB could not write the file (" + oneLine(e.what()) + ")");
         }
     });
     if (onStep) onStep(steps, steps);
