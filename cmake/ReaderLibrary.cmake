@@ -37,7 +37,10 @@ include(CMakePackageConfigHelpers)
 install(TARGETS vdbdag_lib EXPORT vdbdagTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(FILES include/vdbdag/vdbdag.h include/vdbdag/Error.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vdbdag)
+# The accessor headers that compile as C++ and as GLSL go with it, so that
+# another program's shaders can walk a .ssvdag as ours do (the PNanoVDB way).
+install(FILES include/vdbdag/vdbdag.h include/vdbdag/Error.h include/vdbdag/shader_lang.h include/vdbdag/dag_access.h
+              include/vdbdag/palette_access.h include/vdbdag/normal_access.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vdbdag)
 install(EXPORT vdbdagTargets NAMESPACE vdbdag:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdbdag)
 configure_package_config_file(${CMAKE_CURRENT_SOURCE_DIR}/cmake/vdbdagConfig.cmake.in ${CMAKE_CURRENT_BINARY_DIR}/vdbdagConfig.cmake
                               INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdbdag)

@@ -26,6 +26,8 @@
 
 #include "dispatch.glsl"
 #include "trace_params.glsl"
+#define VDBDAG_GLSL 1
+#include "src/trace/shading_constants.h"
 
 layout(constant_id = 1) const uint MODE = 0u;          // 0: hits, 1: render, 2: primary
 layout(constant_id = 2) const bool LEVEL_SET = false;  // surface = first active voxel with value <= 0
@@ -80,9 +82,6 @@ void traceOneRay(uint i) {
 
 // ---- shading (Shading.cpp, CpuRenderer.cpp) ----------------------------------
 
-const double kAmbient = 0.2lf;
-const double kShadowNormalOffset = 1.5lf;  // Shading.h
-const dvec3 kMaterial = dvec3(0.80lf, 0.78lf, 0.74lf);
 
 double dot3(dvec3 a, dvec3 b) {
     precise double r = a.x * b.x + a.y * b.y + a.z * b.z;
@@ -123,8 +122,7 @@ dvec3 baseColour(uint64_t entry) {
         const double v = valueAsDoubles(entry).x;
         double s = (v - P.valueMin) / (P.valueMax - P.valueMin);
         s = finite(s) ? clampUnit(s) : 0.0lf;
-        const dvec3 cool = dvec3(0.23lf, 0.30lf, 0.75lf), mid = dvec3(0.87lf, 0.87lf, 0.87lf), warm = dvec3(0.71lf, 0.02lf, 0.15lf);
-        return s < 0.5lf ? mixD(cool, mid, s * 2.0lf) : mixD(mid, warm, s * 2.0lf - 1.0lf);
+        return s < 0.5lf ? mixD(kCoolRgb, kMidRgb, s * 2.0lf) : mixD(kMidRgb, kWarmRgb, s * 2.0lf - 1.0lf);
     }
     if (COLOURING == 2u) {
         const dvec3 c = valueAsDoubles(entry);
@@ -139,7 +137,7 @@ dvec3 baseColour(uint64_t entry) {
         if (!(len > 0.0lf) || !finite(len)) return dvec3(0.5lf);
         return dvec3(0.5lf) + (0.5lf * c) / len;
     }
-    return kMaterial;
+    return kMaterialRgb;
 }
 
 // CpuRenderer.cpp levelSetGradient: central differences of the stored values.

@@ -71,6 +71,13 @@ uint64_t leafMask(uint64_t index) {
     return deviceArrayU64(gLeaves, index);
 }
 
+// The DAG's words are parsed by the one source shared with the CPU
+// (include/vdbdag/dag_access.h); the buffer argument is unused (a dummy 0u):
+// the words are this invocation's globals.
+#define VDBDAG_GLSL 1
+#define VDBDAG_INNER_WORD(buf, index) innerWord(index)
+#include "vdbdag/dag_access.h"
+
 const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u;
 
 struct Hit {
@@ -137,66 +144,14 @@ int64_t voxelAtStart(int a, double t, int64_t lo, int64_t hi) {
     return voxelAt(a, t, lo, hi, tIn, tOut);
 }
 
-uint popcount64(uint64_t x) {
-    const uvec2 h = unpackUint2x32(x);
-    return uint(bitCount(h.x) + bitCount(h.y));
-}
-
 uint bitWidth64(uint64_t x) {
     const uvec2 h = unpackUint2x32(x);
     return h.y != 0u ? uint(findMSB(h.y)) + 33u : (h.x != 0u ? uint(findMSB(h.x)) + 1u : 0u);
 }
 
-// dag::reflectBrick.
-uint64_t reflectBrick(uint64_t mask, uint m) {
-    if ((m & 1u) != 0u) {
-        mask = ((mask & 0x3333333333333333ul) << 2) | ((mask >> 2) & 0x3333333333333333ul);
-        mask = ((mask & 0x5555555555555555ul) << 1) | ((mask >> 1) & 0x5555555555555555ul);
-    }
-    if ((m & 2u) != 0u) {
-        mask = ((mask & 0x00FF00FF00FF00FFul) << 8) | ((mask >> 8) & 0x00FF00FF00FF00FFul);
-        mask = ((mask & 0x0F0F0F0F0F0F0F0Ful) << 4) | ((mask >> 4) & 0x0F0F0F0F0F0F0F0Ful);
-    }
-    if ((m & 4u) != 0u) {
-        mask = (mask << 32) | (mask >> 32);
-        mask = ((mask & 0x0000FFFF0000FFFFul) << 16) | ((mask >> 16) & 0x0000FFFF0000FFFFul);
-    }
-    return mask;
-}
-
-uint storedBit(uint x, uint y, uint z, uint m) {
-    if ((m & 1u) != 0u) x = 3u - x;
-    if ((m & 2u) != 0u) y = 3u - y;
-    if ((m & 4u) != 0u) z = 3u - z;
-    return x + 4u * y + 16u * z;
-}
-
-// DagWalk.h readChildPointer: stored child slot j of the node at `pos`.
-void readChildPointer(uint64_t pos, uint header, uint j, uint offsetWords, out uint64_t offset, out uint reflection,
-                      out uint64_t attributeOffset) {
-    const uint earlier = header & ((1u << (2u * j)) - 1u);
-    const uint before = uint(bitCount((earlier | (earlier >> 1)) & 0x5555u));
-    uint64_t at = pos + 1ul + uint64_t(before) + uint64_t(bitCount((earlier >> 1) & 0x5555u));
-    if (before > 1u) at += uint64_t(before - 1u) * uint64_t(offsetWords);
-    const uint tag = (header >> (2u * j)) & 3u;
-    const uint w0 = innerWord(at);
-    reflection = w0 >> 13;
-    if (tag == 1u) {
-        offset = uint64_t(w0 & 0x1FFFu);
-        at += 1ul;
-    } else {
-        offset = (uint64_t(tag & 1u) << 29) | (uint64_t(w0 & 0x1FFFu) << 16) | uint64_t(innerWord(at + 1ul));
-        at += 2ul;
-    }
-    attributeOffset = 0ul;
-    if (before > 0u)
-        for (uint w = 0u; w < offsetWords; ++w) attributeOffset |= uint64_t(innerWord(at + uint64_t(w))) << (16u * w);
-}
-
 // Fog state (CpuRenderer.cpp): transmittance, emitted light, first box entered.
 double gFogTransmittance, gFogFirstHit;
 dvec3 gFogSum;
-const dvec3 kFogEmission = dvec3(0.92lf, 0.92lf, 0.95lf);
 
 // exp(x) in double (GLSL has exp for float only): x = k ln2 + r, |r| <= ln2/2,
 // a degree-13 Taylor polynomial, then ldexp. Relative error ~1e-15.
@@ -236,7 +191,7 @@ bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore,
     const double v = valueAsDoubles(box.entry).x;
     const double density = 0.0lf < v ? v : 0.0lf;
     precise double alpha = 1.0lf - expDouble(-P.fogScale * density * (tLeave - box.t));
-    precise dvec3 add = (gFogTransmittance * alpha) * kFogEmission;
+    precise dvec3 add = (gFogTransmittance * alpha) * kFogEmissionRgb;
     gFogSum = gFogSum + add;
     gFogTransmittance *= 1.0lf - alpha;
     return gFogTransmittance < 1e-3lf;
@@ -348,7 +303,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             if (((header >> (2u * j)) & 3u) == 0u) { skip = halfLog2; break; }
             uint64_t offset, attributeOffset;
             uint reflection;
-            readChildPointer(nodePos, header, j, offsetWordsAt(depth), offset, reflection, attributeOffset);
+            dagChildPointer(0u, nodePos, header, j, offsetWordsAt(depth), offset, reflection, attributeOffset);
             const uint mirror = nodeMirror ^ reflection;
             const uint64_t base = nodeBase + attributeOffset;
             if (depth + 1u == innerLevels) {  // the child is a 4^3 leaf: entered below, once per step
@@ -377,11 +332,11 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             // step for the whole subgroup: this then runs once, not per level.
             leafStored = leafMask(leafOffset);
             // A leaf with no inside voxel is empty space to the zero crossing (DagWalk.h keepLeaf).
-            if (insideTest) leafInside = insideWord(leafBase, popcount64(leafStored));
+            if (insideTest) leafInside = insideWord(leafBase, dagPopcount64(leafStored));
             if (insideTest && leafInside == 0ul) {
                 skip = L - depth - 1u;
             } else {
-                leafSpatial = reflectBrick(leafStored, leafMirror);
+                leafSpatial = dagReflectBrick(leafStored, leafMirror);
                 inLeaf = true;
             }
         }
@@ -395,7 +350,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             const uint x = uint(v[0] & 3l), y = uint(v[1] & 3l), z = uint(v[2] & 3l);
             if (((leafSpatial >> (x + 4u * y + 16u * z)) & 1ul) != 0ul) {
                 if (!insideTest) break;
-                const uint rank = popcount64(leafStored & ((uint64_t(1) << storedBit(x, y, z, leafMirror)) - 1ul));
+                const uint rank = dagLeafRank(leafStored, dagStoredBit(x, y, z, leafMirror));
                 if (((leafInside >> rank) & 1ul) != 0ul) break;
             }
             const double tNew = min(tNext[0], min(tNext[1], tNext[2]));
@@ -414,8 +369,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         if (inLeaf && !occupied && skip == 0u) {
             const uint x = uint(v[0] & 3l), y = uint(v[1] & 3l), z = uint(v[2] & 3l);
             if (((leafSpatial >> (x + 4u * y + 16u * z)) & 1ul) != 0ul) {
-                const uint bit = storedBit(x, y, z, leafMirror);
-                const uint rank = popcount64(leafStored & ((uint64_t(1) << bit) - 1ul));
+                const uint bit = dagStoredBit(x, y, z, leafMirror);
+                const uint rank = dagLeafRank(leafStored, bit);
                 // An outside voxel would be rejected by the visitor: not passed at all.
                 if (!insideTest || ((leafInside >> rank) & 1ul) != 0ul) {
                     hitEntry = leafBase + uint64_t(rank);
@@ -518,14 +473,14 @@ bool findVoxel(i64vec3 voxel, out uint64_t entry) {
         if (((header >> (2u * j)) & 3u) == 0u) return false;
         uint64_t offset, attributeOffset;
         uint reflection;
-        readChildPointer(pos, header, j, offsetWordsAt(depth), offset, reflection, attributeOffset);
+        dagChildPointer(0u, pos, header, j, offsetWordsAt(depth), offset, reflection, attributeOffset);
         mirror ^= reflection;
         base += attributeOffset;
         if (depth + 1u == gInnerLevels) {
             const uint64_t mask = leafMask(offset);
-            const uint bit = storedBit(uint(v[0] & 3l), uint(v[1] & 3l), uint(v[2] & 3l), mirror);
+            const uint bit = dagStoredBit(uint(v[0] & 3l), uint(v[1] & 3l), uint(v[2] & 3l), mirror);
             if (((mask >> bit) & 1ul) == 0ul) return false;
-            entry = base + uint64_t(popcount64(mask & ((uint64_t(1) << bit) - 1ul)));
+            entry = base + uint64_t(dagLeafRank(mask, bit));
             return true;
         }
         pos = P.levelStart[depth + 1u] + offset;

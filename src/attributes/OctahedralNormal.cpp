@@ -1,6 +1,8 @@
 // See OctahedralNormal.h.
 #include "src/attributes/OctahedralNormal.h"
 
+#include <vdbdag/normal_access.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -21,17 +23,6 @@ std::array<double, 2> fold(double x, double y, double z) {
     return {u, v};
 }
 
-std::array<double, 3> unfold(double u, double v) {
-    double x = u, y = v;
-    const double z = 1.0 - std::fabs(u) - std::fabs(v);
-    if (z < 0.0) {
-        x = (1.0 - std::fabs(v)) * signNotZero(u);
-        y = (1.0 - std::fabs(u)) * signNotZero(v);
-    }
-    const double len = std::sqrt(x * x + y * y + z * z);
-    return {x / len, y / len, z / len};
-}
-
 } // namespace
 
 OctahedralCode encodeOctahedral(const std::array<float, 3>& n, unsigned k, bool* zeroLength) {
@@ -50,7 +41,8 @@ OctahedralCode encodeOctahedral(const std::array<float, 3>& n, unsigned k, bool*
         for (int dv = 0; dv < 2; ++dv) {
             const int64_t qu = std::clamp<int64_t>(int64_t(std::floor(u * scale)) + du, -int64_t(scale), int64_t(scale));
             const int64_t qv = std::clamp<int64_t>(int64_t(std::floor(v * scale)) + dv, -int64_t(scale), int64_t(scale));
-            const auto d = unfold(double(qu) / scale, double(qv) / scale);
+            std::array<double, 3> d{};
+            access::onvUnfold(double(qu) / scale, double(qv) / scale, d[0], d[1], d[2]);
             const double cosine = d[0] * x + d[1] * y + d[2] * z;
             if (cosine > best) { best = cosine; bu = qu; bv = qv; }
         }
@@ -59,17 +51,9 @@ OctahedralCode encodeOctahedral(const std::array<float, 3>& n, unsigned k, bool*
 }
 
 std::array<float, 3> decodeOctahedral(OctahedralCode code, unsigned k) {
-    const unsigned half = k / 2;
-    const double scale = double((uint64_t(1) << (half - 1)) - 1);
-    const uint32_t mask = (uint32_t(1) << half) - 1;
-    auto field = [&](uint32_t bits) {  // sign-extend a half-bit field
-        const int64_t raw = int64_t(bits & mask);
-        return raw >= (int64_t(1) << (half - 1)) ? raw - (int64_t(1) << half) : raw;
-    };
-    const double u = std::clamp(double(field(code.bits)) / scale, -1.0, 1.0);
-    const double v = std::clamp(double(field(code.bits >> half)) / scale, -1.0, 1.0);
-    const auto d = unfold(u, v);
-    return {float(d[0]), float(d[1]), float(d[2])};
+    std::array<float, 3> n{};
+    access::onvDecode(code.bits, k, n[0], n[1], n[2]);
+    return n;
 }
 
 double angleDegrees(const std::array<float, 3>& a, const std::array<float, 3>& b) {

@@ -10,17 +10,25 @@
 #include "src/format/ByteIO.h"
 #include "src/util/Error.h"
 
+// The lookup itself is the one source shared with the shaders
+// (include/vdbdag/palette_access.h), reading this channel's vectors.
+#define VDBDAG_PALETTE_T const vdbdag::attributes::PaletteChannel&
+#define VDBDAG_PALETTE_BLOCK_COUNT(c) uint64_t((c).blocks.size())
+#define VDBDAG_PALETTE_BLOCK_FIRST(c, b) (c).blocks[b].firstEntry
+#define VDBDAG_PALETTE_BLOCK_DATA(c, b) (c).blocks[b].dataOffset
+#define VDBDAG_PALETTE_BLOCK_PALETTE(c, b) uint((c).blocks[b].paletteOffset)
+#define VDBDAG_PALETTE_BLOCK_BITS(c, b) uint((c).blocks[b].indexBits)
+#define VDBDAG_PALETTE_INDEX_WORD(c, w) (c).indexBits[w]
+#define VDBDAG_PALETTE_ENTRY(c, i) uint((c).palettes[i])
+#define VDBDAG_PALETTE_VALUE_SIZE(c) uint((c).valueSize)
+#include <vdbdag/palette_access.h>
+
+static_assert(vdbdag::attributes::PaletteBlock::kDirect == vdbdag::access::kPaletteDirect);
+static_assert(vdbdag::attributes::PaletteBlock::kWholeMaterialArray == vdbdag::access::kPaletteWholeMaterialArray);
+
 namespace vdbdag::attributes {
 
-uint64_t readPackedBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigned bits) {
-    if (bits == 0) return 0;
-    const uint64_t word = bitOffset >> 6;
-    const unsigned shift = unsigned(bitOffset & 63);
-    uint64_t v = words[word] >> shift;
-    if (shift + bits > 64) v |= words[word + 1] << (64 - shift);
-    return v & ((uint64_t(1) << bits) - 1);
-}
-
+uint64_t readPackedBits(const PaletteChannel& channel, uint64_t bitOffset, unsigned bits) { return access::paletteBits(channel, bitOffset, bits); }
 
 uint64_t PaletteChannel::byteSize() const {
     return materials.size() + palettes.size() * 4 + blocks.size() * sizeof(PaletteBlock) + indexBits.size() * 8 + direct.size();
@@ -32,19 +40,11 @@ void PaletteChannel::lookup(uint64_t index, uint8_t* out) const {
 }
 
 void PaletteChannel::lookup(uint64_t index, uint8_t* out, size_t& hint) const {
-    if (!(hint < blocks.size() && blocks[hint].firstEntry <= index && (hint + 1 == blocks.size() || index < blocks[hint + 1].firstEntry))) {
-        auto it = std::upper_bound(blocks.begin(), blocks.end(), index, [](uint64_t i, const PaletteBlock& b) { return i < b.firstEntry; });
-        hint = size_t(std::prev(it) - blocks.begin());
-    }
-    const PaletteBlock& b = blocks[hint];
-    const uint64_t k = index - b.firstEntry;
-    if (b.indexBits == PaletteBlock::kDirect) {
-        std::memcpy(out, &direct[b.dataOffset + k * valueSize], valueSize);
-    } else {
-        const uint64_t local = readPackedBits(indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
-        const uint64_t m = b.paletteOffset == PaletteBlock::kWholeMaterialArray ? local : palettes[b.paletteOffset + local];
-        std::memcpy(out, &materials[m * valueSize], valueSize);
-    }
+    uint64_t block = hint;
+    bool isDirect = false;
+    const uint64_t at = access::paletteLocate(*this, index, block, isDirect);
+    hint = size_t(block);
+    std::memcpy(out, isDirect ? &direct[at] : &materials[at], valueSize);
 }
 
 std::vector<uint8_t> PaletteChannel::decodeAll() const {
@@ -56,11 +56,8 @@ std::vector<uint8_t> PaletteChannel::decodeAll() const {
             std::memcpy(&out[b.firstEntry * valueSize], &direct[b.dataOffset], (end - b.firstEntry) * valueSize);
             continue;
         }
-        for (uint64_t e = b.firstEntry; e < end; ++e) {
-            const uint64_t local = readPackedBits(indexBits, b.dataOffset + (e - b.firstEntry) * b.indexBits, b.indexBits);
-            const uint64_t m = b.paletteOffset == PaletteBlock::kWholeMaterialArray ? local : palettes[b.paletteOffset + local];
-            std::memcpy(&out[e * valueSize], &materials[m * valueSize], valueSize);
-        }
+        size_t hint = bi;
+        for (uint64_t e = b.firstEntry; e < end; ++e) lookup(e, &out[e * valueSize], hint);
     }
     return out;
 }
@@ -231,7 +228,7 @@ PaletteChannel deserializePalette(std::span<const uint8_t> bytes, const std::str
             continue;
         }
         for (uint64_t k = 0; k < len; ++k) {
-            const uint64_t local = readPackedBits(c.indexBits, b.dataOffset + k * b.indexBits, b.indexBits);
+            const uint64_t local = readPackedBits(c, b.dataOffset + k * b.indexBits, b.indexBits);
             if (local >= available) r.fail("index out of its palette in block " + std::to_string(i));
         }
     }

@@ -46,9 +46,9 @@ struct PaletteChannel {
     std::vector<uint8_t> decodeAll() const;
 };
 
-// The `bits`-bit field (0..63 bits) at `bitOffset` of a bit-packed array
-// such as PaletteChannel::indexBits.
-uint64_t readPackedBits(const std::vector<uint64_t>& words, uint64_t bitOffset, unsigned bits);
+// The `bits`-bit field (0..63 bits) at `bitOffset` of the channel's
+// bit-packed indices (PaletteChannel::indexBits).
+uint64_t readPackedBits(const PaletteChannel& channel, uint64_t bitOffset, unsigned bits);
 
 // Serialisation for the .ssvdag Values sections (validated on read).
 std::vector<uint8_t> serializePalette(const PaletteChannel& channel);

@@ -11,24 +11,12 @@
 #include <array>
 #include <cstdint>
 
+#include <vdbdag/dag_access.h>
+
 namespace vdbdag::dag {
 
 // Reflects a 4^3 brick mask by m.
-constexpr uint64_t reflectBrick(uint64_t mask, unsigned m) {
-    if (m & 1u) {  // x: reverse the 4 bits of every row
-        mask = ((mask & 0x3333333333333333ull) << 2) | ((mask >> 2) & 0x3333333333333333ull);
-        mask = ((mask & 0x5555555555555555ull) << 1) | ((mask >> 1) & 0x5555555555555555ull);
-    }
-    if (m & 2u) {  // y: reverse the 4 rows (nibbles) of every 16-bit slice
-        mask = ((mask & 0x00FF00FF00FF00FFull) << 8) | ((mask >> 8) & 0x00FF00FF00FF00FFull);
-        mask = ((mask & 0x0F0F0F0F0F0F0F0Full) << 4) | ((mask >> 4) & 0x0F0F0F0F0F0F0F0Full);
-    }
-    if (m & 4u) {  // z: reverse the 4 slices (16-bit groups)
-        mask = (mask << 32) | (mask >> 32);
-        mask = ((mask & 0x0000FFFF0000FFFFull) << 16) | ((mask >> 16) & 0x0000FFFF0000FFFFull);
-    }
-    return mask;
-}
+constexpr uint64_t reflectBrick(uint64_t mask, unsigned m) { return access::dagReflectBrick(mask, m); }
 
 // A set of reflections that leaves a node unchanged is a subgroup G; a child
 // tag t is then only defined modulo G. canonicalTag(t, G) = min{t ^ g : g in G}

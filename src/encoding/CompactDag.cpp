@@ -40,6 +40,8 @@
 // in a leaf it reads bit mirror(m, voxel) (DESIGN.md invariant 2).
 #include "src/encoding/CompactDag.h"
 
+#include <vdbdag/dag_access.h>
+
 #include <algorithm>
 #include <bit>
 #include <limits>
@@ -84,28 +86,8 @@ unsigned nodeWordCount(uint16_t header, unsigned offsetWords) {
 }
 
 ChildPointer readChild(const std::vector<uint16_t>& inner, uint64_t pos, unsigned j, unsigned offsetWords) {
-    const uint16_t header = inner[pos];
-    uint64_t at = pos + 1;
-    bool first = true;
-    for (unsigned k = 0; k < j; ++k) {
-        const unsigned tag = (header >> (2 * k)) & 3u;
-        if (!tag) continue;
-        at += tagWords(tag) + (first ? 0 : offsetWords);
-        first = false;
-    }
-    const unsigned tag = (header >> (2 * j)) & 3u;
-    const uint16_t w0 = inner[at];
     ChildPointer child{};
-    child.reflection = unsigned(w0 >> 13);
-    if (tag == 1) {
-        child.offset = uint64_t(w0 & 0x1FFFu);
-        at += 1;
-    } else {
-        child.offset = (uint64_t(tag & 1u) << 29) | (uint64_t(w0 & 0x1FFFu) << 16) | inner[at + 1];
-        at += 2;
-    }
-    if (!first)
-        for (unsigned w = 0; w < offsetWords; ++w) child.attributeOffset |= uint64_t(inner[at + w]) << (16 * w);
+    access::dagChildPointer(inner.data(), pos, inner[pos], j, offsetWords, child.offset, child.reflection, child.attributeOffset);
     return child;
 }
 

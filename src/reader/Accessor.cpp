@@ -6,9 +6,10 @@
 // and its attribute offset adds to the entry base (DESIGN.md invariant 2).
 // A solid node holds one entry for its whole cube; in a 4^3 leaf the entry
 // is the base plus the rank of the voxel's stored bit among the brick's set
-// bits. The child pointers are read by encoding::readChild, the one parser
-// of the inner words on the CPU.
+// bits. The words are read by <vdbdag/dag_access.h>, the one parser of
+// the compact DAG for C++ and GLSL.
 #include <vdbdag/vdbdag.h>
+#include <vdbdag/dag_access.h>
 
 #include <bit>
 #include <cstring>
@@ -51,22 +52,20 @@ bool Layer::find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t
         const unsigned spatial = unsigned((rel[0] >> half) & 1u) | unsigned((rel[1] >> half) & 1u) << 1 | unsigned((rel[2] >> half) & 1u) << 2;
         const unsigned slot = spatial ^ n.mirror;
         if (((header >> (2 * slot)) & 3u) == 0) return false;
-        const encoding::ChildPointer child = encoding::readChild(d.inner, n.pos, slot, d.offsetWords[t]);
-        const unsigned mirror = n.mirror ^ child.reflection;
-        const uint64_t base = n.base + child.attributeOffset;
+        uint64_t childOffset, attributeOffset;
+        unsigned reflection;
+        access::dagChildPointer(d.inner.data(), n.pos, header, slot, d.offsetWords[t], childOffset, reflection, attributeOffset);
+        const unsigned mirror = n.mirror ^ reflection;
+        const uint64_t base = n.base + attributeOffset;
         if (t + 1 == d.innerLevelCount()) {  // the child is a 4^3 leaf
-            const uint64_t stored = d.leaves[child.offset];
-            unsigned x = unsigned(rel[0] & 3u), y = unsigned(rel[1] & 3u), z = unsigned(rel[2] & 3u);
-            if (mirror & 1u) x = 3 - x;
-            if (mirror & 2u) y = 3 - y;
-            if (mirror & 4u) z = 3 - z;
-            const unsigned bit = x + 4 * y + 16 * z;
+            const uint64_t stored = d.leaves[childOffset];
+            const unsigned bit = access::dagStoredBit(unsigned(rel[0] & 3u), unsigned(rel[1] & 3u), unsigned(rel[2] & 3u), mirror);
             if (((stored >> bit) & 1u) == 0) return false;
-            entry = base + uint64_t(std::popcount(stored & ((uint64_t(1) << bit) - 1)));
+            entry = base + access::dagLeafRank(stored, bit);
             return true;
         }
         if (t + 1 >= Accessor::Path::kMaxDepth) throw Error(what + ": the DAG is deeper than " + std::to_string(Accessor::Path::kMaxDepth) + " levels");
-        path.nodes[t + 1] = {d.levelStart[t + 1] + child.offset, base, mirror};
+        path.nodes[t + 1] = {d.levelStart[t + 1] + childOffset, base, mirror};
     }
 }
 

@@ -73,14 +73,14 @@ std::optional<uint64_t> DagTracer::find(const std::array<int64_t, 3>& voxel) con
         if (((header >> (2 * j)) & 3u) == 0) return std::nullopt;
         uint64_t offset, attributeOffset;
         unsigned reflection;
-        detail::readChildPointer(dag.inner.data(), pos, header, j, dag.offsetWords[depth], offset, reflection, attributeOffset);
+        access::dagChildPointer(dag.inner.data(), pos, header, j, dag.offsetWords[depth], offset, reflection, attributeOffset);
         mirror ^= reflection;
         base += attributeOffset;
         if (depth + 1 == innerLevels) {
             const uint64_t mask = dag.leaves[offset];
-            const unsigned bit = detail::storedBit(unsigned(v[0] & 3), unsigned(v[1] & 3), unsigned(v[2] & 3), mirror);
+            const unsigned bit = access::dagStoredBit(unsigned(v[0] & 3), unsigned(v[1] & 3), unsigned(v[2] & 3), mirror);
             if (!((mask >> bit) & 1u)) return std::nullopt;
-            return base + uint64_t(std::popcount(mask & ((uint64_t(1) << bit) - 1)));
+            return base + access::dagLeafRank(mask, bit);
         }
         pos = dag.levelStart[depth + 1] + offset;
     }

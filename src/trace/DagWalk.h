@@ -18,7 +18,8 @@
 #include <cmath>
 #include <limits>
 
-#include "src/dag/Reflection.h"
+#include <vdbdag/dag_access.h>
+
 #include "src/encoding/CompactDag.h"
 #include "src/trace/DagTracer.h"
 #include "src/trace/Ray.h"
@@ -79,46 +80,6 @@ struct OctantRay {
         return c;
     }
 };
-
-inline unsigned tagWords(unsigned tag) { return tag == 0 ? 0 : tag == 1 ? 1 : 2; }
-
-// Reads stored child slot j of the node at `pos` (whose header is nonzero).
-inline void readChildPointer(const uint16_t* inner, uint64_t pos, uint16_t header, unsigned j, unsigned offsetWords,
-                             uint64_t& offset, unsigned& reflection, uint64_t& attributeOffset) {
-    // Tags of the slots before j: 00 none, 01 one word, 1x two words.
-    const unsigned earlier = header & ((1u << (2 * j)) - 1);
-    const unsigned before = unsigned(std::popcount((earlier | (earlier >> 1)) & 0x5555u));
-    uint64_t at = pos + 1 + before + unsigned(std::popcount((earlier >> 1) & 0x5555u));
-    if (before > 1) at += uint64_t(before - 1) * offsetWords;
-    const unsigned tag = (header >> (2 * j)) & 3u;
-    const uint16_t w0 = inner[at];
-    reflection = unsigned(w0 >> 13);
-    if (tag == 1) {
-        offset = w0 & 0x1FFFu;
-        at += 1;
-    } else {
-        offset = (uint64_t(tag & 1u) << 29) | (uint64_t(w0 & 0x1FFFu) << 16) | inner[at + 1];
-        at += 2;
-    }
-    attributeOffset = 0;
-    if (before > 0) {
-        switch (offsetWords) {  // constant per level: predicted, unlike a loop's exit
-        case 0: break;
-        case 1: attributeOffset = inner[at]; break;
-        case 2: attributeOffset = inner[at] | uint64_t(inner[at + 1]) << 16; break;
-        default:
-            for (unsigned w = 0; w < offsetWords; ++w) attributeOffset |= uint64_t(inner[at + w]) << (16 * w);
-        }
-    }
-}
-
-// Bit of a 4^3 brick stored under reflection m for spatial voxel (x, y, z).
-inline unsigned storedBit(unsigned x, unsigned y, unsigned z, unsigned m) {
-    if (m & 1u) x = 3 - x;
-    if (m & 2u) y = 3 - y;
-    if (m & 4u) z = 3 - z;
-    return x + 4 * y + 16 * z;
-}
 
 // Leaf filter of walkRay that keeps every leaf.
 struct EveryLeaf {
@@ -225,13 +186,13 @@ RayHit walkOctant(const encoding::CompactDag& dag, const TraceOptions& options, 
             if (((header >> (2 * j)) & 3u) == 0) { skip = half; break; }
             uint64_t offset, attributeOffset;
             unsigned reflection;
-            readChildPointer(inner, node.pos, header, j, dag.offsetWords[depth], offset, reflection, attributeOffset);
+            access::dagChildPointer(inner, node.pos, header, j, dag.offsetWords[depth], offset, reflection, attributeOffset);
             const unsigned mirror = node.mirror ^ reflection;
             const uint64_t base = node.base + attributeOffset;
             if (depth + 1 == innerLevels) {  // the child is a 4^3 leaf
                 leafStored = leaves[offset];
                 if (!keepLeaf(base, unsigned(std::popcount(leafStored)))) { skip = half; break; }
-                leafSpatial = dag::reflectBrick(leafStored, mirror);
+                leafSpatial = access::dagReflectBrick(leafStored, mirror);
                 leafMirror = mirror;
                 leafBase = base;
                 inLeaf = true;
@@ -259,8 +220,7 @@ RayHit walkOctant(const encoding::CompactDag& dag, const TraceOptions& options, 
                 const unsigned x = unsigned(v[0] & 3), y = unsigned(v[1] & 3), z = unsigned(v[2] & 3);
                 const bool here = (leafSpatial >> (x + 4 * y + 16 * z)) & 1u;
                 if (here) {
-                    const unsigned bit = storedBit(x, y, z, leafMirror);
-                    makeHit(leafBase + uint64_t(std::popcount(leafStored & ((uint64_t(1) << bit) - 1))), 0);
+                    makeHit(leafBase + access::dagLeafRank(leafStored, access::dagStoredBit(x, y, z, leafMirror)), 0);
                     if constexpr (kFirstHitOnly) return result;
                 }
                 if (++steps > options.maxSteps) return miss();

@@ -38,7 +38,7 @@ InsideBits insideBitsOf(const attributes::PaletteChannel& values, ValueType type
         }
         const bool whole = b.paletteOffset == attributes::PaletteBlock::kWholeMaterialArray;
         for (uint64_t e = b.firstEntry; e < end; ++e) {
-            const uint64_t local = attributes::readPackedBits(values.indexBits, b.dataOffset + (e - b.firstEntry) * b.indexBits, b.indexBits);
+            const uint64_t local = attributes::readPackedBits(values, b.dataOffset + (e - b.firstEntry) * b.indexBits, b.indexBits);
             const uint64_t m = whole ? local : values.palettes[b.paletteOffset + local];
             if (materialInside[m]) set(e);
         }

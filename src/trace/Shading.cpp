@@ -6,6 +6,10 @@
 
 namespace vdbdag::trace {
 
+// shading_constants.h spells its doubles as integer ratios (for GLSL): they are
+// the nearest doubles to the decimals they stand for.
+static_assert(kAmbient == 0.2 && access::kMaterialRgb[1] == 0.78 && access::kWarmRgb[1] == 0.02 && access::kFogEmissionRgb[2] == 0.95);
+
 glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute) {
     switch (grid.colouring) {
     case ValueColouring::None: return kMaterial;
@@ -14,7 +18,8 @@ glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute) {
         const double v = valueAsDoubles(grid, attribute)[0];
         double s = (v - grid.valueMin) / (grid.valueMax - grid.valueMin);
         s = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
-        const glm::dvec3 cool{0.23, 0.30, 0.75}, mid{0.87, 0.87, 0.87}, warm{0.71, 0.02, 0.15};
+        const auto rgb = [](const double (&c)[3]) { return glm::dvec3(c[0], c[1], c[2]); };
+        const glm::dvec3 cool = rgb(access::kCoolRgb), mid = rgb(access::kMidRgb), warm = rgb(access::kWarmRgb);
         return s < 0.5 ? glm::mix(cool, mid, s * 2) : glm::mix(mid, warm, s * 2 - 1);
     }
     case ValueColouring::Colour: {

@@ -1,10 +1,12 @@
-// Shading shared by the CPU renderer and (line by line) the Vulkan shader:
+// Shading shared by the CPU renderer and (line by line) the Vulkan shader,
+// whose constants both include from shading_constants.h:
 // base colours from values, Lambert with one directional light, and the
 // emission-absorption step of fog volumes.
 #pragma once
 #include <glm/glm.hpp>
 
 #include "src/trace/RenderGrid.h"
+#include "src/trace/shading_constants.h"
 
 namespace vdbdag::trace {
 
@@ -15,14 +17,11 @@ struct RenderOptions {
     glm::dvec3 background{0.10, 0.11, 0.13};
 };
 
-inline constexpr double kAmbient = 0.2;
-// Level-set shadow rays skip voxels within this many voxel lengths of their
-// start: the narrow band's staircase would otherwise shadow its own surface.
-inline constexpr double kShadowBias = 3.0;
-// ... and start this many voxels off the surface along its gradient.
-inline constexpr double kShadowNormalOffset = 1.5;
-inline const glm::dvec3 kMaterial{0.80, 0.78, 0.74};
-inline const glm::dvec3 kFogEmission{0.92, 0.92, 0.95};
+using access::kAmbient;
+using access::kShadowBias;
+using access::kShadowNormalOffset;
+inline const glm::dvec3 kMaterial{access::kMaterialRgb[0], access::kMaterialRgb[1], access::kMaterialRgb[2]};
+inline const glm::dvec3 kFogEmission{access::kFogEmissionRgb[0], access::kFogEmissionRgb[1], access::kFogEmissionRgb[2]};
 
 // Linear RGB base colour of a hit's value.
 glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute);
