@@ -87,6 +87,25 @@ public:
         std::array<int64_t, 3> key{};  // the voxel of the last walk, relative to the root
         unsigned depth = 0;             // nodes[0 .. depth) hold the last walk's path
         size_t paletteHint = 0;         // palette block of the last value
+        // The 4^3 leaf that the last walk ended in, if it ended in one: a
+        // voxel of the same brick is answered from it without a walk.
+        struct Leaf {
+            uint64_t stored = 0, base = 0;  // its stored bits, the entry of its first set bit
+            unsigned mirror = 0;            // the mirror mask it is read through
+            bool valid = false;
+        } leaf;
+        // Or the cube of 2^log2 voxels that it ended in, where every voxel
+        // has the same answer: a solid node's (one entry) or an empty
+        // child's (none). log2 = 64: none.
+        struct Uniform {
+            unsigned log2 = 64;
+            bool found = false;
+            uint64_t entry = 0;
+        } uniform;
+        // The last value read, by entry: a run of voxels of one entry (a
+        // solid node, a tile) reads the channel once.
+        uint64_t valueEntry = ~uint64_t(0);
+        uint8_t value[24] = {};  // the largest value: vec3d
     };
 
 private:

@@ -11,6 +11,7 @@
 #include <vdbdag/vdbdag.h>
 #include <vdbdag/dag_access.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 
@@ -31,14 +32,29 @@ bool Layer::find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t
     unsigned t = 0;
     if (path.depth == 0) {
         path.nodes[0] = {d.levelStart[0], 0, d.rootReflection};
-    } else {  // the deepest node of the last walk whose cube holds this voxel too
+    } else {
+        // The highest coordinate bit in which this voxel and the last one
+        // differ gives the deepest node of the last walk that holds both.
         const auto& key = path.key;
-        while (t + 1 < path.depth) {
-            const unsigned s = d.log2Size - (t + 1);
-            if ((rel[0] >> s) != (uint64_t(key[0]) >> s) || (rel[1] >> s) != (uint64_t(key[1]) >> s) || (rel[2] >> s) != (uint64_t(key[2]) >> s)) break;
-            ++t;
+        const uint64_t diff = (rel[0] ^ uint64_t(key[0])) | (rel[1] ^ uint64_t(key[1])) | (rel[2] ^ uint64_t(key[2]));
+        if (diff < 4 && path.leaf.valid) {  // the same 4^3 brick: no walk
+            const Accessor::Path::Leaf& leaf = path.leaf;
+            path.key = {int64_t(rel[0]), int64_t(rel[1]), int64_t(rel[2])};
+            const unsigned bit = access::dagStoredBit(unsigned(rel[0] & 3u), unsigned(rel[1] & 3u), unsigned(rel[2] & 3u), leaf.mirror);
+            if (((leaf.stored >> bit) & 1u) == 0) return false;
+            entry = leaf.base + access::dagLeafRank(leaf.stored, bit);
+            return true;
         }
+        if (path.uniform.log2 < 64 && (diff >> path.uniform.log2) == 0) {  // the same solid or empty cube
+            path.key = {int64_t(rel[0]), int64_t(rel[1]), int64_t(rel[2])};
+            entry = path.uniform.entry;
+            return path.uniform.found;
+        }
+        const unsigned shared = d.log2Size - unsigned(std::bit_width(diff));  // levels whose cube holds both
+        t = std::min(path.depth - 1, shared);
     }
+    path.leaf.valid = false;
+    path.uniform.log2 = 64;
     path.key = {int64_t(rel[0]), int64_t(rel[1]), int64_t(rel[2])};
     for (;; ++t) {
         path.depth = t + 1;
@@ -46,12 +62,16 @@ bool Layer::find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t
         const uint16_t header = d.inner[n.pos];
         if (header == 0) {  // solid: one entry for the whole cube
             entry = n.base;
+            path.uniform = {d.log2Size - t, true, entry};
             return true;
         }
         const unsigned half = d.log2Size - t - 1;  // log2 of a child's size
         const unsigned spatial = unsigned((rel[0] >> half) & 1u) | unsigned((rel[1] >> half) & 1u) << 1 | unsigned((rel[2] >> half) & 1u) << 2;
         const unsigned slot = spatial ^ n.mirror;
-        if (((header >> (2 * slot)) & 3u) == 0) return false;
+        if (((header >> (2 * slot)) & 3u) == 0) {  // an empty child: none of its cube
+            path.uniform = {half, false, 0};
+            return false;
+        }
         uint64_t childOffset, attributeOffset;
         unsigned reflection;
         access::dagChildPointer(d.inner.data(), n.pos, header, slot, d.offsetWords[t], childOffset, reflection, attributeOffset);
@@ -59,6 +79,7 @@ bool Layer::find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t
         const uint64_t base = n.base + attributeOffset;
         if (t + 1 == d.innerLevelCount()) {  // the child is a 4^3 leaf
             const uint64_t stored = d.leaves[childOffset];
+            path.leaf = {stored, base, mirror, true};
             const unsigned bit = access::dagStoredBit(unsigned(rel[0] & 3u), unsigned(rel[1] & 3u), unsigned(rel[2] & 3u), mirror);
             if (((stored >> bit) & 1u) == 0) return false;
             entry = base + access::dagLeafRank(stored, bit);
@@ -80,10 +101,17 @@ void Accessor::valueBytes(int64_t i, int64_t j, int64_t k, void* out) {
     if (grid_->valueSize == 0) return;
     auto* bytes = static_cast<uint8_t*>(out);
     uint64_t entry = 0;
+    const auto read = [&](const detail::Layer& layer, Path& path) {
+        if (entry != path.valueEntry) {
+            layer.value(entry, path.value, path.paletteHint);
+            path.valueEntry = entry;
+        }
+        std::memcpy(bytes, path.value, grid_->valueSize);
+    };
     if (grid_->active.find(i, j, k, active_, entry)) {
-        grid_->active.value(entry, bytes, active_.paletteHint);
+        read(grid_->active, active_);
     } else if (grid_->inactive.find(i, j, k, inactive_, entry)) {
-        grid_->inactive.value(entry, bytes, inactive_.paletteHint);
+        read(grid_->inactive, inactive_);
     } else {
         std::memcpy(bytes, grid_->grid.record.background.data(), grid_->valueSize);
     }

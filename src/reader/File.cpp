@@ -60,6 +60,7 @@ std::shared_ptr<FileData> FileData::read(const std::string& path) {
         data->grid = std::move(g);
         data->valueSize = valueSize(data->grid.record.valueType);
         const std::string what = path + ": grid '" + data->grid.record.name + "'";
+        if (data->valueSize > sizeof(Accessor::Path::value)) throw Error(what + ": a " + std::to_string(data->valueSize) + "-byte value type is not supported");
         if (data->grid.record.background.size() != data->valueSize)
             throw Error(what + ": its background holds " + std::to_string(data->grid.record.background.size()) + " bytes, expected " +
                         std::to_string(data->valueSize));
