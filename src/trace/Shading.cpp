@@ -18,7 +18,6 @@ glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute) {
         const double v = valueAsDoubles(grid, attribute)[0];
         double s = (v - grid.valueMin) / (grid.valueMax - grid.valueMin);
         s = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
-        const auto rgb = [](const double (&c)[3]) { return glm::dvec3(c[0], c[1], c[2]); };
         const glm::dvec3 cool = rgb(access::kCoolRgb), mid = rgb(access::kMidRgb), warm = rgb(access::kWarmRgb);
         return s < 0.5 ? glm::mix(cool, mid, s * 2) : glm::mix(mid, warm, s * 2 - 1);
     }

@@ -20,8 +20,10 @@ struct RenderOptions {
 using access::kAmbient;
 using access::kShadowBias;
 using access::kShadowNormalOffset;
-inline const glm::dvec3 kMaterial{access::kMaterialRgb[0], access::kMaterialRgb[1], access::kMaterialRgb[2]};
-inline const glm::dvec3 kFogEmission{access::kFogEmissionRgb[0], access::kFogEmissionRgb[1], access::kFogEmissionRgb[2]};
+// A colour of shading_constants.h as a glm vector.
+constexpr glm::dvec3 rgb(const double (&c)[3]) { return {c[0], c[1], c[2]}; }
+inline const glm::dvec3 kMaterial = rgb(access::kMaterialRgb);
+inline const glm::dvec3 kFogEmission = rgb(access::kFogEmissionRgb);
 
 // Linear RGB base colour of a hit's value.
 glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute);
