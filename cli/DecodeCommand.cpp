@@ -39,14 +39,16 @@ const Grid& denseGridOf(const std::vector<Grid>& grids, const std::string& input
 // A dense output straight from the DAG, cube by cube, the values decoded a
 // window at a time: never the whole grid in memory. False when the output
 // or the grid needs the whole grid (exportsByCubes).
-bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& input, const std::string& output, const std::string& gridName) {
+bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& input, const std::string& output, const std::string& gridName,
+                        const bridge::DenseExportOptions& options, std::vector<std::string>& notes) {
+    if (gridName.empty() && scene.grids.size() > 1) return false;  // a 4-D series, or a refusal naming the grids
     const format::EncodedGrid& grid = denseGridOf(scene.grids, input, gridName, [](const format::EncodedGrid& g) { return g.record.name; });
     if (!bridge::exportsByCubes(grid.record, output)) return false;
     constexpr unsigned kCubeLog2 = 7;
     const encoding::CompactDag& active = grid.dag;
     const uint64_t total = (grid.inactiveDag.empty() ? 0 : 1) + (active.empty() ? 0 : 1);
     Progress progress("decode " + std::filesystem::path(output).filename().string(), 1000 * std::max<uint64_t>(total, 1));
-    bridge::exportDenseByCubes(grid.record, output, [&](bridge::DenseCubeSink& sink) {
+    const bridge::DenseExportReport report = bridge::exportDenseByCubes(grid.record, output, [&](bridge::DenseCubeSink& sink) {
         uint64_t layer = 0;
         for (const bool inactive : {true, false}) {  // inactive first: active voxels win
             if ((inactive ? grid.inactiveDag : active).empty()) continue;
@@ -59,8 +61,9 @@ bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& inp
                                           [&](uint64_t done, uint64_t all) { progress.set(layer * 1000 + done * 1000 / std::max<uint64_t>(all, 1)); });
             ++layer;
         }
-    });
+    }, options);
     progress.finish();
+    notes = report.notes;
     return true;
 }
 
@@ -69,7 +72,7 @@ bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& inp
 void addDecodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string input, output, grid;
-        bool force = false;
+        bool force = false, storedValues = false;
         ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
@@ -77,6 +80,9 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("input", opt->input, "input .ssvdag file")->required();
     cmd->add_option("-o,--output", opt->output, "output .vdb or .nvdb, or .nrrd/.nhdr/.mha/.mhd/.nii/.nii.gz/.raw for a dense scan")->required();
     cmd->add_option("--grid", opt->grid, "scan output: the grid to write (default: the file's only grid)");
+    cmd->add_flag("--stored-values", opt->storedValues,
+                  "scan output of a rescaled scan (DICOM, NIfTI scl_slope) to .nrrd/.nhdr/.mha/.mhd/.raw: write the stored integers, with the rescale as "
+                  "key/value pairs, instead of the grid's values (NIfTI always holds the stored integers and the rescale)");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
@@ -86,6 +92,14 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         if (!dense && !nano && lowerExtension(opt->output) != ".vdb")
             throw Error(opt->output + ": decode writes .vdb or .nvdb, or a dense scan as .nrrd, .nhdr, .mha, .mhd, .nii, .nii.gz or .raw");
         if (!dense && !opt->grid.empty()) throw Error(opt->output + ": --grid applies to scan outputs (a .vdb or .nvdb file takes every grid)");
+        if (!dense && opt->storedValues) throw Error(opt->output + ": --stored-values applies to scan outputs (a .vdb or .nvdb file holds the grid's values)");
+        bridge::DenseExportOptions denseOptions;
+        denseOptions.storedValues = opt->storedValues;
+        std::vector<std::string> notes;
+        // What changed on the way out, one line each (not silenced by -q: a value written otherwise than stored).
+        auto printNotes = [&] {
+            for (const std::string& n : notes) fmt::print(stderr, "{}: note: {}\n", opt->output, n);
+        };
         const OutputRules rules{{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt->force};
         checkOutputPath(opt->output, {opt->input}, rules);
         const std::string ext = lowerExtension(opt->output);
@@ -104,7 +118,8 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         Progress progress("decode: reading " + std::filesystem::path(opt->input).filename().string(), 1000);
         {
             const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);
-            if (dense && decodeDenseByCubes(scene, opt->input, opt->output, opt->grid)) {
+            if (dense && decodeDenseByCubes(scene, opt->input, opt->output, opt->grid, denseOptions, notes)) {
+                printNotes();
                 exitCode = 0;
                 return;
             }
@@ -119,10 +134,20 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
             progress.set(500);
         }  // the scene is released before the output is built
         progress.setLabel("decode: writing " + std::filesystem::path(opt->output).filename().string());
-        if (dense) bridge::exportDense(denseGridOf(volume.grids, opt->input, opt->grid, [](const GridRecord& g) { return g.name; }), opt->output);
+        if (dense) {
+            // The volumes of a 4-D scan go back as one file; else one grid.
+            if (const auto series = opt->grid.empty() ? bridge::volumeSeriesOf(volume.grids) : std::nullopt) {
+                std::vector<const GridRecord*> volumes;
+                for (size_t i : *series) volumes.push_back(&volume.grids[i]);
+                notes = bridge::exportDenseVolumes(volumes, opt->output, denseOptions).notes;
+            } else {
+                notes = bridge::exportDense(denseGridOf(volume.grids, opt->input, opt->grid, [](const GridRecord& g) { return g.name; }), opt->output, denseOptions).notes;
+            }
+        }
         else if (nano) bridge::exportNanoVdb(volume, opt->output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
         else bridge::exportVdb(volume, opt->output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
         progress.finish();
+        printNotes();
         exitCode = 0;
     });
 }

@@ -24,6 +24,9 @@ void DenseInputOptions::addTo(CLI::App& cmd) {
     backgroundValueOption =
         cmd.add_option("--background-value", backgroundValue, "dense input: the value removed samples become (default: their mean)")->check(finiteNumber());
     volumeOption = cmd.add_option("--volume", volume, "4-D NIfTI input: which volume (0-based)")->check(CLI::NonNegativeNumber);
+    cmd.add_flag("--drop-patient-tags", dropPatientTags,
+                 "DICOM input: leave the patient-identifying tags (name, ID, birth date, institution, physicians, dates) out of the grid's "
+                 "metadata (by default they are kept with the series' other tags)");
     cmd.add_flag("--allow-external-data", allowExternalData,
                  "dense header: read a data file outside the header's folder (an absolute path, '..', or a link leading out)");
 }
@@ -58,6 +61,9 @@ bridge::DenseImportOptions DenseInputOptions::resolve(const std::string& path) c
     if (aboveOption && aboveOption->count()) o.backgroundAbove = above;
     if (backgroundValueOption && backgroundValueOption->count()) o.backgroundValue = backgroundValue;
     o.allowExternalData = allowExternalData;
+    if (dropPatientTags && bridge::denseFormatOf(path) != bridge::DenseFormat::Dicom)
+        throw Error(path + ": --drop-patient-tags applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
+    o.dropPatientTags = dropPatientTags;
     if (volumeOption && volumeOption->count()) {
         if (bridge::denseFormatOf(path) != bridge::DenseFormat::Nifti) throw Error(path + ": --volume applies to NIfTI inputs only");
         o.volume = volume;

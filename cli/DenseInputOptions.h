@@ -20,7 +20,7 @@ struct DenseInputOptions {
     std::string series;  // DICOM input: --series N|UID
     std::vector<double> spacing, origin;
     double below = 0, above = 0;
-    bool allowExternalData = false;
+    bool allowExternalData = false, dropPatientTags = false;
     int64_t volume = 0;
     CLI::Option* volumeOption = nullptr;
     CLI::Option* belowOption = nullptr;

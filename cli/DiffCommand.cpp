@@ -27,7 +27,7 @@ nlohmann::json number(double v) {
 
 void addDiffCommand(CLI::App& app, int& exitCode) {
     struct Options {
-        std::string a, b, output, compressor = "zlib";
+        std::string a, b, output, compressor = "zlib", pair = "auto";
         std::vector<std::string> grids;
         bool onlyDifferences = false, json = false, force = false;
         uint64_t maxCells = 20'000'000;
@@ -38,6 +38,11 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("b", opt->b, "second volume (B)")->required();
     cmd->add_option("-o,--output", opt->output, "write the cells (a, b, abs_error, rel_error, status) to a .vtu or .vtm");
     cmd->add_option("--grid", opt->grids, "compare only grids with this name (repeatable)");
+    cmd->add_option("--pair", opt->pair,
+                    "how grids are paired: auto (two single-grid files pair whatever their names, else by name), name (grids of the same name), "
+                    "order (in file order)")
+        ->check(CLI::IsMember({"auto", "name", "order"}))
+        ->capture_default_str();
     cmd->add_flag("--only-differences", opt->onlyDifferences, "write only cells whose status is not 'same'");
     cmd->add_option("--max-cells", opt->maxCells, "stop if a written block would exceed this many cells")->capture_default_str();
     cmd->add_option("--compressor", opt->compressor, "zlib or lz4")->capture_default_str();
@@ -53,9 +58,10 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
         options.onlyDifferences = opt->onlyDifferences;
         options.maxCells = opt->maxCells;
         options.compressor = opt->compressor;
+        options.pairing = opt->pair == "name" ? bridge::DiffPairing::Name : opt->pair == "order" ? bridge::DiffPairing::Order : bridge::DiffPairing::Auto;
         const bridge::DiffReport r = bridge::diffVolumes(opt->a, opt->b, opt->output, options);
         static const char* kStatus[4] = {"same", "value_differs", "only_in_a", "only_in_b"};
-        nlohmann::json report{{"inputs", {opt->a, opt->b}}, {"a", opt->a}, {"b", opt->b}, {"identical", r.identical}, {"header_differences", r.headerDifferences},
+        nlohmann::json report{{"inputs", {opt->a, opt->b}}, {"a", opt->a}, {"b", opt->b}, {"identical", r.identical}, {"header_differences", r.headerDifferences}, {"notes", r.notes},
                               {"peak", "value range (max - min) of A's active values; vector magnitudes"}, {"grids", nlohmann::json::array()}};
         if (!opt->output.empty()) { report["output"] = opt->output; report["bytes"] = r.bytes; }
         for (const auto& g : r.grids) {
@@ -73,6 +79,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
         } else {
             fmt::print("{} vs {}: {}\n", opt->a, opt->b, r.identical ? "same" : "DIFFER");
             for (const auto& h : r.headerDifferences) fmt::print("  {}\n", h);
+            for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
             for (const auto& g : r.grids) {
                 fmt::print("  grid '{}' ({}): {} same, {} value differs, {} only in A, {} only in B (voxels)\n", g.name, g.valueType, g.voxels[0],
                            g.voxels[1], g.voxels[2], g.voxels[3]);

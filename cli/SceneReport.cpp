@@ -1,6 +1,7 @@
 // See SceneReport.h.
 #include "cli/SceneReport.h"
 
+#include <algorithm>
 #include <cmath>
 #include <tuple>
 
@@ -111,7 +112,34 @@ std::string formatGridHeader(const nlohmann::json& g) {
     for (int r = 0; r < 4; ++r)
         out += fmt::format(" [{:.6g}, {:.6g}, {:.6g}, {:.6g}]", m[4 * r].get<double>(), m[4 * r + 1].get<double>(), m[4 * r + 2].get<double>(), m[4 * r + 3].get<double>());
     out += "\n";
-    for (const auto& [name, e] : g["metadata"].items()) out += fmt::format("  metadata {}: {}\n", name, e["value"].get<std::string>());
+    // A source header's fields (nifti_*, dicom_*, nrrd_*, mha_tag_*:
+    // docs/SCAN_METADATA.md) as one line per header, with the few a reader
+    // looks for; --json lists every one.
+    struct HeaderGroup {
+        const char* prefix;
+        const char* what;
+        std::vector<std::string> shown;
+        size_t count = 0;
+        std::string summary;
+    };
+    HeaderGroup groups[] = {{"nifti_", "NIfTI header fields", {"nifti_version", "nifti_qform_code", "nifti_sform_code", "nifti_intent_code", "nifti_descrip"}},
+                            {"dicom_", "DICOM tags", {"dicom_Modality", "dicom_SeriesDescription", "dicom_SeriesInstanceUID"}},
+                            {"nrrd_", "NRRD fields and key/value pairs", {}},
+                            {"mha_tag_", "MetaImage tags", {}}};
+    for (const auto& [name, e] : g["metadata"].items()) {
+        HeaderGroup* group = nullptr;
+        for (HeaderGroup& h : groups)
+            if (name.rfind(h.prefix, 0) == 0) group = &h;
+        if (!group) {
+            out += fmt::format("  metadata {}: {}\n", name, e["value"].get<std::string>());
+            continue;
+        }
+        ++group->count;
+        if (std::find(group->shown.begin(), group->shown.end(), name) != group->shown.end())
+            group->summary += fmt::format(", {} {}", name.substr(std::string(group->prefix).size()), e["value"].get<std::string>());
+    }
+    for (const HeaderGroup& h : groups)
+        if (h.count) out += fmt::format("  metadata {}*: {} {}{} (--json lists them)\n", h.prefix, h.count, h.what, h.summary);
     return out;
 }
 

@@ -18,7 +18,6 @@
 #include <unistd.h>
 
 #include <fmt/core.h>
-#include <nifti2_io.h>
 #include <openvdb/openvdb.h>
 #include <tbb/parallel_for.h>
 #include <zlib.h>
@@ -27,125 +26,16 @@
 #include "src/util/Error.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
+#include "vdb_bridge/detail/ScanHeaderWriters.h"
 
 namespace vdbdag::bridge {
 namespace {
 
-enum class OutFormat { Nrrd, Nhdr, Mha, Mhd, Nii, NiiGz, Raw };
-
-std::optional<OutFormat> outFormatOf(const std::string& path) {
-    std::string name = std::filesystem::path(path).filename().string();
-    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    const std::string ext = std::filesystem::path(name).extension().string();
-    if (name.size() > 7 && name.ends_with(".nii.gz")) return OutFormat::NiiGz;
-    if (ext == ".nrrd") return OutFormat::Nrrd;
-    if (ext == ".nhdr") return OutFormat::Nhdr;
-    if (ext == ".mha") return OutFormat::Mha;
-    if (ext == ".mhd") return OutFormat::Mhd;
-    if (ext == ".nii") return OutFormat::Nii;
-    if (ext == ".raw") return OutFormat::Raw;
-    return std::nullopt;
-}
-
-// Where the samples go and how the file describes them.
-struct Layout {
-    std::array<int64_t, 3> dims{0, 0, 0};
-    std::array<int64_t, 3> lo{0, 0, 0};  // index coordinate of sample (0, 0, 0)
-    SampleType type = SampleType::I32;
-    bool rescaled = false;
-    double slope = 1, intercept = 0;
-    std::array<double, 3> origin{0, 0, 0};  // world position of sample (0, 0, 0)
-    std::array<std::array<double, 3>, 3> axes{};
-    std::string space;  // "LPS" or empty
-    unsigned components = 1;  // 3 for vector and colour grids
-    bool colour = false;      // RGB (NIfTI RGB24, NRRD "RGB-color")
-    uint64_t sliceSamples() const { return uint64_t(dims[0]) * uint64_t(dims[1]); }
-};
-
-std::optional<SampleType> sampleTypeNamed(const std::string& name) {
-    for (SampleType t : {SampleType::U8, SampleType::I8, SampleType::U16, SampleType::I16, SampleType::U32, SampleType::I32, SampleType::F32,
-                         SampleType::F64})
-        if (name == sampleTypeName(t)) return t;
-    return std::nullopt;
-}
-
-// The active and stored-inactive voxels' bounding box [lo, hi].
-bool boundsOf(const GridRecord& g, std::array<int64_t, 3>& lo, std::array<int64_t, 3>& hi) {
-    bool any = false;
-    auto add = [&](int64_t x, int64_t y, int64_t z, int64_t size) {
-        const int64_t p[3] = {x, y, z};
-        for (int a = 0; a < 3; ++a) {
-            lo[size_t(a)] = any ? std::min(lo[size_t(a)], p[a]) : p[a];
-            hi[size_t(a)] = any ? std::max(hi[size_t(a)], p[a] + size - 1) : p[a] + size - 1;
-        }
-        any = true;
-    };
-    for (const GridTopology* t : {&g.topology, &g.inactiveTopology}) {
-        for (const Brick& b : t->bricks)
-            for (uint64_t m = b.mask; m; m &= m - 1) {
-                const int bit = std::countr_zero(m);
-                add(b.x + (bit & 3), b.y + ((bit >> 2) & 3), b.z + (bit >> 4), 1);
-            }
-        for (const Tile& tile : t->tiles) add(tile.x, tile.y, tile.z, int64_t(1) << tile.log2Size);
-    }
-    return any;
-}
-
-Layout layoutOf(const GridRecord& grid, const std::string& path) {
-    const std::string what = path + ": grid '" + grid.name + "'";
-    const openvdb::GridBase::Ptr g = detail::readDescriptor(grid.vdbDescriptor, what);
-    Layout l;
-    if (auto t = g->getMetadata<openvdb::StringMetadata>("source_sample_type")) {
-        const auto type = sampleTypeNamed(t->value());
-        if (!type) throw Error(what + ": its source_sample_type '" + t->value() + "' is not a sample type");
-        l.type = *type;
-    } else {
-        switch (grid.valueType) {
-            case ValueType::Int32:
-            case ValueType::Vec3I: l.type = SampleType::I32; break;
-            case ValueType::Float:
-            case ValueType::Vec3S: l.type = SampleType::F32; break;
-            case ValueType::Double:
-            case ValueType::Vec3D: l.type = SampleType::F64; break;
-            case ValueType::Bool:
-            case ValueType::Mask: l.type = SampleType::U8; break;
-            default:
-                throw Error(what + " holds " + valueTypeName(grid.valueType) + " values, which a scan file cannot hold (int32, float, double, bool, mask and vec3 can)");
-        }
-    }
-    if (grid.valueType == ValueType::Vec3I || grid.valueType == ValueType::Vec3S || grid.valueType == ValueType::Vec3D) {
-        l.components = 3;
-        if (auto c = g->getMetadata<openvdb::StringMetadata>("source_colour"); c && c->value() == "rgb") l.colour = true;
-    }
-    if (auto s = g->getMetadata<openvdb::DoubleMetadata>("source_rescale_slope")) {
-        l.rescaled = true;
-        l.slope = s->value();
-        if (auto i = g->getMetadata<openvdb::DoubleMetadata>("source_rescale_intercept")) l.intercept = i->value();
-        if (!std::isfinite(l.slope) || l.slope == 0 || !std::isfinite(l.intercept)) throw Error(what + ": its rescale slope/intercept is not usable");
-    }
-    if (auto s = g->getMetadata<openvdb::StringMetadata>("space"); s && s->value() == "LPS") l.space = "LPS";
-    std::array<int64_t, 3> lo{0, 0, 0}, hi{-1, -1, -1};
-    const bool any = boundsOf(grid, lo, hi);
-    if (auto d = g->getMetadata<openvdb::Vec3IMetadata>("source_dims")) {
-        for (int a = 0; a < 3; ++a) l.dims[size_t(a)] = d->value()[a];
-        for (int a = 0; a < 3; ++a)
-            if (l.dims[size_t(a)] < 1) throw Error(what + ": its source_dims are not positive");
-        if (any && (lo[0] < 0 || lo[1] < 0 || lo[2] < 0 || hi[0] >= l.dims[0] || hi[1] >= l.dims[1] || hi[2] >= l.dims[2]))
-            throw Error(what + ": voxels lie outside its recorded extent " + fmt::format("{}x{}x{}", l.dims[0], l.dims[1], l.dims[2]));
-    } else {
-        if (!any) throw Error(what + " has no voxels, so no extent to write (and no source_dims)");
-        l.lo = lo;
-        for (int a = 0; a < 3; ++a) l.dims[size_t(a)] = hi[size_t(a)] - lo[size_t(a)] + 1;
-    }
-    for (int a = 0; a < 3; ++a)
-        if (l.dims[size_t(a)] > std::numeric_limits<int32_t>::max()) throw Error(what + ": its extent is too large for a scan file");
-    const auto& m = grid.indexToWorld;  // world = [i j k 1] * M
-    for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 3; ++c) l.axes[size_t(a)][size_t(c)] = m[size_t(4 * a + c)];
-    for (int c = 0; c < 3; ++c)
-        l.origin[size_t(c)] = m[size_t(12 + c)] + double(l.lo[0]) * m[size_t(c)] + double(l.lo[1]) * m[size_t(4 + c)] + double(l.lo[2]) * m[size_t(8 + c)];
-    return l;
-}
+using detail::OutFormat;
+using detail::outFormatOf;
+using detail::ScanLayout;
+using Layout = ScanLayout;
+using detail::layoutOf;
 
 // ---- samples ---------------------------------------------------------------
 
@@ -397,166 +287,30 @@ void writeAllSamples(const GridRecord& grid, const Layout& l, SampleSink& sink, 
     }
 }
 
-// ---- headers ---------------------------------------------------------------
-
-std::string g17(double x) { return fmt::format("{:.17g}", x); }
-
-const char* nrrdTypeName(SampleType t) {
-    switch (t) {
-        case SampleType::U8: return "uint8";
-        case SampleType::I8: return "int8";
-        case SampleType::U16: return "uint16";
-        case SampleType::I16: return "int16";
-        case SampleType::U32: return "uint32";
-        case SampleType::I32: return "int32";
-        case SampleType::F32: return "float";
-        case SampleType::F64: return "double";
-    }
-    return "";
-}
-
-std::string nrrdHeader(const Layout& l, const std::string& dataFile) {
-    std::string h = "NRRD0004\n# written by vdbdag decode\n";
-    const bool vector = l.components == 3;
-    h += fmt::format("type: {}\ndimension: {}\n", nrrdTypeName(l.type), vector ? 4 : 3);
-    h += l.space == "LPS" ? "space: left-posterior-superior\n" : "space dimension: 3\n";
-    h += fmt::format("sizes: {}{} {} {}\n", vector ? "3 " : "", l.dims[0], l.dims[1], l.dims[2]);
-    h += vector ? "space directions: none" : "space directions:";
-    for (const auto& a : l.axes) h += fmt::format(" ({},{},{})", g17(a[0]), g17(a[1]), g17(a[2]));
-    h += fmt::format("\nkinds: {}domain domain domain\nendian: little\nencoding: raw\n", vector ? (l.colour ? "RGB-color " : "vector ") : "");
-    h += fmt::format("space origin: ({},{},{})\n", g17(l.origin[0]), g17(l.origin[1]), g17(l.origin[2]));
-    if (!dataFile.empty()) h += "data file: " + dataFile + "\n";
-    else h += "\n";
-    return h;
-}
-
-const char* metTypeName(SampleType t) {
-    switch (t) {
-        case SampleType::U8: return "MET_UCHAR";
-        case SampleType::I8: return "MET_CHAR";
-        case SampleType::U16: return "MET_USHORT";
-        case SampleType::I16: return "MET_SHORT";
-        case SampleType::U32: return "MET_UINT";
-        case SampleType::I32: return "MET_INT";
-        case SampleType::F32: return "MET_FLOAT";
-        case SampleType::F64: return "MET_DOUBLE";
-    }
-    return "";
-}
-
-// TransformMatrix triple a = index axis a's direction; ElementSpacing its length.
-std::string metaImageHeader(const Layout& l, const std::string& dataFile) {
-    std::string h = "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\nCompressedData = False\nTransformMatrix =";
-    std::array<double, 3> spacing{};
-    for (int a = 0; a < 3; ++a) {
-        const auto& v = l.axes[size_t(a)];
-        spacing[size_t(a)] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        for (int c = 0; c < 3; ++c) h += " " + g17(v[size_t(c)] / spacing[size_t(a)]);
-    }
-    h += fmt::format("\nOffset = {} {} {}\nCenterOfRotation = 0 0 0\n", g17(l.origin[0]), g17(l.origin[1]), g17(l.origin[2]));
-    if (l.space == "LPS") h += "AnatomicalOrientation = RAI\n";
-    if (l.components != 1) h += fmt::format("ElementNumberOfChannels = {}\n", l.components);
-    h += fmt::format("ElementSpacing = {} {} {}\nDimSize = {} {} {}\nElementType = {}\nElementDataFile = {}\n", g17(spacing[0]), g17(spacing[1]),
-                     g17(spacing[2]), l.dims[0], l.dims[1], l.dims[2], metTypeName(l.type), dataFile.empty() ? "LOCAL" : dataFile);
-    return h;
-}
-
-int niftiDatatype(SampleType t) {
-    switch (t) {
-        case SampleType::U8: return DT_UINT8;
-        case SampleType::I8: return DT_INT8;
-        case SampleType::U16: return DT_UINT16;
-        case SampleType::I16: return DT_INT16;
-        case SampleType::U32: return DT_UINT32;
-        case SampleType::I32: return DT_INT32;
-        case SampleType::F32: return DT_FLOAT32;
-        case SampleType::F64: return DT_FLOAT64;
-    }
-    return 0;
-}
-
-// A NIfTI-1 single-file header (348 bytes) and an empty extension flag.
-// NIfTI is RAS: the grid's (LPS) x and y change sign. The sform carries the
-// exact affine (as float, NIfTI-1's precision); the qform too when the axes
-// are orthogonal (a quaternion cannot hold a shear).
-std::vector<uint8_t> niftiHeader(const Layout& l, const std::string& path) {
-    for (int a = 0; a < 3; ++a)
-        if (l.dims[size_t(a)] > 32767)
-            throw Error(path + ": " + std::to_string(l.dims[size_t(a)]) + " samples along an axis exceed NIfTI-1's 32767; write .nrrd or .mha instead");
-    nifti_1_header h;
-    std::memset(&h, 0, sizeof h);
-    h.sizeof_hdr = 348;
-    h.dim[0] = 3;
-    for (int a = 0; a < 3; ++a) h.dim[a + 1] = short(l.dims[size_t(a)]);
-    for (int a = 4; a < 8; ++a) h.dim[a] = 1;
-    h.datatype = short(niftiDatatype(l.type));
-    h.bitpix = short(8 * sampleBytes(l.type));
-    if (l.colour) {
-        if (l.type != SampleType::U8) throw Error(path + ": NIfTI holds RGB colours as 8-bit samples; this grid's are " + sampleTypeName(l.type));
-        h.datatype = DT_RGB24;
-        h.bitpix = 24;
-    } else if (l.components == 3) {  // a vector per voxel: the 5th dimension, in planes
-        h.dim[0] = 5;
-        h.dim[5] = 3;
-        h.intent_code = NIFTI_INTENT_VECTOR;
-    }
-    h.vox_offset = 352;
-    h.scl_slope = l.rescaled ? float(l.slope) : 0.0f;
-    h.scl_inter = l.rescaled ? float(l.intercept) : 0.0f;
-    h.xyzt_units = l.space.empty() ? 0 : NIFTI_UNITS_MM;
-    std::snprintf(h.descrip, sizeof h.descrip, "vdbdag decode");
-    // A grid without a named space is taken as LPS too, as ITK does when it
-    // writes NIfTI from its (LPS) physical space: read back, it is the same.
-    const double flip[3] = {-1.0, -1.0, 1.0};
-    nifti_dmat44 m;
-    std::memset(&m, 0, sizeof m);
-    for (int r = 0; r < 3; ++r) {
-        for (int a = 0; a < 3; ++a) m.m[r][a] = flip[r] * l.axes[size_t(a)][size_t(r)];
-        m.m[r][3] = flip[r] * l.origin[size_t(r)];
-    }
-    m.m[3][3] = 1;
-    float* srow[3] = {h.srow_x, h.srow_y, h.srow_z};
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) srow[r][c] = float(m.m[r][c]);
-    h.sform_code = short(l.space.empty() ? NIFTI_XFORM_ALIGNED_ANAT : NIFTI_XFORM_SCANNER_ANAT);
-    double length[3];
-    for (int a = 0; a < 3; ++a) length[a] = std::sqrt(m.m[0][a] * m.m[0][a] + m.m[1][a] * m.m[1][a] + m.m[2][a] * m.m[2][a]);
-    bool orthogonal = true;
-    for (int a = 0; a < 3; ++a)
-        for (int b = a + 1; b < 3; ++b) {
-            const double dot = m.m[0][a] * m.m[0][b] + m.m[1][a] * m.m[1][b] + m.m[2][a] * m.m[2][b];
-            if (std::abs(dot) > 1e-6 * length[a] * length[b]) orthogonal = false;
-        }
-    double qb, qc, qd, qx, qy, qz, dx, dy, dz, qfac;
-    nifti_dmat44_to_quatern(m, &qb, &qc, &qd, &qx, &qy, &qz, &dx, &dy, &dz, &qfac);
-    h.pixdim[0] = float(qfac);
-    h.pixdim[1] = float(length[0]);
-    h.pixdim[2] = float(length[1]);
-    h.pixdim[3] = float(length[2]);
-    if (orthogonal) {
-        h.qform_code = h.sform_code;
-        h.quatern_b = float(qb);
-        h.quatern_c = float(qc);
-        h.quatern_d = float(qd);
-        h.qoffset_x = float(qx);
-        h.qoffset_y = float(qy);
-        h.qoffset_z = float(qz);
-    }
-    std::memcpy(h.magic, "n+1", 4);
-    std::vector<uint8_t> bytes(352, 0);
-    std::memcpy(bytes.data(), &h, sizeof h);  // bytes 348..351: no extensions
-    return bytes;
-}
-
 } // namespace
 
 bool isDenseOutput(const std::string& path) { return outFormatOf(path).has_value(); }
 
-DenseExportReport exportDense(const GridRecord& grid, const std::string& path, bool showProgress) {
+namespace {
+
+// One scan file from `grids`: one grid, or the volumes of a 4-D series in
+// order (NIfTI only), each volume's samples after the one before.
+DenseExportReport exportGrids(const std::vector<const GridRecord*>& grids, const std::string& path, const DenseExportOptions& options) {
     const std::optional<OutFormat> format = outFormatOf(path);
     if (!format) throw Error(path + ": not a dense scan file name (.nrrd, .nhdr, .mha, .mhd, .nii, .nii.gz, .raw)");
-    const Layout l = layoutOf(grid, path);
+    const bool showProgress = options.showProgress;
     DenseExportReport report;
+    Layout l = layoutOf(*grids.front(), path, *format, options, report.notes);
+    std::vector<Layout> layouts{l};
+    for (size_t t = 1; t < grids.size(); ++t) {
+        std::vector<std::string> ignored;  // the first volume's notes speak for all
+        layouts.push_back(layoutOf(*grids[t], path, *format, options, ignored));
+        const Layout& o = layouts.back();
+        if (o.dims != l.dims || o.type != l.type || o.axes != l.axes || o.origin != l.origin || o.components != l.components)
+            throw Error(path + ": grid '" + grids[t]->name + "' differs from '" + grids.front()->name +
+                        "' in extent, sample type or transform, so they cannot be one 4-D file; pick one with --grid NAME");
+    }
+    l.volumes = int64_t(grids.size());
     report.dims = l.dims;
     report.type = l.type;
     report.dataPath = path;
@@ -566,16 +320,15 @@ DenseExportReport exportDense(const GridRecord& grid, const std::string& path, b
         dataName = std::filesystem::path(path).stem().string() + ".raw";
         report.dataPath = (std::filesystem::path(path).parent_path() / dataName).string();
     }
+    std::vector<uint8_t> niftiBytes;  // checked before any file is created
+    if (*format == OutFormat::Nii || *format == OutFormat::NiiGz) niftiBytes = niftiHeader(l, path, &report.notes);
     auto samplesTo = [&](std::ostream& out, bool gzip) {
         SampleSink sink(out, gzip);
-        if (*format == OutFormat::NiiGz) {
-            const std::vector<uint8_t> header = niftiHeader(l, path);
-            sink.write(header.data(), header.size());
-        }
+        if (*format == OutFormat::NiiGz) sink.write(niftiBytes.data(), niftiBytes.size());
         // NIfTI vectors are planes (the 5th dimension); RGB24 and the
         // other formats interleave a voxel's components.
         const bool nifti = *format == OutFormat::Nii || *format == OutFormat::NiiGz;
-        writeAllSamples(grid, l, sink, path, showProgress, nifti && !l.colour);
+        for (size_t t = 0; t < grids.size(); ++t) writeAllSamples(*grids[t], layouts[t], sink, path, showProgress, nifti && !l.colour);
         sink.finish();
     };
     switch (*format) {
@@ -589,12 +342,11 @@ DenseExportReport exportDense(const GridRecord& grid, const std::string& path, b
             break;
         case OutFormat::Nii:
             writeStreamAtomically(path, [&](std::ostream& out) {
-                const std::vector<uint8_t> header = niftiHeader(l, path);
-                out.write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size()));
+                out.write(reinterpret_cast<const char*>(niftiBytes.data()), std::streamsize(niftiBytes.size()));
                 samplesTo(out, false);
             });
             break;
-        case OutFormat::NiiGz: niftiHeader(l, path); writeStreamAtomically(path, [&](std::ostream& out) { samplesTo(out, true); }); break;
+        case OutFormat::NiiGz: writeStreamAtomically(path, [&](std::ostream& out) { samplesTo(out, true); }); break;
         case OutFormat::Nhdr:
         case OutFormat::Mhd: {
             // The samples first, then the header that names them; if the
@@ -612,6 +364,34 @@ DenseExportReport exportDense(const GridRecord& grid, const std::string& path, b
         }
     }
     return report;
+}
+
+} // namespace
+
+DenseExportReport exportDense(const GridRecord& grid, const std::string& path, const DenseExportOptions& options) {
+    return exportGrids({&grid}, path, options);
+}
+
+std::optional<std::vector<size_t>> volumeSeriesOf(const std::vector<GridRecord>& grids) {
+    if (grids.size() < 2) return std::nullopt;
+    std::vector<size_t> order(grids.size(), grids.size());
+    for (size_t i = 0; i < grids.size(); ++i) {
+        const openvdb::GridBase::Ptr g = detail::readDescriptor(grids[i].vdbDescriptor, "grid '" + grids[i].name + "'");
+        const auto index = g->getMetadata<openvdb::Int64Metadata>("source_volume");
+        const auto count = g->getMetadata<openvdb::Int64Metadata>("source_volumes");
+        if (!index || !count || count->value() != int64_t(grids.size()) || index->value() < 0 || index->value() >= count->value()) return std::nullopt;
+        if (order[size_t(index->value())] != grids.size()) return std::nullopt;  // an index twice
+        order[size_t(index->value())] = i;
+    }
+    return order;
+}
+
+DenseExportReport exportDenseVolumes(const std::vector<const GridRecord*>& volumes, const std::string& path, const DenseExportOptions& options) {
+    const std::optional<OutFormat> format = outFormatOf(path);
+    if (volumes.empty()) throw Error(path + ": no grid to write");
+    if (volumes.size() > 1 && format != OutFormat::Nii && format != OutFormat::NiiGz)
+        throw Error(path + ": " + std::to_string(volumes.size()) + " volumes of a 4-D scan go to one .nii or .nii.gz file; this format holds one: pick it with --grid NAME");
+    return exportGrids(volumes, path, options);
 }
 
 // ---- cube by cube -----------------------------------------------------------
@@ -773,11 +553,12 @@ bool exportsByCubes(const GridRecord& header, const std::string& path) {
     return hasSourceDims(header);  // the extent, without walking the voxels
 }
 
-DenseExportReport exportDenseByCubes(const GridRecord& header, const std::string& path, const std::function<void(DenseCubeSink&)>& produce) {
+DenseExportReport exportDenseByCubes(const GridRecord& header, const std::string& path, const std::function<void(DenseCubeSink&)>& produce,
+                                     const DenseExportOptions& options) {
     if (!exportsByCubes(header, path)) throw Error("internal error: " + path + " cannot be written cube by cube");
     const OutFormat format = *outFormatOf(path);
-    const Layout l = layoutOf(header, path);
     DenseExportReport report;
+    const Layout l = layoutOf(header, path, format, options, report.notes);
     report.dims = l.dims;
     report.type = l.type;
     report.dataPath = path;
@@ -792,7 +573,7 @@ DenseExportReport exportDenseByCubes(const GridRecord& header, const std::string
         const std::string h = format == OutFormat::Nrrd ? nrrdHeader(l, "") : metaImageHeader(l, "");
         head.assign(h.begin(), h.end());
     } else if (format == OutFormat::Nii) {
-        head = niftiHeader(l, path);
+        head = niftiHeader(l, path, &report.notes);
     }
     writeViaTemporary(report.dataPath, [&](const std::string& tmp) {
         const int fd = ::open(tmp.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);

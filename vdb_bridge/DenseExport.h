@@ -15,7 +15,9 @@
 #pragma once
 #include <array>
 #include <functional>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "src/volume/GridRecord.h"
 #include "vdb_bridge/DenseVolume.h"
@@ -25,15 +27,38 @@ namespace vdbdag::bridge {
 // Whether `path`'s extension names a dense format exportDense writes.
 bool isDenseOutput(const std::string& path);
 
+struct DenseExportOptions {
+    bool showProgress = true;
+    // A rescaled scan (DICOM Rescale Slope/Intercept, NIfTI scl_*) written
+    // to a format without a rescale field (.nrrd, .nhdr, .mha, .mhd, .raw):
+    // false (the default) writes the grid's values, in a type that holds
+    // them exactly; true writes the stored integers, with the rescale as
+    // NRRD key/value pairs rescale_slope / rescale_intercept or MetaImage
+    // tags RescaleSlope / RescaleIntercept. NIfTI always gets the stored
+    // integers and scl_slope / scl_inter.
+    bool storedValues = false;
+};
+
 struct DenseExportReport {
     std::array<int64_t, 3> dims{0, 0, 0};
     SampleType type = SampleType::U8;
     std::string dataPath;  // the sample file (== path unless .nhdr / .mhd)
+    // What a user should read: values written otherwise than stored, header
+    // fields that could not go back (decode prints them).
+    std::vector<std::string> notes;
 };
 
 // Throws vdbdag::Error naming `path` (or the grid) when the grid cannot be
 // written as that format; nothing is left behind then.
-DenseExportReport exportDense(const GridRecord& grid, const std::string& path, bool showProgress = true);
+DenseExportReport exportDense(const GridRecord& grid, const std::string& path, const DenseExportOptions& options = {});
+
+// The grids of one 4-D scan (DenseImport's NAME_t0, NAME_t1, ... with
+// metadata source_volume / source_volumes), as indices into `grids` in
+// volume order; none unless every grid is one volume of the same series.
+std::optional<std::vector<size_t>> volumeSeriesOf(const std::vector<GridRecord>& grids);
+// Those volumes as one 4-D .nii / .nii.gz file (dim[4] = their count, the
+// source's header fields as exportDense writes them); other formats are refused.
+DenseExportReport exportDenseVolumes(const std::vector<const GridRecord*>& volumes, const std::string& path, const DenseExportOptions& options = {});
 
 // Cube by cube, for a grid that does not fit in memory (decode from a DAG
 // layer by layer, pipeline/LayerScatter.h): the voxels come in any order,
@@ -57,6 +82,7 @@ public:
 bool exportsByCubes(const GridRecord& header, const std::string& path);
 // The same file as exportDense, atomically: `produce` hands every voxel to
 // the sink; voxels it never gives are the background.
-DenseExportReport exportDenseByCubes(const GridRecord& header, const std::string& path, const std::function<void(DenseCubeSink&)>& produce);
+DenseExportReport exportDenseByCubes(const GridRecord& header, const std::string& path, const std::function<void(DenseCubeSink&)>& produce,
+                                     const DenseExportOptions& options = {});
 
 } // namespace vdbdag::bridge

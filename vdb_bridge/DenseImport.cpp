@@ -16,10 +16,12 @@
 #include "src/util/Error.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/DicomSeries.h"
+#include "vdb_bridge/DicomTags.h"
 #include "vdb_bridge/MetaImageHeader.h"
 #include "vdb_bridge/NiftiHeader.h"
 #include "vdb_bridge/NrrdHeader.h"
 #include "vdb_bridge/detail/DenseBricks.h"
+#include "vdb_bridge/detail/HeaderFieldMeta.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 
 namespace vdbdag::bridge {
@@ -70,6 +72,12 @@ void describeGrid(const DenseVolume& v, const V& background, const Thresholds* t
     if (v.colour) grid->insertMeta("source_colour", openvdb::StringMetadata(v.storedComponents == 4 ? "rgba" : "rgb"));
     else if (v.storedComponents == 4) grid->insertMeta("source_colour", openvdb::StringMetadata("alpha"));  // the A of RGBA
     if (!v.space.empty()) grid->insertMeta("space", openvdb::StringMetadata(v.space));  // of the grid's world coordinates
+    if (v.bitsStored) grid->insertMeta("source_bits_stored", openvdb::Int64Metadata(int64_t(v.bitsStored)));
+    if (v.volumeCount > 1) {  // one volume of a 4-D file
+        grid->insertMeta("source_volume", openvdb::Int64Metadata(v.volumeIndex));
+        grid->insertMeta("source_volumes", openvdb::Int64Metadata(v.volumeCount));
+    }
+    detail::insertHeaderFields(*grid, v.headerFields);
     if (th && th->below) grid->insertMeta("background_below", openvdb::DoubleMetadata(th->belowValue));
     if (th && th->above) grid->insertMeta("background_above", openvdb::DoubleMetadata(th->aboveValue));
     if (report && report->applied) {  // what the thresholds cost, for `info` (scanProvenanceOf)
@@ -246,7 +254,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
         };
         r.psnr = psnrAt(r.inputMax - r.inputMin);
         if (isIntegerSample(v.type)) {  // peak = the stored range, in grid units
-            r.storedBits = 8 * sampleBytes(v.type);
+            r.storedBits = v.bitsStored ? v.bitsStored : 8 * sampleBytes(v.type);  // DICOM Bits Stored: a 12-bit CT's peak is 4095
             r.psnrStoredRange = psnrAt(std::abs(v.rescaleSlope) * (std::ldexp(1.0, int(r.storedBits)) - 1));
         }
         r.sharedBackground = th.below && th.above;
@@ -311,6 +319,7 @@ DenseVolume describeDense(const std::string& path, const DenseImportOptions& opt
             inputs.insert(inputs.end(), options.moreInputs.begin(), options.moreInputs.end());
             v = describeDicomSeries(inputs, options.series);
             v.format = DenseFormat::Dicom;
+            if (options.dropPatientTags) dropIdentifyingDicomTags(v.headerFields);
             return v;
         }
         case DenseFormat::None: throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz, .hdr or DICOM)");

@@ -46,6 +46,10 @@ struct DenseImportOptions {
     // DICOM: further files, folders or DICOMDIRs named beside the path,
     // scanned with it as one set (`encode a.dcm b.dcm ... -o x.ssvdag`).
     std::vector<std::string> moreInputs;
+    // DICOM: drop the patient-identifying tags (name, ID, birth date,
+    // institution, physicians, dates: DicomTags.h) from the grid's metadata
+    // (`--drop-patient-tags`; by default every kept tag travels).
+    bool dropPatientTags = false;
     // NIfTI: which volume of a 4-D file (`--volume N`, 0-based).
     std::optional<int64_t> volume;
     // Read a scalar scan cube by cube (DenseImportResult::cubes): its
@@ -63,7 +67,7 @@ struct ThresholdReport {
     double inputMin = 0, inputMax = 0;  // finite input range (peak = max - min)
     double maxAbsChange = 0, meanAbsChange = 0, rmsChange = 0;  // over all samples
     double psnr = 0;            // dB, peak = inputMax - inputMin; +inf when nothing changed
-    unsigned storedBits = 0;    // integer scans: bits per stored sample (0 for float scans)
+    unsigned storedBits = 0;    // integer scans: bits per stored sample, DICOM's Bits Stored when given (0 for float scans)
     double psnrStoredRange = 0; // dB, peak = the stored type's range (2^bits - 1, times the rescale slope)
     bool sharedBackground = false;  // both thresholds: the samples below and above became one background
     bool backgroundChosen = false;  // --background-value, not the mean

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace vdbdag::bridge {
@@ -38,6 +39,15 @@ std::string scanNameOf(const std::string& path);
 struct DicomSlice {
     std::string file;
     uint32_t frame = 0;
+};
+
+// One field of the source file's header, kept in the grid's metadata under
+// `key` (docs/SCAN_METADATA.md lists the keys) so that a decode to the same
+// format writes it back: NIfTI's "nifti_*" fields, for instance.
+struct HeaderField {
+    using Value = std::variant<int64_t, double, std::string>;
+    std::string key;
+    Value value;
 };
 
 struct DenseVolume {
@@ -89,6 +99,16 @@ struct DenseVolume {
     // What a user should know about how the file was read (e.g. missing
     // slices kept empty); `encode` prints them as warnings.
     std::vector<std::string> notes;
+    // The source header's fields beyond what the members above hold.
+    std::vector<HeaderField> headerFields;
+    // Bits of each integer sample that hold data (DICOM Bits Stored: 12 for
+    // most CT in 16-bit samples); 0 when the header does not say (then the
+    // sample type's width). PSNR's peak and a decode's output type use it.
+    unsigned bitsStored = 0;
+    // One volume of a 4-D file (a NIfTI time series): its index, 0-based,
+    // and how many the file holds; -1 and 1 for a 3-D scan. A decode to
+    // NIfTI writes the grids of one series back as one 4-D file.
+    int64_t volumeIndex = -1, volumeCount = 1;
 
     uint64_t sampleCount() const { return uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]); }
     uint64_t sliceSamples() const { return uint64_t(dims[0]) * uint64_t(dims[1]); }

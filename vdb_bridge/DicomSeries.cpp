@@ -33,6 +33,7 @@
 #include <gdcmUIDs.h>
 
 #include "src/util/Error.h"
+#include "vdb_bridge/DicomTags.h"
 
 namespace vdbdag::bridge {
 namespace {
@@ -135,9 +136,10 @@ struct FileInfo {
     std::string seriesUid, modality, description;
     int64_t seriesNumber = 0;
     uint32_t rows = 0, columns = 0;
-    unsigned bitsAllocated = 0, pixelRepresentation = 0, samplesPerPixel = 1;
+    unsigned bitsAllocated = 0, bitsStored = 0, pixelRepresentation = 0, samplesPerPixel = 1;
     std::string photometric;
     std::string damaged;  // why its pixel data cannot be read (a truncated file), or ""
+    std::vector<HeaderField> tags;  // DicomTags.h, from the top-level data set
 };
 
 struct Group {
@@ -431,9 +433,11 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
         return v && v->size() == 1 && (*v)[0] >= 0 ? unsigned((*v)[0]) : fallback;
     };
     info.bitsAllocated = number(0x0028, 0x0100, 0);
+    info.bitsStored = number(0x0028, 0x0101, 0);
     info.pixelRepresentation = number(0x0028, 0x0103, 0);
     info.samplesPerPixel = number(0x0028, 0x0002, 1);
     info.photometric = f.text(ds, 0x0028, 0x0004);
+    info.tags = dicomTagsOf([&](uint16_t group, uint16_t element) { return f.text(ds, group, element); });
 
     // Geometry, rescale: from `where` (a functional group item or the top level).
     const auto readPlane = [&](const gdcm::DataSet* posDs, const gdcm::DataSet* oriDs, const gdcm::DataSet* pixDs, const gdcm::DataSet* resDs,
@@ -979,10 +983,12 @@ DenseVolume describeDicomSeries(const std::vector<std::string>& inputs, const st
     v.space = "LPS";
     v.rescaleSlope = f0.slope;
     v.rescaleIntercept = f0.intercept;
+    if (g.first.bitsStored > 0 && g.first.bitsStored < g.first.bitsAllocated) v.bitsStored = g.first.bitsStored;
     v.slices.assign(size_t(n), DicomSlice{});  // missing slots keep an empty file name
     for (size_t i = 0; i < g.frames.size(); ++i) v.slices[size_t(g.slots[i])] = {g.frames[i].file, g.frames[i].frame};
     v.missingSlices = g.missing;
     for (const std::string& note : g.info.notes) v.notes.push_back(fmt::format("{}: series {}: {}", path, index + 1, note));
+    v.headerFields = g.first.tags;
     v.validate();
     return v;
 }

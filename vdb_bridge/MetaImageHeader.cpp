@@ -1,10 +1,12 @@
 // See MetaImageHeader.h. "Key = Value" lines; ElementDataFile must be the
 // last field (MetaIO's rule); for LOCAL the samples start right after its line.
+// Tags this reader does not use are kept as header fields (mha_tag_*).
 // TransformMatrix: MetaIO writes ITK's direction matrix D as
 // M[3*i + j] = D[j][i], so the i-th written triple is the direction of
 // index axis i (ITK's itkMetaImageIO).
 #include "vdb_bridge/MetaImageHeader.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -33,6 +35,7 @@ DenseVolume readMetaImageHeader(const std::string& path) {
     if (!in) throw Error(path + ": cannot open");
 
     std::map<std::string, std::string> fields;  // lower-case keys
+    std::vector<std::pair<std::string, std::string>> tags;  // as written, in order
     std::string line;
     size_t budget = kMaxHeaderBytes;
     bool sawDataFile = false;
@@ -44,6 +47,7 @@ DenseVolume readMetaImageHeader(const std::string& path) {
         const std::string key = detail::lower(detail::trim(line.substr(0, eq)));
         if (key.empty()) throw Error(path + ": MetaImage header line '" + line.substr(0, 80) + "' has no key");
         if (!fields.emplace(key, detail::trim(line.substr(eq + 1))).second) throw Error(path + ": MetaImage field '" + key + "' appears twice");
+        tags.emplace_back(detail::trim(line.substr(0, eq)), detail::trim(line.substr(eq + 1)));
         if (key == "elementdatafile") { sawDataFile = true; break; }
     }
     if (!sawDataFile) throw Error(path + ": MetaImage header has no ElementDataFile field");
@@ -135,6 +139,15 @@ DenseVolume readMetaImageHeader(const std::string& path) {
         else if (compressed) v.dataOffset = headerSize;
         else v.decodedSkip = headerSize;
     }
+    // Tags that say more than the layout above, as written, for a decode
+    // back to MetaImage (mha_tag_*, docs/SCAN_METADATA.md).
+    static const char* layoutTags[] = {"objecttype", "ndims", "dimsize", "elementnumberofchannels", "elementtype", "binarydata", "binarydatabyteordermsb",
+                                       "elementbyteordermsb", "compresseddata", "compresseddatasize", "transformmatrix", "rotation", "orientation",
+                                       "offset", "position", "origin", "centerofrotation", "anatomicalorientation", "elementspacing", "headersize",
+                                       "elementdatafile"};
+    for (const auto& [tag, value] : tags)
+        if (std::find(std::begin(layoutTags), std::end(layoutTags), detail::lower(tag)) == std::end(layoutTags))
+            v.headerFields.push_back({"mha_tag_" + tag, value});
     v.validate();
     return v;
 }

@@ -14,6 +14,7 @@
 #include <zlib.h>
 
 #include "src/util/Error.h"
+#include "vdb_bridge/NiftiFields.h"
 
 namespace vdbdag::bridge {
 namespace {
@@ -120,12 +121,16 @@ DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volu
         if (n.dim[d] < 1 && d <= n.ndim) throw Error(path + ": NIfTI dim[" + std::to_string(d) + "] = " + std::to_string(n.dim[d]) + " is not positive");
     // A 5th dimension of 3 is a vector per voxel (NIFTI_INTENT_VECTOR and
     // the like): its components are planes nx*ny*nz*nt samples apart.
-    const bool vector = n.ndim >= 5 && n.nu == 3 && n.nv <= 1 && n.nw <= 1 && v.components == 1;
+    // A 4th dimension of 3 under a vector intent (RGB_VECTOR, VECTOR,
+    // DISPVECT) is the same, as some writers store it: a vector grid too.
+    const bool vectorIntent = n.intent_code == NIFTI_INTENT_RGB_VECTOR || n.intent_code == NIFTI_INTENT_VECTOR || n.intent_code == NIFTI_INTENT_DISPVECT;
+    const bool vectorOnT = vectorIntent && n.ndim == 4 && n.nt == 3 && v.components == 1;
+    const bool vector = (n.ndim >= 5 && n.nu == 3 && n.nv <= 1 && n.nw <= 1 && v.components == 1) || vectorOnT;
     if (!vector && (n.nu > 1 || n.nv > 1 || n.nw > 1))
         throw Error(path + ": NIfTI dimensions 5 to 7 (" + std::to_string(n.nu) + "x" + std::to_string(n.nv) + "x" + std::to_string(n.nw) +
                     ", intent " + std::to_string(n.intent_code) + ") are not supported (a 5th dimension of 3, a vector per voxel, is)");
     v.dims = {n.nx, n.ny, n.nz};
-    const int64_t volumes = n.nt > 0 ? n.nt : 1;
+    const int64_t volumes = vectorOnT ? 1 : (n.nt > 0 ? n.nt : 1);
     int64_t chosen = 0;
     if (volume) {
         if (*volume < 0 || *volume >= volumes)
@@ -134,6 +139,8 @@ DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volu
         chosen = *volume;
         if (volumes > 1) {
             v.gridName = scanNameOf(path) + "_t" + std::to_string(chosen);
+            v.volumeIndex = chosen;
+            v.volumeCount = volumes;
         }
     } else if (volumes > 1) {
         throw Error(path + ": a 4-D NIfTI file with " + std::to_string(volumes) + " volumes of " + std::to_string(n.nx) + "x" + std::to_string(n.ny) +
@@ -183,6 +190,7 @@ DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volu
         v.rescaleSlope = n.scl_slope;
         v.rescaleIntercept = std::isfinite(n.scl_inter) ? n.scl_inter : 0.0;
     }
+    v.headerFields = niftiFieldsOf(path);  // every field, for a decode back to NIfTI (NiftiFields.h)
     v.validate();
     return v;
 }
@@ -191,7 +199,9 @@ int64_t niftiVolumeCount(const std::string& path) {
     precheck(path);
     std::unique_ptr<nifti_image, NiftiDeleter> nim(nifti_image_read(path.c_str(), 0));
     if (!nim) throw Error(path + ": not a readable NIfTI-1 or NIfTI-2 header (missing, truncated, or a field out of range)");
-    return nim->nt > 1 ? nim->nt : 1;
+    const bool vectorOnT = (nim->intent_code == NIFTI_INTENT_RGB_VECTOR || nim->intent_code == NIFTI_INTENT_VECTOR || nim->intent_code == NIFTI_INTENT_DISPVECT) &&
+                           nim->ndim == 4 && nim->nt == 3 && nim->datatype != DT_RGB24 && nim->datatype != DT_RGBA32;
+    return nim->nt > 1 && !vectorOnT ? nim->nt : 1;  // vectors on the 4th axis are one vector volume (readNiftiHeader)
 }
 
 } // namespace vdbdag::bridge

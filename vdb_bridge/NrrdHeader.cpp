@@ -1,8 +1,10 @@
 // See NrrdHeader.h. Parsing is strict: a field whose value cannot be read is
-// an error, never a silent default; unknown fields and key/value pairs
-// ("key:=value") are ignored, as the NRRD specification allows.
+// an error, never a silent default; fields this reader does not use and
+// key/value pairs ("key:=value") are kept as header fields (nrrd_field_*,
+// nrrd_key_*) for a decode back to NRRD.
 #include "vdb_bridge/NrrdHeader.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -79,6 +81,7 @@ DenseVolume readNrrdHeader(const std::string& path) {
     detail::getBoundedLine(in, line, budget, tooLong);
 
     std::map<std::string, std::string> fields;
+    std::vector<std::pair<std::string, std::string>> keyValues;
     bool blankLineSeen = false;
     while (detail::getBoundedLine(in, line, budget, tooLong)) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -86,7 +89,10 @@ DenseVolume readNrrdHeader(const std::string& path) {
         if (line[0] == '#') continue;
         const size_t kv = line.find(":=");
         const size_t colon = line.find(": ");
-        if (kv != std::string::npos && (colon == std::string::npos || kv < colon)) continue;  // key/value pair
+        if (kv != std::string::npos && (colon == std::string::npos || kv < colon)) {  // key/value pair, kept for a decode
+            keyValues.emplace_back(line.substr(0, kv), line.substr(kv + 2));
+            continue;
+        }
         if (colon == std::string::npos) throw Error(path + ": malformed NRRD header line '" + line + "' (expected 'field: value')");
         std::string key = detail::lower(detail::trim(line.substr(0, colon)));
         // Field names may be written with or without their spaces ("datafile").
@@ -215,6 +221,14 @@ DenseVolume readNrrdHeader(const std::string& path) {
     if (byteSkip == -1) v.dataOffset = DenseVolume::kSkipToEnd;
     else v.decodedSkip = byteSkip;
     v.lineSkip = lineSkip;
+    // Fields that say more than the layout above, and every key/value pair,
+    // for a decode back to NRRD (docs/SCAN_METADATA.md).
+    static const char* layoutFields[] = {"type", "dimension", "sizes", "encoding", "endian", "space", "space dimension", "space directions",
+                                         "spacings", "space origin", "byte skip", "line skip", "data file", "kinds"};
+    for (const auto& [key, value] : fields)
+        if (std::find(std::begin(layoutFields), std::end(layoutFields), key) == std::end(layoutFields))
+            v.headerFields.push_back({"nrrd_field_" + key, detail::trim(value)});
+    for (const auto& [key, value] : keyValues) v.headerFields.push_back({"nrrd_key_" + key, value});
     v.validate();
     return v;
 }

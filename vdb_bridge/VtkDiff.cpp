@@ -3,6 +3,7 @@
 // OpenVDB accessors, so this is independent of the DAG code.
 #include "vdb_bridge/VtkDiff.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -245,21 +246,28 @@ vtkSmartPointer<vtkUnstructuredGrid> diffGrids(const GridT& a, const GridT& b, b
     return buildCells ? builder.grid() : nullptr;
 }
 
-} // namespace
-
-DiffReport diffVolumes(const std::string& pathA, const std::string& pathB, const std::string& output, const DiffOptions& options) {
-    std::string ext;
-    if (!output.empty()) {
-        ext = detail::extensionOf(output);
-        if (ext != ".vtu" && ext != ".vtm") throw Error(output + ": a diff is written as .vtu (one grid) or .vtm (several grids)");
-    }
-    const detail::Compressor compressor = detail::parseCompressor(options.compressor);
-    const std::vector<LoadedGrid> gridsA = detail::loadGrids(pathA, options.grids);
-    const std::vector<LoadedGrid> gridsB = detail::loadGrids(pathB, options.grids);
-    DiffReport report;
-    // Grids are paired by name, and among grids of the same name by their
-    // rank (the second 'density' of A with the second 'density' of B).
+// Which grid of B each grid of A is compared with (DiffOptions::pairing);
+// what is left unpaired is a header difference.
+std::vector<std::pair<size_t, size_t>> pairGrids(const std::vector<LoadedGrid>& gridsA, const std::vector<LoadedGrid>& gridsB, const std::string& pathA,
+                                                 const std::string& pathB, DiffPairing how, DiffReport& report) {
     std::vector<std::pair<size_t, size_t>> pairing;
+    if (how == DiffPairing::Auto && gridsA.size() == 1 && gridsB.size() == 1) how = DiffPairing::Order;  // one grid each: whatever their names
+    if (how == DiffPairing::Order) {
+        const size_t n = std::min(gridsA.size(), gridsB.size());
+        for (size_t i = 0; i < n; ++i) {
+            pairing.emplace_back(i, i);
+            if (gridsA[i].grid->getName() != gridsB[i].grid->getName())
+                report.notes.push_back(fmt::format("grid {} of {} is compared with grid {} of {}", detail::gridLabel(gridsA[i]), pathA,
+                                                   detail::gridLabel(gridsB[i]), pathB));
+        }
+        for (size_t i = n; i < gridsA.size(); ++i)
+            report.headerDifferences.push_back(fmt::format("grid {} of {} has no counterpart in {}", detail::gridLabel(gridsA[i]), pathA, pathB));
+        for (size_t j = n; j < gridsB.size(); ++j)
+            report.headerDifferences.push_back(fmt::format("grid {} of {} has no counterpart in {}", detail::gridLabel(gridsB[j]), pathB, pathA));
+        return pairing;
+    }
+    // By name, and among grids of the same name by their rank (the second
+    // 'density' of A with the second 'density' of B).
     std::vector<bool> usedB(gridsB.size(), false);
     for (size_t i = 0; i < gridsA.size(); ++i) {
         const std::string& name = gridsA[i].grid->getName();
@@ -277,6 +285,42 @@ DiffReport diffVolumes(const std::string& pathA, const std::string& pathB, const
     }
     for (size_t j = 0; j < gridsB.size(); ++j)
         if (!usedB[j]) report.headerDifferences.push_back(fmt::format("grid {} of {} has no namesake in {}", detail::gridLabel(gridsB[j]), pathB, pathA));
+    return pairing;
+}
+
+// Transforms that differ by at most 1e-6 of the voxel size (a NIfTI file's
+// float32 affine against a NRRD's decimal one) are equal, with a note;
+// anything else is a header difference.
+void compareTransforms(const openvdb::GridBase& a, const openvdb::GridBase& b, const std::string& label, DiffReport& report) {
+    if (a.transform() == b.transform()) return;
+    const auto mapA = a.transform().baseMap()->getAffineMap(), mapB = b.transform().baseMap()->getAffineMap();
+    const openvdb::Mat4d ma = mapA->getMat4(), mb = mapB->getMat4();
+    const openvdb::Vec3d voxel = a.voxelSize();
+    const double tolerance = kTransformTolerance * std::min({voxel[0], voxel[1], voxel[2]});
+    double largest = 0;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) largest = std::max(largest, std::abs(ma(r, c) - mb(r, c)));
+    const bool linear = a.transform().isLinear() && b.transform().isLinear();
+    if (linear && largest <= tolerance) {
+        report.notes.push_back(fmt::format("grid {}: the transforms are equal to 1e-6 of the voxel size (largest difference {:.3g})", label, largest));
+        return;
+    }
+    report.headerDifferences.push_back(fmt::format("grid {}: the transforms differ (largest difference {:.6g}, more than 1e-6 of the voxel size); cells are placed with A's", label, largest));
+}
+
+} // namespace
+
+DiffReport diffVolumes(const std::string& pathA, const std::string& pathB, const std::string& output, const DiffOptions& options) {
+    std::string ext;
+    if (!output.empty()) {
+        ext = detail::extensionOf(output);
+        if (ext != ".vtu" && ext != ".vtm") throw Error(output + ": a diff is written as .vtu (one grid) or .vtm (several grids)");
+    }
+    const detail::Compressor compressor = detail::parseCompressor(options.compressor);
+    const std::vector<LoadedGrid> gridsA = detail::loadGrids(pathA, options.grids);
+    const std::vector<LoadedGrid> gridsB = detail::loadGrids(pathB, options.grids);
+    DiffReport report;
+    const std::vector<std::pair<size_t, size_t>> pairing = pairGrids(gridsA, gridsB, pathA, pathB, options.pairing, report);
     const size_t pairs = pairing.size();
     if (ext == ".vtu" && pairs > 1)
         throw Error(fmt::format("{}: {} grid pairs to compare but a .vtu holds one: pick one with --grid NAME or write a .vtm", output, pairs));
@@ -287,8 +331,7 @@ DiffReport diffVolumes(const std::string& pathA, const std::string& pathB, const
         if (a.type() != b.type())
             throw Error(fmt::format("grid {} of {} is {} but grid {} of {} is {}: only grids of the same type are compared", detail::gridLabel(gridsA[ia]),
                                     pathA, a.valueType(), detail::gridLabel(gridsB[ib]), pathB, b.valueType()));
-        if (a.transform() != b.transform())
-            report.headerDifferences.push_back(fmt::format("grid {}: the transforms differ; cells are placed with A's", detail::gridLabel(gridsA[ia])));
+        compareTransforms(a, b, detail::gridLabel(gridsA[ia]), report);
         leaves += a.baseTree().leafCount();
     }
     vtkNew<vtkMultiBlockDataSet> blocks;

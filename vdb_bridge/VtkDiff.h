@@ -1,6 +1,6 @@
 // Voxel-by-voxel comparison of two volumes (.vdb, .ssvdag or a dense scan each) for
 // ParaView and scripts (`vdbdag diff A B [-o DIFF.vtu]`). Grids are paired
-// in file order (after --grid selection). For each pair, every voxel active
+// as DiffPairing says (after --grid selection). For each pair, every voxel active
 // in either grid gets a status: 0 same (bit-identical value), 1 value differs,
 // 2 active only in A, 3 active only in B. Active tiles stay single cells when
 // both grids hold the tile region uniformly, else they are walked voxel by
@@ -20,8 +20,19 @@
 
 namespace vdbdag::bridge {
 
+// How grids of A and B are paired (`--pair`): Auto pairs the two grids of
+// two single-grid files whatever their names (a scan's grid is named after
+// its file), else as Name; Name pairs grids of the same name, the k-th of a
+// name in A with the k-th of that name in B; Order pairs them in file order.
+enum class DiffPairing { Auto, Name, Order };
+
+// Two transforms whose matrices differ by at most this fraction of A's
+// smallest voxel size are reported equal (with a note), not as a difference.
+inline constexpr double kTransformTolerance = 1e-6;
+
 struct DiffOptions {
     std::vector<std::string> grids;  // empty: all
+    DiffPairing pairing = DiffPairing::Auto;
     bool onlyDifferences = false;    // write only cells whose status is not 0
     uint64_t maxCells = 20'000'000;  // per written block
     std::string compressor = "zlib";
@@ -49,6 +60,7 @@ struct GridDiff {
 
 struct DiffReport {
     std::vector<std::string> headerDifferences;  // grid count, transforms
+    std::vector<std::string> notes;  // what is equal only within a tolerance, grids paired across names
     std::vector<GridDiff> grids;
     bool identical = true;
     uint64_t bytes = 0;  // written, when an output was given

@@ -45,20 +45,22 @@ def nifti(path, volume):
     if components == 3:
         info = {"dims": list(data.shape[:3]), "components": 3}
         flat = np.ascontiguousarray(np.transpose(data, (2, 1, 0, 3))).reshape(-1)
-        return finish(info, hdr, flat)
+        return finish(info, hdr, flat, (img.dataobj.slope, img.dataobj.inter))
     if data.ndim == 4:
         if volume is None:
             return {"error": "4-D"}, None
         data = data[..., volume]
     if data.ndim == 2:
         data = data[..., np.newaxis]
-    return finish({"dims": list(data.shape), "components": 1}, hdr, np.asarray(data).reshape(-1, order='F'))
+    return finish({"dims": list(data.shape), "components": 1}, hdr, np.asarray(data).reshape(-1, order='F'), (img.dataobj.slope, img.dataobj.inter))
 
 
-def finish(info, hdr, flat):
-    slope, inter = hdr.get_slope_inter()
-    slope = 1.0 if slope is None else float(slope)
-    inter = 0.0 if inter is None else float(inter)
+def finish(info, hdr, flat, scaling=(None, None)):
+    # nibabel moves scl_slope / scl_inter from a loaded header to the data
+    # proxy (img.dataobj.slope / .inter): they come from there.
+    slope, inter = scaling
+    slope = 1.0 if slope is None or not np.isfinite(slope) else float(slope)
+    inter = 0.0 if inter is None or not np.isfinite(inter) else float(inter)
     sform = int(hdr['sform_code'])
     qform = int(hdr['qform_code'])
     if sform > 0:
