@@ -323,3 +323,13 @@ def test_dicom_tags_travel_and_patient_tags_can_be_dropped(tmp_path):
     meta = json.loads(run("info", dropped, "--json").stdout)["grids"][0]["metadata"]
     assert "dicom_PatientName" not in meta and "dicom_PatientID" not in meta
     assert meta["dicom_SeriesInstanceUID"]["value"] == first.SeriesInstanceUID
+
+
+def test_what_another_format_cannot_carry_is_said_in_one_note(tmp_path):
+    src = str(tmp_path / "made.nii.gz")
+    made_nifti(src, 1)
+    _, out, r = round_trip(src, str(tmp_path), "made", ".nrrd")
+    notes = [line for line in r.stderr.splitlines() if "note:" in line]
+    assert len(notes) == 1 and "NIfTI header fields (nifti_*) have no place in made_back.nrrd" in notes[0], r.stderr
+    _, out, r = round_trip(src, str(tmp_path), "made", ".nii.gz")
+    assert "note:" not in r.stderr, r.stderr  # everything went back

@@ -216,6 +216,25 @@ ScanLayout layoutOf(const GridRecord& grid, const std::string& path, OutFormat f
         strings("nrrd_key_", l.keyValues);
     }
     if (mha) strings("mha_tag_", l.keyValues);
+    // What another format's header held and this one has no place for: one
+    // note line (the fields stay in the grid's metadata, docs/SCAN_METADATA.md).
+    struct Foreign {
+        const char* prefix;
+        const char* what;
+        bool carried;
+    };
+    const Foreign foreign[] = {{"nifti_", "NIfTI header fields", format == OutFormat::Nii || format == OutFormat::NiiGz},
+                               {"nrrd_", "NRRD fields and key/value pairs", nrrd},
+                               {"mha_tag_", "MetaImage tags", mha},
+                               {"dicom_", "DICOM tags", false}};
+    std::string lost;
+    for (const Foreign& f : foreign) {
+        const size_t n = f.carried ? 0 : detail::headerFieldsWithPrefix(*g, f.prefix).size();
+        if (n) lost += fmt::format("{}{} {} ({}*)", lost.empty() ? "" : ", ", n, f.what, f.prefix);
+    }
+    if (!lost.empty())
+        notes.push_back("the source's " + lost + " have no place in " + std::filesystem::path(path).filename().string() +
+                        " and are not written; they stay in the grid's metadata (.ssvdag, .vdb)");
     return l;
 }
 
