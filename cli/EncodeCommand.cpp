@@ -13,6 +13,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "cli/ByteSize.h"
 #include "cli/Commands.h"
 #include "cli/GlobalOptions.h"
 #include "cli/JsonReport.h"
@@ -74,7 +75,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--memory-limit", opt->memoryLimit,
                     "working memory for the cubes being encoded, e.g. 512M or 4G (default: half the physical memory); "
                     "a .vdb is read region by region, a scan's samples go to a scratch file; the output is the same bytes")
-        ->transform(CLI::AsSizeValue(false))
+        ->transform(byteSize())
         ->excludes(normals);
     cmd->add_option("--scratch", opt->scratch, "folder for the scratch files of a region-by-region encode: the input's bricks and the coded values (default: the output's folder)")
         ->check(CLI::ExistingDirectory);

@@ -1,6 +1,8 @@
 // See ReadLimitOptions.h.
 #include "cli/ReadLimitOptions.h"
 
+#include "cli/ByteSize.h"
+
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -54,7 +56,7 @@ void ReadLimitOptions::add(CLI::App& cmd) {
     cmd.add_option("--max-memory", maxMemory,
                    "refuse a file whose sections and decoded values would take more memory than this, e.g. 2G "
                    "(default: three quarters of the physical memory or of the process's memory limit)")
-        ->transform(CLI::AsSizeValue(false));
+        ->transform(byteSize());
 }
 
 format::ReadLimits ReadLimitOptions::limits(unsigned valueCopies) const {

@@ -14,6 +14,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "cli/ByteSize.h"
 #include "cli/Commands.h"
 #include "cli/JsonReport.h"
 #include "cli/MemoryBudget.h"
@@ -133,7 +134,7 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--encoded", opt->encoded, "compare this .ssvdag file (e.g. what `encode` wrote) with the input, instead of encoding one")
         ->check(CLI::ExistingFile);
     cmd->add_option("--memory-limit", opt->memoryLimit, "working memory of the encode, as for `encode` (default: half the physical memory)")
-        ->transform(CLI::AsSizeValue(false));
+        ->transform(byteSize());
     cmd->add_option("--scratch", opt->scratch, "folder for the encoded file and the scratch files while verifying (default: the system's temporary folder)")
         ->check(CLI::ExistingDirectory);
     cmd->add_flag("--json", opt->json, "print JSON");

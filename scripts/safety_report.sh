@@ -57,6 +57,7 @@ run() {  # NAME SCRIPT [ENV...]: the script's summary line and its failures
     echo "## Failures and interruptions"
     run full_disk full_disk
     run signals signals
+    run race race
     run bad_vdb_inputs bad_vdb_inputs VDBDAG_FUZZ_CASES=1000
     echo
     echo "Bit flips by outcome (encode exit, OpenVDB's own full read exit):"

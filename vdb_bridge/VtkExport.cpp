@@ -4,6 +4,9 @@
 // iterator limited to the internal levels) and written atomically.
 #include "vdb_bridge/VtkExport.h"
 
+#include <array>
+#include <limits>
+
 #include <fmt/core.h>
 
 #include <openvdb/tools/Dense.h>
@@ -77,11 +80,31 @@ uint64_t countCells(const TreeT& tree, const std::optional<openvdb::CoordBBox>& 
 
 std::string limitAdvice() { return "export a region with --bbox X0,Y0,Z0,X1,Y1,Z1 (index space) or fewer grids with --grid NAME"; }
 
+// A box's voxels along each axis and in all, without OpenVDB's int32
+// arithmetic (CoordBBox::dim and ::volume wrap for boxes wider than 2^31 - 1,
+// and a wrapped count passed every limit). Saturates at UINT64_MAX.
+struct BoxSize {
+    std::array<int64_t, 3> dim{0, 0, 0};
+    uint64_t voxels = 0;
+};
+BoxSize sizeOf(const openvdb::CoordBBox& box) {
+    BoxSize s;
+    if (box.empty()) return s;
+    unsigned __int128 n = 1;
+    for (int a = 0; a < 3; ++a) {
+        s.dim[size_t(a)] = int64_t(box.max()[a]) - int64_t(box.min()[a]) + 1;
+        n *= uint64_t(s.dim[size_t(a)]);
+        if (n > std::numeric_limits<uint64_t>::max()) n = std::numeric_limits<uint64_t>::max();
+    }
+    s.voxels = uint64_t(n);
+    return s;
+}
+
 template <typename GridT>
 Plan planGrid(const GridT& grid, const LoadedGrid& loaded, const std::string& input, const std::string& ext, const VtkExportOptions& options) {
     Plan plan;
     const openvdb::CoordBBox active = grid.evalActiveVoxelBoundingBox();
-    const bool dense = !active.empty() && grid.activeVoxelCount() == active.volume();
+    const bool dense = !active.empty() && grid.activeVoxelCount() == sizeOf(active).voxels;
     plan.image = ext == ".vti" || (ext == ".vtm" && (options.bbox || dense));
     std::optional<openvdb::CoordBBox> box;
     if (options.bbox) {
@@ -94,11 +117,15 @@ Plan planGrid(const GridT& grid, const LoadedGrid& loaded, const std::string& in
             throw Error(what + " has a non-linear (frustum) transform, which a .vti cannot hold: write a .vtu");
         plan.region = box ? *box : active;
         if (plan.region.empty()) throw Error(what + " has no active voxels: there is no region to write as an image (give --bbox)");
-        const uint64_t cells = plan.region.volume();
-        const uint64_t bytes = cells * (valueBytes<GridT>() + 1);
-        if (cells > uint64_t(std::numeric_limits<int32_t>::max()) || bytes > options.maxImageBytes)
+        const BoxSize size = sizeOf(plan.region);
+        const uint64_t cells = size.voxels;
+        const unsigned __int128 wideBytes = (unsigned __int128)cells * (valueBytes<GridT>() + 1);
+        const uint64_t bytes = wideBytes > std::numeric_limits<uint64_t>::max() ? std::numeric_limits<uint64_t>::max() : uint64_t(wideBytes);
+        bool tooWide = false;  // a vtkImageData counts points per axis in int
+        for (int64_t d : size.dim) tooWide = tooWide || d >= int64_t(std::numeric_limits<int32_t>::max());
+        if (tooWide || cells > uint64_t(std::numeric_limits<int32_t>::max()) || bytes > options.maxImageBytes)
             throw Error(fmt::format("{} as an image of {}x{}x{} voxels would take {} bytes, over the limit of {} (--max-bytes){}: {}, or write a .vtu of the active voxels",
-                                    what, plan.region.dim().x(), plan.region.dim().y(), plan.region.dim().z(), withCommas(bytes),
+                                    what, size.dim[0], size.dim[1], size.dim[2], withCommas(bytes),
                                     withCommas(options.maxImageBytes), dense ? "" : " although only " + withCommas(grid.activeVoxelCount()) + " voxels are active",
                                     limitAdvice()));
         plan.cells = cells;

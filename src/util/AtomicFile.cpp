@@ -10,7 +10,9 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <optional>
+#include <set>
 #include <ostream>
 #include <streambuf>
 #include <vector>
@@ -72,7 +74,52 @@ void syncFolder(const std::string& path) {
     ::close(fd);
 }
 
+// The outputs that must still be absent when they are written (expectNewFile).
+std::mutex newFilesMutex;
+std::set<std::string>& newFiles() {
+    static std::set<std::string> files;
+    return files;
+}
+std::string keyOf(const std::string& path) { return fs::absolute(path).lexically_normal().string(); }
+bool mustBeNew(const std::string& path) {
+    std::lock_guard lock(newFilesMutex);
+    return newFiles().count(keyOf(path)) > 0;
+}
+void forgetNewFile(const std::string& path) {
+    std::lock_guard lock(newFilesMutex);
+    newFiles().erase(keyOf(path));
+}
+
+// rename(2) that never replaces: renameat2's RENAME_NOREPLACE, or, on file
+// systems without it, link(2) (which fails on an existing name) and unlink.
+void renameNoReplace(const std::string& tmp, const std::string& path) {
+    auto appeared = [&] {
+        removeQuietly(tmp);
+        throw Error(path + ": appeared while this command was writing it (another program made it meanwhile); it was not replaced, and nothing "
+                           "was written (use -f or --force to replace it)");
+    };
+    if (::renameat2(AT_FDCWD, tmp.c_str(), AT_FDCWD, path.c_str(), RENAME_NOREPLACE) == 0) return;
+    int err = errno;
+    if (err == EEXIST) appeared();
+    if (err == EINVAL || err == ENOSYS || err == ENOTSUP) {
+        if (::link(tmp.c_str(), path.c_str()) == 0) {
+            removeQuietly(tmp);
+            return;
+        }
+        err = errno;
+        if (err == EEXIST) appeared();
+    }
+    removeQuietly(tmp);
+    fail(path, "cannot create the file", err);
+}
+
 void renameOver(const std::string& tmp, const std::string& path) {
+    if (mustBeNew(path)) {
+        renameNoReplace(tmp, path);
+        forgetNewFile(path);  // created: a later write in this process is the command's own
+        syncFolder(path);
+        return;
+    }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
         const int err = errno;
         removeQuietly(tmp);
@@ -185,6 +232,14 @@ void finishTemporary(const std::string& path, const std::string& tmp, int fd) {
 
 } // namespace
 
+void moveIntoPlace(const std::string& from, const std::string& path) { renameOver(from, path); }
+
+void expectNewFile(const std::string& path, bool isNew) {
+    if (!isNew) return forgetNewFile(path);
+    std::lock_guard lock(newFilesMutex);
+    newFiles().insert(keyOf(path));
+}
+
 void writeFileAtomically(const std::string& path, std::span<const uint8_t> bytes) {
     checkDestination(path);
     std::string tmp;
@@ -204,8 +259,8 @@ void writeStreamAtomically(const std::string& path, const std::function<void(std
     std::optional<TemporaryGuard> guard;
     const int fd = createTemporary(path, tmp, guard);
     int err = 0;
+    FdStreamBuf buffer(fd);
     try {
-        FdStreamBuf buffer(fd);
         std::ostream out(&buffer);
         writeTo(out);
         out.flush();
@@ -213,8 +268,12 @@ void writeStreamAtomically(const std::string& path, const std::function<void(std
         err = buffer.error();
         if (!err && !out) err = EIO;
     } catch (...) {
+        const int writeError = buffer.error();
         ::close(fd);
         removeQuietly(tmp);
+        // A writer that gave up on a failed stream has its own message
+        // ("writing ... failed"); the path and the system's reason say more.
+        if (writeError) fail(path, "write failed", writeError);
         throw;
     }
     if (err) {

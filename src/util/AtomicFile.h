@@ -14,6 +14,18 @@
 
 namespace vdbdag {
 
+// Marks `path` as an output that must not exist when it is written (a new
+// output, no --force: OutputPath.h calls this): its rename will not replace
+// a file another program created meanwhile, and reports it instead, until
+// it has been written once. isNew false clears the mark (--force).
+void expectNewFile(const std::string& path, bool isNew = true);
+
+// Renames a finished temporary `from` (beside `path`) to `path` by the
+// rules above (never over a file that appeared meanwhile for a new output),
+// for writers that place several files themselves (a .vtm and its pieces).
+// On failure `from` is removed and vdbdag::Error thrown naming `path`.
+void moveIntoPlace(const std::string& from, const std::string& path);
+
 // Writes `bytes` to `path` atomically; throws vdbdag::Error naming the path.
 void writeFileAtomically(const std::string& path, std::span<const uint8_t> bytes);
 

@@ -8,6 +8,7 @@
 
 #include <sys/stat.h>
 
+#include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 #include "src/util/InputPath.h"
 
@@ -45,6 +46,9 @@ void checkOutputPath(const std::string& output, const std::vector<std::string>& 
         const std::string dir = std::filesystem::path(output).parent_path().empty() ? "." : std::filesystem::path(output).parent_path().string();
         struct stat folder{};
         if (::stat(dir.c_str(), &folder) != 0 && (errno == ENOENT || errno == ENOTDIR)) throw Error(output + ": the folder " + dir + " does not exist");
+        // Absent now: it must still be absent when written (two commands
+        // racing to create it: the later one fails, nothing is replaced).
+        expectNewFile(output, !rules.force);
         return;  // the rest of the folder's checks are the atomic writer's
     }
     if (S_ISLNK(out.st_mode)) throw Error(output + ": is a symbolic link; not writing through it (give the path it points to)");
@@ -52,6 +56,7 @@ void checkOutputPath(const std::string& output, const std::vector<std::string>& 
     if (!S_ISREG(out.st_mode)) throw Error(output + ": is " + fileKindName(out.st_mode) + "; " + rules.command + " writes only regular files");
     if ((out.st_mode & 0222) == 0) throw Error(output + ": exists and is read-only; not replacing it");
     if (!rules.force) throw Error(output + ": already exists (use -f or --force to replace it)");
+    expectNewFile(output, false);  // replacing it is what the user asked for
 }
 
 } // namespace vdbdag

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Full disk: `decode`, `import`, `encode` and `export` (.vtu) writing onto a
+# Full disk: `decode`, `import`, `encode`, `export` (.vtu) and `render` (.png,
+# whose OpenImageIO writer does not report a failed write) writing onto a
 # small tmpfs that fills up must fail non-zero, keep the previous output
 # byte-identical (same inode: not replaced) and leave no temporary behind
 # (the folder's listing is exactly what it was).
@@ -59,6 +60,7 @@ CASES=(
     "encode|ssvdag|small.vdb|big.vdb"
     "encode|ssvdag|small.vdb|big.vdb|--memory-limit 1M"
     "export|vtu|small.vdb|big.vdb"
+    "render|png|small.ssvdag|big.ssvdag|--width 1600 --height 1600 -q"
 )
 
 for c in "${CASES[@]}"; do
@@ -119,6 +121,8 @@ for c in "${CASES[@]}"; do
     fi
     if [ "$rc" -ne 0 ] && ! one_error_line "$WORK/err"; then
         why="$why; stderr is not one 'vdbdag: ' line: $(flat "$WORK/err")"
+    elif [ "$rc" -ne 0 ] && ! grep -q -- "$MNT/" "$WORK/err"; then
+        why="$why; the error names no file in $MNT: $(flat "$WORK/err")"
     fi
     if [ -z "$why" ]; then
         pass "$name (exit $rc: $(flat "$WORK/err"))"

@@ -311,7 +311,12 @@ TEST(Cli, UsageMistakesAreOneLineWithASuggestionAndExitTwo) {
                                             {"encode " + ball + " -o x.ssvdag --abs-eror 0.1", "unknown option '--abs-eror'; did you mean '--abs-error'?"},
                                             {"render x.ssvdag -o x.png --widht=8", "unknown option '--widht'; did you mean '--width'?"},
                                             {"encode " + ball, "--output is required"},
-                                            {"help encdoe", "'encdoe' is not a command; did you mean 'encode'?"}}) {
+                                            {"help encdoe", "'encdoe' is not a command; did you mean 'encode'?"},
+                                            // sizes (issue 38: -1, 0 and 23 digits were taken)
+                                            {"encode " + ball + " -o x.ssvdag --memory-limit -1", "'-1' is not a size"},
+                                            {"encode " + ball + " -o x.ssvdag --memory-limit 0", "0 is not a size"},
+                                            {"verify " + ball + " --memory-limit 12345678901234567890123", "at most 2^60 bytes"},
+                                            {"decode x.ssvdag -o x.vdb --max-memory 2X", "units: K, M, G, T"}}) {
         const CommandResult r = runCli(c.args);
         EXPECT_EQ(r.exitCode, 2) << c.args << "\n" << r.err;
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

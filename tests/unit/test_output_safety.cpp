@@ -155,6 +155,44 @@ TEST(AtomicFile, AWriterThatThrowsLeavesThePreviousFileAndNoTemporary) {
     EXPECT_EQ(entries(t.path), 1u);
 }
 
+// Issue 38: two commands creating the same new output (no --force) both
+// exited 0 and the later silently replaced the earlier. A file that appears
+// after the check is never replaced; with --force it is.
+TEST(AtomicFile, ANewOutputNeverReplacesAFileThatAppearedMeanwhile) {
+    TempFolder t;
+    const std::string out = t / "race.ssvdag";
+    ASSERT_EQ(refusal(out, {}, false), "");  // absent: checked as a new output
+    std::string message;
+    try {
+        vdbdag::writeStreamAtomically(out, [&](std::ostream& s) {
+            s << "ours";
+            writeText(out, "theirs");  // the other command finishes first
+        });
+    } catch (const vdbdag::Error& e) {
+        message = e.what();
+    }
+    EXPECT_NE(message.find("appeared while"), std::string::npos) << message;
+    EXPECT_NE(message.find(out), std::string::npos) << message;
+    EXPECT_EQ(readText(out), "theirs");
+    EXPECT_EQ(entries(t.path), 1u);  // no temporary left
+    // Through the file-name writers (VTK, images) too.
+    const std::string other = t / "race2.ssvdag";
+    ASSERT_EQ(refusal(other, {}, false), "");
+    EXPECT_THROW(vdbdag::writeViaTemporary(other, [&](const std::string& tmp) {
+        writeText(tmp, "ours");
+        writeText(other, "theirs");
+    }), vdbdag::Error);
+    EXPECT_EQ(readText(other), "theirs");
+    // --force: replacing is what the user asked for.
+    const std::string forced = t / "forced.ssvdag";
+    ASSERT_EQ(refusal(forced, {}, true), "");
+    vdbdag::writeStreamAtomically(forced, [&](std::ostream& s) {
+        s << "ours";
+        writeText(forced, "theirs");
+    });
+    EXPECT_EQ(readText(forced), "ours");
+}
+
 TEST(TemporaryFiles, TemporaryNamesAreHiddenBesideTheOutputAndCarryThePid) {
     const std::string name = vdbdag::temporaryNameFor("/some/folder/out.vdb", ".png");
     const std::string expected = "/some/folder/.out.vdb.tmp." + std::to_string(getpid()) + ".";

@@ -290,6 +290,20 @@ TEST(VtkExport, LimitsStopWithOneLineErrorsAndWriteNothing) {
     EXPECT_NE(r.err.find("--bbox"), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_FALSE(fs::exists(vti));
+    // Boxes wider than OpenVDB's int32 arithmetic (issue 38: CoordBBox::volume
+    // wrapped to 0, passed --max-bytes, and copyToDense wrote out of bounds):
+    // refused by the limit with their true size, never written.
+    const std::pair<const char*, const char*> boxes[] = {{"0,0,0,2147483647,2147483647,2147483647", "2147483648x2147483648x2147483648"},
+                                                         {"-100,0,0,2147483547,200,200", "2147483648x201x201"},
+                                                         {"-2147483648,0,0,2147483647,0,0", "4294967296x1x1"}};
+    for (const auto& [box, size] : boxes) {
+        r = runCli("export " + in.string() + " -o " + vti.string() + " --bbox=" + box);
+        EXPECT_NE(r.exitCode, 0) << box << ": " << r.err;
+        EXPECT_NE(r.err.find("--max-bytes"), std::string::npos) << box << ": " << r.err;
+        EXPECT_NE(r.err.find(std::string("image of ") + size + " voxels"), std::string::npos) << box << ": not its true size in " << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_FALSE(fs::exists(vti)) << box;
+    }
     // Several grids into a single-grid file, a missing file, an unknown grid, a bad box, a bad extension.
     const fs::path two = workDir() / "two.vdb";
     auto other = grid->deepCopy();

@@ -104,7 +104,7 @@ void writeMultiBlock(vtkMultiBlockDataSet* blocks, const std::string& path, Comp
         // Replace the earlier pieces (if any), then the .vtm itself last.
         if (fs::exists(pieces, ec)) fs::remove_all(pieces);
         if (fs::exists(temporary / stem)) fs::rename(temporary / stem, pieces);
-        fs::rename(temporary / dest.filename(), dest);
+        moveIntoPlace((temporary / dest.filename()).string(), dest.string());  // a new .vtm never replaces one made meanwhile
         fs::remove_all(temporary);
     } catch (const fs::filesystem_error& e) {
         fs::remove_all(temporary, ec);

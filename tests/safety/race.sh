@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Racing writers: a command creating a new output (no --force) while another
+# program creates the same file must not replace it. For each writing
+# command, the output appears (written by this script) while the command
+# runs: the command must exit non-zero with one line naming the output, the
+# other program's file must be byte-identical, and no temporary may be left.
+# Either outcome of the race is fine (refused at the start: "already
+# exists"; at the end: "appeared while"), losing the other file is not.
+#
+#   bash tests/safety/race.sh BUILD_DIR
+#
+# Inputs are made here (vdb_tool); ../shared/data is not needed.
+set -u
+source "$(dirname "$0")/common.sh"
+safety_init "${1:-}" race
+
+if ! command -v vdb_tool > /dev/null; then
+    echo "SKIP: vdb_tool not installed"
+    exit 77
+fi
+IN=$WORK/in
+OUT=$WORK/out
+mkdir -p "$IN" "$OUT"
+vdb_tool -quiet -sphere d=400 r=1.0 w=3 -write "$IN/big.vdb" > /dev/null 2>&1
+"$VDBDAG" encode "$IN/big.vdb" -o "$IN/big.ssvdag" -q > /dev/null 2>&1
+if [ ! -s "$IN/big.ssvdag" ]; then
+    echo "FAIL: could not make the inputs"
+    exit 1
+fi
+
+# command | input | output extension | options
+CASES=(
+    "encode|big.vdb|ssvdag|"
+    "decode|big.ssvdag|vdb|"
+    "export|big.ssvdag|vtu|"
+    "render|big.ssvdag|png|--width 1200 --height 1200 -q"
+)
+for c in "${CASES[@]}"; do
+    IFS='|' read -r cmd input ext options <<< "$c"
+    name="race: $cmd -> new .$ext"
+    rm -rf "${OUT:?}"/*
+    out=$OUT/new.$ext
+    # shellcheck disable=SC2086  # options split into words on purpose
+    "$VDBDAG" "$cmd" "$IN/$input" -o "$out" $options > /dev/null 2> "$WORK/err" &
+    pid=$!
+    sleep 0.3
+    echo "the other program's file" > "$out.other" && mv "$out.other" "$out"  # appears at once, complete
+    theirs=$(sha "$out")
+    wait "$pid"
+    rc=$?
+    why=""
+    [ "$rc" -eq 0 ] && why="exit 0"
+    [ "$(sha "$out")" != "$theirs" ] && why="$why; the other program's file was replaced"
+    [ "$(names "$OUT")" != "new.$ext" ] && why="$why; the folder holds $(names "$OUT" | tr '\n' ' ')"
+    if [ "$rc" -ne 0 ] && { ! one_error_line "$WORK/err" || ! grep -q -- "$out" "$WORK/err"; }; then
+        why="$why; stderr is not one 'vdbdag: ' line naming the output: $(flat "$WORK/err")"
+    fi
+    if [ -z "$why" ]; then
+        pass "$name (exit $rc: $(flat "$WORK/err"))"
+    else
+        fail "$name" "${why#; }"
+    fi
+done
+
+summary
