@@ -6,6 +6,8 @@
 #                         mutations reach the structural checks), then the
 #                         section parsers, DAG validation and a DAG walk
 #   fuzz_ssvdag_sections  section payloads and DAG validation behind the checksums
+#   fuzz_int_volume_coder the integer value coder: hostile streams, and
+#                         encode/decode round trips of the fuzzer's samples
 #   fuzz_scan_headers     NRRD, MetaImage, NIfTI (libnifti) and DICOM (GDCM)
 #                         headers and raw file names, then their samples,
 #                         seeded from ../shared/data
@@ -20,12 +22,12 @@ cd "$(dirname "$0")/.."
 SECONDS_TO_RUN=${1:-120}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(fuzz_ssvdag_reader fuzz_ssvdag_sections fuzz_scan_headers)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(fuzz_ssvdag_reader fuzz_ssvdag_sections fuzz_scan_headers fuzz_int_volume_coder)
 JOBS=${JOBS:-2}
 
 CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVDBDAG_BUILD_FUZZERS=ON -DVDBDAG_BUILD_TESTS=OFF >/dev/null
 cmake --build build-fuzz -j"$JOBS" --target "${TARGETS[@]}" make_seed_corpus
-[ -n "${FUZZ_RUNS:-}" ] && rm -rf build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/corpus_scan_headers
+[ -n "${FUZZ_RUNS:-}" ] && rm -rf build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/corpus_scan_headers build-fuzz/corpus_int_volume_coder
 mkdir -p build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/artifacts
 build-fuzz/make_seed_corpus build-fuzz/corpus_reader build-fuzz/corpus_sections
 # Scan seeds: a format byte (0 NRRD, 1 MetaImage, 2 NIfTI, 3 gzip NIfTI, 4
@@ -50,6 +52,7 @@ status=0
 for target in "${TARGETS[@]}"; do
   corpus=build-fuzz/corpus_${target#fuzz_ssvdag_}
   [ "$target" = fuzz_scan_headers ] && corpus=build-fuzz/corpus_scan_headers
+  [ "$target" = fuzz_int_volume_coder ] && corpus=build-fuzz/corpus_int_volume_coder && mkdir -p "$corpus"
   limit=(-max_total_time="$SECONDS_TO_RUN")
   [ -n "${FUZZ_RUNS:-}" ] && limit=(-runs="$FUZZ_RUNS" -seed=1)
   echo "== $target: ${limit[*]} from $(ls "$corpus" | wc -l) corpus files"

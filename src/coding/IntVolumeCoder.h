@@ -1,0 +1,68 @@
+// Lossless (and near-lossless) coding of a 3-D block of integer samples:
+// a causal 3-D neighbourhood, four predictors blended by their recent local
+// errors, bias correction and an adaptive binary range coder whose models
+// are chosen by the local activity. The coding layer of values at rest
+// (issue "smaller than JPEG-LS"); docs/CODING.md describes the stream.
+//
+// Samples are visited in raster order (x fastest, then y, then z). Each is
+// predicted from the already coded neighbours
+//      this slice:  NW N NE        previous slice:  PNW PN
+//                   W  *                            PW  P
+// by four predictors:
+//   MED   the median edge detector of JPEG-LS on W, N, NW (edges in-plane);
+//   3-D   Lorenzo's plane through the 2x2x2 cube: W + N + P - NW - PW - PN + PNW
+//         (smooth volumes, gradients along z);
+//   SLICE P + MED(W, N, NW) - MED(PW, PN, PNW): the previous slice moved by
+//         the in-plane change (structures that continue across slices);
+//   DIAG  W + NE - N (edges running diagonally in-plane).
+// Each predictor's absolute error is kept per sample; the blend weights
+// each by 2^24 / (1 + its errors at W, N, NE and P), integers only, so the
+// result is the same on every machine. The blend is clamped to the range of
+// W, N, NE and P, then corrected by the mean residual of its context.
+//
+// Context: the final residuals' magnitudes at W, N, NE and P, summed and
+// bucketed by bit length (24 buckets): it predicts how large this residual
+// will be, so each bucket's models learn their own distribution.
+// Residual coding under a context: a zero flag, a sign, the magnitude's bit
+// length in unary (adaptive bits per position), then the bits below the
+// leading one (the two highest adaptive per length, the rest per position).
+//
+// Near-lossless (near > 0, JPEG-LS NEAR): the residual is quantised to
+// multiples of 2 near + 1 inside the loop, so every reconstructed sample is
+// within `near` of the original and the decoder predicts from the same
+// reconstructed values.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace vdbdag::coding {
+
+struct IntVolumeShape {
+    int64_t nx = 0, ny = 0, nz = 0;
+    uint64_t count() const { return uint64_t(nx) * uint64_t(ny) * uint64_t(nz); }
+};
+
+struct IntCoderOptions {
+    // Every sample and every reconstruction lies in [minValue, maxValue]
+    // (the sample type's range: 0..4095 for 12-bit CT).
+    int64_t minValue = INT32_MIN, maxValue = INT32_MAX;
+    // 0: lossless; n > 0: |decoded - original| <= n for every sample.
+    int32_t near = 0;
+};
+
+// Codes `samples` (shape.count() of them, raster order). With near > 0,
+// `reconstructed` (if given) receives what the decoder will produce.
+// Throws vdbdag::Error when a sample lies outside [minValue, maxValue].
+std::vector<uint8_t> encodeIntVolume(std::span<const int32_t> samples, IntVolumeShape shape, const IntCoderOptions& options,
+                                     std::vector<int32_t>* reconstructed = nullptr);
+
+// Decodes into `out` (shape.count() samples). Throws vdbdag::Error naming
+// `what` when the stream ends early or carries bytes it does not use
+// (corrupt); never reads outside `bytes`, and its time is bounded by the
+// sample count.
+void decodeIntVolume(std::span<const uint8_t> bytes, IntVolumeShape shape, const IntCoderOptions& options, std::span<int32_t> out,
+                     const std::string& what = "value stream");
+
+} // namespace vdbdag::coding

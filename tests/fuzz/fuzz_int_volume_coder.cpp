@@ -1,0 +1,44 @@
+// libFuzzer target for src/coding/IntVolumeCoder: the first 8 bytes choose
+// a small shape (up to 16^3), the sample range and near; the rest is (a) a
+// stream to decode, which must throw vdbdag::Error or give samples inside
+// the range, never crash or read out of bounds, and (b) the samples of a
+// volume to encode, whose decode must give every sample back (within near).
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <span>
+#include <vector>
+
+#include "src/coding/IntVolumeCoder.h"
+#include "src/util/Error.h"
+
+using namespace vdbdag::coding;
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    if (size < 8) return 0;
+    IntVolumeShape shape{1 + data[0] % 16, 1 + data[1] % 16, 1 + data[2] % 16};
+    IntCoderOptions o;
+    const unsigned bits = 1 + data[3] % 32;
+    o.minValue = data[4] & 1 ? -(int64_t(1) << (bits - 1)) : 0;
+    o.maxValue = std::min<int64_t>(INT32_MAX, o.minValue + (int64_t(1) << bits) - 1);
+    o.near = data[5] % 4 == 0 ? data[6] % 5 : 0;
+    const std::span<const uint8_t> rest(data + 8, size - 8);
+    std::vector<int32_t> out(shape.count());
+    try {
+        decodeIntVolume(rest, shape, o, out);
+        for (int32_t x : out)
+            if (x < o.minValue || x > o.maxValue) std::abort();
+    } catch (const vdbdag::Error&) {
+    }
+    std::vector<int32_t> samples(shape.count());
+    for (size_t i = 0; i < samples.size(); ++i) {
+        uint32_t raw = 0;
+        if (!rest.empty()) std::memcpy(&raw, rest.data() + (i * 4) % rest.size(), std::min<size_t>(4, rest.size() - (i * 4) % rest.size()));
+        samples[i] = int32_t(o.minValue + int64_t(raw % uint64_t(o.maxValue - o.minValue + 1)));
+    }
+    const std::vector<uint8_t> bytes = encodeIntVolume(samples, shape, o);
+    decodeIntVolume(bytes, shape, o, out);
+    for (size_t i = 0; i < samples.size(); ++i)
+        if (std::abs(int64_t(out[i]) - samples[i]) > o.near) std::abort();
+    return 0;
+}
