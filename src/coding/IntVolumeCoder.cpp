@@ -129,7 +129,8 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
                 } else {
                     P = inPlane, PW = W, PN = N, PNW = NW;
                 }
-                const std::array<int64_t, kPredictors> p{inPlane, W + N + P - NW - PW - PN + PNW, P + inPlane - med(PW, PN, PNW), W + NE - N, N + P - PN, W + P - PW};
+                std::array<int64_t, kPredictors> p{inPlane, W + N + P - NW - PW - PN + PNW, P + inPlane - med(PW, PN, PNW), W + NE - N, N + P - PN, W + P - PW};
+                for (int64_t& q : p) q = std::clamp(q, options.minValue, options.maxValue);  // a prediction outside the range helps no one
                 const SampleRecord& rW = hx ? curRec[i - 1] : none;
                 const SampleRecord& rN = hy ? curRec[i - size_t(nx)] : none;
                 const SampleRecord& rNE = hne ? curRec[i - size_t(nx) + 1] : none;
@@ -137,15 +138,16 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
                 const SampleRecord& rNW = hx && hy ? curRec[i - size_t(nx) - 1] : none;
                 const SampleRecord& rPW = hz && hx ? prevRec[i - 1] : none;
                 const SampleRecord& rPN = hz && hy ? prevRec[i - size_t(nx)] : none;
-                int64_t weightSum = 0, weighted = 0;
+                int64_t weightSum = 0;
+                __int128 weighted = 0;  // up to 6 x 2^30 x 2^31
                 for (int k = 0; k < kPredictors; ++k) {
                     const uint64_t errors = (2 * (uint64_t(rW.err[size_t(k)]) + rN.err[size_t(k)] + rP.err[size_t(k)]) + rNE.err[size_t(k)] +
                                              rNW.err[size_t(k)] + rPW.err[size_t(k)] + rPN.err[size_t(k)]) / 2;
                     const int64_t w = weightOf(errors);
                     weightSum += w;
-                    weighted += w * p[size_t(k)];
+                    weighted += __int128(w) * p[size_t(k)];
                 }
-                int64_t blend = divRound(weighted, weightSum);
+                int64_t blend = int64_t(weighted >= 0 ? (weighted + weightSum / 2) / weightSum : -((-weighted + weightSum / 2) / weightSum));
                 blend = std::clamp(blend, std::min({W, N, NE, P}), std::max({W, N, NE, P}));
                 const uint64_t gradient = uint64_t(std::abs(W - NW) + std::abs(N - NW) + std::abs(NE - N) + std::abs(P - med(PW, PN, PNW)));
                 const uint64_t activity = (2 * (uint64_t(rW.residual) + rN.residual + rP.residual) + rNE.residual + rNW.residual + rPW.residual + rPN.residual) / 2 + gradient / 2;
