@@ -333,3 +333,23 @@ def test_what_another_format_cannot_carry_is_said_in_one_note(tmp_path):
     assert len(notes) == 1 and "NIfTI header fields (nifti_*) have no place in made_back.nrrd" in notes[0], r.stderr
     _, out, r = round_trip(src, str(tmp_path), "made", ".nii.gz")
     assert "note:" not in r.stderr, r.stderr  # everything went back
+
+
+@pytest.mark.parametrize("unit,nifti_code", [("mm", 2), ("m", 1), ("um", 3)])
+def test_units_map_between_nifti_and_nrrd(unit, nifti_code, tmp_path):
+    # NIfTI xyzt_units -> NRRD space units
+    data = np.arange(4 * 5 * 6, dtype=np.int16).reshape(4, 5, 6)
+    img = nib.Nifti1Image(data, np.diag([0.5, 0.5, 2.0, 1.0]))
+    img.header.set_xyzt_units({"mm": "mm", "m": "meter", "um": "micron"}[unit], "sec")
+    src = str(tmp_path / "units.nii.gz")
+    nib.save(img, src)
+    _, out, _ = round_trip(src, str(tmp_path), "units", ".nrrd")
+    assert f'space units: "{unit}" "{unit}" "{unit}"' in header_lines(out)
+    # NRRD space units -> NIfTI xyzt_units
+    nrrd = tmp_path / "units_src.nrrd"
+    head = ("NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\nsizes: 6 5 4\n"
+            "space directions: (0.5,0,0) (0,0.5,0) (0,0,2)\nendian: little\nencoding: raw\nspace origin: (0,0,0)\n"
+            f'space units: "{unit}" "{unit}" "{unit}"\n\n')
+    nrrd.write_bytes(head.encode() + data.astype("<i2").tobytes())
+    _, out, _ = round_trip(str(nrrd), str(tmp_path), "units_src", ".nii.gz")
+    assert int(nib.load(out).header["xyzt_units"]) & 7 == nifti_code

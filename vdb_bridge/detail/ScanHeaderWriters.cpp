@@ -73,6 +73,9 @@ std::string nrrdHeader(const Layout& l, const std::string& dataFile) {
     for (const auto& a : l.axes) h += fmt::format(" ({},{},{})", g17(a[0]), g17(a[1]), g17(a[2]));
     h += fmt::format("\nkinds: {}domain domain domain\nendian: little\nencoding: raw\n", vector ? (l.colour ? "RGB-color " : "vector ") : "");
     h += fmt::format("space origin: ({},{},{})\n", g17(l.origin[0]), g17(l.origin[1]), g17(l.origin[2]));
+    const bool unitsGiven = std::any_of(l.nrrdFields.begin(), l.nrrdFields.end(), [](const auto& f) { return f.first == "space units"; });
+    if (!unitsGiven && !l.spaceUnit.empty())  // the unit a NIfTI source's xyzt_units named
+        h += fmt::format("space units: \"{0}\" \"{0}\" \"{0}\"\n", l.spaceUnit);
     for (const auto& [name, value] : l.nrrdFields) h += name + ": " + value + "\n";
     for (const auto& [key, value] : l.keyValues) h += key + ":=" + value + "\n";
     if (!dataFile.empty()) h += "data file: " + dataFile + "\n";
@@ -134,7 +137,9 @@ std::vector<uint8_t> niftiHeaderAs(const Layout& l, const std::string& path, std
     }
     h.scl_slope = l.rescaled ? Real(l.slope) : Real(0);
     h.scl_inter = l.rescaled ? Real(l.intercept) : Real(0);
-    h.xyzt_units = l.space.empty() ? 0 : NIFTI_UNITS_MM;
+    // The unit the source named (an NRRD's space units), else mm for a patient space.
+    h.xyzt_units = l.spaceUnit == "m" ? NIFTI_UNITS_METER : l.spaceUnit == "um" ? NIFTI_UNITS_MICRON
+                 : l.spaceUnit == "mm" || !l.space.empty() ? NIFTI_UNITS_MM : 0;
     std::snprintf(h.descrip, sizeof h.descrip, "vdbdag decode");
     // A grid without a named space is taken as LPS too, as ITK does when it
     // writes NIfTI from its (LPS) physical space: read back, it is the same.

@@ -144,6 +144,29 @@ void attachNiftiFields(Layout& l, const openvdb::GridBase& g) {
     l.niftiGeometry = same;
 }
 
+// The source's unit of world coordinates: NIfTI's xyzt_units (its spatial
+// bits: 1 m, 2 mm, 3 micron) or NRRD's space units (the first axis's; the
+// writer gives all three the same), else none.
+std::string spaceUnitOf(const openvdb::GridBase& g) {
+    if (auto u = g.getMetadata<openvdb::Int64Metadata>("nifti_xyzt_units")) {
+        switch (u->value() & 7) {
+            case 1: return "m";
+            case 2: return "mm";
+            case 3: return "um";
+            default: return "";
+        }
+    }
+    if (auto u = g.getMetadata<openvdb::StringMetadata>("nrrd_field_space units")) {
+        const std::string& text = u->value();
+        const size_t open = text.find('"'), close = open == std::string::npos ? open : text.find('"', open + 1);
+        if (close != std::string::npos) {
+            const std::string unit = text.substr(open + 1, close - open - 1);
+            if (unit == "mm" || unit == "m" || unit == "um" || unit == "µm" || unit == "micron") return unit == "mm" || unit == "m" ? unit : "um";
+        }
+    }
+    return "";
+}
+
 } // namespace
 
 ScanLayout layoutOf(const GridRecord& grid, const std::string& path, OutFormat format, const DenseExportOptions& options, std::vector<std::string>& notes) {
@@ -179,6 +202,7 @@ ScanLayout layoutOf(const GridRecord& grid, const std::string& path, OutFormat f
         if (!std::isfinite(l.slope) || l.slope == 0 || !std::isfinite(l.intercept)) throw Error(what + ": its rescale slope/intercept is not usable");
     }
     if (auto s = g->getMetadata<openvdb::StringMetadata>("space"); s && s->value() == "LPS") l.space = "LPS";
+    l.spaceUnit = spaceUnitOf(*g);
     std::array<int64_t, 3> lo{0, 0, 0}, hi{-1, -1, -1};
     const bool any = boundsOf(grid, lo, hi);
     if (auto d = g->getMetadata<openvdb::Vec3IMetadata>("source_dims")) {

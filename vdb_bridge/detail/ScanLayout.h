@@ -32,6 +32,9 @@ struct ScanLayout {
     std::array<double, 3> origin{0, 0, 0};  // world position of sample (0, 0, 0)
     std::array<std::array<double, 3>, 3> axes{};
     std::string space;  // "LPS" or empty
+    // The unit of world coordinates when the source said ("mm", "m", "um":
+    // NIfTI xyzt_units, NRRD space units), else empty (readers take mm).
+    std::string spaceUnit;
     unsigned components = 1;  // 3 for vector and colour grids
     int64_t volumes = 1;      // NIfTI: the volumes of a 4-D file (dim[4]), one after the other
     bool colour = false;      // RGB (NIfTI RGB24, NRRD "RGB-color")
