@@ -23,7 +23,7 @@ void DenseInputOptions::addTo(CLI::App& cmd) {
                       ->check(finiteNumber());
     backgroundValueOption =
         cmd.add_option("--background-value", backgroundValue, "dense input: the value removed samples become (default: their mean)")->check(finiteNumber());
-    volumeOption = cmd.add_option("--volume", volume, "4-D NIfTI input: which volume (0-based)")->check(CLI::NonNegativeNumber);
+    volumeOption = cmd.add_option("--volume", volume, "4-D NIfTI or NRRD input: which volume (0-based; without it, one grid per volume)")->check(CLI::NonNegativeNumber);
     cmd.add_flag("--drop-patient-tags", dropPatientTags,
                  "DICOM input: leave the patient-identifying tags (name, ID, birth date, institution, physicians, dates) out of the grid's "
                  "metadata (by default they are kept with the series' other tags)");
@@ -65,7 +65,8 @@ bridge::DenseImportOptions DenseInputOptions::resolve(const std::string& path) c
         throw Error(path + ": --drop-patient-tags applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
     o.dropPatientTags = dropPatientTags;
     if (volumeOption && volumeOption->count()) {
-        if (bridge::denseFormatOf(path) != bridge::DenseFormat::Nifti) throw Error(path + ": --volume applies to NIfTI inputs only");
+        if (bridge::denseFormatOf(path) != bridge::DenseFormat::Nifti && bridge::denseFormatOf(path) != bridge::DenseFormat::Nrrd)
+            throw Error(path + ": --volume applies to 4-D NIfTI and NRRD inputs only");
         o.volume = volume;
     }
     return o;

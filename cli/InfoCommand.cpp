@@ -96,7 +96,7 @@ nlohmann::json scanHeaderReport(const std::string& input, const bridge::DenseVol
                      {"rescale_intercept", v.rescaleIntercept},
                      {"data_file", v.dataPath},
                      {"compressed", v.encoding == bridge::DataEncoding::Zlib}};
-    if (v.format == bridge::DenseFormat::Nifti) r["volumes"] = bridge::niftiVolumeCount(input);
+    if (v.format == bridge::DenseFormat::Nifti || v.format == bridge::DenseFormat::Nrrd) r["volumes"] = bridge::volumeCountOf(input);
     return r;
 }
 

@@ -294,7 +294,7 @@ bool isDenseOutput(const std::string& path) { return outFormatOf(path).has_value
 namespace {
 
 // One scan file from `grids`: one grid, or the volumes of a 4-D series in
-// order (NIfTI only), each volume's samples after the one before.
+// order (NIfTI, NRRD), each volume's samples after the one before.
 DenseExportReport exportGrids(const std::vector<const GridRecord*>& grids, const std::string& path, const DenseExportOptions& options) {
     const std::optional<OutFormat> format = outFormatOf(path);
     if (!format) throw Error(path + ": not a dense scan file name (.nrrd, .nhdr, .mha, .mhd, .nii, .nii.gz, .raw)");
@@ -389,8 +389,10 @@ std::optional<std::vector<size_t>> volumeSeriesOf(const std::vector<GridRecord>&
 DenseExportReport exportDenseVolumes(const std::vector<const GridRecord*>& volumes, const std::string& path, const DenseExportOptions& options) {
     const std::optional<OutFormat> format = outFormatOf(path);
     if (volumes.empty()) throw Error(path + ": no grid to write");
-    if (volumes.size() > 1 && format != OutFormat::Nii && format != OutFormat::NiiGz)
-        throw Error(path + ": " + std::to_string(volumes.size()) + " volumes of a 4-D scan go to one .nii or .nii.gz file; this format holds one: pick it with --grid NAME");
+    const bool holdsSeries = format == OutFormat::Nii || format == OutFormat::NiiGz || format == OutFormat::Nrrd || format == OutFormat::Nhdr;
+    if (volumes.size() > 1 && !holdsSeries)
+        throw Error(path + ": " + std::to_string(volumes.size()) +
+                    " volumes of a 4-D scan go to one .nii, .nii.gz, .nrrd or .nhdr file; this format holds one volume: pick it with --grid NAME");
     return exportGrids(volumes, path, options);
 }
 

@@ -56,8 +56,9 @@ DenseExportReport exportDense(const GridRecord& grid, const std::string& path, c
 // metadata source_volume / source_volumes), as indices into `grids` in
 // volume order; none unless every grid is one volume of the same series.
 std::optional<std::vector<size_t>> volumeSeriesOf(const std::vector<GridRecord>& grids);
-// Those volumes as one 4-D .nii / .nii.gz file (dim[4] = their count, the
-// source's header fields as exportDense writes them); other formats are refused.
+// Those volumes as one 4-D .nii / .nii.gz (dim[4] = their count) or .nrrd /
+// .nhdr file (a last axis of kind "list"), the source's header fields as
+// exportDense writes them; other formats are refused.
 DenseExportReport exportDenseVolumes(const std::vector<const GridRecord*>& volumes, const std::string& path, const DenseExportOptions& options = {});
 
 // Cube by cube, for a grid that does not fit in memory (decode from a DAG

@@ -309,7 +309,9 @@ DenseVolume describeDense(const std::string& path, const DenseImportOptions& opt
     DenseVolume v;
     switch (denseFormatOf(path)) {
         case DenseFormat::Raw: v = describeRaw(path, options.raw); v.format = DenseFormat::Raw; return v;
-        case DenseFormat::Nrrd: v = readNrrdHeader(path); break;
+        case DenseFormat::Nrrd:  // a 4-D series without --volume: described by its first volume
+            v = readNrrdHeader(path, options.volume ? options.volume : std::optional<int64_t>(0));
+            break;
         case DenseFormat::MetaImage: v = readMetaImageHeader(path); break;
         case DenseFormat::Nifti:  // a 4-D file without --volume: described by its first volume (importDense reads them all)
             v = readNiftiHeader(path, options.volume ? options.volume : (niftiVolumeCount(path) > 1 ? std::optional<int64_t>(0) : std::nullopt));
@@ -377,6 +379,14 @@ DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, boo
 
 } // namespace
 
+int64_t volumeCountOf(const std::string& path) {
+    switch (denseFormatOf(path)) {
+        case DenseFormat::Nifti: return niftiVolumeCount(path);
+        case DenseFormat::Nrrd: return readNrrdHeader(path, 0).volumeCount;
+        default: return 1;
+    }
+}
+
 std::optional<ScanProvenance> scanProvenanceOf(const GridRecord& grid) {
     const openvdb::GridBase::Ptr g = detail::readDescriptor(grid.vdbDescriptor, "grid '" + grid.name + "'");
     const auto format = g->getMetadata<openvdb::StringMetadata>("source_format");
@@ -404,12 +414,12 @@ std::optional<ScanProvenance> scanProvenanceOf(const GridRecord& grid) {
 }
 
 DenseImportResult importDense(const std::string& path, const DenseImportOptions& options) {
-    if (denseFormatOf(path) == DenseFormat::Nifti && !options.volume) {
-        // A 4-D NIfTI file without --volume: one grid per volume, NAME_t0, NAME_t1, ...
-        const int64_t volumes = niftiVolumeCount(path);
+    if (!options.volume) {
+        // A 4-D NIfTI or NRRD file without --volume: one grid per volume, NAME_t0, NAME_t1, ...
+        const int64_t volumes = volumeCountOf(path);
         if (volumes > 1) {
             if (options.backgroundBelow || options.backgroundAbove)
-                throw Error(path + ": background thresholds apply to one volume of a 4-D NIfTI file: pick it with --volume N");
+                throw Error(path + ": background thresholds apply to one volume of a 4-D file: pick it with --volume N");
             DenseImportResult all;
             for (int64_t t = 0; t < volumes; ++t) {
                 DenseImportOptions one = options;

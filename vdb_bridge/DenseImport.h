@@ -50,7 +50,7 @@ struct DenseImportOptions {
     // institution, physicians, dates: DicomTags.h) from the grid's metadata
     // (`--drop-patient-tags`; by default every kept tag travels).
     bool dropPatientTags = false;
-    // NIfTI: which volume of a 4-D file (`--volume N`, 0-based).
+    // NIfTI or NRRD: which volume of a 4-D file (`--volume N`, 0-based).
     std::optional<int64_t> volume;
     // Read a scalar scan cube by cube (DenseImportResult::cubes): its
     // samples go once to a scratch file beside this path (ScratchFile.h)
@@ -101,6 +101,10 @@ struct ScanProvenance {
     std::optional<double> below, above;
     std::optional<ThresholdReport> threshold;  // inactive, changed, max and RMS change, PSNR (input range)
 };
+// The volumes of a 4-D NIfTI or NRRD file (its 4th dimension), 1 for any
+// other scan. Throws vdbdag::Error naming the file.
+int64_t volumeCountOf(const std::string& path);
+
 std::optional<ScanProvenance> scanProvenanceOf(const GridRecord& grid);
 
 } // namespace vdbdag::bridge

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 
 #include "src/util/Error.h"
 #include "src/util/InputPath.h"
@@ -65,9 +66,29 @@ std::vector<std::vector<double>> parseVectors(const std::string& s, const std::s
     return out;
 }
 
+// A 4-D NRRD whose last axis holds volumes (a time series, a list): its
+// space direction is "none" while the first's is not, or, with spacings or
+// no directions, its kind is not a spatial one ("domain", "space") while
+// the first's is.
+bool lastAxisIsVolumes(const std::map<std::string, std::string>& fields, const std::string& path) {
+    if (auto dirs = fields.find("space directions"); dirs != fields.end()) {
+        const auto vectors = parseVectors(dirs->second, path + ": space directions");
+        return vectors.size() == 4 && vectors[3].empty() && !vectors[0].empty();
+    }
+    if (auto kinds = fields.find("kinds"); kinds != fields.end()) {
+        const std::vector<std::string> k = detail::tokens(kinds->second);
+        auto spatial = [](const std::string& kind) {
+            const std::string l = detail::lower(kind);
+            return l == "domain" || l == "space";
+        };
+        return k.size() == 4 && !spatial(k[3]) && spatial(k[0]);
+    }
+    return false;
+}
+
 } // namespace
 
-DenseVolume readNrrdHeader(const std::string& path) {
+DenseVolume readNrrdHeader(const std::string& path, std::optional<int64_t> volume) {
     checkInputFile(path, "a NRRD file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open");
@@ -116,15 +137,32 @@ DenseVolume readNrrdHeader(const std::string& path) {
     v.headerPath = path;
     const int64_t dimension = detail::parseInteger(detail::trim(required("dimension")), path + ": dimension");
     if (dimension != 3 && dimension != 4)
-        throw Error(path + ": NRRD dimension " + std::to_string(dimension) + " is not supported (3-D volumes, and 4-D with a leading axis of 3 components)");
+        throw Error(path + ": NRRD dimension " + std::to_string(dimension) +
+                    " is not supported (3-D volumes; 4-D with a leading axis of 3 components or a last, non-spatial axis of volumes)");
     v.type = nrrdType(required("type"), path);
     const std::vector<std::string> sizes = detail::tokens(required("sizes"));
     if (int64_t(sizes.size()) != dimension)
         throw Error(path + ": 'sizes' has " + std::to_string(sizes.size()) + " values, dimension is " + std::to_string(dimension));
-    // 4-D: a leading (fastest) axis of 3 components per sample, a vector or
-    // an RGB colour (kinds "RGB-color"); the other three axes are space.
-    const size_t first = dimension == 4 ? 1 : 0;
-    if (dimension == 4) {
+    // 4-D: either a leading (fastest) axis of 3 components per sample, a
+    // vector or an RGB colour (kinds "RGB-color"), or a last (slowest) axis
+    // of volumes, a time series: the axis whose space direction is "none"
+    // (or, with spacings, whose kind is not a spatial one) says which.
+    const bool series = dimension == 4 && lastAxisIsVolumes(fields, path);
+    const size_t first = dimension == 4 && !series ? 1 : 0;
+    int64_t volumes = 1;
+    if (series) {
+        volumes = detail::parseInteger(sizes[3], path + ": sizes");
+        if (volumes < 1) throw Error(path + ": sizes: the volume axis is empty");
+        const int64_t t = volume.value_or(0);
+        if (t < 0 || t >= volumes)
+            throw Error(path + ": --volume " + std::to_string(t) + " is out of range: the file holds " + std::to_string(volumes) + " volumes (0.." +
+                        std::to_string(volumes - 1) + ")");
+        if (volumes > 1) {
+            v.gridName = scanNameOf(path) + "_t" + std::to_string(t);
+            v.volumeIndex = t;
+            v.volumeCount = volumes;
+        }
+    } else if (dimension == 4) {
         const int64_t components = detail::parseInteger(sizes[0], path + ": sizes");
         if (components != 3)
             throw Error(path + ": a 4-D NRRD needs a leading axis of 3 components (a vector or RGB per sample); this one has " + sizes[0]);
@@ -172,6 +210,8 @@ DenseVolume readNrrdHeader(const std::string& path) {
         if (first) {
             if (!vectors[0].empty()) throw Error(path + ": the component axis of a 4-D NRRD must have space direction 'none'");
             vectors.erase(vectors.begin());
+        } else if (series) {
+            vectors.pop_back();  // the volume axis: 'none' (lastAxisIsVolumes)
         }
         for (int a = 0; a < 3; ++a) {
             if (vectors[size_t(a)].empty()) throw Error(path + ": axis " + std::to_string(a) + " has space direction 'none' (non-spatial axes are not supported)");
@@ -183,7 +223,7 @@ DenseVolume readNrrdHeader(const std::string& path) {
         if (int64_t(t.size()) != dimension)
             throw Error(path + ": 'spacings' has " + std::to_string(t.size()) + " values, dimension is " + std::to_string(dimension));
         if (first) t.erase(t.begin());
-        for (int a = 0; a < 3; ++a) {
+        for (int a = 0; a < 3; ++a) {  // (a series' 4th spacing is its time step)
             // NRRD writes "nan" for an unknown spacing: take 1.
             const double s = detail::lower(t[size_t(a)]) == "nan" ? 1.0 : detail::parseNumber(t[size_t(a)], path + ": spacings");
             v.axes[size_t(a)] = {0, 0, 0};
@@ -221,6 +261,12 @@ DenseVolume readNrrdHeader(const std::string& path) {
     if (byteSkip == -1) v.dataOffset = DenseVolume::kSkipToEnd;
     else v.decodedSkip = byteSkip;
     v.lineSkip = lineSkip;
+    if (v.volumeCount > 1) {  // volume t of a series: its samples follow the t volumes before it
+        if (byteSkip == -1) throw Error(path + ": byte skip -1 (data at the end of the file) is not supported for a 4-D series");
+        const uint64_t volumeBytes = v.sampleCount() * sampleBytes(v.type);
+        if (v.encoding == DataEncoding::Raw) v.dataOffset += int64_t(uint64_t(v.volumeIndex) * volumeBytes);
+        else v.decodedSkip += int64_t(uint64_t(v.volumeIndex) * volumeBytes);
+    }
     // Fields that say more than the layout above, and every key/value pair,
     // for a decode back to NRRD (docs/SCAN_METADATA.md).
     static const char* layoutFields[] = {"type", "dimension", "sizes", "encoding", "endian", "space", "space dimension", "space directions",

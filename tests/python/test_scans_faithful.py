@@ -353,3 +353,36 @@ def test_units_map_between_nifti_and_nrrd(unit, nifti_code, tmp_path):
     nrrd.write_bytes(head.encode() + data.astype("<i2").tobytes())
     _, out, _ = round_trip(str(nrrd), str(tmp_path), "units_src", ".nii.gz")
     assert int(nib.load(out).header["xyzt_units"]) & 7 == nifti_code
+
+
+def test_nrrd_series_comes_back_as_one_4d_file(tmp_path):
+    rng = np.random.default_rng(9)
+    samples = rng.integers(-300, 300, size=(3, 4, 5, 6)).astype("<i2")  # t, z, y, x
+    src = tmp_path / "series.nrrd"
+    head = ("NRRD0004\ntype: short\ndimension: 4\nspace: left-posterior-superior\nsizes: 6 5 4 3\n"
+            "space directions: (0.5,0,0) (0,0.5,0) (0,0,1.5) none\nkinds: domain domain domain list\nendian: little\nencoding: raw\n"
+            "space origin: (1,2,3)\nlabels: \"x\" \"y\" \"z\" \"t\"\nsubject:=7\n\n")
+    src.write_bytes(head.encode() + samples.tobytes())
+    enc = str(tmp_path / "series.ssvdag")
+    run("encode", str(src), "-o", enc, "-q")
+    grids = json.loads(run("info", enc, "--json").stdout)["grids"]
+    assert sorted(g["name"] for g in grids) == ["series_t0", "series_t1", "series_t2"]
+    # Back as one 4-D NRRD: the same header fields and the same bytes.
+    out = str(tmp_path / "series_back.nrrd")
+    run("decode", enc, "-o", out)
+    lines = header_lines(out)
+    for line in ["sizes: 6 5 4 3", "kinds: domain domain domain list", 'labels: "x" "y" "z" "t"', "subject:=7"]:
+        assert line in lines, (line, lines)
+    assert any(line.startswith("space directions:") and line.endswith(" none") for line in lines)
+    with open(out, "rb") as f:
+        blob = f.read()
+    assert blob[blob.index(b"\n\n") + 2:] == samples.tobytes()
+    # One volume: a 3-D file (the 4-entry labels left out), volume 1's samples.
+    one = str(tmp_path / "t1.nrrd")
+    run("decode", enc, "-o", one, "--grid", "series_t1")
+    back, info, _ = read_reference(one)
+    assert np.array_equal(back, samples[1]) and not any(l.startswith("labels:") for l in header_lines(one))
+    # As NIfTI: one 4-D file, nibabel's (x, y, z, t).
+    nii = str(tmp_path / "series.nii.gz")
+    run("decode", enc, "-o", nii)
+    assert np.array_equal(np.asanyarray(nib.load(nii).dataobj), samples.transpose(3, 2, 1, 0))

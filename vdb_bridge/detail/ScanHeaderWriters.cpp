@@ -2,6 +2,7 @@
 #include "vdb_bridge/detail/ScanHeaderWriters.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <type_traits>
@@ -65,18 +66,36 @@ int niftiDatatype(SampleType t) {
 
 std::string nrrdHeader(const Layout& l, const std::string& dataFile) {
     std::string h = "NRRD0004\n# written by vdbdag decode\n";
-    const bool vector = l.components == 3;
-    h += fmt::format("type: {}\ndimension: {}\n", nrrdTypeName(l.type), vector ? 4 : 3);
+    const bool vector = l.components == 3, series = l.volumes > 1;
+    if (vector && series) throw Error("internal error: a NRRD of vectors in volumes");
+    const int dimension = vector || series ? 4 : 3;
+    h += fmt::format("type: {}\ndimension: {}\n", nrrdTypeName(l.type), dimension);
     h += l.space == "LPS" ? "space: left-posterior-superior\n" : "space dimension: 3\n";
-    h += fmt::format("sizes: {}{} {} {}\n", vector ? "3 " : "", l.dims[0], l.dims[1], l.dims[2]);
+    h += fmt::format("sizes: {}{} {} {}{}\n", vector ? "3 " : "", l.dims[0], l.dims[1], l.dims[2], series ? " " + std::to_string(l.volumes) : "");
     h += vector ? "space directions: none" : "space directions:";
     for (const auto& a : l.axes) h += fmt::format(" ({},{},{})", g17(a[0]), g17(a[1]), g17(a[2]));
-    h += fmt::format("\nkinds: {}domain domain domain\nendian: little\nencoding: raw\n", vector ? (l.colour ? "RGB-color " : "vector ") : "");
+    h += fmt::format("{}\nkinds: {}domain domain domain{}\nendian: little\nencoding: raw\n", series ? " none" : "",
+                     vector ? (l.colour ? "RGB-color " : "vector ") : "", series ? " list" : "");
     h += fmt::format("space origin: ({},{},{})\n", g17(l.origin[0]), g17(l.origin[1]), g17(l.origin[2]));
     const bool unitsGiven = std::any_of(l.nrrdFields.begin(), l.nrrdFields.end(), [](const auto& f) { return f.first == "space units"; });
     if (!unitsGiven && !l.spaceUnit.empty())  // the unit a NIfTI source's xyzt_units named
         h += fmt::format("space units: \"{0}\" \"{0}\" \"{0}\"\n", l.spaceUnit);
-    for (const auto& [name, value] : l.nrrdFields) h += name + ": " + value + "\n";
+    // The source's fields; a per-axis one only when it has a value per axis
+    // of this file (one volume of a 4-D series is a 3-D file).
+    static const char* perAxis[] = {"thicknesses", "labels", "units", "centers", "axis mins", "axis maxs"};
+    for (const auto& [name, value] : l.nrrdFields) {
+        if (std::find(std::begin(perAxis), std::end(perAxis), name) != std::end(perAxis)) {
+            const size_t quotes = size_t(std::count(value.begin(), value.end(), '"'));
+            size_t words = 0;
+            for (size_t i = 0; i < value.size();) {
+                while (i < value.size() && std::isspace(static_cast<unsigned char>(value[i]))) ++i;
+                if (i < value.size()) ++words;
+                while (i < value.size() && !std::isspace(static_cast<unsigned char>(value[i]))) ++i;
+            }
+            if ((quotes ? quotes / 2 : words) != size_t(dimension)) continue;
+        }
+        h += name + ": " + value + "\n";
+    }
     for (const auto& [key, value] : l.keyValues) h += key + ":=" + value + "\n";
     if (!dataFile.empty()) h += "data file: " + dataFile + "\n";
     else h += "\n";

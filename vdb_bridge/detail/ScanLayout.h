@@ -36,7 +36,7 @@ struct ScanLayout {
     // NIfTI xyzt_units, NRRD space units), else empty (readers take mm).
     std::string spaceUnit;
     unsigned components = 1;  // 3 for vector and colour grids
-    int64_t volumes = 1;      // NIfTI: the volumes of a 4-D file (dim[4]), one after the other
+    int64_t volumes = 1;      // the volumes of a 4-D file (NIfTI dim[4], NRRD's last axis), one after the other
     bool colour = false;      // RGB (NIfTI RGB24, NRRD "RGB-color")
     // The source's NIfTI header fields (NiftiFields.h), for a NIfTI output.
     HeaderFieldMap nifti;
