@@ -45,13 +45,14 @@ struct Models {
 
 uint32_t saturate(int64_t v) { return v > int64_t(UINT32_MAX) ? UINT32_MAX : uint32_t(v); }
 
-// A predictor's weight from its summed local errors E: 2^30 / (1 + E)^2 + 1
-// (E capped at 2^14), from a table: the blend's only divisions otherwise.
-constexpr uint32_t kWeightCap = 1u << 14;
+// A predictor's weight from its summed local errors E: 2^26 / (1 + E)^2 + 1
+// (E capped at 2^13), from a table: the blend's only divisions otherwise.
+// 2^26 keeps the weighted sum of six int32 predictions inside int64.
+constexpr uint32_t kWeightCap = 1u << 13;
 int64_t weightOf(uint64_t errors) {
     static const std::vector<uint32_t> table = [] {
         std::vector<uint32_t> t(kWeightCap + 1);
-        for (uint64_t e = 0; e <= kWeightCap; ++e) t[e] = uint32_t((uint64_t(1) << 30) / ((1 + e) * (1 + e))) + 1;
+        for (uint64_t e = 0; e <= kWeightCap; ++e) t[e] = uint32_t((uint64_t(1) << 26) / ((1 + e) * (1 + e))) + 1;
         return t;
     }();
     return table[errors < kWeightCap ? errors : kWeightCap];
@@ -109,8 +110,27 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
     std::vector<int64_t> cur(plane), prev(plane);
     std::vector<SampleRecord> curRec(plane), prevRec(plane);
     const SampleRecord none{};
+    // Per row, what the neighbours above and behind contribute to each
+    // predictor's error sum (2 N + NE + NW + 2 P + PW + PN) and to the
+    // activity (the same of the residuals): summed once per row, in a loop
+    // the compiler vectorises; W's part is added per sample.
+    std::vector<uint64_t> rowErrors(size_t(nx) * kPredictors);
+    std::vector<uint64_t> rowResiduals(static_cast<size_t>(nx));
     for (int64_t z = 0; z < nz; ++z) {
         for (int64_t y = 0; y < ny; ++y) {
+            for (int64_t x = 0; x < nx; ++x) {
+                const size_t i = size_t(y * nx + x);
+                const bool hx = x > 0, hy = y > 0, hz = z > 0, hne = hy && x + 1 < nx;
+                const SampleRecord& rN = hy ? curRec[i - size_t(nx)] : none;
+                const SampleRecord& rNE = hne ? curRec[i - size_t(nx) + 1] : none;
+                const SampleRecord& rNW = hx && hy ? curRec[i - size_t(nx) - 1] : none;
+                const SampleRecord& rP = hz ? prevRec[i] : none;
+                const SampleRecord& rPW = hz && hx ? prevRec[i - 1] : none;
+                const SampleRecord& rPN = hz && hy ? prevRec[i - size_t(nx)] : none;
+                for (size_t k = 0; k < kPredictors; ++k)
+                    rowErrors[size_t(x) * kPredictors + k] = 2 * (uint64_t(rN.err[k]) + rP.err[k]) + rNE.err[k] + rNW.err[k] + rPW.err[k] + rPN.err[k];
+                rowResiduals[size_t(x)] = 2 * (uint64_t(rN.residual) + rP.residual) + rNE.residual + rNW.residual + rPW.residual + rPN.residual;
+            }
             for (int64_t x = 0; x < nx; ++x) {
                 const size_t i = size_t(y * nx + x);
                 // Neighbours, with the nearest coded one where the volume ends.
@@ -133,24 +153,19 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
                 for (int64_t& q : p) q = std::clamp(q, options.minValue, options.maxValue);  // a prediction outside the range helps no one
                 const SampleRecord& rW = hx ? curRec[i - 1] : none;
                 const SampleRecord& rN = hy ? curRec[i - size_t(nx)] : none;
-                const SampleRecord& rNE = hne ? curRec[i - size_t(nx) + 1] : none;
                 const SampleRecord& rP = hz ? prevRec[i] : none;
-                const SampleRecord& rNW = hx && hy ? curRec[i - size_t(nx) - 1] : none;
-                const SampleRecord& rPW = hz && hx ? prevRec[i - 1] : none;
-                const SampleRecord& rPN = hz && hy ? prevRec[i - size_t(nx)] : none;
-                int64_t weightSum = 0;
-                __int128 weighted = 0;  // up to 6 x 2^30 x 2^31
+                const uint64_t* above = &rowErrors[size_t(x) * kPredictors];
+                int64_t weightSum = 0, weighted = 0;  // |weighted| < 6 x (2^26 + 1) x 2^31 < 2^60
                 for (int k = 0; k < kPredictors; ++k) {
-                    const uint64_t errors = (2 * (uint64_t(rW.err[size_t(k)]) + rN.err[size_t(k)] + rP.err[size_t(k)]) + rNE.err[size_t(k)] +
-                                             rNW.err[size_t(k)] + rPW.err[size_t(k)] + rPN.err[size_t(k)]) / 2;
+                    const uint64_t errors = (above[k] + 2 * uint64_t(rW.err[size_t(k)])) / 2;  // 2 (W + N + P) + NE + NW + PW + PN, halved
                     const int64_t w = weightOf(errors);
                     weightSum += w;
-                    weighted += __int128(w) * p[size_t(k)];
+                    weighted += w * p[size_t(k)];
                 }
-                int64_t blend = int64_t(weighted >= 0 ? (weighted + weightSum / 2) / weightSum : -((-weighted + weightSum / 2) / weightSum));
+                int64_t blend = divRound(weighted, weightSum);
                 blend = std::clamp(blend, std::min({W, N, NE, P}), std::max({W, N, NE, P}));
                 const uint64_t gradient = uint64_t(std::abs(W - NW) + std::abs(N - NW) + std::abs(NE - N) + std::abs(P - med(PW, PN, PNW)));
-                const uint64_t activity = (2 * (uint64_t(rW.residual) + rN.residual + rP.residual) + rNE.residual + rNW.residual + rPW.residual + rPN.residual) / 2 + gradient / 2;
+                const uint64_t activity = (rowResiduals[size_t(x)] + 2 * uint64_t(rW.residual)) / 2 + gradient / 2;
                 const int length = 64 - std::countl_zero(activity);
                 const int context = std::min(kContexts - 1, 2 * length + (length >= 2 ? int(activity >> (length - 2)) & 1 : 0));
                 ContextModels& c = models.ctx[size_t(context)];
