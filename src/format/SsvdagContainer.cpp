@@ -100,6 +100,26 @@ std::string describe(size_t index, uint32_t kind, uint32_t grid) {
     return text;
 }
 
+// What a file that is not an .ssvdag is, by its first bytes, when it is a
+// format vdbdag reads (an .ssvdag command given the input of `encode`), with
+// the command that takes it; empty otherwise.
+std::string foreignFormatOf(std::span<const uint8_t> b, const std::string& name) {
+    auto starts = [&](size_t at, const char* text) {
+        const size_t n = std::strlen(text);
+        return b.size() >= at + n && std::memcmp(b.data() + at, text, n) == 0;
+    };
+    std::string what;
+    if (starts(0, "\x20\x42\x44\x56")) what = "an OpenVDB .vdb file";  // its magic, 0x56444220 little-endian
+    else if (starts(0, "NanoVDB")) what = "a NanoVDB file";
+    else if (starts(0, "NRRD000")) what = "a NRRD file";
+    else if (starts(0, "ObjectType") || starts(0, "NDims")) what = "a MetaImage header";
+    else if (starts(128, "DICM")) what = "a DICOM file";
+    else if (starts(344, "n+1") || starts(344, "ni1") || starts(4, "n+2")) what = "a NIfTI file";
+    else if (starts(0, "\x1f\x8b")) what = "gzip-compressed data (a .nii.gz or .nrrd, if it is a scan)";
+    if (what.empty()) return "";
+    return ": it is " + what + ", which `vdbdag encode " + name + " -o OUT.ssvdag` reads (and `diff` and `info` take as it is)";
+}
+
 // `bytes`: the file, or (readContainerFile) at least its header, table and
 // table checksum; `size`: the file's size.
 std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string& name, uint64_t size) {
@@ -113,7 +133,8 @@ std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string&
     if (std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
         if (std::memcmp(bytes.data() + 1, kMagic + 1, 6) == 0 && bytes[7] == '\r')
             fail("not an .ssvdag file (bad magic: line endings were translated, copy it in binary mode)");
-        fail("not an .ssvdag file (bad magic)");
+        const std::string foreign = foreignFormatOf(bytes, name);
+        fail(foreign.empty() ? "not an .ssvdag file (bad magic)" : "not an .ssvdag file" + foreign);
     }
     if (size < kHeaderBytes + kChecksumBytes)
         fail("truncated: the file has " + num(size) + " bytes, the header alone needs " + num(kHeaderBytes + kChecksumBytes));
@@ -420,6 +441,8 @@ std::vector<Section> readContainerFile(const std::string& path, bool unknownKind
         uint32_t count;
         std::memcpy(&count, head.data() + 12, 4);
         head = file.read(0, std::min<uint64_t>(file.size, kHeaderBytes + uint64_t(count) * kEntryBytes + kChecksumBytes), path);
+    } else {
+        head = file.read(0, std::min<uint64_t>(file.size, 352), path);  // enough to tell a NIfTI or DICOM file in the refusal
     }
     const std::vector<Entry> entries = parseTable(head, path, file.size);
     checkInflatedSize(entries, unknownKinds, limits, path);

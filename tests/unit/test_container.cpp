@@ -450,6 +450,20 @@ TEST(Container, NotAnSsvdagFile) {
     auto crlf = format::writeContainer({});
     crlf.insert(crlf.begin() + 7, '\r');  // a text-mode copy turned the LF into CRLF
     EXPECT_NE(errorOf(crlf, "c.ssvdag").find("line endings"), std::string::npos) << errorOf(crlf, "c.ssvdag");
+    // The inputs of `encode` given to a command that reads .ssvdag files: named, with the command that takes them
+    // (issue 38: "bad magic" for a .nvdb or a scan).
+    auto named = [&](std::vector<uint8_t> head, size_t at, const std::string& magic, const std::string& expect) {
+        head.resize(std::max(head.size(), at + magic.size() + 8), 0);
+        std::memcpy(head.data() + at, magic.data(), magic.size());
+        const std::string e = errorOf(head, "in.x");
+        EXPECT_NE(e.find("not an .ssvdag file: it is " + expect), std::string::npos) << e;
+        EXPECT_NE(e.find("vdbdag encode in.x -o OUT.ssvdag"), std::string::npos) << e;
+    };
+    named({}, 0, std::string("\x20\x42\x44\x56\0\0\0\0", 8), "an OpenVDB .vdb file");
+    named({}, 0, "NanoVDB0", "a NanoVDB file");
+    named({}, 0, "NRRD0004\n", "a NRRD file");
+    named(std::vector<uint8_t>(352, 0), 344, "n+1", "a NIfTI file");
+    named(std::vector<uint8_t>(200, 0), 128, "DICM", "a DICOM file");
 }
 
 // ---- files ----------------------------------------------------------------------
