@@ -108,16 +108,17 @@ std::string foreignFormatOf(std::span<const uint8_t> b, const std::string& name)
         const size_t n = std::strlen(text);
         return b.size() >= at + n && std::memcmp(b.data() + at, text, n) == 0;
     };
-    std::string what;
-    if (starts(0, "\x20\x42\x44\x56")) what = "an OpenVDB .vdb file";  // its magic, 0x56444220 little-endian
+    std::string what, also;
+    const std::string scan = " (`info`, `diff` and `import` take it as it is)";
+    if (starts(0, "\x20\x42\x44\x56")) what = "an OpenVDB .vdb file", also = " (`info`, `diff` and `verify` take it as it is)";  // magic 0x56444220, LE
     else if (starts(0, "NanoVDB")) what = "a NanoVDB file";
-    else if (starts(0, "NRRD000")) what = "a NRRD file";
-    else if (starts(0, "ObjectType") || starts(0, "NDims")) what = "a MetaImage header";
-    else if (starts(128, "DICM")) what = "a DICOM file";
-    else if (starts(344, "n+1") || starts(344, "ni1") || starts(4, "n+2")) what = "a NIfTI file";
-    else if (starts(0, "\x1f\x8b")) what = "gzip-compressed data (a .nii.gz or .nrrd, if it is a scan)";
+    else if (starts(0, "NRRD000")) what = "a NRRD file", also = scan;
+    else if (starts(0, "ObjectType") || starts(0, "NDims")) what = "a MetaImage header", also = scan;
+    else if (starts(128, "DICM")) what = "a DICOM file", also = scan;
+    else if (starts(344, "n+1") || starts(344, "ni1") || starts(4, "n+2")) what = "a NIfTI file", also = scan;
+    else if (starts(0, "\x1f\x8b")) what = "gzip-compressed data (a .nii.gz or .nrrd, if it is a scan)", also = scan;
     if (what.empty()) return "";
-    return ": it is " + what + ", which `vdbdag encode " + name + " -o OUT.ssvdag` reads (and `diff` and `info` take as it is)";
+    return ": it is " + what + ", which `vdbdag encode " + name + " -o OUT.ssvdag` reads" + also;
 }
 
 // `bytes`: the file, or (readContainerFile) at least its header, table and
