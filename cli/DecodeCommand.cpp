@@ -41,7 +41,14 @@ const Grid& denseGridOf(const std::vector<Grid>& grids, const std::string& input
 // or the grid needs the whole grid (exportsByCubes).
 bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& input, const std::string& output, const std::string& gridName,
                         const bridge::DenseExportOptions& options, std::vector<std::string>& notes) {
-    if (gridName.empty() && scene.grids.size() > 1) return false;  // a 4-D series, or a refusal naming the grids
+    if (gridName.empty() && scene.grids.size() > 1) {
+        // The volumes of a 4-D scan are written from the decoded grids; any
+        // other file of several grids is refused now, before it is decoded.
+        std::vector<GridRecord> headers;
+        for (const auto& g : scene.grids) headers.push_back(g.record);
+        if (!bridge::volumeSeriesOf(headers)) denseGridOf(scene.grids, input, gridName, [](const format::EncodedGrid& g) { return g.record.name; });
+        return false;
+    }
     const format::EncodedGrid& grid = denseGridOf(scene.grids, input, gridName, [](const format::EncodedGrid& g) { return g.record.name; });
     if (!bridge::exportsByCubes(grid.record, output)) return false;
     constexpr unsigned kCubeLog2 = 7;

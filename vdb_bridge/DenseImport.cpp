@@ -342,16 +342,7 @@ DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, boo
     const double a = v.rescaleSlope, b = v.rescaleIntercept;
     if (!std::isfinite(a) || !std::isfinite(b) || a == 0)
         throw Error(v.headerPath + ": the rescale slope " + std::to_string(a) + " / intercept " + std::to_string(b) + " is not usable");
-    double lo = 0, hi = 0;
-    switch (v.type) {
-        case SampleType::U8: hi = 255; break;
-        case SampleType::I8: lo = -128; hi = 127; break;
-        case SampleType::U16: hi = 65535; break;
-        case SampleType::I16: lo = -32768; hi = 32767; break;
-        case SampleType::U32: hi = 4294967295.0; break;
-        case SampleType::I32: lo = -2147483648.0; hi = 2147483647.0; break;
-        default: lo = hi = std::numeric_limits<double>::quiet_NaN();
-    }
+    const auto [lo, hi] = sampleRange(v.type);  // NaN for float samples
     const bool integral = isIntegerSample(v.type) && a == std::trunc(a) && b == std::trunc(b) && std::abs(a) < 2147483648.0 &&
                           std::abs(b) < 2147483648.0;
     const double r0 = a * lo + b, r1 = a * hi + b;

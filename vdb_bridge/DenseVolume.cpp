@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 
 #include <zlib.h>
 
@@ -40,6 +41,14 @@ unsigned sampleBytes(SampleType type) {
 }
 
 bool isIntegerSample(SampleType type) { return type != SampleType::F32 && type != SampleType::F64; }
+
+std::pair<double, double> sampleRange(SampleType type, unsigned bits) {
+    if (!isIntegerSample(type)) return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+    const bool isSigned = type == SampleType::I8 || type == SampleType::I16 || type == SampleType::I32;
+    const int b = int(bits ? bits : 8 * sampleBytes(type));
+    if (isSigned) return {-std::ldexp(1.0, b - 1), std::ldexp(1.0, b - 1) - 1};
+    return {0.0, std::ldexp(1.0, b) - 1};
+}
 
 SampleType parseSampleType(const std::string& name, const std::string& what) {
     for (SampleType t : {SampleType::U8, SampleType::I8, SampleType::U16, SampleType::I16, SampleType::U32, SampleType::I32, SampleType::F32,

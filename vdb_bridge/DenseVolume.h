@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -20,6 +21,9 @@ enum class SampleType : uint8_t { U8, I8, U16, I16, U32, I32, F32, F64 };
 const char* sampleTypeName(SampleType type);  // "u8", ..., "f64"
 unsigned sampleBytes(SampleType type);
 bool isIntegerSample(SampleType type);
+// The values an integer sample type holds, [min, max], narrowed to its low
+// `bits` when given (DICOM Bits Stored); NaN for float types.
+std::pair<double, double> sampleRange(SampleType type, unsigned bits = 0);
 // "u8|i8|u16|i16|u32|i32|f32|f64"; throws vdbdag::Error naming `what` otherwise.
 SampleType parseSampleType(const std::string& name, const std::string& what);
 

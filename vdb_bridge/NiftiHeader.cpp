@@ -95,6 +95,14 @@ void precheck(const std::string& path) {
         throw Error(path + ": NIfTI datatype code " + std::to_string(datatype) + " is not a NIfTI datatype");
 }
 
+// Vectors on the 4th axis: a 4th dimension of 3 under a vector intent
+// (RGB_VECTOR, VECTOR, DISPVECT), as some writers store them instead of in
+// the 5th; one vector volume, not three.
+bool vectorsOnFourthAxis(const nifti_image& n) {
+    const bool vectorIntent = n.intent_code == NIFTI_INTENT_RGB_VECTOR || n.intent_code == NIFTI_INTENT_VECTOR || n.intent_code == NIFTI_INTENT_DISPVECT;
+    return vectorIntent && n.ndim == 4 && n.nt == 3 && n.datatype != DT_RGB24 && n.datatype != DT_RGBA32;
+}
+
 } // namespace
 
 DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volume) {
@@ -121,10 +129,7 @@ DenseVolume readNiftiHeader(const std::string& path, std::optional<int64_t> volu
         if (n.dim[d] < 1 && d <= n.ndim) throw Error(path + ": NIfTI dim[" + std::to_string(d) + "] = " + std::to_string(n.dim[d]) + " is not positive");
     // A 5th dimension of 3 is a vector per voxel (NIFTI_INTENT_VECTOR and
     // the like): its components are planes nx*ny*nz*nt samples apart.
-    // A 4th dimension of 3 under a vector intent (RGB_VECTOR, VECTOR,
-    // DISPVECT) is the same, as some writers store it: a vector grid too.
-    const bool vectorIntent = n.intent_code == NIFTI_INTENT_RGB_VECTOR || n.intent_code == NIFTI_INTENT_VECTOR || n.intent_code == NIFTI_INTENT_DISPVECT;
-    const bool vectorOnT = vectorIntent && n.ndim == 4 && n.nt == 3 && v.components == 1;
+    const bool vectorOnT = vectorsOnFourthAxis(n);  // the same, as some writers store it
     const bool vector = (n.ndim >= 5 && n.nu == 3 && n.nv <= 1 && n.nw <= 1 && v.components == 1) || vectorOnT;
     if (!vector && (n.nu > 1 || n.nv > 1 || n.nw > 1))
         throw Error(path + ": NIfTI dimensions 5 to 7 (" + std::to_string(n.nu) + "x" + std::to_string(n.nv) + "x" + std::to_string(n.nw) +
@@ -199,8 +204,7 @@ int64_t niftiVolumeCount(const std::string& path) {
     precheck(path);
     std::unique_ptr<nifti_image, NiftiDeleter> nim(nifti_image_read(path.c_str(), 0));
     if (!nim) throw Error(path + ": not a readable NIfTI-1 or NIfTI-2 header (missing, truncated, or a field out of range)");
-    const bool vectorOnT = (nim->intent_code == NIFTI_INTENT_RGB_VECTOR || nim->intent_code == NIFTI_INTENT_VECTOR || nim->intent_code == NIFTI_INTENT_DISPVECT) &&
-                           nim->ndim == 4 && nim->nt == 3 && nim->datatype != DT_RGB24 && nim->datatype != DT_RGBA32;
+    const bool vectorOnT = vectorsOnFourthAxis(*nim);
     return nim->nt > 1 && !vectorOnT ? nim->nt : 1;  // vectors on the 4th axis are one vector volume (readNiftiHeader)
 }
 

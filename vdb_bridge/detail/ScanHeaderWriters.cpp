@@ -2,7 +2,6 @@
 #include "vdb_bridge/detail/ScanHeaderWriters.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <type_traits>
@@ -11,6 +10,7 @@
 #include <nifti2_io.h>
 
 #include "src/util/Error.h"
+#include "vdb_bridge/detail/HeaderText.h"
 
 namespace vdbdag::bridge::detail {
 namespace {
@@ -85,14 +85,8 @@ std::string nrrdHeader(const Layout& l, const std::string& dataFile) {
     static const char* perAxis[] = {"thicknesses", "labels", "units", "centers", "axis mins", "axis maxs"};
     for (const auto& [name, value] : l.nrrdFields) {
         if (std::find(std::begin(perAxis), std::end(perAxis), name) != std::end(perAxis)) {
-            const size_t quotes = size_t(std::count(value.begin(), value.end(), '"'));
-            size_t words = 0;
-            for (size_t i = 0; i < value.size();) {
-                while (i < value.size() && std::isspace(static_cast<unsigned char>(value[i]))) ++i;
-                if (i < value.size()) ++words;
-                while (i < value.size() && !std::isspace(static_cast<unsigned char>(value[i]))) ++i;
-            }
-            if ((quotes ? quotes / 2 : words) != size_t(dimension)) continue;
+            const size_t quotes = size_t(std::count(value.begin(), value.end(), '"'));  // "a b" "c": quoted values may hold spaces
+            if ((quotes ? quotes / 2 : detail::tokens(value).size()) != size_t(dimension)) continue;
         }
         h += name + ": " + value + "\n";
     }

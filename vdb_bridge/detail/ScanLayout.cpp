@@ -67,21 +67,10 @@ bool boundsOf(const GridRecord& g, std::array<int64_t, 3>& lo, std::array<int64_
 // The narrowest integer sample type that holds [lo, hi], or none.
 std::optional<SampleType> integerTypeFor(double lo, double hi) {
     for (SampleType t : {SampleType::U8, SampleType::I8, SampleType::U16, SampleType::I16, SampleType::U32, SampleType::I32}) {
-        const unsigned bits = 8 * sampleBytes(t);
-        const bool isSigned = t == SampleType::I8 || t == SampleType::I16 || t == SampleType::I32;
-        const double min = isSigned ? -std::ldexp(1.0, int(bits) - 1) : 0, max = std::ldexp(1.0, int(bits) - int(isSigned)) - 1;
+        const auto [min, max] = sampleRange(t);
         if (lo >= min && hi <= max) return t;
     }
     return std::nullopt;
-}
-
-// The range of stored samples of `type` (narrowed to `bitsStored` bits
-// when the source said so, as DICOM's Bits Stored does).
-std::pair<double, double> storedRange(SampleType type, unsigned bitsStored) {
-    const bool isSigned = type == SampleType::I8 || type == SampleType::I16 || type == SampleType::I32;
-    const unsigned bits = bitsStored ? bitsStored : 8 * sampleBytes(type);
-    if (isSigned) return {-std::ldexp(1.0, int(bits) - 1), std::ldexp(1.0, int(bits) - 1) - 1};
-    return {0.0, std::ldexp(1.0, int(bits)) - 1};
 }
 
 // Formats with a place for a rescale: value = stored * slope + intercept.
@@ -113,7 +102,7 @@ void chooseValuesWithoutRescale(Layout& l, const GridRecord& grid, unsigned bits
     switch (grid.valueType) {
         case ValueType::Int32:
         case ValueType::Int64: {
-            const auto [a, b] = storedRange(stored, bitsStored);
+            const auto [a, b] = sampleRange(stored, bitsStored);  // the stored samples' range (DICOM Bits Stored)
             const double r0 = a * l.slope + l.intercept, r1 = b * l.slope + l.intercept;
             const std::optional<SampleType> t = integerTypeFor(std::min(r0, r1), std::max(r0, r1));
             if (!t) throw Error(path + ": grid '" + grid.name + "' holds values beyond 32-bit integers; write it as .nii/.nii.gz (stored samples and the rescale) or .vdb");
