@@ -1,6 +1,8 @@
 // See DicomSeries.h. GDCM reads the headers (gdcm::Reader up to the Pixel
-// Data, then a second look for the Pixel Data element itself) and decodes
-// the pixel data (gdcm::ImageReader, any transfer syntax it supports).
+// Data, then a second look for the Pixel Data element itself) once the
+// element walk (detail/DicomElementWalk.h) has passed the file; native pixel
+// data are read where the walk found them, compressed ones are decoded by
+// gdcm::ImageReader (any transfer syntax it supports).
 // Every file, or every frame of a multi-frame file, becomes one candidate
 // slice; candidates are grouped by Series Instance UID, rows/columns and
 // Image Orientation (Patient), and each group is sorted by its position along
@@ -34,6 +36,7 @@
 
 #include "src/util/Error.h"
 #include "vdb_bridge/DicomTags.h"
+#include "vdb_bridge/detail/DicomElementWalk.h"
 
 namespace vdbdag::bridge {
 namespace {
@@ -185,185 +188,9 @@ std::string nonImageClass(const std::string& sop) {
 }
 
 constexpr uint16_t kPixelGroup = 0x7fe0;
+using detail::checkNativeLength;
+using detail::elementLengthProblem;
 
-// GDCM reads a file cut short inside native (uncompressed) pixel data
-// without complaint. The Pixel Data element's header is found in the file
-// (its tag followed by its length, explicit or implicit VR, the first such
-// match) and the file must hold all of its value. Returns "" when it does or
-// when the element cannot be found (deflated data sets).
-std::string checkNativeLength(const std::string& path, uint32_t length, bool bigEndian) {
-    std::FILE* file = std::fopen(path.c_str(), "rb");
-    if (!file) return "";
-    std::error_code ec;
-    const uint64_t size = fs::file_size(path, ec);
-    const uint8_t tag[4] = {uint8_t(bigEndian ? 0x7f : 0xe0), uint8_t(bigEndian ? 0xe0 : 0x7f), uint8_t(bigEndian ? 0x00 : 0x10),
-                            uint8_t(bigEndian ? 0x10 : 0x00)};
-    const auto u32 = [&](const uint8_t* p) {
-        return bigEndian ? uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]
-                         : uint32_t(p[3]) << 24 | uint32_t(p[2]) << 16 | uint32_t(p[1]) << 8 | p[0];
-    };
-    constexpr size_t kChunk = size_t(1) << 16, kKeep = 12;
-    std::vector<uint8_t> buf;
-    uint64_t bufStart = 0;  // file offset of buf[0]
-    std::string result;
-    std::vector<uint8_t> chunk(kChunk);
-    for (;;) {
-        const size_t got = std::fread(chunk.data(), 1, kChunk, file);
-        buf.insert(buf.end(), chunk.begin(), chunk.begin() + ptrdiff_t(got));
-        bool found = false;
-        for (size_t i = 0; i + kKeep <= buf.size() && !found; ++i) {
-            if (std::memcmp(buf.data() + i, tag, 4) != 0) continue;
-            const uint8_t* p = buf.data() + i + 4;
-            uint64_t header = 0;
-            if ((p[0] == 'O' && (p[1] == 'W' || p[1] == 'B')) && p[2] == 0 && p[3] == 0 && u32(p + 4) == length) header = 12;
-            else if (u32(p) == length) header = 8;
-            if (!header) continue;
-            found = true;
-            const uint64_t end = bufStart + i + header + length;
-            if (end > size)
-                result = fmt::format("is truncated: its pixel data are {} bytes from byte {} on, but the file holds only {} of them", length, bufStart + i + header,
-                                     size - (bufStart + i + header));
-        }
-        if (found || got < kChunk) break;
-        if (buf.size() > kKeep) {  // keep the tail: a header may straddle chunks
-            bufStart += buf.size() - kKeep;
-            buf.erase(buf.begin(), buf.end() - ptrdiff_t(kKeep));
-        }
-    }
-    std::fclose(file);
-    return result;
-}
-
-// GDCM allocates each element's declared length before it reads the bytes,
-// so a 1 KB file that declares a 3 GB element makes it allocate (and touch)
-// 3 GB. This walk reads only the element headers (tag, VR, length; into
-// sequences and items of undefined length) and refuses any length that runs
-// past the end of the file, before GDCM sees it. "" when the file passes
-// (or is not DICOM at all, which GDCM then reports). `beforePixels`: stop at
-// the Pixel Data element (a header read; a short pixel data element is a
-// truncated slice, which the series check names).
-// `pixelLength`: set to the Pixel Data element's declared length when it is
-// that element that runs past the end.
-std::string walkElementLengths(const std::string& path, bool beforePixels, uint64_t* pixelLength, bool& unknownStart) {
-    std::FILE* file = std::fopen(path.c_str(), "rb");
-    if (!file) return "";
-    struct Closer {
-        std::FILE* f;
-        ~Closer() { std::fclose(f); }
-    } closer{file};
-    std::error_code ec;
-    const uint64_t size = fs::file_size(path, ec);
-    if (ec) return "";
-    auto readAt = [&](uint64_t at, void* out, size_t n) {
-        return at + n <= size && std::fseek(file, long(at), SEEK_SET) == 0 && std::fread(out, 1, n, file) == n;
-    };
-    uint64_t pos = 0;
-    char magic[4];
-    if (readAt(128, magic, 4) && std::memcmp(magic, "DICM", 4) == 0) pos = 132;
-    bool explicitVr = true, bigEndian = false, metaGroup = pos == 132, declaredImplicit = false;
-    unknownStart = false;
-    if (pos == 0) {  // no preamble: walk only what starts like a DICOM dataset (else GDCM refuses it as not DICOM)
-        uint8_t h[6];
-        // GDCM asserts (aborts) on a file shorter than one element header
-        // (02 00 00 00, E0 7F 10 00: found by fuzz_scan_headers).
-        if (size > 0 && size < 8) return fmt::format("the file ({} bytes) ends inside its first element", size);
-        if (!readAt(0, h, 6)) return "";
-        uint16_t group = uint16_t(h[0] | h[1] << 8);
-        if (group == 0x0200 || group == 0x0800) {  // big-endian: GDCM reads it so (and asserts on a cut-off element)
-            bigEndian = true;
-            group = uint16_t(h[0] << 8 | h[1]);
-        }
-        // Neither a file meta group nor a dataset's first group: GDCM still
-        // parses it as a dataset (and allocated 1.8 GB for a 107-byte file
-        // whose bytes read as a 1.8 GB element: found by fuzz_scan_headers),
-        // so it is walked the same way, its VRs taken as they come.
-        unknownStart = group != 0x0002 && group != 0x0008;
-        explicitVr = std::isupper(h[4]) && std::isupper(h[5]);
-        declaredImplicit = !explicitVr && !unknownStart;
-        metaGroup = group == 0x0002;
-    }
-    auto u16 = [&](const uint8_t* b) { return bigEndian ? uint16_t(b[0] << 8 | b[1]) : uint16_t(b[0] | b[1] << 8); };
-    auto u32 = [&](const uint8_t* b) {
-        return bigEndian ? uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | b[3] : uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
-    };
-    std::string transferSyntax;
-    for (unsigned steps = 0; pos + 8 <= size && steps < 10'000'000; ++steps) {
-        uint8_t h[12];
-        if (!readAt(pos, h, 8)) break;
-        const bool inMeta = metaGroup && (h[0] | h[1] << 8) == 0x0002;
-        if (metaGroup && !inMeta) {  // the meta group ends: the dataset's encoding from its transfer syntax
-            metaGroup = false;
-            if (transferSyntax == "1.2.840.10008.1.2") explicitVr = false, declaredImplicit = true;
-            else if (transferSyntax == "1.2.840.10008.1.2.2") bigEndian = true;
-            else if (transferSyntax == "1.2.840.10008.1.2.1.99") return "";  // deflated: GDCM inflates and checks
-        }
-        const bool le = inMeta || !bigEndian;
-        const uint16_t group = le ? uint16_t(h[0] | h[1] << 8) : u16(h), element = le ? uint16_t(h[2] | h[3] << 8) : u16(h + 2);
-        uint64_t length, header;
-        if (group == 0xFFFE) {  // item and delimiters: always a 4-byte length
-            length = le ? uint32_t(h[4]) | uint32_t(h[5]) << 8 | uint32_t(h[6]) << 16 | uint32_t(h[7]) << 24 : u32(h + 4);
-            header = 8;
-            if (element != 0xE000) length = 0;  // delimiters
-            if (length == 0xFFFFFFFFu) length = 0;  // an item of undefined length: walk into it
-            else if (element == 0xE000 && length > size - pos - header)
-                return fmt::format("item at byte {} claims {} bytes, but only {} follow", pos, length, size - pos - header);
-            pos += header + (element == 0xE000 && length ? length : 0);
-            continue;
-        }
-        const char vr[3] = {char(h[4]), char(h[5]), 0};
-        // GDCM asserts (aborts) on a meta group element whose VR is not one of DICOM's.
-        static const std::set<std::string> knownVr{"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL", "IS", "LO", "LT", "OB", "OD", "OF",
-                                                   "OL", "OV", "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC", "UI", "UL", "UN",
-                                                   "UR", "US", "UT", "UV"};
-        if (inMeta && !knownVr.count(vr)) return fmt::format("file meta element ({:04X},{:04X}) at byte {} has no valid VR", group, element, pos);
-        // An implicit transfer syntax is read as implicit (as GDCM does); under
-        // an explicit one, an element whose VR bytes are no VR as implicit.
-        if (!inMeta && !declaredImplicit) explicitVr = knownVr.count(vr) > 0;
-        if (inMeta || explicitVr) {
-            static const std::set<std::string> longVr{"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
-            if (longVr.count(vr)) {
-                if (!readAt(pos, h, 12)) return fmt::format("element ({:04X},{:04X}) at byte {} is cut off", group, element, pos);
-                length = le ? uint32_t(h[8]) | uint32_t(h[9]) << 8 | uint32_t(h[10]) << 16 | uint32_t(h[11]) << 24 : u32(h + 8);
-                header = 12;
-            } else {
-                length = le ? uint16_t(h[6] | h[7] << 8) : u16(h + 6);
-                header = 8;
-            }
-        } else {
-            length = u32(h + 4);
-            header = 8;
-        }
-        if (inMeta && length == 0xFFFFFFFFu)  // GDCM asserts on it too
-            return fmt::format("file meta element ({:04X},{:04X}) at byte {} has an undefined length", group, element, pos);
-        if (beforePixels && group == kPixelGroup && element == 0x0010) return "";
-        if (length == 0xFFFFFFFFu) {  // a sequence or encapsulated pixel data: walk into it
-            pos += header;
-            continue;
-        }
-        if (length > size - pos - header) {
-            if (pixelLength && group == kPixelGroup && element == 0x0010) *pixelLength = length;
-            return fmt::format("element ({:04X},{:04X}) at byte {} claims {} bytes, but only {} follow", group, element, pos, length, size - pos - header);
-        }
-        if (inMeta && element == 0x0010 && length < 256) {
-            std::string uid(length, '\0');
-            readAt(pos + header, uid.data(), length);
-            while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' ')) uid.pop_back();
-            transferSyntax = uid;
-        }
-        pos += header + length;
-    }
-    // A file that ends inside its file meta group (GDCM asserts on it).
-    if (metaGroup) return fmt::format("the file ends inside its file meta group (at byte {} of {})", pos, size);
-    return "";
-}
-
-std::string elementLengthProblem(const std::string& path, bool beforePixels = false, uint64_t* pixelLength = nullptr) {
-    bool unknownStart = false;
-    const std::string problem = walkElementLengths(path, beforePixels, pixelLength, unknownStart);
-    // What starts like no DICOM and does not walk as one is not DICOM.
-    if (!problem.empty() && unknownStart) return "not a DICOM file (no DICM preamble, and read as one: " + problem + ")";
-    return problem;
-}
 
 // Reads one file's header into `frames` (one per frame); returns the reason
 // to skip it, or "" when it is an image.
@@ -662,6 +489,8 @@ void analyse(Group& g) {
                          g.first.samplesPerPixel, g.first.photometric.empty() ? "unknown" : g.first.photometric));
     else if (g.first.photometric == "PALETTE COLOR")
         fail("PALETTE COLOR (indexed colour); only greyscale is supported for now");
+    else if (!g.first.photometric.empty() && g.first.photometric != "MONOCHROME1" && g.first.photometric != "MONOCHROME2")
+        fail(fmt::format("Photometric Interpretation '{}' is no greyscale DICOM defines (MONOCHROME1 or MONOCHROME2)", g.first.photometric));
     for (const FileInfo* f : g.files)
         if (!f->damaged.empty()) {
             fail(f->file + " " + f->damaged);
@@ -1029,37 +858,116 @@ private:
             cache_.clear();
             quietGdcm();
             const std::string where = fmt::format("{}: slice file of {}", slice.file, v_.headerPath);
-            if (const std::string bad = elementLengthProblem(slice.file); !bad.empty()) throw Error(where + ": corrupt DICOM: " + bad);
-            gdcm::ImageReader reader;
-            reader.SetFileName(slice.file.c_str());
-            if (!reader.Read()) throw Error(where + ": GDCM cannot read it as a DICOM image (truncated or corrupt?)");
-            const gdcm::Image& image = reader.GetImage();
-            const gdcm::PixelFormat& pf = image.GetPixelFormat();
-            const unsigned dimsCount = image.GetNumberOfDimensions();
-            const uint64_t cols = image.GetDimension(0), rows = image.GetDimension(1);
-            const uint64_t frames = dimsCount >= 3 ? image.GetDimension(2) : 1;
-            if (int64_t(cols) != v_.dims[0] || int64_t(rows) != v_.dims[1])
-                throw Error(fmt::format("{}: holds {}x{} pixels where the series has {}x{}", where, cols, rows, v_.dims[0], v_.dims[1]));
-            if (pf.GetSamplesPerPixel() != 1) throw Error(fmt::format("{}: holds {} samples per pixel; the series has 1", where, pf.GetSamplesPerPixel()));
-            const std::optional<SampleType> t = sampleTypeOf(pf.GetBitsAllocated(), pf.GetPixelRepresentation());
-            if (!t || *t != v_.type)
-                throw Error(fmt::format("{}: its pixels decode as {} bits {} (Pixel Representation {}), not the series' {}", where, pf.GetBitsAllocated(),
-                                        pf.GetPixelRepresentation() ? "signed" : "unsigned", pf.GetPixelRepresentation(), sampleTypeName(v_.type)));
-            if (frames <= slice.frame) throw Error(fmt::format("{}: holds {} frame(s); frame {} is missing", where, frames, slice.frame + 1));
-            const uint64_t length = image.GetBufferLength();
-            if (length < frames * sliceBytes)
-                throw Error(fmt::format("{}: its pixel data decode to {} bytes, fewer than the {} its {} frame(s) need", where, length, frames * sliceBytes, frames));
-            cache_.resize(size_t(length));
-            if (!image.GetBuffer(reinterpret_cast<char*>(cache_.data())))
-                throw Error(fmt::format("{}: GDCM cannot decode its pixel data (transfer syntax {}; truncated or corrupt?)", where,
-                                        reader.GetFile().GetHeader().GetDataSetTransferSyntax().GetString()
-                                            ? reader.GetFile().GetHeader().GetDataSetTransferSyntax().GetString()
-                                            : "unknown"));
+            detail::DicomPixelData px;
+            if (const std::string bad = elementLengthProblem(slice.file, false, nullptr, &px); !bad.empty())
+                throw Error(where + ": corrupt DICOM: " + bad);
+            cachedFrames_ = px.found && !px.encapsulated && nativeSyntax(px.transferSyntax) ? decodeNative(slice.file, where, px, sliceBytes)
+                                                                                           : decodeWithGdcm(slice.file, where, sliceBytes);
             cachedFile_ = slice.file;
-            cachedFrames_ = frames;
         }
         if (slice.frame >= cachedFrames_) throw Error(fmt::format("{}: frame {} is missing", slice.file, slice.frame + 1));
         std::copy_n(cache_.data() + size_t(slice.frame) * sliceBytes, sliceBytes, out);
+    }
+
+    // The pixel format a file declares must be the series'.
+    void checkFormat(const std::string& where, uint64_t cols, uint64_t rows, unsigned samples, unsigned bits, unsigned representation) const {
+        if (int64_t(cols) != v_.dims[0] || int64_t(rows) != v_.dims[1])
+            throw Error(fmt::format("{}: holds {}x{} pixels where the series has {}x{}", where, cols, rows, v_.dims[0], v_.dims[1]));
+        if (samples != 1) throw Error(fmt::format("{}: holds {} samples per pixel; the series has 1", where, samples));
+        const std::optional<SampleType> t = sampleTypeOf(bits, representation);
+        if (!t || *t != v_.type)
+            throw Error(fmt::format("{}: its pixels decode as {} bits {} (Pixel Representation {}), not the series' {}", where, bits,
+                                    representation ? "signed" : "unsigned", representation, sampleTypeName(v_.type)));
+    }
+
+    // Native (uncompressed) pixel data, read by vdbdag from where the
+    // element walk found them: GDCM parses the header (the walk has checked
+    // its structure) but never the pixels, whose reader asserts on forged
+    // fields. As GDCM's image reader: the stored values as they are, byte
+    // swapped from big-endian, unused high bits cleared (sign-extended when
+    // signed) only where an overlay lives in them. Returns the frame count.
+    uint64_t decodeNative(const std::string& file, const std::string& where, const detail::DicomPixelData& px, size_t sliceBytes) {
+        gdcm::Reader reader;
+        reader.SetFileName(file.c_str());
+        if (!reader.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008), {gdcm::Tag(kPixelGroup, 0x0010)}))
+            throw Error(where + ": GDCM cannot read its header (truncated or corrupt?)");
+        const gdcm::DataSet& ds = reader.GetFile().GetDataSet();
+        const Fields f(reader.GetFile());
+        const auto number = [&](uint16_t g, uint16_t e, double fallback) {
+            const auto v = f.numbers(ds, g, e);
+            return v && v->size() == 1 && (*v)[0] >= 0 && (*v)[0] < 4294967296.0 ? (*v)[0] : fallback;
+        };
+        const uint64_t cols = uint64_t(number(0x0028, 0x0011, 0)), rows = uint64_t(number(0x0028, 0x0010, 0));
+        const unsigned bits = unsigned(number(0x0028, 0x0100, 0)), stored = unsigned(number(0x0028, 0x0101, 0));
+        const unsigned representation = unsigned(number(0x0028, 0x0103, 0));
+        checkFormat(where, cols, rows, unsigned(number(0x0028, 0x0002, 1)), bits, representation);
+        const uint64_t frames = std::max<uint64_t>(1, uint64_t(number(0x0028, 0x0008, 1)));
+        if (frames > px.length / sliceBytes)
+            throw Error(fmt::format("{}: its pixel data hold {} bytes, fewer than the {} bytes per frame its {} frame(s) need", where, px.length,
+                                    sliceBytes, frames));
+        cache_.resize(size_t(frames * sliceBytes));
+        std::FILE* in = std::fopen(file.c_str(), "rb");
+        const bool read = in && std::fseek(in, long(px.offset), SEEK_SET) == 0 && std::fread(cache_.data(), 1, cache_.size(), in) == cache_.size();
+        if (in) std::fclose(in);
+        if (!read) throw Error(fmt::format("{}: cannot read its {} bytes of pixel data", where, cache_.size()));
+        const size_t bytes = sampleBytes(v_.type);
+        if (px.bigEndian && bytes > 1)
+            for (size_t i = 0; i < cache_.size(); i += bytes) std::reverse(cache_.begin() + long(i), cache_.begin() + long(i + bytes));
+        bool overlayInPixels = false;  // (60xx,0010) Overlay Rows without (60xx,3000) Overlay Data
+        for (uint16_t g = 0x6000; g <= 0x601e; g += 2)
+            overlayInPixels |= ds.FindDataElement(gdcm::Tag(g, 0x0010)) && !ds.FindDataElement(gdcm::Tag(g, 0x3000));
+        if (overlayInPixels && stored > 0 && stored < bits) clearUnusedBits(stored, representation != 0);
+        return frames;
+    }
+
+    void clearUnusedBits(unsigned stored, bool isSigned) {
+        const size_t bytes = sampleBytes(v_.type);
+        for (size_t i = 0; i < cache_.size(); i += bytes) {
+            uint64_t v = 0;
+            std::memcpy(&v, cache_.data() + i, bytes);
+            v &= (uint64_t(1) << stored) - 1;
+            if (isSigned && (v >> (stored - 1) & 1)) v |= ~uint64_t(0) << stored;
+            std::memcpy(cache_.data() + i, &v, bytes);
+        }
+    }
+
+    // Compressed pixel data: GDCM's image reader and codecs, after the
+    // fields its reader asserts on are checked. Returns the frame count.
+    uint64_t decodeWithGdcm(const std::string& file, const std::string& where, size_t sliceBytes) {
+        {
+            gdcm::Reader header;
+            header.SetFileName(file.c_str());
+            if (!header.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008), {gdcm::Tag(kPixelGroup, 0x0010)}))
+                throw Error(where + ": GDCM cannot read its header (truncated or corrupt?)");
+            const Fields f(header.GetFile());
+            const std::string photometric = f.text(header.GetFile().GetDataSet(), 0x0028, 0x0004);
+            if (photometric != "MONOCHROME1" && photometric != "MONOCHROME2")
+                throw Error(fmt::format("{}: compressed pixel data with Photometric Interpretation '{}' (a greyscale series needs MONOCHROME1 or MONOCHROME2)",
+                                        where, photometric));
+        }
+        gdcm::ImageReader reader;
+        reader.SetFileName(file.c_str());
+        if (!reader.Read()) throw Error(where + ": GDCM cannot read it as a DICOM image (truncated or corrupt?)");
+        const gdcm::Image& image = reader.GetImage();
+        const gdcm::PixelFormat& pf = image.GetPixelFormat();
+        const unsigned dimsCount = image.GetNumberOfDimensions();
+        const uint64_t frames = dimsCount >= 3 ? image.GetDimension(2) : 1;
+        checkFormat(where, image.GetDimension(0), image.GetDimension(1), pf.GetSamplesPerPixel(), pf.GetBitsAllocated(), pf.GetPixelRepresentation());
+        const uint64_t length = image.GetBufferLength();
+        if (length < frames * sliceBytes)
+            throw Error(fmt::format("{}: its pixel data decode to {} bytes, fewer than the {} its {} frame(s) need", where, length, frames * sliceBytes, frames));
+        cache_.resize(size_t(length));
+        if (!image.GetBuffer(reinterpret_cast<char*>(cache_.data())))
+            throw Error(fmt::format("{}: GDCM cannot decode its pixel data (transfer syntax {}; truncated or corrupt?)", where,
+                                    reader.GetFile().GetHeader().GetDataSetTransferSyntax().GetString()
+                                        ? reader.GetFile().GetHeader().GetDataSetTransferSyntax().GetString()
+                                        : "unknown"));
+        return frames;
+    }
+
+    static bool nativeSyntax(const std::string& uid) {
+        // No file meta group (ACR-NEMA style), implicit LE, explicit LE, explicit BE.
+        return uid.empty() || uid == "1.2.840.10008.1.2" || uid == "1.2.840.10008.1.2.1" || uid == "1.2.840.10008.1.2.2";
     }
 
     DenseVolume v_;

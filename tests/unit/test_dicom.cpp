@@ -666,6 +666,41 @@ TEST(DicomSeries, AnElementLongerThanItsFileIsRefusedBeforeItIsAllocated) {
     EXPECT_NE(scan.skipped[0].find("claims 3204448256 bytes"), std::string::npos) << scan.skipped[0];
 }
 
+// Forged headers from fuzz_scan_headers (issue 38 #6), in-process so that an
+// abort ends this test: a Photometric Interpretation no greyscale has made
+// GDCM's image reader assert (gdcmPixmapReader.cxx) while the slices were
+// read; native pixel data are now read without it and the series is refused
+// in one line. Delimiters and item tags where DICOM has none are refused by
+// the element walk before GDCM parses the file.
+TEST(DicomSeries, ForgedHeadersAreRefusedBeforeGdcmAssertsOnThem) {
+    REQUIRE_REFERENCE();
+    const std::string source = petByPosition().front();
+    std::ifstream in(source, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    struct Case {
+        std::string from, to, expect;
+    };
+    for (const Case& c : std::vector<Case>{{"MONOCHROME2 ", "PALETTE COL ", "Photometric Interpretation 'PALETTE COL' is no greyscale"},
+                                           {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\xdd\xe0", 4), "a delimiter (FFFE,E0DD) at byte"},
+                                           {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\x00\x00", 4), "unknown item tag (FFFE,0000)"}}) {
+        const fs::path dir = freshDir("forged_header");
+        std::string forged = bytes;
+        const size_t at = forged.find(c.from);
+        ASSERT_NE(at, std::string::npos) << c.expect;
+        forged.replace(at, c.to.size(), c.to);
+        const fs::path bad = dir / "forged.dcm";
+        std::ofstream(bad, std::ios::binary) << forged;
+        const std::string m = errorOf([&] {
+            const DenseVolume v = describeDicomSeries(bad.string(), "");
+            std::vector<uint8_t> slab;
+            openDicomSlices(v)->readSlices(v.dims[2], slab);
+        });
+        EXPECT_TRUE(oneLine(m)) << m;
+        EXPECT_EQ(m.rfind(bad.string() + ": ", 0), 0u) << m;
+        EXPECT_NE(m.find(c.expect), std::string::npos) << m;
+    }
+}
+
 // A list of files (extensionless, named on the command line in no useful
 // order, one of them twice) is one set: its series equals pydicom's stack
 // of the folder; a non-DICOM file among the inputs is refused in one line.

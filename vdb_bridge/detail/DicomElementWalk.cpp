@@ -1,0 +1,220 @@
+// The element walk that guards GDCM (see DicomElementWalk.h).
+#include "vdb_bridge/detail/DicomElementWalk.h"
+
+#include <cctype>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <set>
+#include <vector>
+
+#include <fmt/core.h>
+
+namespace vdbdag::bridge::detail {
+namespace fs = std::filesystem;
+constexpr uint16_t kPixelGroup = 0x7fe0;
+
+// GDCM reads a file cut short inside native (uncompressed) pixel data
+// without complaint. The Pixel Data element's header is found in the file
+// (its tag followed by its length, explicit or implicit VR, the first such
+// match) and the file must hold all of its value. Returns "" when it does or
+// when the element cannot be found (deflated data sets).
+std::string checkNativeLength(const std::string& path, uint32_t length, bool bigEndian) {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (!file) return "";
+    std::error_code ec;
+    const uint64_t size = fs::file_size(path, ec);
+    const uint8_t tag[4] = {uint8_t(bigEndian ? 0x7f : 0xe0), uint8_t(bigEndian ? 0xe0 : 0x7f), uint8_t(bigEndian ? 0x00 : 0x10),
+                            uint8_t(bigEndian ? 0x10 : 0x00)};
+    const auto u32 = [&](const uint8_t* p) {
+        return bigEndian ? uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]
+                         : uint32_t(p[3]) << 24 | uint32_t(p[2]) << 16 | uint32_t(p[1]) << 8 | p[0];
+    };
+    constexpr size_t kChunk = size_t(1) << 16, kKeep = 12;
+    std::vector<uint8_t> buf;
+    uint64_t bufStart = 0;  // file offset of buf[0]
+    std::string result;
+    std::vector<uint8_t> chunk(kChunk);
+    for (;;) {
+        const size_t got = std::fread(chunk.data(), 1, kChunk, file);
+        buf.insert(buf.end(), chunk.begin(), chunk.begin() + ptrdiff_t(got));
+        bool found = false;
+        for (size_t i = 0; i + kKeep <= buf.size() && !found; ++i) {
+            if (std::memcmp(buf.data() + i, tag, 4) != 0) continue;
+            const uint8_t* p = buf.data() + i + 4;
+            uint64_t header = 0;
+            if ((p[0] == 'O' && (p[1] == 'W' || p[1] == 'B')) && p[2] == 0 && p[3] == 0 && u32(p + 4) == length) header = 12;
+            else if (u32(p) == length) header = 8;
+            if (!header) continue;
+            found = true;
+            const uint64_t end = bufStart + i + header + length;
+            if (end > size)
+                result = fmt::format("is truncated: its pixel data are {} bytes from byte {} on, but the file holds only {} of them", length, bufStart + i + header,
+                                     size - (bufStart + i + header));
+        }
+        if (found || got < kChunk) break;
+        if (buf.size() > kKeep) {  // keep the tail: a header may straddle chunks
+            bufStart += buf.size() - kKeep;
+            buf.erase(buf.begin(), buf.end() - ptrdiff_t(kKeep));
+        }
+    }
+    std::fclose(file);
+    return result;
+}
+
+namespace {
+
+// GDCM allocates each element's declared length before it reads the bytes,
+// so a 1 KB file that declares a 3 GB element makes it allocate (and touch)
+// 3 GB. This walk reads only the element headers (tag, VR, length; into
+// sequences and items of undefined length) and refuses any length that runs
+// past the end of the file, before GDCM sees it. "" when the file passes
+// (or is not DICOM at all, which GDCM then reports). `beforePixels`: stop at
+// the Pixel Data element (a header read; a short pixel data element is a
+// truncated slice, which the series check names).
+// `pixelLength`: set to the Pixel Data element's declared length when it is
+// that element that runs past the end.
+std::string walkElementLengths(const std::string& path, bool beforePixels, uint64_t* pixelLength, bool& unknownStart, DicomPixelData* pixels) {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (!file) return "";
+    struct Closer {
+        std::FILE* f;
+        ~Closer() { std::fclose(f); }
+    } closer{file};
+    std::error_code ec;
+    const uint64_t size = fs::file_size(path, ec);
+    if (ec) return "";
+    auto readAt = [&](uint64_t at, void* out, size_t n) {
+        return at + n <= size && std::fseek(file, long(at), SEEK_SET) == 0 && std::fread(out, 1, n, file) == n;
+    };
+    uint64_t pos = 0;
+    char magic[4];
+    if (readAt(128, magic, 4) && std::memcmp(magic, "DICM", 4) == 0) pos = 132;
+    bool explicitVr = true, bigEndian = false, metaGroup = pos == 132, declaredImplicit = false;
+    unknownStart = false;
+    if (pos == 0) {  // no preamble: walk only what starts like a DICOM dataset (else GDCM refuses it as not DICOM)
+        uint8_t h[6];
+        // GDCM asserts (aborts) on a file shorter than one element header
+        // (02 00 00 00, E0 7F 10 00: found by fuzz_scan_headers).
+        if (size > 0 && size < 8) return fmt::format("the file ({} bytes) ends inside its first element", size);
+        if (!readAt(0, h, 6)) return "";
+        uint16_t group = uint16_t(h[0] | h[1] << 8);
+        if (group == 0x0200 || group == 0x0800) {  // big-endian: GDCM reads it so (and asserts on a cut-off element)
+            bigEndian = true;
+            group = uint16_t(h[0] << 8 | h[1]);
+        }
+        // Neither a file meta group nor a dataset's first group: GDCM still
+        // parses it as a dataset (and allocated 1.8 GB for a 107-byte file
+        // whose bytes read as a 1.8 GB element: found by fuzz_scan_headers),
+        // so it is walked the same way, its VRs taken as they come.
+        unknownStart = group != 0x0002 && group != 0x0008;
+        explicitVr = std::isupper(h[4]) && std::isupper(h[5]);
+        declaredImplicit = !explicitVr && !unknownStart;
+        metaGroup = group == 0x0002;
+    }
+    auto u16 = [&](const uint8_t* b) { return bigEndian ? uint16_t(b[0] << 8 | b[1]) : uint16_t(b[0] | b[1] << 8); };
+    auto u32 = [&](const uint8_t* b) {
+        return bigEndian ? uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | b[3] : uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+    };
+    std::string transferSyntax;
+    unsigned depth = 0;  // sequences and items of undefined length the walk is inside
+    for (unsigned steps = 0; pos + 8 <= size && steps < 10'000'000; ++steps) {
+        uint8_t h[12];
+        if (!readAt(pos, h, 8)) break;
+        const bool inMeta = metaGroup && (h[0] | h[1] << 8) == 0x0002;
+        if (metaGroup && !inMeta) {  // the meta group ends: the dataset's encoding from its transfer syntax
+            metaGroup = false;
+            if (transferSyntax == "1.2.840.10008.1.2") explicitVr = false, declaredImplicit = true;
+            else if (transferSyntax == "1.2.840.10008.1.2.2") bigEndian = true;
+            else if (transferSyntax == "1.2.840.10008.1.2.1.99") return "";  // deflated: GDCM inflates and checks
+        }
+        const bool le = inMeta || !bigEndian;
+        const uint16_t group = le ? uint16_t(h[0] | h[1] << 8) : u16(h), element = le ? uint16_t(h[2] | h[3] << 8) : u16(h + 2);
+        uint64_t length, header;
+        if (group == 0xFFFE) {  // item and delimiters: always a 4-byte length
+            length = le ? uint32_t(h[4]) | uint32_t(h[5]) << 8 | uint32_t(h[6]) << 16 | uint32_t(h[7]) << 24 : u32(h + 4);
+            header = 8;
+            // GDCM asserts on an item tag it does not know and on a
+            // sequence delimiter where an element belongs.
+            if (element != 0xE000 && element != 0xE00D && element != 0xE0DD)
+                return fmt::format("unknown item tag (FFFE,{:04X}) at byte {}", element, pos);
+            if (element != 0xE000) {  // delimiters
+                if (depth == 0) return fmt::format("a delimiter (FFFE,{:04X}) at byte {} outside any sequence or item", element, pos);
+                --depth;
+                length = 0;
+            }
+            if (length == 0xFFFFFFFFu) length = 0, ++depth;  // an item of undefined length: walk into it
+            else if (element == 0xE000 && length > size - pos - header)
+                return fmt::format("item at byte {} claims {} bytes, but only {} follow", pos, length, size - pos - header);
+            pos += header + (element == 0xE000 && length ? length : 0);
+            continue;
+        }
+        const char vr[3] = {char(h[4]), char(h[5]), 0};
+        // GDCM asserts (aborts) on a meta group element whose VR is not one of DICOM's.
+        static const std::set<std::string> knownVr{"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL", "IS", "LO", "LT", "OB", "OD", "OF",
+                                                   "OL", "OV", "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC", "UI", "UL", "UN",
+                                                   "UR", "US", "UT", "UV"};
+        if (inMeta && !knownVr.count(vr)) return fmt::format("file meta element ({:04X},{:04X}) at byte {} has no valid VR", group, element, pos);
+        // An implicit transfer syntax is read as implicit (as GDCM does); under
+        // an explicit one, an element whose VR bytes are no VR as implicit.
+        if (!inMeta && !declaredImplicit) explicitVr = knownVr.count(vr) > 0;
+        if (inMeta || explicitVr) {
+            static const std::set<std::string> longVr{"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
+            if (longVr.count(vr)) {
+                if (!readAt(pos, h, 12)) return fmt::format("element ({:04X},{:04X}) at byte {} is cut off", group, element, pos);
+                length = le ? uint32_t(h[8]) | uint32_t(h[9]) << 8 | uint32_t(h[10]) << 16 | uint32_t(h[11]) << 24 : u32(h + 8);
+                header = 12;
+            } else {
+                length = le ? uint16_t(h[6] | h[7] << 8) : u16(h + 6);
+                header = 8;
+            }
+        } else {
+            length = u32(h + 4);
+            header = 8;
+        }
+        if (inMeta && length == 0xFFFFFFFFu)  // GDCM asserts on it too
+            return fmt::format("file meta element ({:04X},{:04X}) at byte {} has an undefined length", group, element, pos);
+        if (beforePixels && group == kPixelGroup && element == 0x0010 && depth == 0) return "";
+        const bool pixelData = group == kPixelGroup && element == 0x0010 && depth == 0;
+        if (pixels && pixelData && !pixels->found) {
+            pixels->found = true;
+            pixels->encapsulated = length == 0xFFFFFFFFu;
+            pixels->offset = pos + header;
+            pixels->length = pixels->encapsulated ? 0 : length;
+            pixels->bigEndian = bigEndian;
+            pixels->transferSyntax = transferSyntax;
+        }
+        if (length == 0xFFFFFFFFu) {  // a sequence or encapsulated pixel data: walk into it
+            pos += header;
+            ++depth;
+            continue;
+        }
+        if (length > size - pos - header) {
+            if (pixelLength && group == kPixelGroup && element == 0x0010) *pixelLength = length;
+            return fmt::format("element ({:04X},{:04X}) at byte {} claims {} bytes, but only {} follow", group, element, pos, length, size - pos - header);
+        }
+        if (inMeta && element == 0x0010 && length < 256) {
+            std::string uid(length, '\0');
+            readAt(pos + header, uid.data(), length);
+            while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' ')) uid.pop_back();
+            transferSyntax = uid;
+        }
+        pos += header + length;
+    }
+    // A file that ends inside its file meta group (GDCM asserts on it).
+    if (metaGroup) return fmt::format("the file ends inside its file meta group (at byte {} of {})", pos, size);
+    return "";
+}
+
+} // namespace
+
+std::string elementLengthProblem(const std::string& path, bool beforePixels, uint64_t* pixelLength, DicomPixelData* pixels) {
+    bool unknownStart = false;
+    if (pixels) *pixels = DicomPixelData{};
+    const std::string problem = walkElementLengths(path, beforePixels, pixelLength, unknownStart, pixels);
+    // What starts like no DICOM and does not walk as one is not DICOM.
+    if (!problem.empty() && unknownStart) return "not a DICOM file (no DICM preamble, and read as one: " + problem + ")";
+    return problem;
+}
+
+} // namespace vdbdag::bridge::detail
