@@ -670,8 +670,9 @@ TEST(DicomSeries, AnElementLongerThanItsFileIsRefusedBeforeItIsAllocated) {
 // abort ends this test: a Photometric Interpretation no greyscale has made
 // GDCM's image reader assert (gdcmPixmapReader.cxx) while the slices were
 // read; native pixel data are now read without it and the series is refused
-// in one line. Delimiters and item tags where DICOM has none are refused by
-// the element walk before GDCM parses the file.
+// in one line. Items, delimiters and item tags where DICOM has none are
+// refused by the element walk before GDCM parses the file (an item where an
+// element belongs made GDCM's header reader assert).
 TEST(DicomSeries, ForgedHeadersAreRefusedBeforeGdcmAssertsOnThem) {
     REQUIRE_REFERENCE();
     const std::string source = petByPosition().front();
@@ -682,7 +683,9 @@ TEST(DicomSeries, ForgedHeadersAreRefusedBeforeGdcmAssertsOnThem) {
     };
     for (const Case& c : std::vector<Case>{{"MONOCHROME2 ", "PALETTE COL ", "Photometric Interpretation 'PALETTE COL' is no greyscale"},
                                            {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\xdd\xe0", 4), "a delimiter (FFFE,E0DD) at byte"},
-                                           {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\x00\x00", 4), "unknown item tag (FFFE,0000)"}}) {
+                                           {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\x00\x00", 4), "unknown item tag (FFFE,0000)"},
+                                           // GDCM aborts on it (gdcmImplicitDataElement.txx:66, also in gdcmdump)
+                                           {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\x00\xe0", 4), "an item (FFFE,E000) at byte"}}) {
         const fs::path dir = freshDir("forged_header");
         std::string forged = bytes;
         const size_t at = forged.find(c.from);

@@ -117,8 +117,29 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         return bigEndian ? uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | b[3] : uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
     };
     std::string transferSyntax;
-    unsigned depth = 0;  // sequences and items of undefined length the walk is inside
-    for (unsigned steps = 0; pos + 8 <= size && steps < 10'000'000; ++steps) {
+    // Where the walk is: the data set, a sequence (its items), encapsulated
+    // pixel data (their fragments) or an item (its elements), each of a
+    // defined length (it ends at `end`) or an undefined one (a delimiter
+    // ends it). GDCM asserts on an item where an element belongs and on an
+    // element where an item belongs, so neither passes.
+    enum class Kind { DataSet, Sequence, Fragments, Item };
+    struct Frame {
+        Kind kind;
+        uint64_t end;  // 0: undefined length
+    };
+    std::vector<Frame> frames{{Kind::DataSet, 0}};
+    const auto enter = [&](Kind kind, uint64_t at, uint64_t length) -> std::string {
+        if (frames.size() >= 64) return fmt::format("sequences nested more than 64 deep at byte {}", at);
+        frames.push_back({kind, length == 0xFFFFFFFFu ? 0 : at + length});
+        return "";
+    };
+    for (unsigned steps = 0; steps < 10'000'000; ++steps) {
+        while (frames.size() > 1 && frames.back().end && pos >= frames.back().end) {
+            if (pos > frames.back().end) return fmt::format("an element at byte {} runs past the end of its sequence or item", pos);
+            frames.pop_back();
+        }
+        if (pos + 8 > size) break;
+        const Kind where = frames.back().kind;
         uint8_t h[12];
         if (!readAt(pos, h, 8)) break;
         const bool inMeta = metaGroup && (h[0] | h[1] << 8) == 0x0002;
@@ -134,21 +155,27 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         if (group == 0xFFFE) {  // item and delimiters: always a 4-byte length
             length = le ? uint32_t(h[4]) | uint32_t(h[5]) << 8 | uint32_t(h[6]) << 16 | uint32_t(h[7]) << 24 : u32(h + 4);
             header = 8;
-            // GDCM asserts on an item tag it does not know and on a
-            // sequence delimiter where an element belongs.
-            if (element != 0xE000 && element != 0xE00D && element != 0xE0DD)
-                return fmt::format("unknown item tag (FFFE,{:04X}) at byte {}", element, pos);
-            if (element != 0xE000) {  // delimiters
-                if (depth == 0) return fmt::format("a delimiter (FFFE,{:04X}) at byte {} outside any sequence or item", element, pos);
-                --depth;
-                length = 0;
+            const bool inSequence = where == Kind::Sequence || where == Kind::Fragments;
+            if (element == 0xE000) {
+                if (!inSequence) return fmt::format("an item (FFFE,E000) at byte {} where an element belongs", pos);
+                if (length != 0xFFFFFFFFu && length > size - pos - header)
+                    return fmt::format("item at byte {} claims {} bytes, but only {} follow", pos, length, size - pos - header);
+                pos += header;
+                // A fragment is bytes; an item holds elements.
+                if (where == Kind::Fragments) pos += length == 0xFFFFFFFFu ? 0 : length;
+                else if (const std::string bad = enter(Kind::Item, pos, length); !bad.empty()) return bad;
+                continue;
             }
-            if (length == 0xFFFFFFFFu) length = 0, ++depth;  // an item of undefined length: walk into it
-            else if (element == 0xE000 && length > size - pos - header)
-                return fmt::format("item at byte {} claims {} bytes, but only {} follow", pos, length, size - pos - header);
-            pos += header + (element == 0xE000 && length ? length : 0);
+            const bool endsItem = element == 0xE00D && where == Kind::Item, endsSequence = element == 0xE0DD && inSequence;
+            if (element != 0xE00D && element != 0xE0DD) return fmt::format("unknown item tag (FFFE,{:04X}) at byte {}", element, pos);
+            if ((!endsItem && !endsSequence) || frames.back().end)
+                return fmt::format("a delimiter (FFFE,{:04X}) at byte {} outside a sequence or item of undefined length it could end", element, pos);
+            frames.pop_back();
+            pos += header;
             continue;
         }
+        if (where == Kind::Sequence || where == Kind::Fragments)
+            return fmt::format("an element ({:04X},{:04X}) at byte {} where an item belongs", group, element, pos);
         const char vr[3] = {char(h[4]), char(h[5]), 0};
         // GDCM asserts (aborts) on a meta group element whose VR is not one of DICOM's.
         static const std::set<std::string> knownVr{"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL", "IS", "LO", "LT", "OB", "OD", "OF",
@@ -174,8 +201,8 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         }
         if (inMeta && length == 0xFFFFFFFFu)  // GDCM asserts on it too
             return fmt::format("file meta element ({:04X},{:04X}) at byte {} has an undefined length", group, element, pos);
-        if (beforePixels && group == kPixelGroup && element == 0x0010 && depth == 0) return "";
-        const bool pixelData = group == kPixelGroup && element == 0x0010 && depth == 0;
+        const bool pixelData = group == kPixelGroup && element == 0x0010 && frames.size() == 1;
+        if (beforePixels && pixelData) return "";
         if (pixels && pixelData && !pixels->found) {
             pixels->found = true;
             pixels->encapsulated = length == 0xFFFFFFFFu;
@@ -186,7 +213,8 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         }
         if (length == 0xFFFFFFFFu) {  // a sequence or encapsulated pixel data: walk into it
             pos += header;
-            ++depth;
+            if (const std::string bad = enter(group == kPixelGroup && element == 0x0010 ? Kind::Fragments : Kind::Sequence, pos, length); !bad.empty())
+                return bad;
             continue;
         }
         if (length > size - pos - header) {
@@ -199,9 +227,17 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
             while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' ')) uid.pop_back();
             transferSyntax = uid;
         }
+        // An explicit SQ of defined length: GDCM reads its items, so the walk does.
+        if ((inMeta || explicitVr) && std::string(vr) == "SQ" && length > 0) {
+            pos += header;
+            if (const std::string bad = enter(Kind::Sequence, pos, length); !bad.empty()) return bad;
+            continue;
+        }
         pos += header + length;
     }
     // A file that ends inside its file meta group (GDCM asserts on it).
+    if (frames.size() > 1 && !unknownStart)
+        return fmt::format("the file ends inside a sequence or item (at byte {} of {})", pos, size);
     if (metaGroup) return fmt::format("the file ends inside its file meta group (at byte {} of {})", pos, size);
     return "";
 }
