@@ -10,6 +10,7 @@
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
+#include "src/attributes/ContextChannel.h"
 #include "src/attributes/PaletteCompressor.h"
 #include "src/attributes/PredictedChannel.h"
 #include "src/format/ByteIO.h"
@@ -22,16 +23,20 @@ namespace {
 constexpr uint64_t kSmallWindowBytes = uint64_t(4) << 20;  // level 9 up to this, then 3 (the container's rule)
 constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;
 
-// A window's raw bytes: its coding byte, then the smaller (by zstd's fast
-// estimate) of its palettes and its residuals.
+// A window's raw bytes: its coding byte, then the smaller of its palettes
+// (by zstd's fast estimate) and its entries coded from their neighbours:
+// context-modelled (int32; range coded already) or brick MED residuals
+// (int64, zstd's estimate).
 std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, uint32_t vs) {
     std::vector<uint8_t> palette = serializePalette(compressPalette(values, vs));
-    std::vector<uint8_t> predicted = encodePredicted(values, vs, layout);
-    const bool usePredicted = format::zstdFastSize(predicted) < format::zstdFastSize(palette);
+    const bool contextCoded = vs == 4;
+    std::vector<uint8_t> predicted = contextCoded ? encodeContextChannel(values, layout) : encodePredicted(values, vs, layout);
+    const uint64_t predictedSize = contextCoded ? predicted.size() : format::zstdFastSize(predicted);
+    const bool usePredicted = predictedSize < format::zstdFastSize(palette);
     std::vector<uint8_t>& chosen = usePredicted ? predicted : palette;
     std::vector<uint8_t> raw;
     raw.reserve(chosen.size() + 1);
-    raw.push_back(usePredicted ? detail::kPredictedCoding : detail::kPaletteCoding);
+    raw.push_back(!usePredicted ? detail::kPaletteCoding : contextCoded ? detail::kContextCoding : detail::kPredictedCoding);
     raw.insert(raw.end(), chosen.begin(), chosen.end());
     return raw;
 }

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstring>
 
+#include "src/attributes/ContextChannel.h"
 #include "src/attributes/PredictedChannel.h"
 #include "src/format/ByteIO.h"
 #include "src/format/ZstdFrame.h"
@@ -74,7 +75,12 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
                         std::to_string(e.entries) + " of " + std::to_string(dir.valueSize));
         return c.decodeAll();
     }
-    if (raw[0] == detail::kPredictedCoding) return decodePredicted(body, dir.valueSize, layout.subspan(size_t(e.firstBrick), size_t(e.bricks)), where);
+    const std::span<const uint64_t> bricks = layout.subspan(size_t(e.firstBrick), size_t(e.bricks));
+    if (raw[0] == detail::kPredictedCoding) return decodePredicted(body, dir.valueSize, bricks, where);
+    if (raw[0] == detail::kContextCoding) {
+        if (dir.valueSize != 4) throw Error(where + ": a context-coded window of " + std::to_string(dir.valueSize) + "-byte values (int32 only)");
+        return decodeContextChannel(body, bricks, e.entries, where);
+    }
     throw Error(where + ": unknown coding " + std::to_string(raw[0]));
 }
 

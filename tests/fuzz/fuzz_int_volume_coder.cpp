@@ -1,14 +1,17 @@
-// libFuzzer target for src/coding/IntVolumeCoder: the first 8 bytes choose
-// a small shape (up to 16^3), the sample range and near; the rest is (a) a
-// stream to decode, which must throw vdbdag::Error or give samples inside
-// the range, never crash or read out of bounds, and (b) the samples of a
-// volume to encode, whose decode must give every sample back (within near).
+// libFuzzer target for src/coding/IntVolumeCoder and BrickValueCoder: the
+// first 8 bytes choose a small shape (up to 16^3; for the brick coder, byte
+// 7 odd, a layout of up to 16 bricks whose masks come from the data, tiles
+// among them), the sample range and near; the rest is (a) a stream to
+// decode, which must throw vdbdag::Error or give samples inside the range,
+// never crash or read out of bounds, and (b) the samples of a volume to
+// encode, whose decode must give every sample back (within near).
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <span>
 #include <vector>
 
+#include "src/coding/BrickValueCoder.h"
 #include "src/coding/IntVolumeCoder.h"
 #include "src/util/Error.h"
 
@@ -23,21 +26,37 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     o.maxValue = std::min<int64_t>(INT32_MAX, o.minValue + (int64_t(1) << bits) - 1);
     o.near = data[5] % 4 == 0 ? data[6] % 5 : 0;
     const std::span<const uint8_t> rest(data + 8, size - 8);
-    std::vector<int32_t> out(shape.count());
+    const bool bricks = data[7] & 1;
+    std::vector<uint64_t> layout;
+    if (bricks) {
+        for (unsigned b = 0; b < 1u + data[0] % 16; ++b) {
+            uint64_t mask = 0;
+            const size_t at = (b * 8) % std::max<size_t>(1, rest.size());
+            if (!rest.empty()) std::memcpy(&mask, rest.data() + at, std::min<size_t>(8, rest.size() - at));
+            layout.push_back(b % 5 == 4 ? 0 : mask);
+        }
+    }
+    const auto decode = [&](std::span<const uint8_t> stream, std::vector<int32_t>& out) {
+        if (bricks) decodeBrickValues(stream, layout, o, out, "fuzz");
+        else decodeIntVolume(stream, shape, o, out);
+    };
+    const auto encode = [&](const std::vector<int32_t>& samples) { return bricks ? encodeBrickValues(samples, layout, o) : encodeIntVolume(samples, shape, o); };
+    const uint64_t count = bricks ? layoutEntryCount(layout) : shape.count();
+    std::vector<int32_t> out(count);
     try {
-        decodeIntVolume(rest, shape, o, out);
+        decode(rest, out);
         for (int32_t x : out)
             if (x < o.minValue || x > o.maxValue) std::abort();
     } catch (const vdbdag::Error&) {
     }
-    std::vector<int32_t> samples(shape.count());
+    std::vector<int32_t> samples(count);
     for (size_t i = 0; i < samples.size(); ++i) {
         uint32_t raw = 0;
         if (!rest.empty()) std::memcpy(&raw, rest.data() + (i * 4) % rest.size(), std::min<size_t>(4, rest.size() - (i * 4) % rest.size()));
         samples[i] = int32_t(o.minValue + int64_t(raw % uint64_t(o.maxValue - o.minValue + 1)));
     }
-    const std::vector<uint8_t> bytes = encodeIntVolume(samples, shape, o);
-    decodeIntVolume(bytes, shape, o, out);
+    const std::vector<uint8_t> bytes = encode(samples);
+    decode(bytes, out);
     for (size_t i = 0; i < samples.size(); ++i)
         if (std::abs(int64_t(out[i]) - samples[i]) > o.near) std::abort();
     return 0;

@@ -1,0 +1,43 @@
+// Lossless (and near-lossless) coding of int32 entries in a DAG's attribute
+// order: the brick instances of a layout (attributes/PredictedChannel.h: per
+// instance its stored mask, 0 for a tile) in order, each brick's entries in
+// its stored raster order (bit i: x = i & 3, y = (i >> 2) & 3, z = i >> 4).
+// Each entry is predicted, context-modelled and range coded by the model of
+// SamplePredictor.h from its causal neighbours inside the same brick (W, N,
+// NW, NE in its slice; P, PW, PN, PNW in the slice below; a missing one is
+// replaced as IntVolumeCoder replaces a neighbour beyond the volume's face,
+// and an entry with none at all is predicted by the previous entry in
+// attribute order, whose record then stands in for W's). A tile is one
+// entry without neighbours.
+//
+// It is the coding of a predicted window that beats brick MED + zstd byte
+// planes (PredictedChannel.h) by modelling the residuals instead of
+// compressing them as bytes; neighbours across brick boundaries are the
+// next step (docs/CODING.md).
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "src/coding/IntVolumeCoder.h"
+
+namespace vdbdag::coding {
+
+// Codes `entries` (as many as `layout` implies). Throws vdbdag::Error when
+// an entry lies outside [minValue, maxValue] or the layout and the entries
+// disagree. With near > 0, `reconstructed` (if given) receives what the
+// decoder will produce.
+std::vector<uint8_t> encodeBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, const IntCoderOptions& options,
+                                       std::vector<int32_t>* reconstructed = nullptr);
+
+// Decodes into `out` (as many entries as `layout` implies). Throws
+// vdbdag::Error naming `what` on a corrupt or truncated stream; never reads
+// outside `bytes`; its time is bounded by the entry count.
+void decodeBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, const IntCoderOptions& options, std::span<int32_t> out,
+                       const std::string& what);
+
+// The entries `layout` implies (a tile counts one).
+uint64_t layoutEntryCount(std::span<const uint64_t> layout);
+
+} // namespace vdbdag::coding

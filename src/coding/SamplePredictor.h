@@ -1,0 +1,196 @@
+// The per-sample model of the integer value coders (docs/CODING.md): six
+// predictions from a causal 3-D neighbourhood blended by their local errors,
+// an activity context, bias correction, and the residual's binary coding.
+// IntVolumeCoder walks a raster box with it, BrickValueCoder the 4^3 bricks
+// of a DAG's attribute order; both hand it the same neighbourhood
+//      this slice:  NW N NE        previous slice:  PNW PN
+//                   W  *                            PW  P
+// (with substitutes where a neighbour is missing) and the records the
+// neighbours left, so the two cannot drift apart.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <cstdlib>
+#include <vector>
+
+#include "src/coding/RangeCoder.h"
+
+namespace vdbdag::coding::detail {
+
+inline constexpr int kPredictors = 6;
+inline constexpr int kContexts = 44;    // residual-activity buckets: half bit lengths
+inline constexpr int kMaxLength = 40;   // bit length of a residual magnitude (|e| < 2^34 fits)
+inline constexpr int kBiasWindow = 64;  // bias statistics are halved at this count
+
+// What a coded sample leaves for its neighbours: each predictor's error and
+// the final residual's magnitude and sign.
+struct SampleRecord {
+    std::array<uint32_t, kPredictors> err{};
+    uint32_t residual = 0;
+    int8_t sign = 0;  // -1, 0, 1
+};
+
+// The models of one activity context.
+struct ContextModels {
+    std::array<BitModel, 27> zero, sign;                        // by the signs of W's, N's and P's residuals
+    std::array<BitModel, kMaxLength + 1> length;                // unary bit length
+    std::array<std::array<BitModel, 4>, kMaxLength + 1> high;   // the two bits below the leading one, as a prefix tree
+    int64_t biasSum = 0;
+    int32_t biasCount = 0;
+};
+
+struct Models {
+    std::array<ContextModels, kContexts> ctx;
+    std::array<std::array<BitModel, kMaxLength + 1>, kMaxLength + 1> low;  // [length][bit]: the remaining bits
+};
+
+inline uint32_t saturate(int64_t v) { return v > int64_t(UINT32_MAX) ? UINT32_MAX : uint32_t(v); }
+
+inline int64_t divRound(int64_t a, int64_t b) { return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b); }
+
+inline int64_t med(int64_t w, int64_t n, int64_t nw) {
+    if (nw >= std::max(w, n)) return std::min(w, n);
+    if (nw <= std::min(w, n)) return std::max(w, n);
+    return w + n - nw;
+}
+
+// A predictor's weight from its summed local errors E: 2^26 / (1 + E)^2 + 1
+// (E capped at 2^13), from a table: the blend's only divisions otherwise.
+// 2^26 keeps the weighted sum of six int32 predictions inside int64.
+inline int64_t weightOf(uint64_t errors) {
+    constexpr uint32_t kWeightCap = 1u << 13;
+    static const std::vector<uint32_t> table = [] {
+        std::vector<uint32_t> t(kWeightCap + 1);
+        for (uint64_t e = 0; e <= kWeightCap; ++e) t[e] = uint32_t((uint64_t(1) << 26) / ((1 + e) * (1 + e))) + 1;
+        return t;
+    }();
+    return table[errors < kWeightCap ? errors : kWeightCap];
+}
+
+// The neighbourhood of one sample: values (substitutes where missing) and
+// the records of W, N and P (a default record where missing).
+struct Neighbourhood {
+    int64_t W = 0, N = 0, NW = 0, NE = 0, P = 0, PW = 0, PN = 0, PNW = 0;
+    const SampleRecord* rW = nullptr;
+    const SampleRecord* rN = nullptr;
+    const SampleRecord* rP = nullptr;
+    // Summed over N, P (twice) and NE, NW, PW, PN (once): each predictor's
+    // errors and the residual magnitudes. W's part is added by predict().
+    std::array<uint64_t, kPredictors> errorsAbove{};
+    uint64_t residualsAbove = 0;
+};
+
+// One sample's prediction, and what it needs to learn from the sample.
+struct Prediction {
+    std::array<int64_t, kPredictors> p{};
+    int64_t blend = 0, value = 0;  // value: the final prediction
+    ContextModels* ctx = nullptr;
+    unsigned signs = 0;
+};
+
+inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxValue, Models& models) {
+    Prediction out;
+    const int64_t inPlane = med(n.W, n.N, n.NW);
+    out.p = {inPlane, n.W + n.N + n.P - n.NW - n.PW - n.PN + n.PNW, n.P + inPlane - med(n.PW, n.PN, n.PNW), n.W + n.NE - n.N, n.N + n.P - n.PN,
+             n.W + n.P - n.PW};
+    for (int64_t& q : out.p) q = std::clamp(q, minValue, maxValue);  // a prediction outside the range helps no one
+    const SampleRecord none{};
+    const SampleRecord& rW = n.rW ? *n.rW : none;
+    const SampleRecord& rN = n.rN ? *n.rN : none;
+    const SampleRecord& rP = n.rP ? *n.rP : none;
+    int64_t weightSum = 0, weighted = 0;  // |weighted| < 6 x (2^26 + 1) x 2^31 < 2^60
+    for (size_t k = 0; k < size_t(kPredictors); ++k) {
+        const int64_t w = weightOf((n.errorsAbove[k] + 2 * uint64_t(rW.err[k])) / 2);  // 2 (W + N + P) + NE + NW + PW + PN, halved
+        weightSum += w;
+        weighted += w * out.p[k];
+    }
+    out.blend = std::clamp(divRound(weighted, weightSum), std::min({n.W, n.N, n.NE, n.P}), std::max({n.W, n.N, n.NE, n.P}));
+    const uint64_t gradient = uint64_t(std::abs(n.W - n.NW) + std::abs(n.N - n.NW) + std::abs(n.NE - n.N) + std::abs(n.P - med(n.PW, n.PN, n.PNW)));
+    const uint64_t activity = (n.residualsAbove + 2 * uint64_t(rW.residual)) / 2 + gradient / 2;
+    const int length = 64 - std::countl_zero(activity);
+    const int context = std::min(kContexts - 1, 2 * length + (length >= 2 ? int(activity >> (length - 2)) & 1 : 0));
+    out.ctx = &models.ctx[size_t(context)];
+    const int64_t bias = out.ctx->biasCount ? divRound(out.ctx->biasSum, out.ctx->biasCount) : 0;
+    out.value = std::clamp(out.blend + bias, minValue, maxValue);
+    out.signs = unsigned(9 * (rP.sign + 1) + 3 * (rW.sign + 1) + (rN.sign + 1));
+    return out;
+}
+
+// What the neighbours learn from the reconstructed `value`: its record and
+// the context's bias.
+inline void learn(const Prediction& pr, int64_t value, SampleRecord& r) {
+    for (size_t k = 0; k < size_t(kPredictors); ++k) r.err[k] = saturate(std::abs(pr.p[k] - value));
+    r.residual = saturate(std::abs(value - pr.value));
+    r.sign = int8_t((value > pr.value) - (value < pr.value));
+    ContextModels& c = *pr.ctx;
+    c.biasSum += value - pr.blend;
+    if (++c.biasCount == kBiasWindow) {
+        c.biasSum = divRound(c.biasSum, 2);
+        c.biasCount /= 2;
+    }
+}
+
+// Residual coding under one context: a zero flag, a sign, the magnitude's
+// bit length in unary, the two bits below the leading one (a prefix tree),
+// the rest by position.
+inline void putResidual(RangeEncoder& rc, Models& models, ContextModels& c, unsigned signs, int64_t e) {
+    rc.encode(c.zero[signs], e != 0);
+    if (e == 0) return;
+    rc.encode(c.sign[signs], e < 0);
+    const uint64_t m = uint64_t(e < 0 ? -e : e);
+    const int k = 64 - std::countl_zero(m);  // 1..kMaxLength
+    for (int i = 1; i < k; ++i) rc.encode(c.length[size_t(i)], 1);
+    if (k < kMaxLength) rc.encode(c.length[size_t(k)], 0);
+    unsigned prefix = 1;
+    for (int j = k - 2; j >= 0; --j) {
+        const unsigned bit = unsigned(m >> j) & 1u;
+        const int depth = k - 2 - j;
+        if (depth < 2) rc.encode(c.high[size_t(k)][prefix], bit);
+        else rc.encode(models.low[size_t(k)][size_t(j)], bit);
+        if (depth == 0) prefix = 2 + bit;  // the second bit's model knows the first
+    }
+}
+
+inline int64_t getResidual(RangeDecoder& rc, Models& models, ContextModels& c, unsigned signs) {
+    if (!rc.decode(c.zero[signs])) return 0;
+    const bool negative = rc.decode(c.sign[signs]);
+    int k = 1;
+    while (k < kMaxLength && rc.decode(c.length[size_t(k)])) ++k;
+    uint64_t m = 1;
+    unsigned prefix = 1;
+    for (int j = k - 2; j >= 0; --j) {
+        const int depth = k - 2 - j;
+        const unsigned bit = depth < 2 ? rc.decode(c.high[size_t(k)][prefix]) : rc.decode(models.low[size_t(k)][size_t(j)]);
+        m = m << 1 | bit;
+        if (depth == 0) prefix = 2 + bit;
+    }
+    return negative ? -int64_t(m) : int64_t(m);
+}
+
+// Lossless residuals modulo the range R = maxValue - minValue + 1, into
+// [-R/2, R/2) (JPEG-LS's modulo reduction): a residual never needs more bits
+// than the samples, so noise costs no more than its bit depth.
+inline int64_t wrap(int64_t e, int64_t minValue, int64_t maxValue) {
+    const int64_t range = maxValue - minValue + 1;
+    if (e < -range / 2) e += range;
+    else if (e >= range - range / 2) e -= range;
+    return e;
+}
+
+// The sample the decoder rebuilds: lossless (step 1), the prediction plus
+// the residual brought back into the range; near-lossless, the quantised
+// residual's centre, clamped (which only brings it closer to the sample).
+inline int64_t reconstruct(int64_t prediction, int64_t q, int64_t step, int64_t minValue, int64_t maxValue) {
+    if (step == 1) {
+        const int64_t range = maxValue - minValue + 1;
+        int64_t v = prediction + q;
+        if (v < minValue) v += range;
+        else if (v > maxValue) v -= range;
+        return std::clamp(v, minValue, maxValue);  // only a corrupt stream needs the clamp
+    }
+    return std::clamp(prediction + q * step, minValue, maxValue);
+}
+
+} // namespace vdbdag::coding::detail
