@@ -2,8 +2,12 @@
 #include "vdb_bridge/NanoVdb.h"
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 
+#include <iostream>  // nanovdb/util/GridValidator.h uses std::cerr without including it
+
+#include <nanovdb/util/GridValidator.h>
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/NanoToOpenVDB.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
@@ -21,6 +25,101 @@ namespace vdbdag::bridge {
 using detail::oneLine;
 
 bool isNanoVdbPath(const std::string& path) { return lowerExtension(path) == ".nvdb"; }
+
+namespace {
+
+// NanoVDB trusts the offsets in a grid's buffer: nanoToOpenVDB walks them
+// as pointers, so a damaged file crashed inside it. Before the walk, each
+// grid goes through NanoVDB's own validator (nanovdb/util/GridValidator.h:
+// magic, version, the full checksum where the file carries one, grid type
+// and class, every node pointer inside the buffer and 32-byte aligned), and
+// its name must end inside its 256 bytes. "" when the grid passes (or is of
+// a type nanoToOpenVDB does not convert, which the caller reports).
+// Every child pointer of the tree (root tiles, upper and lower internal
+// nodes) must point at a node of the level below, inside the buffer: the
+// nodes of a level lie back to back where the tree's node offsets say, so a
+// child is the start of one of them. NanoVDB's validator checks the first
+// node of each level only; a flipped child offset or child-mask bit crashed
+// nanoToOpenVDB.
+template <typename T>
+std::string checkChildPointers(const nanovdb::NanoGrid<T>& grid, uint64_t bufferSize) {
+    using TreeT = nanovdb::NanoTree<T>;
+    const auto* base = reinterpret_cast<const uint8_t*>(&grid);
+    const TreeT& tree = grid.tree();
+    const auto* treeBytes = reinterpret_cast<const uint8_t*>(&tree);
+    const auto* data = tree.data();
+    // Level L's nodes: [begin, begin + count * size), inside the buffer.
+    const auto level = [&](int l, uint64_t count, uint64_t size, const uint8_t*& begin) -> bool {
+        const uint64_t offset = data->mNodeOffset[l];
+        const uint64_t treeAt = uint64_t(treeBytes - base);
+        if (count == 0) return begin = nullptr, true;
+        if (offset > bufferSize - treeAt || count > (bufferSize - treeAt - offset) / size) return false;
+        begin = treeBytes + offset;
+        return true;
+    };
+    using UpperT = nanovdb::NanoUpper<T>;
+    using LowerT = nanovdb::NanoLower<T>;
+    using LeafT = nanovdb::NanoLeaf<T>;
+    const uint64_t leaves = data->mNodeCount[0], lowers = data->mNodeCount[1], uppers = data->mNodeCount[2];
+    const uint8_t *leafBegin, *lowerBegin, *upperBegin;
+    if (!level(0, leaves, sizeof(LeafT), leafBegin) || !level(1, lowers, sizeof(LowerT), lowerBegin) || !level(2, uppers, sizeof(UpperT), upperBegin))
+        return "its node counts and offsets run past its buffer";
+    const auto isNode = [](const void* p, const uint8_t* begin, uint64_t count, uint64_t size) {
+        const auto* b = static_cast<const uint8_t*>(p);
+        return begin && b >= begin && uint64_t(b - begin) < count * size && uint64_t(b - begin) % size == 0;
+    };
+    const auto& root = tree.root();
+    const auto* rootBytes = reinterpret_cast<const uint8_t*>(&root);
+    if (rootBytes < base || uint64_t(rootBytes - base) + sizeof(root) > bufferSize) return "its root lies outside its buffer";
+    const uint64_t tiles = root.data()->mTableSize;
+    using TileT = typename nanovdb::NanoRoot<T>::DataType::Tile;
+    if (tiles > (bufferSize - uint64_t(rootBytes - base) - sizeof(root)) / sizeof(TileT)) return "its root's tile table runs past its buffer";
+    for (uint32_t i = 0; i < tiles; ++i) {
+        const auto* tile = root.data()->tile(i);
+        if (tile->isChild() && !isNode(root.data()->getChild(tile), upperBegin, uppers, sizeof(UpperT))) return "a root child pointer points at no upper node";
+    }
+    for (uint64_t k = 0; k < uppers; ++k) {
+        const auto* node = reinterpret_cast<const UpperT*>(upperBegin + k * sizeof(UpperT));
+        for (auto it = node->data()->mChildMask.beginOn(); it; ++it)
+            if (!isNode(node->data()->getChild(*it), lowerBegin, lowers, sizeof(LowerT))) return "an upper node's child pointer points at no lower node";
+    }
+    for (uint64_t k = 0; k < lowers; ++k) {
+        const auto* node = reinterpret_cast<const LowerT*>(lowerBegin + k * sizeof(LowerT));
+        for (auto it = node->data()->mChildMask.beginOn(); it; ++it)
+            if (!isNode(node->data()->getChild(*it), leafBegin, leaves, sizeof(LeafT))) return "a lower node's child pointer points at no leaf";
+    }
+    return "";
+}
+
+template <typename T>
+std::string validateAs(const nanovdb::NanoGrid<T>& grid, uint64_t bufferSize) {
+    if (std::string bad = nanovdb::GridValidator<T>::check(grid, /*detailed*/ true); !bad.empty()) return bad;
+    return checkChildPointers(grid, bufferSize);
+}
+
+std::string validateGrid(const nanovdb::GridHandle<nanovdb::HostBuffer>& handle) {
+    const nanovdb::GridData* data = reinterpret_cast<const nanovdb::GridData*>(handle.data());
+    if (!data || handle.size() < sizeof(nanovdb::GridData)) return "its grid holds fewer bytes than a grid header";
+    if (data->mGridSize > handle.size()) return "its grid declares more bytes than it holds";
+    if (!std::memchr(data->mGridName, 0, nanovdb::GridData::MaxNameSize)) return "its grid name does not end";
+    if (auto g = handle.grid<float>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<double>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<int32_t>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<int64_t>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<bool>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::Fp4>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::Fp8>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::Fp16>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::FpN>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::ValueMask>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::Vec3f>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::Vec3d>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::Vec4f>()) return validateAs(*g, handle.size());
+    if (auto g = handle.grid<nanovdb::Vec4d>()) return validateAs(*g, handle.size());
+    return "";
+}
+
+} // namespace
 
 ImportResult importNanoVdb(const std::string& path, const ImportOptions& options) {
     checkInputFile(path, "a NanoVDB file");
@@ -45,6 +144,8 @@ ImportResult importNanoVdb(const std::string& path, const ImportOptions& options
     try {
         const auto handles = nanovdb::io::readGrids(path);
         for (size_t i = 0; i < handles.size(); ++i) {
+            if (const std::string bad = validateGrid(handles[i]); !bad.empty())
+                throw Error(path + ": grid " + std::to_string(i) + " is damaged (" + bad + ")");
             const nanovdb::GridMetaData* meta = handles[i].gridMetaData();
             try {
                 grids.push_back(nanovdb::nanoToOpenVDB(handles[i]));

@@ -88,6 +88,9 @@ TEST(BrickValueCoder, ExtremesAndNoiseRoundTripNoiseCostsItsBits) {
     for (size_t i = 0; i < 40 * 64; ++i) c.entries.push_back(int32_t(rng()));
     c.entries[0] = INT32_MIN, c.entries[1] = INT32_MAX, c.entries[64] = INT32_MAX;
     expectRoundTrip(c, {}, "int32 noise");
+    // 8-bit white noise over 400 bricks: no coder gets below 8 bits an entry.
+    c.layout.assign(400, ~uint64_t(0));
+    c.entries.resize(400 * 64);
     for (auto& v : c.entries) v = int32_t(rng() & 255u);
     IntCoderOptions u8;
     u8.minValue = 0, u8.maxValue = 255;

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/io/File.h>
@@ -113,4 +114,53 @@ TEST(NanoVdb, BadFilesAndUnsupportedOutputsGetOneLineErrors) {
     EXPECT_NE(r.err.find("junk.nvdb"), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_FALSE(fs::exists(dir / "x.ssvdag"));
+}
+
+// A damaged .nvdb (issue 38 #5): NanoVDB trusts its buffer's offsets, and 22
+// of 40 copies of a real file with four flipped bits crashed inside
+// nanoToOpenVDB; a grid name without its NUL was read past its end. Forty
+// such copies (a fixed seed, bits flipped in the grid buffer) and one with
+// an unterminated name now either convert or stop with one line naming the
+// file; none crashes ("crashed while encoding" is the crash handler's line).
+TEST(NanoVdb, DamagedFilesAreRefusedBeforeNanoVdbWalksThem) {
+    if (!haveNanoTools()) GTEST_SKIP() << "nanovdb_convert / nanovdb_print not installed (libnanovdb-tools)";
+    const fs::path dir = testFolder("nanovdb_damaged");
+    ASSERT_EQ(runShell(std::string(VDBDAG_SAMPLES_TOOL) + " " + (dir / "samples").string() + " >/dev/null").exitCode, 0);
+    const fs::path nvdb = dir / "sphere.nvdb";
+    ASSERT_EQ(runShell("nanovdb_convert -f " + (dir / "samples" / "sphere_ls.vdb").string() + " " + nvdb.string() + " >/dev/null").exitCode, 0);
+    std::ifstream in(nvdb, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    const size_t gridStart = 16 + 176;  // the file header and one grid's metadata, then its name and buffer
+    ASSERT_GT(bytes.size(), gridStart + 4096);
+    std::mt19937_64 rng(38);
+    int refused = 0;
+    for (int copy = 0; copy < 41; ++copy) {
+        std::string damaged = bytes;
+        if (copy < 40) {
+            for (int k = 0; k < 4; ++k) {
+                const size_t at = gridStart + size_t(rng() % (damaged.size() - gridStart));
+                damaged[at] = char(damaged[at] ^ char(1u << (rng() % 8)));
+            }
+        } else {  // the grid buffer's name, 256 bytes without a NUL
+            const size_t name = damaged.find("sphere", damaged.find("sphere") + 1);
+            ASSERT_NE(name, std::string::npos);
+            std::fill_n(damaged.begin() + ptrdiff_t(name), 256, 'A');
+        }
+        const fs::path bad = dir / ("damaged_" + std::to_string(copy) + ".nvdb"), out = dir / ("damaged_" + std::to_string(copy) + ".ssvdag");
+        std::ofstream(bad, std::ios::binary) << damaged;
+        const auto r = runCli("encode " + bad.string() + " -o " + out.string() + " -q");
+        EXPECT_TRUE(r.exitCode == 0 || r.exitCode == 1) << copy << ": exit " << r.exitCode << " " << r.err;
+        EXPECT_EQ(r.err.find("crashed"), std::string::npos) << copy << ": " << r.err;
+        if (r.exitCode == 1) {
+            ++refused;
+            EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+            EXPECT_NE(r.err.find(bad.string()), std::string::npos) << r.err;
+            EXPECT_FALSE(fs::exists(out));
+        }
+        if (copy == 40) EXPECT_NE(r.err.find("grid name does not end"), std::string::npos) << r.err;
+    }
+    // The file carries a partial checksum only, so a flip in a voxel value is
+    // a value (the copy converts); flips in the tree's offsets and masks are
+    // refused (4 of these 40 crashed before).
+    EXPECT_GE(refused, 2);
 }
