@@ -2,8 +2,8 @@
 // context-modelled brick coder (coding/BrickValueCoder.h): each entry
 // predicted from its neighbours in its 4^3 brick by six blended predictors,
 // its residual range coded under an activity context. What a predicted
-// window stores as coding 2 (PredictedWindows.h) when it is smaller than
-// the window's palettes: on dense scans 0.6-0.8x brick MED + zstd.
+// window stores as coding 2, or with neighbours across bricks as coding 3
+// (PredictedWindows.h), when it is smaller than the window's palettes.
 //
 // Payload: u8 value size (4), i32 minValue, i32 maxValue (the entries'
 // range, which bounds every prediction and the residuals' modulo), u64 n
@@ -14,13 +14,21 @@
 #include <string>
 #include <vector>
 
+#include "src/coding/BrickValueCoder.h"
+
 namespace vdbdag::attributes {
 
 // `values`: n little-endian int32 entries; `layout` as encodePredicted's.
-std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout);
+// With `places` (one per layout entry), neighbours come from the bricks
+// around too (coding 3, encodePlacedBrickValues); without, from each brick
+// alone (coding 2).
+std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
+                                          std::span<const coding::BrickPlace> places = {});
 
-// Inverse; validates the payload against `layout` and `entries` (throws
+// Inverse (`places` given exactly when the payload was coded with them);
+// validates the payload against `layout` and `entries` (throws
 // vdbdag::Error starting with `what`).
-std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what);
+std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
+                                          std::span<const coding::BrickPlace> places = {});
 
 } // namespace vdbdag::attributes

@@ -25,18 +25,23 @@ constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;
 
 // A window's raw bytes: its coding byte, then the smaller of its palettes
 // (by zstd's fast estimate) and its entries coded from their neighbours:
-// context-modelled (int32; range coded already) or brick MED residuals
-// (int64, zstd's estimate).
-std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, uint32_t vs) {
+// context-modelled (int32; range coded already; with neighbours across
+// bricks when their places are known) or brick MED residuals (int64,
+// zstd's estimate).
+std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
+                                uint32_t vs) {
     std::vector<uint8_t> palette = serializePalette(compressPalette(values, vs));
-    const bool contextCoded = vs == 4;
-    std::vector<uint8_t> predicted = contextCoded ? encodeContextChannel(values, layout) : encodePredicted(values, vs, layout);
+    const bool contextCoded = vs == 4, placed = contextCoded && !places.empty();
+    std::vector<uint8_t> predicted = contextCoded ? encodeContextChannel(values, layout, places) : encodePredicted(values, vs, layout);
     const uint64_t predictedSize = contextCoded ? predicted.size() : format::zstdFastSize(predicted);
     const bool usePredicted = predictedSize < format::zstdFastSize(palette);
     std::vector<uint8_t>& chosen = usePredicted ? predicted : palette;
     std::vector<uint8_t> raw;
     raw.reserve(chosen.size() + 1);
-    raw.push_back(!usePredicted ? detail::kPaletteCoding : contextCoded ? detail::kContextCoding : detail::kPredictedCoding);
+    raw.push_back(!usePredicted ? detail::kPaletteCoding
+                  : placed      ? detail::kPlacedContextCoding
+                  : contextCoded ? detail::kContextCoding
+                                 : detail::kPredictedCoding);
     raw.insert(raw.end(), chosen.begin(), chosen.end());
     return raw;
 }
@@ -66,13 +71,19 @@ void PredictedWindowWriter::beginShare(uint64_t firstEntry, bool endsLayer) {
     payload_.clear();  // coded windows only: process 0 writes the header
 }
 
-void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const uint64_t> layout) {
+void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
+    if (!layout.empty()) {
+        if (!places.empty() && places.size() != layout.size()) throw Error("internal error: a layout and its places differ in length");
+        if (placed_ && *placed_ != !places.empty()) throw Error("internal error: brick places given in some calls only");
+        placed_ = !places.empty();
+    }
     size_t at = 0;  // byte position in `values`
     size_t i = 0;
     // The bricks that start before this share's first window: its head.
     while (share_ && i < layout.size() && entries_ < headEnd_) {
         const uint64_t n = detail::layoutEntries(layout[i]);
         if (at + n * valueSize_ > values.size()) throw Error("internal error: the layout holds more entries than the values given");
+        if (!places.empty()) head_.places.push_back(places[i]);
         head_.layout.push_back(layout[i++]);
         head_.values.insert(head_.values.end(), values.begin() + long(at), values.begin() + long(at + n * valueSize_));
         at += size_t(n * valueSize_);
@@ -96,6 +107,7 @@ void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const
         while (j < layout.size() && entries_ + n < windowEnd) n += detail::layoutEntries(layout[j++]);
         if (at + n * valueSize_ > values.size()) throw Error("internal error: the layout holds more entries than the values given");
         w.layout.insert(w.layout.end(), layout.begin() + long(i), layout.begin() + long(j));
+        if (!places.empty()) w.places.insert(w.places.end(), places.begin() + long(i), places.begin() + long(j));
         w.values.insert(w.values.end(), values.begin() + long(at), values.begin() + long(at + n * valueSize_));
         w.entries += n;
         entries_ += n;
@@ -109,9 +121,10 @@ void PredictedWindowWriter::codePending() {
     std::vector<std::vector<uint8_t>> stored(pending_.size());
     std::vector<uint64_t> rawBytes(pending_.size());
     tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
-        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, valueSize_);
+        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, pending_[i].places, valueSize_);
         std::vector<uint8_t>().swap(pending_[i].values);
         std::vector<uint64_t>().swap(pending_[i].layout);
+        std::vector<coding::BrickPlace>().swap(pending_[i].places);
         rawBytes[i] = raw.size();
         stored[i] = format::zstdCompressIfSmaller(raw, {raw.size() <= kSmallWindowBytes ? 9 : 3, /*checksum*/ true, 0});
         if (stored[i].empty()) stored[i] = std::move(raw);
@@ -132,6 +145,7 @@ ShareWindows PredictedWindowWriter::finishShare() {
         out.tail.window = windows_ - 1;
         out.tail.values = std::move(pending_.back().values);
         out.tail.layout = std::move(pending_.back().layout);
+        out.tail.places = std::move(pending_.back().places);
         pending_.pop_back();
     }
     codePending();
@@ -144,7 +158,7 @@ ShareWindows PredictedWindowWriter::finishShare() {
 }
 
 void PredictedWindowWriter::addShare(const ShareWindows& share) {
-    add(share.head.values, share.head.layout);
+    add(share.head.values, share.head.layout, share.head.places);
     uint64_t at = 0;
     for (size_t j = 0; j < share.directory.size(); ++j) {
         const ShareWindows::Coded& c = share.directory[j];
@@ -152,7 +166,7 @@ void PredictedWindowWriter::addShare(const ShareWindows& share) {
         addCoded(share.firstWindow + j, c, std::span<const uint8_t>(share.coded).subspan(size_t(at), size_t(c.stored)));
         at += c.stored;
     }
-    add(share.tail.values, share.tail.layout);
+    add(share.tail.values, share.tail.layout, share.tail.places);
 }
 
 void PredictedWindowWriter::addCoded(uint64_t window, const ShareWindows::Coded& coded, std::span<const uint8_t> bytes) {
@@ -184,9 +198,10 @@ ValueWindowsPayload PredictedWindowWriter::finish() {
     return out;
 }
 
-std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout) {
+std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout,
+                                            std::span<const coding::BrickPlace> places) {
     PredictedWindowWriter writer(valueSize, 0);
-    writer.add(values, layout);
+    writer.add(values, layout, places);
     return std::move(writer.finish().bytes);
 }
 

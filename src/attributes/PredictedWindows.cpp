@@ -63,7 +63,7 @@ WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, u
 }
 
 std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, const WindowDirectory& dir, size_t k, std::span<const uint64_t> layout,
-                                           const std::string& what) {
+                                           const std::string& what, std::span<const coding::BrickPlace> places) {
     const WindowDirectory::Window& e = dir.windows.at(k);
     const std::string where = what + " window " + std::to_string(k);
     const std::vector<uint8_t> raw = windowRawBytes(payload, e, where);
@@ -77,20 +77,22 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
     }
     const std::span<const uint64_t> bricks = layout.subspan(size_t(e.firstBrick), size_t(e.bricks));
     if (raw[0] == detail::kPredictedCoding) return decodePredicted(body, dir.valueSize, bricks, where);
-    if (raw[0] == detail::kContextCoding) {
+    if (raw[0] == detail::kContextCoding || raw[0] == detail::kPlacedContextCoding) {
         if (dir.valueSize != 4) throw Error(where + ": a context-coded window of " + std::to_string(dir.valueSize) + "-byte values (int32 only)");
-        return decodeContextChannel(body, bricks, e.entries, where);
+        if (raw[0] == detail::kContextCoding) return decodeContextChannel(body, bricks, e.entries, where);
+        if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
+        return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)));
     }
     throw Error(where + ": unknown coding " + std::to_string(raw[0]));
 }
 
 std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            const std::string& what) {
+                                            const std::string& what, std::span<const coding::BrickPlace> places) {
     const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
     std::vector<uint8_t> out;
     out.reserve(size_t(dir.entries * valueSize));  // entries matched the DAG's layout
     for (size_t k = 0; k < dir.windows.size(); ++k) {
-        const std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, what);
+        const std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, what, places);
         out.insert(out.end(), values.begin(), values.end());
     }
     return out;

@@ -21,8 +21,9 @@
 //   W x (u64 stored bytes, u64 raw bytes, u64 entries), the directory, last.
 // A window's raw bytes are u8 coding (0: serializePalette bytes of its
 // entries; 1: encodePredicted bytes over its bricks; 2: int32 only,
-// encodeContextChannel bytes over its bricks, ContextChannel.h) then that
-// payload;
+// encodeContextChannel bytes over its bricks, ContextChannel.h; 3: the same
+// with neighbours across bricks, over its bricks and their places) then
+// that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -30,6 +31,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -40,7 +42,7 @@ namespace vdbdag::attributes {
 
 namespace detail {  // the layout above, shared by the writer and the reader
 inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
-inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2;
+inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail
@@ -51,8 +53,11 @@ public:
     explicit PredictedWindowWriter(uint32_t valueSize, unsigned parallel = 0, const std::string& spillNear = "", uint64_t spillInMemory = 0);
     // `values`: the entries of the brick instances `layout` describes (per
     // instance in attribute order its stored mask, 0 for a solid node),
-    // continuing the previous call.
-    void add(std::span<const uint8_t> values, std::span<const uint64_t> layout);
+    // continuing the previous call; `places`: where each lies
+    // (encoding::attributePlaces), for an int32 channel whose windows are
+    // then coded with neighbours across bricks (coding 3). Give them in
+    // every call or in none.
+    void add(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places = {});
     ValueWindowsPayload finish();  // its `predicted` is set
     uint64_t entries() const { return entries_; }
     // Share mode and assembly, as ValueWindowWriter's (the loose parts
@@ -66,6 +71,7 @@ private:
     struct Window {
         std::vector<uint8_t> values;
         std::vector<uint64_t> layout;
+        std::vector<coding::BrickPlace> places;
         uint64_t entries = 0;
     };
     void codePending();
@@ -78,23 +84,26 @@ private:
     struct Directory { uint64_t stored, raw, entries; };
     std::vector<Directory> directory_;
     bool share_ = false, endsLayer_ = true;
+    std::optional<bool> placed_;  // whether the calls so far gave places
     uint64_t headEnd_ = 0;
     ShareWindows::Loose head_;
 };
 
 // All at once.
-std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout);
+std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout,
+                                            std::span<const coding::BrickPlace> places = {});
 
 // The entries in attribute order; validates the payload against `layout`
 // (the DAG's attributeLayout) and throws vdbdag::Error starting with `what`.
+// `places` (encoding::attributePlaces) are needed by coding-3 windows.
 std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            const std::string& what);
+                                            const std::string& what, std::span<const coding::BrickPlace> places);
 
 // Window by window (WindowCursor.h): the directory, checked against
 // `layout` as decodePredictedWindows checks it, and window k's entries.
 WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
                                              const std::string& what);
 std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, const WindowDirectory& dir, size_t k, std::span<const uint64_t> layout,
-                                           const std::string& what);
+                                           const std::string& what, std::span<const coding::BrickPlace> places);
 
 } // namespace vdbdag::attributes

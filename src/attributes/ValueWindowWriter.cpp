@@ -203,6 +203,8 @@ std::vector<uint8_t> ShareWindows::serialize() const {
         w.putBytes(l->values);
         w.put<uint64_t>(l->layout.size());
         for (uint64_t m : l->layout) w.put<uint64_t>(m);
+        w.put<uint64_t>(l->places.size());
+        for (const coding::BrickPlace& p : l->places) w.put(p);
     }
     return w.take();
 }
@@ -224,6 +226,7 @@ ShareWindows ShareWindows::deserialize(std::span<const uint8_t> bytes) {
         l->window = r.get<uint64_t>();
         l->values = r.getArray<uint8_t>(r.get<uint64_t>());
         l->layout = r.getArray<uint64_t>(r.get<uint64_t>());
+        l->places = r.getArray<coding::BrickPlace>(r.get<uint64_t>());
     }
     r.expectEnd();
     return s;

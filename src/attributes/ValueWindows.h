@@ -27,6 +27,8 @@
 #include <string>
 #include <vector>
 
+#include "src/coding/BrickValueCoder.h"
+
 #include "src/attributes/PaletteChannel.h"
 #include "src/util/ScratchFile.h"
 
@@ -63,6 +65,7 @@ struct ShareWindows {
         uint64_t window = 0;            // the window they belong to
         std::vector<uint8_t> values;    // entries
         std::vector<uint64_t> layout;   // their brick instances (predicted windows)
+        std::vector<coding::BrickPlace> places;  // and where they lie (int32 predicted windows)
         bool empty() const { return values.empty(); }
     };
     Loose head, tail;

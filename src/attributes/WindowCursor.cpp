@@ -9,8 +9,9 @@
 
 namespace vdbdag::attributes {
 
-WindowCursor::WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what)
-    : payload_(payload), predicted_(predicted), layout_(layout), what_(std::move(what)) {
+WindowCursor::WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what,
+                           std::span<const coding::BrickPlace> places)
+    : payload_(payload), predicted_(predicted), layout_(layout), places_(places), what_(std::move(what)) {
     dir_ = predicted ? readPredictedWindowDirectory(payload, valueSize, layout, what_) : readValueWindowDirectory(payload, what_);
     if (dir_.valueSize != valueSize)
         throw Error(what_ + ": holds " + std::to_string(dir_.valueSize) + "-byte values, expected " + std::to_string(valueSize));
@@ -18,7 +19,7 @@ WindowCursor::WindowCursor(std::span<const uint8_t> payload, bool predicted, uin
 
 void WindowCursor::load(size_t k) {
     values_.clear();
-    values_ = predicted_ ? decodePredictedWindow(payload_, dir_, k, layout_, what_) : decodeValueWindow(payload_, dir_, k, what_).decodeAll();
+    values_ = predicted_ ? decodePredictedWindow(payload_, dir_, k, layout_, what_, places_) : decodeValueWindow(payload_, dir_, k, what_).decodeAll();
     window_ = k;
     loaded_ = true;
     at_ = 0;

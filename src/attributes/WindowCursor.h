@@ -15,9 +15,10 @@ namespace vdbdag::attributes {
 class WindowCursor {
 public:
     // `payload` (and for predicted windows the DAG's attributeLayout,
-    // `layout`) must outlive the cursor. Checks the directory; each window
+    // `layout`, and attributePlaces, `places`) must outlive the cursor. Checks the directory; each window
     // is checked when it is reached (throws vdbdag::Error starting with `what`).
-    WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what);
+    WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what,
+                 std::span<const coding::BrickPlace> places = {});
     uint64_t entries() const { return dir_.entries; }
     // Copies the next `n` entries (n * valueSize bytes) to `out`.
     void read(uint64_t n, uint8_t* out);
@@ -27,6 +28,7 @@ private:
     std::span<const uint8_t> payload_;
     bool predicted_;
     std::span<const uint64_t> layout_;
+    std::span<const coding::BrickPlace> places_;
     std::string what_;
     WindowDirectory dir_;
     size_t window_ = 0;            // the window in `values_`

@@ -2,10 +2,13 @@
 // directions, as IntVolumeCoder.cpp does.
 #include "src/coding/BrickValueCoder.h"
 
+#include <array>
 #include <bit>
+#include <map>
 #include <memory>
 
 #include "src/coding/SamplePredictor.h"
+#include "src/dag/Reflection.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::coding {
@@ -76,29 +79,143 @@ void walk(std::span<const uint64_t> layout, uint64_t entries, const IntCoderOpti
     if (e != entries) throw Error("the layout holds " + std::to_string(e) + " entries, the channel " + std::to_string(entries));
 }
 
+// What a coded voxel keeps for its neighbours, compactly (a window holds
+// every brick it has coded): errors and residual saturated at 2^16 - 1.
+struct CompactRecord {
+    std::array<uint16_t, kPredictors> err{};
+    uint16_t residual = 0;
+    int8_t sign = 0;
+    SampleRecord expand() const {
+        SampleRecord r;
+        for (size_t k = 0; k < size_t(kPredictors); ++k) r.err[k] = err[k];
+        r.residual = residual, r.sign = sign;
+        return r;
+    }
+    static CompactRecord of(const SampleRecord& r) {
+        CompactRecord c;
+        for (size_t k = 0; k < size_t(kPredictors); ++k) c.err[k] = uint16_t(std::min<uint32_t>(r.err[k], 65535));
+        c.residual = uint16_t(std::min<uint32_t>(r.residual, 65535)), c.sign = r.sign;
+        return c;
+    }
+};
+
+// A brick in spatial order: which voxels are coded, their values and records.
+struct PlacedBrick {
+    uint64_t done = 0;
+    int32_t value[64];
+    CompactRecord rec[64];
+};
+
+template <typename Step>
+void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, const IntCoderOptions& options, Models& models,
+                Step&& step) {
+    if (places.size() != layout.size()) throw Error("the layout has " + std::to_string(layout.size()) + " bricks, their places " + std::to_string(places.size()));
+    std::map<std::array<int32_t, 3>, uint32_t> slots;  // brick coordinates -> index in `bricks`
+    std::vector<PlacedBrick> bricks;
+    bricks.reserve(layout.size());  // `around` points into it
+    int64_t last = 0;
+    SampleRecord lastRec{};
+    uint64_t e = 0;  // the first entry of the current instance
+    for (size_t b = 0; b < layout.size(); ++b) {
+        const uint64_t mask = layout[b];
+        if (mask == 0) {  // a tile: one entry, no neighbours
+            if (e >= entries) throw Error("the layout holds more entries than the channel");
+            Neighbourhood n;
+            n.W = n.N = n.NW = n.NE = n.P = n.PW = n.PN = n.PNW = last;
+            n.rW = &lastRec;
+            const Prediction pr = predict(n, options.minValue, options.maxValue, models);
+            last = step(*pr.ctx, pr.signs, pr.value, e++);
+            learn(pr, last, lastRec);
+            continue;
+        }
+        const BrickPlace& place = places[b];
+        if ((place.x | place.y | place.z) & 3 || place.mirror > 7) throw Error("brick " + std::to_string(b) + " has no brick's place");
+        if (e + uint64_t(std::popcount(mask)) > entries) throw Error("the layout holds more entries than the channel");
+        const std::array<int32_t, 3> at{place.x >> 2, place.y >> 2, place.z >> 2};
+        if (!slots.emplace(at, uint32_t(bricks.size())).second) throw Error("two bricks at the same place");
+        bricks.emplace_back();
+        PlacedBrick& self = bricks.back();
+        // The bricks around that hold causal neighbours: dx in -1..1, dy and dz in -1..0.
+        const PlacedBrick* around[3][2][2];
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 0; ++dy)
+                for (int dz = -1; dz <= 0; ++dz) {
+                    const auto it = slots.find({at[0] + dx, at[1] + dy, at[2] + dz});
+                    around[dx + 1][dy + 1][dz + 1] = (dx == 0 && dy == 0 && dz == 0) ? &self : it == slots.end() ? nullptr : &bricks[it->second];
+                }
+        const uint64_t spatial = dag::reflectBrick(mask, place.mirror);
+        // A neighbour's brick and bit, or null when it is not coded yet.
+        const auto at3 = [&](int x, int y, int z, int& bit) -> const PlacedBrick* {
+            const int ox = x < 0 ? -1 : x > 3 ? 1 : 0, oy = y < 0 ? -1 : 0, oz = z < 0 ? -1 : 0;
+            const PlacedBrick* t = around[ox + 1][oy + 1][oz + 1];
+            bit = (x & 3) + 4 * (y & 3) + 16 * (z & 3);
+            return t && (t->done >> bit & 1) ? t : nullptr;
+        };
+        for (uint64_t bits = spatial; bits; bits &= bits - 1) {
+            const int p = std::countr_zero(bits), x = p & 3, y = (p >> 2) & 3, z = p >> 4;
+            int bW, bN, bNW, bNE, bP, bPW, bPN, bPNW;
+            const PlacedBrick *tW = at3(x - 1, y, z, bW), *tN = at3(x, y - 1, z, bN), *tNW = at3(x - 1, y - 1, z, bNW), *tNE = at3(x + 1, y - 1, z, bNE);
+            const PlacedBrick *tP = at3(x, y, z - 1, bP), *tPW = at3(x - 1, y, z - 1, bPW), *tPN = at3(x, y - 1, z - 1, bPN),
+                              *tPNW = at3(x - 1, y - 1, z - 1, bPNW);
+            Neighbourhood n;
+            n.W = tW ? tW->value[bW] : tN ? tN->value[bN] : tP ? tP->value[bP] : last;
+            n.N = tN ? tN->value[bN] : n.W;
+            n.NW = tNW ? tNW->value[bNW] : n.N;
+            n.NE = tNE ? tNE->value[bNE] : n.N;
+            if (tP) {
+                n.P = tP->value[bP];
+                n.PW = tPW ? tPW->value[bPW] : n.P;
+                n.PN = tPN ? tPN->value[bPN] : n.PW;
+                n.PNW = tPNW ? tPNW->value[bPNW] : n.PN;
+            } else {
+                n.P = med(n.W, n.N, n.NW), n.PW = n.W, n.PN = n.N, n.PNW = n.NW;
+            }
+            SampleRecord rW, rN, rP;
+            if (tW) rW = tW->rec[bW].expand();
+            if (tN) rN = tN->rec[bN].expand();
+            if (tP) rP = tP->rec[bP].expand();
+            n.rW = tW ? &rW : (!tN && !tP) ? &lastRec : nullptr;
+            n.rN = tN ? &rN : nullptr;
+            n.rP = tP ? &rP : nullptr;
+            const auto add = [&](const PlacedBrick* t, int bit, unsigned times) {
+                if (!t) return;
+                for (size_t k = 0; k < size_t(kPredictors); ++k) n.errorsAbove[k] += times * uint64_t(t->rec[bit].err[k]);
+                n.residualsAbove += times * uint64_t(t->rec[bit].residual);
+            };
+            add(tN, bN, 2), add(tP, bP, 2), add(tNE, bNE, 1), add(tNW, bNW, 1), add(tPW, bPW, 1), add(tPN, bPN, 1);
+            const Prediction pr = predict(n, options.minValue, options.maxValue, models);
+            const unsigned stored = access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), place.mirror);
+            const uint64_t entry = e + uint64_t(std::popcount(mask & ((uint64_t(1) << stored) - 1)));
+            const int64_t v = step(*pr.ctx, pr.signs, pr.value, entry);
+            SampleRecord r;
+            learn(pr, v, r);
+            self.value[p] = int32_t(v);
+            self.rec[p] = CompactRecord::of(r);
+            self.done |= uint64_t(1) << p;
+            last = v;
+            lastRec = r;
+        }
+        e += uint64_t(std::popcount(mask));
+    }
+    if (e != entries) throw Error("the layout holds " + std::to_string(e) + " entries, the channel " + std::to_string(entries));
+}
+
 void checkOptions(const IntCoderOptions& options) {
     if (options.minValue > options.maxValue || options.minValue < INT32_MIN || options.maxValue > INT32_MAX)
         throw Error("value coder: the sample range must be a non-empty part of int32");
     if (options.near < 0 || options.near > 1 << 20) throw Error("value coder: near must lie in 0..2^20");
 }
 
-} // namespace
-
-uint64_t layoutEntryCount(std::span<const uint64_t> layout) {
-    uint64_t n = 0;
-    for (const uint64_t mask : layout) n += mask ? uint64_t(std::popcount(mask)) : 1;
-    return n;
-}
-
-std::vector<uint8_t> encodeBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, const IntCoderOptions& options,
-                                       std::vector<int32_t>* reconstructed) {
+// Both directions over either walk: `walk(models, step)` runs the walk.
+template <typename Walk>
+std::vector<uint8_t> encodeWith(std::span<const int32_t> entries, const IntCoderOptions& options, std::vector<int32_t>* reconstructed, Walk&& walk) {
     checkOptions(options);
     std::vector<uint8_t> out;
     RangeEncoder rc(out);
     auto models = std::make_unique<Models>();
     const int64_t step = 2 * int64_t(options.near) + 1;
     if (reconstructed) reconstructed->resize(entries.size());
-    walk(layout, entries.size(), options, *models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
+    walk(*models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
         const int64_t s = entries[at];
         if (s < options.minValue || s > options.maxValue)
             throw Error("value coder: entry " + std::to_string(s) + " lies outside " + std::to_string(options.minValue) + ".." + std::to_string(options.maxValue));
@@ -113,14 +230,14 @@ std::vector<uint8_t> encodeBrickValues(std::span<const int32_t> entries, std::sp
     return out;
 }
 
-void decodeBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, const IntCoderOptions& options, std::span<int32_t> out,
-                       const std::string& what) {
+template <typename Walk>
+void decodeWith(std::span<const uint8_t> bytes, const IntCoderOptions& options, std::span<int32_t> out, const std::string& what, Walk&& walk) {
     checkOptions(options);
     RangeDecoder rc(bytes);
     auto models = std::make_unique<Models>();
     const int64_t step = 2 * int64_t(options.near) + 1;
     try {
-        walk(layout, out.size(), options, *models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
+        walk(*models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
             const int64_t v = reconstruct(prediction, getResidual(rc, *models, c, signs), step, options.minValue, options.maxValue);
             out[at] = int32_t(v);
             return v;
@@ -131,6 +248,35 @@ void decodeBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t>
     // As IntVolumeCoder: at most 4 bytes of the flush unread, at most 4 read past the end.
     if (rc.overrun() > 4 || rc.consumed() + 4 < bytes.size())
         throw Error(what + ": corrupt (the coded values end " + (rc.overrun() > 4 ? "early" : "before the stream does") + ")");
+}
+
+} // namespace
+
+uint64_t layoutEntryCount(std::span<const uint64_t> layout) {
+    uint64_t n = 0;
+    for (const uint64_t mask : layout) n += mask ? uint64_t(std::popcount(mask)) : 1;
+    return n;
+}
+
+
+std::vector<uint8_t> encodeBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, const IntCoderOptions& options,
+                                       std::vector<int32_t>* reconstructed) {
+    return encodeWith(entries, options, reconstructed, [&](Models& models, auto&& step) { walk(layout, entries.size(), options, models, step); });
+}
+
+void decodeBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, const IntCoderOptions& options, std::span<int32_t> out,
+                       const std::string& what) {
+    decodeWith(bytes, options, out, what, [&](Models& models, auto&& step) { walk(layout, out.size(), options, models, step); });
+}
+
+std::vector<uint8_t> encodePlacedBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
+                                             const IntCoderOptions& options, std::vector<int32_t>* reconstructed) {
+    return encodeWith(entries, options, reconstructed, [&](Models& models, auto&& step) { walkPlaced(layout, places, entries.size(), options, models, step); });
+}
+
+void decodePlacedBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
+                             const IntCoderOptions& options, std::span<int32_t> out, const std::string& what) {
+    decodeWith(bytes, options, out, what, [&](Models& models, auto&& step) { walkPlaced(layout, places, out.size(), options, models, step); });
 }
 
 } // namespace vdbdag::coding

@@ -40,4 +40,24 @@ void decodeBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t>
 // The entries `layout` implies (a tile counts one).
 uint64_t layoutEntryCount(std::span<const uint64_t> layout);
 
+// Where a brick instance of a layout lies: its minimum corner in index space
+// (multiples of 4) and the reflection accumulated on the way down to it
+// (bit 0: x, 1: y, 2: z; DESIGN.md invariant 2). A tile's place is unused.
+struct BrickPlace {
+    int32_t x = 0, y = 0, z = 0;
+    uint32_t mirror = 0;
+};
+
+// The same coding with neighbours across brick boundaries: with `places`
+// (one per layout entry), each brick's voxels are visited in spatial raster
+// order (x fastest; the entry of spatial voxel p is the rank of its stored
+// bit, dag_access.h dagStoredBit) and predicted from the spatial neighbours
+// already coded, in this brick or in any brick before it in the same call.
+// A dense region in attribute (Morton) order then has the whole causal
+// neighbourhood of IntVolumeCoder almost everywhere.
+std::vector<uint8_t> encodePlacedBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
+                                             const IntCoderOptions& options, std::vector<int32_t>* reconstructed = nullptr);
+void decodePlacedBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
+                             const IntCoderOptions& options, std::span<int32_t> out, const std::string& what);
+
 } // namespace vdbdag::coding

@@ -31,4 +31,17 @@ std::vector<uint64_t> attributeLayout(const CompactDag& dag) {
     return layout;
 }
 
+std::vector<coding::BrickPlace> attributePlaces(const CompactDag& dag, uint32_t valueSize) {
+    std::vector<coding::BrickPlace> places;
+    if (dag.empty() || valueSize != 4) return places;
+    const uint64_t emitted = decodedSize(dag).emittedBricks;
+    if (emitted > (uint64_t(1) << 31))
+        throw Error("the DAG emits " + std::to_string(emitted) + " bricks, more than the 2^31 a predicted-value layout holds");
+    places.reserve(size_t(emitted));
+    visitInAttributeOrder(
+        dag, [&](const BrickInstance& b) { places.push_back({int32_t(b.x), int32_t(b.y), int32_t(b.z), b.mirror}); },
+        [&](int64_t, int64_t, int64_t, unsigned, uint64_t) { places.push_back({}); });
+    return places;
+}
+
 } // namespace vdbdag::encoding

@@ -7,10 +7,18 @@
 #include <cstdint>
 #include <vector>
 
+#include "src/coding/BrickValueCoder.h"
 #include "src/encoding/CompactDag.h"
 
 namespace vdbdag::encoding {
 
 std::vector<uint64_t> attributeLayout(const CompactDag& dag);
+
+// Where each entry of attributeLayout lies (its minimum corner, the mirror
+// accumulated down to it; a solid node's place is zero): what the value
+// coder of int32 windows needs for neighbours across bricks
+// (coding/BrickValueCoder.h). Empty unless `valueSize` is 4: only int32
+// windows use them.
+std::vector<coding::BrickPlace> attributePlaces(const CompactDag& dag, uint32_t valueSize);
 
 } // namespace vdbdag::encoding

@@ -14,11 +14,14 @@ attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactiv
     const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
     if (values.entryCount || values.valueSize) return values;
     if (!windows.empty() && windows.predicted && !attributes.empty()) return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
-    if (!windows.empty() && windows.predicted)
-        return attributes::compressPalette(attributes::decodePredictedWindows(windows.load(), valueSize(grid.record.valueType),
-                                                                              encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
-                                                                              "grid '" + grid.record.name + "' predicted windows"),
-                                           valueSize(grid.record.valueType));
+    if (!windows.empty() && windows.predicted) {
+        const encoding::CompactDag& dag = inactive ? grid.inactiveDag : grid.dag;
+        const uint32_t vs = valueSize(grid.record.valueType);
+        return attributes::compressPalette(attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(dag),
+                                                                              "grid '" + grid.record.name + "' predicted windows",
+                                                                              encoding::attributePlaces(dag, vs)),
+                                           vs);
+    }
     if (!windows.empty()) return attributes::decodeValueWindows(windows.load(), "grid '" + grid.record.name + "' value windows");
     return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
 }

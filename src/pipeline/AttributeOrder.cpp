@@ -98,7 +98,8 @@ std::vector<uint8_t> gatherAttributes(const encoding::CompactDag& dag, const Gri
 }
 
 void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInstance& subtree, const GridTopology& topology,
-                   const LayerValues& values, unsigned valueSize, uint8_t* buffer, uint64_t bufferFirstEntry, std::vector<uint64_t>* layout) {
+                   const LayerValues& values, unsigned valueSize, uint8_t* buffer, uint64_t bufferFirstEntry, std::vector<uint64_t>* layout,
+                   std::vector<coding::BrickPlace>* places) {
     if (valueSize == 0) return;
     if (subtree.firstEntry < bufferFirstEntry) throw Error("internal error: a subtree's values start before the buffer");
     // Entry e goes to buffer + (e - bufferFirstEntry) * valueSize.
@@ -109,6 +110,7 @@ void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInsta
     if (shifted.solid) {
         input.solid(shifted.x, shifted.y, shifted.z, shifted.firstEntry, attributes);
         if (layout) layout->push_back(0);
+        if (places) places->push_back({});
         return;
     }
     encoding::visitSubtreeInAttributeOrder(
@@ -116,10 +118,12 @@ void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInsta
         [&](const encoding::BrickInstance& b) {
             input.brick(b, attributes);
             if (layout) layout->push_back(b.storedMask);
+            if (places) places->push_back({int32_t(b.x), int32_t(b.y), int32_t(b.z), b.mirror});
         },
         [&](int64_t x, int64_t y, int64_t z, unsigned, uint64_t entry) {
             input.solid(x, y, z, entry, attributes);
             if (layout) layout->push_back(0);
+            if (places) places->push_back({});
         });
 }
 

@@ -8,6 +8,7 @@
 #include <functional>
 #include <vector>
 
+#include "src/coding/BrickValueCoder.h"
 #include "src/encoding/CompactDag.h"
 #include "src/volume/GridRecord.h"
 
@@ -22,10 +23,11 @@ std::vector<uint8_t> gatherAttributes(const encoding::CompactDag& dag, const Gri
 // part of the input inside it: writes the subtree's entries into `buffer`,
 // which holds the attribute array's entries from `bufferFirstEntry` on.
 // With `layout`, appends the subtree's part of encoding::attributeLayout
-// (per brick instance its stored mask, 0 per solid node) to it.
+// (per brick instance its stored mask, 0 per solid node) to it, and with
+// `places` its part of encoding::attributePlaces.
 void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInstance& subtree, const GridTopology& topology,
                    const LayerValues& values, unsigned valueSize, uint8_t* buffer, uint64_t bufferFirstEntry = 0,
-                   std::vector<uint64_t>* layout = nullptr);
+                   std::vector<uint64_t>* layout = nullptr, std::vector<coding::BrickPlace>* places = nullptr);
 
 // One subtree's voxels with their values, for readers that stream a layer:
 // `values` holds its entries (entry e at (e - subtree.firstEntry) *

@@ -238,6 +238,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         LayerValues values;
         std::vector<uint8_t> gathered;  // streaming: the subtree's entries
         std::vector<uint64_t> layout;   // ... and their bricks, for predicted windows
+        std::vector<coding::BrickPlace> places;  // ... and where they lie (int32)
     };
     throughCubes<Piece>(
         budget, begin, end,
@@ -251,7 +252,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
             if (stream) {
                 piece.gathered.resize(entriesOf(piece.index) * vs);
                 gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, piece.gathered.data(), s.firstEntry,
-                              stream->predicted ? &piece.layout : nullptr);
+                              stream->predicted ? &piece.layout : nullptr, stream->predicted && vs == 4 ? &piece.places : nullptr);
             } else {
                 gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, attributes.data(), firstEntry);
             }
@@ -260,10 +261,11 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         },
         [&](Piece& piece) {
             if (stream && stream->quantizer) stream->quantizer->apply(piece.gathered);
-            if (stream && stream->predicted) stream->predicted->add(piece.gathered, piece.layout);
+            if (stream && stream->predicted) stream->predicted->add(piece.gathered, piece.layout, piece.places);
             else if (stream) stream->palette->add(piece.gathered);
             piece.gathered = {};
             piece.layout = {};
+            piece.places = {};
             if (progress) progress(piece.index + 1 - begin, end - begin);
         });
     source.endPass();

@@ -69,7 +69,8 @@ attributes::ValueWindowsPayload codeValues(const encoding::CompactDag& dag, cons
                                            const EncodeOptions& options) {
     attributes::ValueWindowsPayload out;
     if (usesPredictedWindows(type, options)) {
-        out.bytes = attributes::encodePredictedWindows(attributes, valueSize(type), encoding::attributeLayout(dag));
+        out.bytes = attributes::encodePredictedWindows(attributes, valueSize(type), encoding::attributeLayout(dag),
+                                                       encoding::attributePlaces(dag, valueSize(type)));
         out.predicted = true;
     } else {
         out.bytes = attributes::encodeValueWindows(attributes, valueSize(type));
@@ -284,9 +285,12 @@ const std::vector<uint8_t>& attributesOf(const format::EncodedGrid& grid, bool i
     const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
     const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
     if (!attributes.empty() || windows.empty()) return attributes;
-    if (windows.predicted)
-        store = attributes::decodePredictedWindows(windows.load(), valueSize(grid.record.valueType), encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
-                                                   "grid '" + grid.record.name + "' predicted windows");
+    if (windows.predicted) {
+        const encoding::CompactDag& dag = inactive ? grid.inactiveDag : grid.dag;
+        const uint32_t vs = valueSize(grid.record.valueType);
+        store = attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(dag), "grid '" + grid.record.name + "' predicted windows",
+                                                   encoding::attributePlaces(dag, vs));
+    }
     else
         store = format::traceableValues(grid, inactive).decodeAll();
     return store;

@@ -20,11 +20,12 @@ void scatterLayerByCubes(const format::EncodedGrid& grid, bool inactive, unsigne
     const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
     // The values: the attribute array when the reader built it, else the windows.
     std::vector<uint64_t> layout;
+    std::vector<coding::BrickPlace> places;
     std::optional<attributes::WindowCursor> cursor;
     if (vs && attributes.empty()) {
         if (windows.empty()) throw Error("grid '" + grid.record.name + "': its " + (inactive ? "inactive" : "active") + " values were not read");
-        if (windows.predicted) layout = encoding::attributeLayout(dag);
-        cursor.emplace(windows.bytes, windows.predicted, vs, layout, "grid '" + grid.record.name + "' value windows");
+        if (windows.predicted) layout = encoding::attributeLayout(dag), places = encoding::attributePlaces(dag, vs);
+        cursor.emplace(windows.bytes, windows.predicted, vs, layout, "grid '" + grid.record.name + "' value windows", places);
         if (cursor->entries() != entries) throw Error("grid '" + grid.record.name + "': its value windows do not match its DAG");
     } else if (vs && attributes.size() != entries * vs) {
         throw Error("grid '" + grid.record.name + "': its values do not match its DAG");

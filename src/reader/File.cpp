@@ -25,7 +25,8 @@ void Layer::load() const {
         const attributes::PaletteChannel& channel = inactive ? grid->inactiveValues : grid->values;
         const std::vector<uint8_t>& attributes = inactive ? grid->inactiveAttributes : grid->attributes;
         if (!windows.empty() && windows.predicted) {
-            flat_ = attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(*dag), what + " predicted windows");
+            flat_ = attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(*dag), what + " predicted windows",
+                                                       encoding::attributePlaces(*dag, vs));
         } else if (!windows.empty()) {
             channel_ = attributes::decodeValueWindows(windows.load(), what + " value windows");
             palette_ = true;

@@ -1,7 +1,8 @@
 // libFuzzer target for src/coding/IntVolumeCoder and BrickValueCoder: the
 // first 8 bytes choose a small shape (up to 16^3; for the brick coder, byte
 // 7 odd, a layout of up to 16 bricks whose masks come from the data, tiles
-// among them), the sample range and near; the rest is (a) a stream to
+// among them; byte 7 & 2, the bricks placed side by side with mirrors), the
+// sample range and near; the rest is (a) a stream to
 // decode, which must throw vdbdag::Error or give samples inside the range,
 // never crash or read out of bounds, and (b) the samples of a volume to
 // encode, whose decode must give every sample back (within near).
@@ -36,11 +37,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             layout.push_back(b % 5 == 4 ? 0 : mask);
         }
     }
+    // Byte 7 & 2: the bricks placed (distinct places in a 4x4 grid of bricks, mirrors from the data).
+    std::vector<BrickPlace> places;
+    if (bricks && (data[7] & 2))
+        for (unsigned b = 0; b < layout.size(); ++b) places.push_back({int32_t(4 * (b % 4)), int32_t(4 * (b / 4)), 0, uint32_t(data[(b % 6) + 1] % 8)});
     const auto decode = [&](std::span<const uint8_t> stream, std::vector<int32_t>& out) {
-        if (bricks) decodeBrickValues(stream, layout, o, out, "fuzz");
+        if (!places.empty()) decodePlacedBrickValues(stream, layout, places, o, out, "fuzz");
+        else if (bricks) decodeBrickValues(stream, layout, o, out, "fuzz");
         else decodeIntVolume(stream, shape, o, out);
     };
-    const auto encode = [&](const std::vector<int32_t>& samples) { return bricks ? encodeBrickValues(samples, layout, o) : encodeIntVolume(samples, shape, o); };
+    const auto encode = [&](const std::vector<int32_t>& samples) {
+        if (!places.empty()) return encodePlacedBrickValues(samples, layout, places, o);
+        return bricks ? encodeBrickValues(samples, layout, o) : encodeIntVolume(samples, shape, o);
+    };
     const uint64_t count = bricks ? layoutEntryCount(layout) : shape.count();
     std::vector<int32_t> out(count);
     try {

@@ -7,7 +7,8 @@
 // 8 bits); a layout that disagrees with the entries, corrupt, truncated and
 // padded streams refused. The same smooth int32 channel through
 // encodePredictedWindows is stored as coding 2 and is smaller than the
-// brick-MED coding (1) of the same windows.
+// brick-MED coding (1) of the same windows. With their places (a dense box
+// of mirrored bricks), neighbours across bricks: exact, within near, smaller.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -20,6 +21,7 @@
 #include "src/attributes/PredictedChannel.h"
 #include "src/attributes/PredictedWindows.h"
 #include "src/coding/BrickValueCoder.h"
+#include "src/dag/Reflection.h"
 #include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
 
@@ -149,12 +151,93 @@ TEST(BrickValueCoder, PredictedWindowsStoreInt32AsCoding2) {
     const auto& w = dir.windows[0];
     ASSERT_EQ(w.stored, w.raw);  // range coded: stored as it is
     EXPECT_EQ(windows[size_t(w.offset)], attributes::detail::kContextCoding);
-    EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, c.layout, "test"), bytes);
+    EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, c.layout, "test", {}), bytes);
     const std::vector<uint8_t> med = attributes::encodePredicted(bytes, 4, c.layout);
     EXPECT_LT(w.stored, format::zstdCompressIfSmaller(med, {9, true, 0}).size());
     // The payload checks its entry count against the window's.
     const std::vector<uint8_t> payload = attributes::encodeContextChannel(bytes, c.layout);
     EXPECT_THROW(attributes::decodeContextChannel(payload, c.layout, c.entries.size() + 1, "test"), Error);
+}
+
+} // namespace
+} // namespace vdbdag::coding
+
+namespace vdbdag::coding {
+namespace {
+
+// A dense 32^3 region of full bricks in Morton order (as a DAG's attribute
+// order visits a full box), each with a mirror from a fixed seed, holding a
+// smooth field with noise sampled at each voxel's *spatial* position: the
+// entries are stored in each brick's stored order (dag_access.h
+// dagStoredBit), so the placed coder must undo the mirror to see the field.
+struct PlacedChannel {
+    std::vector<uint64_t> layout;
+    std::vector<BrickPlace> places;
+    std::vector<int32_t> entries;
+};
+
+PlacedChannel placedField(uint32_t seed, bool mirrors) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 3.0);
+    PlacedChannel c;
+    for (uint32_t m = 0; m < 512; ++m) {  // 8^3 bricks, Morton order
+        int bx = 0, by = 0, bz = 0;
+        for (int k = 0; k < 3; ++k) bx |= int(m >> (3 * k) & 1) << k, by |= int(m >> (3 * k + 1) & 1) << k, bz |= int(m >> (3 * k + 2) & 1) << k;
+        const uint32_t mirror = mirrors ? rng() % 8 : 0;
+        c.layout.push_back(~uint64_t(0));
+        c.places.push_back({4 * bx, 4 * by, 4 * bz, mirror});
+        std::vector<int32_t> brick(64);
+        for (int z = 0; z < 4; ++z)
+            for (int y = 0; y < 4; ++y)
+                for (int x = 0; x < 4; ++x) {
+                    const double X = 4 * bx + x, Y = 4 * by + y, Z = 4 * bz + z;
+                    const double v = 500 + 200 * std::sin(X / 7.0) + 150 * std::cos(Y / 5.0) + 3 * Z + noise(rng);
+                    brick[access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), mirror)] = int32_t(std::lround(v));
+                }
+        c.entries.insert(c.entries.end(), brick.begin(), brick.end());
+    }
+    return c;
+}
+
+TEST(BrickValueCoder, PlacedBricksRoundTripAndSeeAcrossBrickBoundaries) {
+    for (bool mirrors : {false, true}) {
+        const PlacedChannel c = placedField(9, mirrors);
+        for (int32_t near : {0, 2}) {
+            IntCoderOptions o;
+            o.minValue = -100, o.maxValue = 1100, o.near = near;
+            std::vector<int32_t> reconstructed;
+            const std::vector<uint8_t> bytes = encodePlacedBrickValues(c.entries, c.layout, c.places, o, &reconstructed);
+            std::vector<int32_t> back(c.entries.size());
+            decodePlacedBrickValues(bytes, c.layout, c.places, o, back, "placed");
+            EXPECT_EQ(back, reconstructed);
+            size_t outside = 0;
+            for (size_t i = 0; i < back.size(); ++i) outside += std::abs(int64_t(back[i]) - c.entries[i]) > near;
+            EXPECT_EQ(outside, 0u) << "mirrors " << mirrors << " near " << near;
+            if (near == 0) {
+                // Neighbours across bricks make it smaller than each brick alone.
+                const size_t alone = encodeBrickValues(c.entries, c.layout, o).size();
+                EXPECT_LT(bytes.size(), alone * 95 / 100) << "mirrors " << mirrors;
+            }
+        }
+    }
+}
+
+TEST(BrickValueCoder, PlacesThatAreNoBricksAreRefused) {
+    PlacedChannel c = placedField(4, true);
+    IntCoderOptions o;
+    o.minValue = -100, o.maxValue = 1100;
+    PlacedChannel twice = c;
+    twice.places[7] = twice.places[3];
+    EXPECT_THROW(encodePlacedBrickValues(twice.entries, twice.layout, twice.places, o), Error);
+    PlacedChannel off = c;
+    off.places[5].x += 1;
+    EXPECT_THROW(encodePlacedBrickValues(off.entries, off.layout, off.places, o), Error);
+    PlacedChannel fewer = c;
+    fewer.places.pop_back();
+    EXPECT_THROW(encodePlacedBrickValues(fewer.entries, fewer.layout, fewer.places, o), Error);
+    const std::vector<uint8_t> bytes = encodePlacedBrickValues(c.entries, c.layout, c.places, o);
+    std::vector<int32_t> back(c.entries.size());
+    EXPECT_THROW(decodePlacedBrickValues(bytes, twice.layout, twice.places, o, back, "twice"), Error);
 }
 
 } // namespace

@@ -67,7 +67,7 @@ std::vector<Window> directoryOf(const std::vector<uint8_t>& payload) {
 TEST(PredictedWindows, DecodedChannelEqualsTheInputAndWindowsHoldWholeBricks) {
     const Channel c = makeChannel(kValueWindowEntries * 2 + 9999, kValueWindowEntries * 2 + 9999, 1);
     const std::vector<uint8_t> payload = attributes::encodePredictedWindows(c.values, 4, c.layout);
-    EXPECT_TRUE(attributes::decodePredictedWindows(payload, 4, c.layout, "test") == c.values);
+    EXPECT_TRUE(attributes::decodePredictedWindows(payload, 4, c.layout, "test", {}) == c.values);
     // The cuts: window w holds the bricks whose first entry lies in [wE, (w+1)E).
     const std::vector<Window> dir = directoryOf(payload);
     ASSERT_EQ(dir.size(), 3u);
@@ -90,7 +90,7 @@ TEST(PredictedWindows, EachWindowTakesTheSmallerCoding) {
     // Window 0 smooth noise (prediction wins), windows 1-2 few labels in long runs (palettes win).
     const Channel c = makeChannel(kValueWindowEntries * 3, kValueWindowEntries + 64, 2);
     const std::vector<uint8_t> payload = attributes::encodePredictedWindows(c.values, 4, c.layout);
-    EXPECT_TRUE(attributes::decodePredictedWindows(payload, 4, c.layout, "test") == c.values);
+    EXPECT_TRUE(attributes::decodePredictedWindows(payload, 4, c.layout, "test", {}) == c.values);
     const std::vector<uint8_t> palettesOnly = attributes::encodeValueWindows(c.values, 4);
     // Palettes alone pay for the noise window; the labels windows cost
     // the same either way, so predicted windows are smaller overall.
@@ -128,10 +128,10 @@ TEST(PredictedWindows, SameBytesHoweverTheEntriesArriveAndWhateverTheThreads) {
 TEST(PredictedWindows, DamagedPayloadsAreRefused) {
     const Channel c = makeChannel(kValueWindowEntries + 5000, kValueWindowEntries, 5);
     const std::vector<uint8_t> good = attributes::encodePredictedWindows(c.values, 4, c.layout);
-    ASSERT_NO_THROW(attributes::decodePredictedWindows(good, 4, c.layout, "good"));
+    ASSERT_NO_THROW(attributes::decodePredictedWindows(good, 4, c.layout, "good", {}));
     auto refused = [&](std::vector<uint8_t> bytes, const std::string& what, std::span<const uint64_t> layout) {
         try {
-            attributes::decodePredictedWindows(bytes, 4, layout, "forged");
+            attributes::decodePredictedWindows(bytes, 4, layout, "forged", {});
             ADD_FAILURE() << what << " accepted";
         } catch (const Error& e) {
             const std::string m = e.what();
