@@ -10,7 +10,7 @@
 
 namespace vdbdag::attributes {
 namespace {
-constexpr size_t kHeaderBytes = 1 + 4 + 4 + 8;
+constexpr size_t kHeaderBytes = 1 + 4 + 4 + 4 + 8;
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
@@ -28,6 +28,7 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
         places.empty() ? coding::encodeBrickValues(entries, layout, options) : coding::encodePlacedBrickValues(entries, layout, places, options);
     format::ByteWriter w;
     w.put<uint8_t>(4);
+    w.put<uint32_t>(uint32_t(options.near));
     w.put<int32_t>(int32_t(options.minValue));
     w.put<int32_t>(int32_t(options.maxValue));
     w.put<uint64_t>(entries.size());
@@ -41,6 +42,9 @@ std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std:
     const uint8_t valueSize = r.get<uint8_t>();
     if (valueSize != 4) r.fail("a context-coded channel of " + std::to_string(valueSize) + "-byte values (4 expected)");
     coding::IntCoderOptions options;
+    const uint32_t near = r.get<uint32_t>();
+    if (near > (1u << 20)) r.fail("a near-lossless bound of " + std::to_string(near) + " (at most 2^20)");
+    options.near = int32_t(near);
     options.minValue = r.get<int32_t>();
     options.maxValue = r.get<int32_t>();
     if (options.minValue > options.maxValue) r.fail("its value range is empty");

@@ -5,9 +5,11 @@
 // window stores as coding 2, or with neighbours across bricks as coding 3
 // (PredictedWindows.h), when it is smaller than the window's palettes.
 //
-// Payload: u8 value size (4), i32 minValue, i32 maxValue (the entries'
-// range, which bounds every prediction and the residuals' modulo), u64 n
-// (entries), then the coder's stream to the end.
+// Payload: u8 value size (4), u32 near (0: lossless; n: every entry within
+// n of what was coded, JPEG-LS NEAR; today's writer writes 0), i32
+// minValue, i32 maxValue (the entries' range, which bounds every prediction
+// and the residuals' modulo), u64 n (entries), then the coder's stream to
+// the end.
 #pragma once
 #include <cstdint>
 #include <span>

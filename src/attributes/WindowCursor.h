@@ -18,7 +18,7 @@ public:
     // `layout`, and attributePlaces, `places`) must outlive the cursor. Checks the directory; each window
     // is checked when it is reached (throws vdbdag::Error starting with `what`).
     WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what,
-                 std::span<const coding::BrickPlace> places = {});
+                 std::span<const coding::BrickPlace> places);
     uint64_t entries() const { return dir_.entries; }
     // Copies the next `n` entries (n * valueSize bytes) to `out`.
     void read(uint64_t n, uint8_t* out);

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 
+#include "src/coding/CodingLoop.h"
 #include "src/coding/SamplePredictor.h"
 #include "src/dag/Reflection.h"
 #include "src/util/Error.h"
@@ -200,56 +201,6 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
     if (e != entries) throw Error("the layout holds " + std::to_string(e) + " entries, the channel " + std::to_string(entries));
 }
 
-void checkOptions(const IntCoderOptions& options) {
-    if (options.minValue > options.maxValue || options.minValue < INT32_MIN || options.maxValue > INT32_MAX)
-        throw Error("value coder: the sample range must be a non-empty part of int32");
-    if (options.near < 0 || options.near > 1 << 20) throw Error("value coder: near must lie in 0..2^20");
-}
-
-// Both directions over either walk: `walk(models, step)` runs the walk.
-template <typename Walk>
-std::vector<uint8_t> encodeWith(std::span<const int32_t> entries, const IntCoderOptions& options, std::vector<int32_t>* reconstructed, Walk&& walk) {
-    checkOptions(options);
-    std::vector<uint8_t> out;
-    RangeEncoder rc(out);
-    auto models = std::make_unique<Models>();
-    const int64_t step = 2 * int64_t(options.near) + 1;
-    if (reconstructed) reconstructed->resize(entries.size());
-    walk(*models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
-        const int64_t s = entries[at];
-        if (s < options.minValue || s > options.maxValue)
-            throw Error("value coder: entry " + std::to_string(s) + " lies outside " + std::to_string(options.minValue) + ".." + std::to_string(options.maxValue));
-        const int64_t e = s - prediction;
-        const int64_t q = options.near == 0 ? wrap(e, options.minValue, options.maxValue) : (e >= 0 ? (e + options.near) / step : -((options.near - e) / step));
-        putResidual(rc, *models, c, signs, q);
-        const int64_t v = reconstruct(prediction, q, step, options.minValue, options.maxValue);
-        if (reconstructed) (*reconstructed)[at] = int32_t(v);
-        return v;
-    });
-    rc.finish();
-    return out;
-}
-
-template <typename Walk>
-void decodeWith(std::span<const uint8_t> bytes, const IntCoderOptions& options, std::span<int32_t> out, const std::string& what, Walk&& walk) {
-    checkOptions(options);
-    RangeDecoder rc(bytes);
-    auto models = std::make_unique<Models>();
-    const int64_t step = 2 * int64_t(options.near) + 1;
-    try {
-        walk(*models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
-            const int64_t v = reconstruct(prediction, getResidual(rc, *models, c, signs), step, options.minValue, options.maxValue);
-            out[at] = int32_t(v);
-            return v;
-        });
-    } catch (const Error& e) {
-        throw Error(what + ": " + e.what());
-    }
-    // As IntVolumeCoder: at most 4 bytes of the flush unread, at most 4 read past the end.
-    if (rc.overrun() > 4 || rc.consumed() + 4 < bytes.size())
-        throw Error(what + ": corrupt (the coded values end " + (rc.overrun() > 4 ? "early" : "before the stream does") + ")");
-}
-
 } // namespace
 
 uint64_t layoutEntryCount(std::span<const uint64_t> layout) {
@@ -261,22 +212,22 @@ uint64_t layoutEntryCount(std::span<const uint64_t> layout) {
 
 std::vector<uint8_t> encodeBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, const IntCoderOptions& options,
                                        std::vector<int32_t>* reconstructed) {
-    return encodeWith(entries, options, reconstructed, [&](Models& models, auto&& step) { walk(layout, entries.size(), options, models, step); });
+    return encodeSamples(entries, options, reconstructed, [&](Models& models, auto&& step) { walk(layout, entries.size(), options, models, step); });
 }
 
 void decodeBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, const IntCoderOptions& options, std::span<int32_t> out,
                        const std::string& what) {
-    decodeWith(bytes, options, out, what, [&](Models& models, auto&& step) { walk(layout, out.size(), options, models, step); });
+    decodeSamples(bytes, options, out, what, [&](Models& models, auto&& step) { walk(layout, out.size(), options, models, step); });
 }
 
 std::vector<uint8_t> encodePlacedBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
                                              const IntCoderOptions& options, std::vector<int32_t>* reconstructed) {
-    return encodeWith(entries, options, reconstructed, [&](Models& models, auto&& step) { walkPlaced(layout, places, entries.size(), options, models, step); });
+    return encodeSamples(entries, options, reconstructed, [&](Models& models, auto&& step) { walkPlaced(layout, places, entries.size(), options, models, step); });
 }
 
 void decodePlacedBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
                              const IntCoderOptions& options, std::span<int32_t> out, const std::string& what) {
-    decodeWith(bytes, options, out, what, [&](Models& models, auto&& step) { walkPlaced(layout, places, out.size(), options, models, step); });
+    decodeSamples(bytes, options, out, what, [&](Models& models, auto&& step) { walkPlaced(layout, places, out.size(), options, models, step); });
 }
 
 } // namespace vdbdag::coding

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "src/coding/RangeCoder.h"
+#include "src/coding/CodingLoop.h"
 #include "src/coding/SamplePredictor.h"
 #include "src/util/Error.h"
 
@@ -82,56 +83,24 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
     }
 }
 
-void checkOptions(IntVolumeShape shape, const IntCoderOptions& options) {
+void checkShape(IntVolumeShape shape) {
     if (shape.nx < 0 || shape.ny < 0 || shape.nz < 0) throw Error("value coder: a negative extent");
-    if (options.minValue > options.maxValue || options.minValue < INT32_MIN || options.maxValue > INT32_MAX)
-        throw Error("value coder: the sample range must be a non-empty part of int32");
-    if (options.near < 0 || options.near > 1 << 20) throw Error("value coder: near must lie in 0..2^20");
 }
 
 } // namespace
 
 std::vector<uint8_t> encodeIntVolume(std::span<const int32_t> samples, IntVolumeShape shape, const IntCoderOptions& options,
                                      std::vector<int32_t>* reconstructed) {
-    checkOptions(shape, options);
+    checkShape(shape);
     if (samples.size() != shape.count()) throw Error("value coder: " + std::to_string(samples.size()) + " samples for " + std::to_string(shape.count()));
-    std::vector<uint8_t> out;
-    RangeEncoder rc(out);
-    auto models = std::make_unique<Models>();
-    const int64_t step = 2 * int64_t(options.near) + 1;
-    if (reconstructed) reconstructed->resize(samples.size());
-    walk(shape, options, *models, [&](ContextModels& c, unsigned signs, int64_t prediction, size_t at) {
-        const int64_t s = samples[at];
-        if (s < options.minValue || s > options.maxValue)
-            throw Error("value coder: sample " + std::to_string(s) + " lies outside " + std::to_string(options.minValue) + ".." + std::to_string(options.maxValue));
-        const int64_t e = s - prediction;
-        const int64_t q = options.near == 0 ? wrap(e, options.minValue, options.maxValue) : (e >= 0 ? (e + options.near) / step : -((options.near - e) / step));
-        putResidual(rc, *models, c, signs, q);
-        const int64_t value = reconstruct(prediction, q, step, options.minValue, options.maxValue);
-        if (reconstructed) (*reconstructed)[at] = int32_t(value);
-        return value;
-    });
-    rc.finish();
-    return out;
+    return encodeSamples(samples, options, reconstructed, [&](Models& models, auto&& step) { walk(shape, options, models, step); });
 }
 
 void decodeIntVolume(std::span<const uint8_t> bytes, IntVolumeShape shape, const IntCoderOptions& options, std::span<int32_t> out,
                      const std::string& what) {
-    checkOptions(shape, options);
+    checkShape(shape);
     if (out.size() != shape.count()) throw Error(what + ": room for " + std::to_string(out.size()) + " samples, " + std::to_string(shape.count()) + " to decode");
-    RangeDecoder rc(bytes);
-    auto models = std::make_unique<Models>();
-    const int64_t step = 2 * int64_t(options.near) + 1;
-    walk(shape, options, *models, [&](ContextModels& c, unsigned signs, int64_t prediction, size_t at) {
-        const int64_t q = getResidual(rc, *models, c, signs);
-        const int64_t value = reconstruct(prediction, q, step, options.minValue, options.maxValue);
-        out[at] = int32_t(value);
-        return value;
-    });
-    // The encoder's flush leaves at most 4 bytes the decoder never needs
-    // and the decoder may look up to 4 bytes past its last one.
-    if (rc.overrun() > 4 || rc.consumed() + 4 < bytes.size())
-        throw Error(what + ": corrupt (the coded values end " + (rc.overrun() > 4 ? "early" : "before the stream does") + ")");
+    decodeSamples(bytes, options, out, what, [&](Models& models, auto&& step) { walk(shape, options, models, step); });
 }
 
 } // namespace vdbdag::coding

@@ -101,7 +101,8 @@ GridSummary summarizeGrid(const EncodedGrid& grid) {
         return s;
     }
     const std::vector<uint64_t> layout = encoding::attributeLayout(grid.dag);
-    attributes::WindowCursor cursor(bytes, true, vs, layout, what);
+    const std::vector<coding::BrickPlace> places = encoding::attributePlaces(grid.dag, vs);
+    attributes::WindowCursor cursor(bytes, true, vs, layout, what, places);
     constexpr uint64_t kChunk = uint64_t(1) << 16;
     std::vector<uint8_t> chunk;
     for (uint64_t done = 0; done < cursor.entries();) {

@@ -1,5 +1,6 @@
 // The integer value coder (src/coding/IntVolumeCoder) against JPEG-LS per
-// slice (CharLS, the codec hospitals store CT and MR in), on the stored
+// slice (CharLS, the codec hospitals store CT and MR in), JPEG 2000
+// lossless per slice (OpenJPEG), xz -9e and zstd -19, on the stored
 // samples of a scan as vdbdag reads them (DICOM, NIfTI, NRRD, MetaImage,
 // raw), in one run:
 //
@@ -19,7 +20,10 @@
 #include <vector>
 
 #include <charls/charls.h>
+#include <lzma.h>
+#include <openjpeg.h>
 #include <nlohmann/json.hpp>
+#include <zstd.h>
 
 #include "src/coding/IntVolumeCoder.h"
 #include "src/util/Error.h"
@@ -62,6 +66,88 @@ std::vector<int32_t> storedSamples(const vdbdag::bridge::DenseVolume& v) {
 }
 
 } // namespace
+
+// JPEG 2000 lossless (OpenJPEG, reversible 5/3, one quality layer) of one
+// slice, through memory streams: its codestream's size, and whether it
+// decodes back to the same samples.
+struct MemoryStream {
+    std::vector<uint8_t> data;
+    size_t pos = 0;
+};
+OPJ_SIZE_T memoryWrite(void* buffer, OPJ_SIZE_T n, void* user) {
+    auto* s = static_cast<MemoryStream*>(user);
+    if (s->pos + n > s->data.size()) s->data.resize(s->pos + n);
+    std::memcpy(s->data.data() + s->pos, buffer, n);
+    s->pos += n;
+    return n;
+}
+OPJ_SIZE_T memoryRead(void* buffer, OPJ_SIZE_T n, void* user) {
+    auto* s = static_cast<MemoryStream*>(user);
+    if (s->pos >= s->data.size()) return OPJ_SIZE_T(-1);
+    n = std::min<OPJ_SIZE_T>(n, s->data.size() - s->pos);
+    std::memcpy(buffer, s->data.data() + s->pos, n);
+    s->pos += n;
+    return n;
+}
+OPJ_OFF_T memorySkip(OPJ_OFF_T n, void* user) {
+    static_cast<MemoryStream*>(user)->pos += size_t(n);
+    return n;
+}
+OPJ_BOOL memorySeek(OPJ_OFF_T at, void* user) {
+    static_cast<MemoryStream*>(user)->pos = size_t(at);
+    return OPJ_TRUE;
+}
+opj_stream_t* memoryStream(MemoryStream& s, bool input) {
+    opj_stream_t* st = opj_stream_create(1 << 16, input ? OPJ_TRUE : OPJ_FALSE);
+    opj_stream_set_user_data(st, &s, nullptr);
+    if (input) {
+        opj_stream_set_user_data_length(st, s.data.size());
+        opj_stream_set_read_function(st, memoryRead);
+    } else {
+        opj_stream_set_write_function(st, memoryWrite);
+    }
+    opj_stream_set_skip_function(st, memorySkip);
+    opj_stream_set_seek_function(st, memorySeek);
+    return st;
+}
+
+// Returns the codestream bytes; `same` tells whether it decoded exactly.
+size_t jpeg2000Slice(const int32_t* slice, uint32_t nx, uint32_t ny, int bits, bool& same) {
+    opj_cparameters_t p;
+    opj_set_default_encoder_parameters(&p);
+    p.tcp_numlayers = 1;
+    p.tcp_rates[0] = 0;  // lossless
+    p.cp_disto_alloc = 1;
+    p.irreversible = 0;
+    int levels = 1;
+    while (levels < 6 && (std::min(nx, ny) >> levels) >= 8) ++levels;
+    p.numresolution = levels;
+    opj_image_cmptparm_t c{};
+    c.dx = c.dy = 1, c.w = nx, c.h = ny, c.prec = OPJ_UINT32(bits), c.sgnd = 0;
+    opj_image_t* image = opj_image_create(1, &c, OPJ_CLRSPC_GRAY);
+    image->x0 = image->y0 = 0, image->x1 = nx, image->y1 = ny;
+    std::copy_n(slice, size_t(nx) * ny, image->comps[0].data);
+    MemoryStream out;
+    opj_codec_t* codec = opj_create_compress(OPJ_CODEC_J2K);
+    opj_stream_t* st = memoryStream(out, false);
+    const bool ok = opj_setup_encoder(codec, &p, image) && opj_start_compress(codec, image, st) && opj_encode(codec, st) && opj_end_compress(codec, st);
+    opj_stream_destroy(st);
+    opj_destroy_codec(codec);
+    opj_image_destroy(image);
+    if (!ok) throw vdbdag::Error("OpenJPEG could not encode a slice");
+    MemoryStream in{out.data, 0};
+    opj_dparameters_t d;
+    opj_set_default_decoder_parameters(&d);
+    codec = opj_create_decompress(OPJ_CODEC_J2K);
+    st = memoryStream(in, true);
+    opj_image_t* back = nullptr;
+    same = opj_setup_decoder(codec, &d) && opj_read_header(st, codec, &back) && opj_decode(codec, st, back) && opj_end_decompress(codec, st) &&
+           back->numcomps == 1 && back->comps[0].w == nx && back->comps[0].h == ny && std::equal(slice, slice + size_t(nx) * ny, back->comps[0].data);
+    opj_stream_destroy(st);
+    opj_destroy_codec(codec);
+    if (back) opj_image_destroy(back);
+    return out.data.size();
+}
 
 int main(int argc, char** argv) {
     try {
@@ -139,6 +225,48 @@ int main(int argc, char** argv) {
             jlsEncode.push_back(enc);
             jlsDecode.push_back(dec);
         }
+        // General-purpose peers, lossless only: xz -9e and zstd -19 of the
+        // whole volume's samples as JPEG-LS gets them (min-subtracted, 1 or 2
+        // bytes little-endian), each checked by decompressing.
+        size_t xzBytes = 0, zstdBytes = 0, j2kBytes = 0, j2kWrong = 0;
+        double xzEncode = 0, zstdEncode = 0, j2kSeconds = 0;
+        if (near == 0) {
+            const size_t bytesPerSample = bits <= 8 ? 1 : 2;
+            std::vector<uint8_t> raw(samples.size() * bytesPerSample);
+            for (size_t i = 0; i < samples.size(); ++i) {
+                const uint32_t s = uint32_t(samples[i] - minValue);
+                if (bytesPerSample == 1) raw[i] = uint8_t(s);
+                else { const uint16_t x = uint16_t(s); std::memcpy(&raw[2 * i], &x, 2); }
+            }
+            auto a = Clock::now();
+            std::vector<uint8_t> z(ZSTD_compressBound(raw.size()));
+            zstdBytes = ZSTD_compress(z.data(), z.size(), raw.data(), raw.size(), 19);
+            auto b = Clock::now();
+            if (ZSTD_isError(zstdBytes)) throw vdbdag::Error("zstd failed");
+            std::vector<uint8_t> zback(raw.size());
+            if (ZSTD_decompress(zback.data(), zback.size(), z.data(), zstdBytes) != raw.size() || zback != raw) throw vdbdag::Error("zstd round trip failed");
+            std::vector<uint8_t> x(lzma_stream_buffer_bound(raw.size()));
+            auto c = Clock::now();
+            if (lzma_easy_buffer_encode(9 | LZMA_PRESET_EXTREME, LZMA_CHECK_CRC64, nullptr, raw.data(), raw.size(), x.data(), &xzBytes, x.size()) != LZMA_OK)
+                throw vdbdag::Error("xz failed");
+            auto d = Clock::now();
+            std::vector<uint8_t> xback(raw.size());
+            uint64_t memlimit = UINT64_MAX;
+            size_t inPos = 0, outPos = 0;
+            if (lzma_stream_buffer_decode(&memlimit, 0, nullptr, x.data(), &inPos, xzBytes, xback.data(), &outPos, xback.size()) != LZMA_OK || xback != raw)
+                throw vdbdag::Error("xz round trip failed");
+            zstdEncode = seconds(a, b), xzEncode = seconds(c, d);
+            // JPEG 2000 lossless, each z-slice (min-subtracted, the scan's bit depth), once.
+            std::vector<int32_t> slice(plane);
+            auto e = Clock::now();
+            for (int64_t z = 0; z < nz; ++z) {
+                for (size_t i = 0; i < plane; ++i) slice[i] = samples[size_t(z) * plane + i] - minValue;
+                bool same = false;
+                j2kBytes += jpeg2000Slice(slice.data(), uint32_t(nx), uint32_t(ny), bits, same);
+                j2kWrong += !same;
+            }
+            j2kSeconds = seconds(e, Clock::now());
+        }
         const double mb = double(samples.size() * (bits <= 8 ? 1 : 2)) / 1e6;  // MB of samples at the scan's bit depth
         const nlohmann::json report{{"scan", path},
                                     {"dims", {nx, ny, nz}},
@@ -153,9 +281,16 @@ int main(int argc, char** argv) {
                                     {"ours_decode_mb_s", mb / median(oursDecode)},
                                     {"jpegls_encode_mb_s", mb / median(jlsEncode)},
                                     {"jpegls_decode_mb_s", mb / median(jlsDecode)},
+                                    {"xz_bytes", xzBytes},
+                                    {"zstd_bytes", zstdBytes},
+                                    {"xz_encode_mb_s", xzBytes ? mb / xzEncode : 0.0},
+                                    {"zstd_encode_mb_s", zstdBytes ? mb / zstdEncode : 0.0},
+                                    {"jpeg2000_bytes", j2kBytes},
+                                    {"jpeg2000_slices_wrong", j2kWrong},
+                                    {"jpeg2000_encode_decode_mb_s", j2kBytes ? mb / j2kSeconds : 0.0},
                                     {"repeats", repeats}};
         std::printf("%s\n", report.dump().c_str());
-        return oursWrong || jlsWrong ? 1 : 0;
+        return oursWrong || jlsWrong || j2kWrong ? 1 : 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "vdbdag_int_coder_bench: %s\n", e.what());
         return 2;
