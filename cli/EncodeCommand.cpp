@@ -62,7 +62,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the one whose file is smallest; each codes the values again (1-64)")->check(CLI::Range(1, 64));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
-    auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error")->check(finiteNumber())->check(CLI::PositiveNumber);
+    auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error; an int32/int64 value within its integer part (JPEG-LS NEAR)")->check(finiteNumber())->check(CLI::PositiveNumber);
     cmd->add_option("--rel-error", opt->relError, "lossy: every float/double active value within this relative error")->check(finiteNumber())->check(CLI::Range(1e-12, 0.5))->excludes(abs);
     auto* colourBits = cmd->add_option("--colour-bits,--color-bits", opt->colourBits,
                                        "lossy colours: at most 2^K colours per colour grid, clustered in CIELAB (K = 10, 12, 14; 1..16)")

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <type_traits>
 
 #include <iostream>  // nanovdb/util/GridValidator.h uses std::cerr without including it
 
@@ -83,10 +84,20 @@ std::string checkChildPointers(const nanovdb::NanoGrid<T>& grid, uint64_t buffer
         for (auto it = node->data()->mChildMask.beginOn(); it; ++it)
             if (!isNode(node->data()->getChild(*it), lowerBegin, lowers, sizeof(LowerT))) return "an upper node's child pointer points at no lower node";
     }
+    // FpN leaves vary in size (each its own bit width): a child is then any
+    // 32-byte aligned place from the first leaf on where a leaf header fits.
+    const auto isLeaf = [&](const void* p) {
+        if constexpr (std::is_same_v<T, nanovdb::FpN>) {
+            const auto* b = static_cast<const uint8_t*>(p);
+            return leafBegin && b >= leafBegin && uint64_t(b - base) + sizeof(LeafT) <= bufferSize && uint64_t(b - base) % NANOVDB_DATA_ALIGNMENT == 0;
+        } else {
+            return isNode(p, leafBegin, leaves, sizeof(LeafT));
+        }
+    };
     for (uint64_t k = 0; k < lowers; ++k) {
         const auto* node = reinterpret_cast<const LowerT*>(lowerBegin + k * sizeof(LowerT));
         for (auto it = node->data()->mChildMask.beginOn(); it; ++it)
-            if (!isNode(node->data()->getChild(*it), leafBegin, leaves, sizeof(LeafT))) return "a lower node's child pointer points at no leaf";
+            if (!isLeaf(node->data()->getChild(*it))) return "a lower node's child pointer points at no leaf";
     }
     return "";
 }

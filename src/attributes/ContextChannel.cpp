@@ -2,6 +2,9 @@
 #include "src/attributes/ContextChannel.h"
 
 #include <algorithm>
+#include <numeric>
+#include <tuple>
+#include <utility>
 #include <cstring>
 
 #include "src/coding/BrickValueCoder.h"
@@ -10,27 +13,33 @@
 
 namespace vdbdag::attributes {
 namespace {
-constexpr size_t kHeaderBytes = 1 + 4 + 4 + 4 + 8;
+constexpr size_t kHeaderBytes = 1 + 4 + 4 + 4 + 4 + 8;
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
     if (values.size() % 4) throw Error("internal error: a context-coded channel holds int32 entries");
     std::vector<int32_t> entries(values.size() / 4);
     std::memcpy(entries.data(), values.data(), values.size());
+    int32_t lo = 0, hi = 0;
+    if (!entries.empty()) std::tie(lo, hi) = std::pair(*std::min_element(entries.begin(), entries.end()), *std::max_element(entries.begin(), entries.end()));
+    // The entries' common step above the minimum (values quantised by
+    // --abs-error, or a scanner's): the coder sees (v - min) / step.
+    uint64_t step = 0;
+    for (const int32_t v : entries) step = std::gcd(step, uint64_t(int64_t(v) - lo));
+    if (step == 0) step = 1;
+    if (step > 1)
+        for (int32_t& v : entries) v = int32_t((int64_t(v) - lo) / int64_t(step));
     coding::IntCoderOptions options;
-    if (!entries.empty()) {
-        const auto [lo, hi] = std::minmax_element(entries.begin(), entries.end());
-        options.minValue = *lo, options.maxValue = *hi;
-    } else {
-        options.minValue = options.maxValue = 0;
-    }
+    options.minValue = step > 1 ? 0 : lo;
+    options.maxValue = step > 1 ? (int64_t(hi) - lo) / int64_t(step) : hi;
     const std::vector<uint8_t> stream =
         places.empty() ? coding::encodeBrickValues(entries, layout, options) : coding::encodePlacedBrickValues(entries, layout, places, options);
     format::ByteWriter w;
     w.put<uint8_t>(4);
     w.put<uint32_t>(uint32_t(options.near));
-    w.put<int32_t>(int32_t(options.minValue));
-    w.put<int32_t>(int32_t(options.maxValue));
+    w.put<uint32_t>(uint32_t(step));
+    w.put<int32_t>(lo);
+    w.put<int32_t>(hi);
     w.put<uint64_t>(entries.size());
     w.putBytes(stream);
     return std::move(w.bytes());
@@ -45,15 +54,20 @@ std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std:
     const uint32_t near = r.get<uint32_t>();
     if (near > (1u << 20)) r.fail("a near-lossless bound of " + std::to_string(near) + " (at most 2^20)");
     options.near = int32_t(near);
-    options.minValue = r.get<int32_t>();
-    options.maxValue = r.get<int32_t>();
-    if (options.minValue > options.maxValue) r.fail("its value range is empty");
+    const uint32_t step = r.get<uint32_t>();
+    const int32_t lo = r.get<int32_t>(), hi = r.get<int32_t>();
+    if (lo > hi) r.fail("its value range is empty");
+    if (step == 0 || (int64_t(hi) - lo) % step) r.fail("a step of " + std::to_string(step) + " that does not divide its value range");
+    options.minValue = step > 1 ? 0 : lo;
+    options.maxValue = step > 1 ? (int64_t(hi) - lo) / step : hi;
     const uint64_t n = r.get<uint64_t>();
     if (n != entries || coding::layoutEntryCount(layout) != entries)
         r.fail("holds " + std::to_string(n) + " entries, its bricks " + std::to_string(coding::layoutEntryCount(layout)) + ", expected " + std::to_string(entries));
     std::vector<int32_t> decoded(static_cast<size_t>(entries));
     if (places.empty()) coding::decodeBrickValues(payload.subspan(kHeaderBytes), layout, options, decoded, what);
     else coding::decodePlacedBrickValues(payload.subspan(kHeaderBytes), layout, places, options, decoded, what);
+    if (step > 1)
+        for (int32_t& v : decoded) v = int32_t(lo + int64_t(v) * step);
     std::vector<uint8_t> out(decoded.size() * 4);
     std::memcpy(out.data(), decoded.data(), out.size());
     return out;

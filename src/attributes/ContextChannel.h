@@ -6,10 +6,13 @@
 // (PredictedWindows.h), when it is smaller than the window's palettes.
 //
 // Payload: u8 value size (4), u32 near (0: lossless; n: every entry within
-// n of what was coded, JPEG-LS NEAR; today's writer writes 0), i32
-// minValue, i32 maxValue (the entries' range, which bounds every prediction
-// and the residuals' modulo), u64 n (entries), then the coder's stream to
-// the end.
+// n of what was coded, JPEG-LS NEAR; today's writer writes 0), u32 step
+// (>= 1: every entry is minValue + step k, and the coder codes k; the
+// greatest common divisor of the entries above their minimum, > 1 for
+// values quantised by --abs-error), i32 minValue, i32 maxValue (the
+// entries' range, which bounds every prediction and the residuals' modulo;
+// step divides maxValue - minValue), u64 n (entries), then the coder's
+// stream to the end.
 #pragma once
 #include <cstdint>
 #include <span>

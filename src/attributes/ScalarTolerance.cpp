@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <fmt/core.h>
 
@@ -49,16 +50,53 @@ void ScalarQuantizer::quantise(std::span<uint8_t> bytes) {
     }
 }
 
+// Integers (absolute bound only): each value to the nearest multiple of
+// s = 2 floor(E) + 1, so the error is at most floor(E) and the values share
+// the step s, which the value coder divides out (ContextChannel.h). A value
+// whose multiple would leave the type's range stays exact.
+template <typename T>
+void ScalarQuantizer::quantiseIntegers(std::span<uint8_t> bytes) {
+    const ScalarTolerance& tol = report_.tolerance;
+    if (tol.mode != ScalarTolerance::Mode::Absolute || !(tol.bound >= 1)) return;
+    const __int128 half = __int128(std::min(tol.bound, 1e15)), s = 2 * half + 1;
+    const size_t n = bytes.size() / sizeof(T);
+    for (size_t i = 0; i < n; ++i) {
+        T v;
+        std::memcpy(&v, &bytes[i * sizeof(T)], sizeof(T));
+        __int128 r = __int128(v) % s;
+        if (r < 0) r += s;
+        __int128 q = __int128(v) - r;
+        if (r > half) q += s;
+        if (q < __int128(std::numeric_limits<T>::min()) || q > __int128(std::numeric_limits<T>::max())) {
+            ++report_.keptExact;
+            continue;
+        }
+        const T stored = T(q);
+        const double err = double(q > __int128(v) ? q - __int128(v) : __int128(v) - q);
+        if (stored != v) {
+            ++report_.changed;
+            std::memcpy(&bytes[i * sizeof(T)], &stored, sizeof(T));
+        }
+        report_.maxAbsError = std::max(report_.maxAbsError, err);
+        if (v != 0) report_.maxRelError = std::max(report_.maxRelError, err / std::fabs(double(v)));
+        sumAbs_ += err;
+        sumSq_ += err * err;
+    }
+}
+
 void ScalarQuantizer::apply(std::span<uint8_t> values) {
     report_.entries += values.size() / std::max(1u, valueSize(type_));
     if (report_.tolerance.mode == ScalarTolerance::Mode::Exact) return;
     if (type_ == ValueType::Float) quantise<float>(values);
     else if (type_ == ValueType::Double) quantise<double>(values);
+    else if (type_ == ValueType::Int32) quantiseIntegers<int32_t>(values);
+    else if (type_ == ValueType::Int64) quantiseIntegers<int64_t>(values);
 }
 
 ToleranceReport ScalarQuantizer::finish() const {
     ToleranceReport report = report_;
-    if (report.entries && (type_ == ValueType::Float || type_ == ValueType::Double) && report.tolerance.mode != ScalarTolerance::Mode::Exact) {
+    if (report.entries && (type_ == ValueType::Float || type_ == ValueType::Double || type_ == ValueType::Int32 || type_ == ValueType::Int64) &&
+        report.tolerance.mode != ScalarTolerance::Mode::Exact) {
         report.meanAbsError = sumAbs_ / double(report.entries);
         report.rmsError = std::sqrt(sumSq_ / double(report.entries));
     }

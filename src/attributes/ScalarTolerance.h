@@ -1,5 +1,7 @@
 // Lossy scalar channels with a guarantee, like NanoVDB's FpN tolerance:
-// `--abs-error E` rounds every finite value to a multiple of 2E (error <= E);
+// `--abs-error E` rounds every finite value to a multiple of 2E (error <= E;
+// an int32/int64 value to a multiple of 2 floor(E) + 1, error <= floor(E),
+// JPEG-LS's NEAR: the value coder then codes the multiples);
 // `--rel-error R` rounds |v| on a logarithmic grid of ratio (1+R)^2 (error
 // <= R|v|, so it holds for values spanning 1e-30..1e30). Every quantised
 // value is checked against the bound and kept exact if rounding would break
@@ -33,8 +35,9 @@ struct ToleranceReport {
 // Quantises float or double values (raw bytes, attribute order) in place,
 // chunk after chunk in attribute order, so an encoder in bounded memory
 // quantises each cube's values as they are gathered; the report (its sums
-// taken in the same order) is the same however the values were cut. Other
-// types are left untouched (the report then says 0 changed).
+// taken in the same order) is the same however the values were cut.
+// Integers take the absolute bound only; other types are left untouched
+// (the report then says 0 changed).
 class ScalarQuantizer {
 public:
     ScalarQuantizer(ValueType type, const ScalarTolerance& tolerance);
@@ -44,6 +47,8 @@ public:
 private:
     template <typename T>
     void quantise(std::span<uint8_t> bytes);
+    template <typename T>
+    void quantiseIntegers(std::span<uint8_t> bytes);
     ValueType type_;
     ToleranceReport report_;
     double sumAbs_ = 0, sumSq_ = 0;

@@ -242,3 +242,31 @@ TEST(BrickValueCoder, PlacesThatAreNoBricksAreRefused) {
 
 } // namespace
 } // namespace vdbdag::coding
+
+namespace vdbdag::attributes {
+namespace {
+
+// Entries sharing a step above their minimum (values quantised by
+// --abs-error, or a scanner's multiples): the payload records the step (its
+// greatest common divisor, offset 5) and codes the quotients; exact back.
+TEST(ContextChannel, ACommonStepIsDividedOut) {
+    std::vector<uint64_t> layout(50, ~uint64_t(0));
+    std::vector<int32_t> v(50 * 64);
+    std::mt19937 rng(8);
+    for (size_t i = 0; i < v.size(); ++i) v[i] = -1000 + 7 * int32_t(200 + (i % 64) + rng() % 5);
+    std::vector<uint8_t> bytes(v.size() * 4);
+    std::memcpy(bytes.data(), v.data(), bytes.size());
+    const std::vector<uint8_t> payload = encodeContextChannel(bytes, layout);
+    uint32_t step;
+    std::memcpy(&step, payload.data() + 5, 4);
+    EXPECT_EQ(step, 7u);
+    EXPECT_EQ(decodeContextChannel(payload, layout, v.size(), "step"), bytes);
+    // A step that does not divide the range is refused.
+    std::vector<uint8_t> forged = payload;
+    const uint32_t three = 3;
+    std::memcpy(forged.data() + 5, &three, 4);
+    EXPECT_THROW(decodeContextChannel(forged, layout, v.size(), "forged"), Error);
+}
+
+} // namespace
+} // namespace vdbdag::attributes

@@ -118,3 +118,95 @@ TEST(ScalarTolerance, EndToEndEveryDecodedValueWithinTheBound) {
     for (auto it = g->cbeginValueOff(); it; ++it) ASSERT_EQ(acc.getValue(it.getCoord()), *it);
     fs::remove_all(dir);
 }
+
+// Integers (issue 37's near-lossless): --abs-error N on an int32 or int64
+// channel moves each value to the nearest multiple of 2 floor(N) + 1, so
+// every value is within floor(N) (brute force), a value whose multiple
+// leaves the type stays exact, the report's figures are the brute-force
+// ones, and --rel-error leaves integers exact.
+TEST(ScalarTolerance, IntegersAreNearLosslessWithinTheIntegerBound) {
+    std::mt19937 rng(37);
+    std::vector<int32_t> v(20000);
+    for (auto& x : v) x = int32_t(rng() % 4096) - 1024;
+    v[0] = INT32_MIN, v[1] = INT32_MAX, v[2] = 0;
+    std::vector<uint8_t> bytes(v.size() * 4);
+    std::memcpy(bytes.data(), v.data(), bytes.size());
+    const attributes::ToleranceReport r = attributes::applyScalarTolerance(bytes, ValueType::Int32, {attributes::ScalarTolerance::Mode::Absolute, 2.7});
+    std::vector<int32_t> q(v.size());
+    std::memcpy(q.data(), bytes.data(), bytes.size());
+    double maxErr = 0, sum = 0;
+    uint64_t changed = 0;
+    for (size_t i = 0; i < v.size(); ++i) {
+        const int64_t e = std::llabs(int64_t(q[i]) - v[i]);
+        ASSERT_LE(e, 2) << i;
+        if (i > 0) EXPECT_EQ(((int64_t(q[i]) % 5) + 5) % 5, 0) << i;  // multiples of 2*2+1
+        maxErr = std::max(maxErr, double(e));
+        sum += double(e);
+        changed += e != 0;
+    }
+    EXPECT_EQ(q[0], INT32_MIN);  // its nearest multiple of 5 would leave int32
+    EXPECT_EQ(q[1], INT32_MAX - 2);
+    EXPECT_EQ(r.keptExact, 1u);
+    EXPECT_EQ(r.changed, changed);
+    EXPECT_EQ(r.maxAbsError, maxErr);
+    EXPECT_NEAR(r.meanAbsError, sum / double(v.size()), 1e-12);
+    // Relative: integers stay as they are; a bound under 1 changes nothing.
+    std::vector<uint8_t> same(v.size() * 4);
+    std::memcpy(same.data(), v.data(), same.size());
+    EXPECT_EQ(attributes::applyScalarTolerance(same, ValueType::Int32, {attributes::ScalarTolerance::Mode::Relative, 0.1}).changed, 0u);
+    EXPECT_EQ(attributes::applyScalarTolerance(same, ValueType::Int32, {attributes::ScalarTolerance::Mode::Absolute, 0.9}).changed, 0u);
+    EXPECT_EQ(std::memcmp(same.data(), v.data(), same.size()), 0);
+    // int64 beyond double's 53 bits: exact integer arithmetic.
+    std::vector<int64_t> w{(int64_t(1) << 60) + 3, -(int64_t(1) << 60) - 4, 7};
+    std::vector<uint8_t> wb(w.size() * 8);
+    std::memcpy(wb.data(), w.data(), wb.size());
+    attributes::applyScalarTolerance(wb, ValueType::Int64, {attributes::ScalarTolerance::Mode::Absolute, 1});
+    std::vector<int64_t> wq(w.size());
+    std::memcpy(wq.data(), wb.data(), wb.size());
+    for (size_t i = 0; i < w.size(); ++i) {
+        EXPECT_LE(std::llabs(wq[i] - w[i]), 1);
+        EXPECT_EQ(((wq[i] % 3) + 3) % 3, 0);
+    }
+}
+
+// End to end: an int32 grid (a dense 48^3 block of CT-like samples) encoded
+// with --abs-error 2 is smaller than lossless, and every voxel OpenVDB reads
+// back from the decoded .vdb is within 2 of the original (brute force).
+TEST(ScalarTolerance, EndToEndIntegersWithinTheBound) {
+    openvdb::initialize();
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_tol_int_" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    auto g = openvdb::Int32Grid::create(-1024);
+    g->setName("ct");
+    std::mt19937 rng(5);
+    std::normal_distribution<double> noise(0.0, 8.0);
+    auto acc0 = g->getAccessor();
+    for (int z = 0; z < 48; ++z)
+        for (int y = 0; y < 48; ++y)
+            for (int x = 0; x < 48; ++x)
+                acc0.setValue({x, y, z}, int32_t(std::lround(40 + 300 * std::sin(x / 9.0) * std::cos(y / 7.0) + 2 * z + noise(rng))));
+    const fs::path in = dir / "ct.vdb", out = dir / "ct_lossy.vdb";
+    openvdb::io::File(in.string()).write({g});
+    pipeline::EncodeOptions options;
+    options.tolerance = {attributes::ScalarTolerance::Mode::Absolute, 2};
+    const auto exact = format::writeScene(pipeline::encodeVolume(bridge::importVdb(in.string()).volume));
+    const auto lossy = format::writeScene(pipeline::encodeVolume(bridge::importVdb(in.string()).volume, options));
+    EXPECT_LT(double(lossy.size()), 0.8 * double(exact.size()));
+    const auto scene = format::readScene(lossy, "lossy");
+    EXPECT_EQ(scene.grids[0].lossy.maxAbsError, 2);
+    bridge::exportVdb(pipeline::decodeScene(scene), out.string());
+    openvdb::io::File f(out.string());
+    f.open();
+    const auto back = openvdb::gridPtrCast<openvdb::Int32Grid>(f.readGrid("ct"));
+    ASSERT_TRUE(back);
+    auto acc = back->getConstAccessor();
+    uint64_t checked = 0;
+    for (auto it = g->cbeginValueOn(); it; ++it, ++checked) {
+        ASSERT_TRUE(acc.isValueOn(it.getCoord()));
+        ASSERT_LE(std::llabs(int64_t(acc.getValue(it.getCoord())) - *it), 2);
+    }
+    EXPECT_EQ(checked, uint64_t(48 * 48 * 48));
+    EXPECT_EQ(checked, back->activeVoxelCount());
+    fs::remove_all(dir);
+}
