@@ -4,7 +4,7 @@
 
 #include <array>
 #include <bit>
-#include <map>
+#include <unordered_map>
 #include <memory>
 
 #include "src/coding/CodingLoop.h"
@@ -107,11 +107,27 @@ struct PlacedBrick {
     CompactRecord rec[64];
 };
 
+struct BrickKey {
+    int32_t x, y, z;
+    bool operator==(const BrickKey&) const = default;
+};
+struct BrickKeyHash {
+    size_t operator()(const BrickKey& k) const {
+        uint64_t h = uint64_t(uint32_t(k.x)) * 0x9E3779B97F4A7C15ull;
+        h ^= uint64_t(uint32_t(k.y)) * 0xC2B2AE3D27D4EB4Full + (h >> 29);
+        h ^= uint64_t(uint32_t(k.z)) * 0x165667B19E3779F9ull + (h >> 32);
+        return size_t(h);
+    }
+};
+
 template <typename Step>
 void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, const IntCoderOptions& options, Models& models,
                 Step&& step) {
     if (places.size() != layout.size()) throw Error("the layout has " + std::to_string(layout.size()) + " bricks, their places " + std::to_string(places.size()));
-    std::map<std::array<int32_t, 3>, uint32_t> slots;  // brick coordinates -> index in `bricks`
+    // Brick coordinates (index / 4) -> index in `bricks`.
+    const auto key = [](int64_t x, int64_t y, int64_t z) { return BrickKey{int32_t(x), int32_t(y), int32_t(z)}; };
+    std::unordered_map<BrickKey, uint32_t, BrickKeyHash> slots;
+    slots.reserve(layout.size());
     std::vector<PlacedBrick> bricks;
     bricks.reserve(layout.size());  // `around` points into it
     int64_t last = 0;
@@ -132,8 +148,8 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
         const BrickPlace& place = places[b];
         if ((place.x | place.y | place.z) & 3 || place.mirror > 7) throw Error("brick " + std::to_string(b) + " has no brick's place");
         if (e + uint64_t(std::popcount(mask)) > entries) throw Error("the layout holds more entries than the channel");
-        const std::array<int32_t, 3> at{place.x >> 2, place.y >> 2, place.z >> 2};
-        if (!slots.emplace(at, uint32_t(bricks.size())).second) throw Error("two bricks at the same place");
+        const std::array<int64_t, 3> at{place.x >> 2, place.y >> 2, place.z >> 2};
+        if (!slots.emplace(key(at[0], at[1], at[2]), uint32_t(bricks.size())).second) throw Error("two bricks at the same place");
         bricks.emplace_back();
         PlacedBrick& self = bricks.back();
         // The bricks around that hold causal neighbours: dx in -1..1, dy and dz in -1..0.
@@ -141,7 +157,7 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
         for (int dx = -1; dx <= 1; ++dx)
             for (int dy = -1; dy <= 0; ++dy)
                 for (int dz = -1; dz <= 0; ++dz) {
-                    const auto it = slots.find({at[0] + dx, at[1] + dy, at[2] + dz});
+                    const auto it = slots.find(key(at[0] + dx, at[1] + dy, at[2] + dz));
                     around[dx + 1][dy + 1][dz + 1] = (dx == 0 && dy == 0 && dz == 0) ? &self : it == slots.end() ? nullptr : &bricks[it->second];
                 }
         const uint64_t spatial = dag::reflectBrick(mask, place.mirror);
