@@ -2,8 +2,9 @@
 // context-modelled brick coder (coding/BrickValueCoder.h): each entry
 // predicted from its neighbours in its 4^3 brick by six blended predictors,
 // its residual range coded under an activity context. What a predicted
-// window stores as coding 2, or with neighbours across bricks as coding 3
-// (PredictedWindows.h), when it is smaller than the window's palettes.
+// window stores as coding 2, or with neighbours across bricks as coding 3,
+// or as labels (coding/LabelCoder.h) as coding 4 (PredictedWindows.h), when
+// it is smaller than the window's palettes.
 //
 // Payload: u8 value size (4), u32 near (0: lossless; n: every entry within
 // n of what was coded, JPEG-LS NEAR; today's writer writes 0), u32 step
@@ -27,13 +28,15 @@ namespace vdbdag::attributes {
 // With `places` (one per layout entry), neighbours come from the bricks
 // around too (coding 3, encodePlacedBrickValues); without, from each brick
 // alone (coding 2).
+// With `labels` (and places), the entries are coded as categories by
+// coding/LabelCoder.h (coding 4).
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
-                                          std::span<const coding::BrickPlace> places = {});
+                                          std::span<const coding::BrickPlace> places = {}, bool labels = false);
 
 // Inverse (`places` given exactly when the payload was coded with them);
 // validates the payload against `layout` and `entries` (throws
 // vdbdag::Error starting with `what`).
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places = {});
+                                          std::span<const coding::BrickPlace> places = {}, bool labels = false);
 
 } // namespace vdbdag::attributes

@@ -23,26 +23,50 @@ namespace {
 constexpr uint64_t kSmallWindowBytes = uint64_t(4) << 20;  // level 9 up to this, then 3 (the container's rule)
 constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;
 
-// A window's raw bytes: its coding byte, then the smaller of its palettes
+// Whether a window looks like labels: most entries repeat the one before
+// (in attribute order, neighbours mostly), as regions of one label do and
+// a scan's noise does not. Only such windows are also coded as labels.
+bool looksLikeLabels(std::span<const uint8_t> values) {
+    const size_t n = values.size() / 4;
+    if (n < 2) return false;
+    size_t repeats = 0;
+    for (size_t i = 1; i < n; ++i) repeats += std::memcmp(values.data() + 4 * i, values.data() + 4 * (i - 1), 4) == 0;
+    return repeats * 4 >= (n - 1) * 3;
+}
+
+// A window's raw bytes: its coding byte, then the smallest of its palettes
 // (by zstd's fast estimate) and its entries coded from their neighbours:
-// context-modelled (int32; range coded already; with neighbours across
-// bricks when their places are known) or brick MED residuals (int64,
-// zstd's estimate).
+// int32 context-modelled (range coded already; with neighbours across
+// bricks when their places are known, and as labels too when the window
+// looks like labels), int64 brick MED residuals (zstd's estimate).
 std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
                                 uint32_t vs) {
-    std::vector<uint8_t> palette = serializePalette(compressPalette(values, vs));
-    const bool contextCoded = vs == 4, placed = contextCoded && !places.empty();
-    std::vector<uint8_t> predicted = contextCoded ? encodeContextChannel(values, layout, places) : encodePredicted(values, vs, layout);
-    const uint64_t predictedSize = contextCoded ? predicted.size() : format::zstdFastSize(predicted);
-    const bool usePredicted = predictedSize < format::zstdFastSize(palette);
-    std::vector<uint8_t>& chosen = usePredicted ? predicted : palette;
+    std::vector<uint8_t> best = serializePalette(compressPalette(values, vs));
+    uint64_t bestSize = format::zstdFastSize(best);
+    uint8_t coding = detail::kPaletteCoding;
+    const auto consider = [&](std::vector<uint8_t>&& payload, uint64_t size, uint8_t kind) {
+        if (size >= bestSize) return;
+        best = std::move(payload), bestSize = size, coding = kind;
+    };
+    if (vs == 4) {
+        const bool placed = !places.empty();
+        std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places);
+        const uint64_t size = numeric.size();
+        consider(std::move(numeric), size, placed ? detail::kPlacedContextCoding : detail::kContextCoding);
+        if (placed && looksLikeLabels(values)) {
+            std::vector<uint8_t> labels = encodeContextChannel(values, layout, places, true);
+            const uint64_t labelSize = labels.size();
+            consider(std::move(labels), labelSize, detail::kPlacedLabelCoding);
+        }
+    } else {
+        std::vector<uint8_t> predicted = encodePredicted(values, vs, layout);
+        const uint64_t size = format::zstdFastSize(predicted);
+        consider(std::move(predicted), size, detail::kPredictedCoding);
+    }
     std::vector<uint8_t> raw;
-    raw.reserve(chosen.size() + 1);
-    raw.push_back(!usePredicted ? detail::kPaletteCoding
-                  : placed      ? detail::kPlacedContextCoding
-                  : contextCoded ? detail::kContextCoding
-                                 : detail::kPredictedCoding);
-    raw.insert(raw.end(), chosen.begin(), chosen.end());
+    raw.reserve(best.size() + 1);
+    raw.push_back(coding);
+    raw.insert(raw.end(), best.begin(), best.end());
     return raw;
 }
 

@@ -77,11 +77,12 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
     }
     const std::span<const uint64_t> bricks = layout.subspan(size_t(e.firstBrick), size_t(e.bricks));
     if (raw[0] == detail::kPredictedCoding) return decodePredicted(body, dir.valueSize, bricks, where);
-    if (raw[0] == detail::kContextCoding || raw[0] == detail::kPlacedContextCoding) {
+    if (raw[0] == detail::kContextCoding || raw[0] == detail::kPlacedContextCoding || raw[0] == detail::kPlacedLabelCoding) {
         if (dir.valueSize != 4) throw Error(where + ": a context-coded window of " + std::to_string(dir.valueSize) + "-byte values (int32 only)");
         if (raw[0] == detail::kContextCoding) return decodeContextChannel(body, bricks, e.entries, where);
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
-        return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)));
+        return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
+                                    raw[0] == detail::kPlacedLabelCoding);
     }
     throw Error(where + ": unknown coding " + std::to_string(raw[0]));
 }

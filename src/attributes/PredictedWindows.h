@@ -22,7 +22,8 @@
 // A window's raw bytes are u8 coding (0: serializePalette bytes of its
 // entries; 1: encodePredicted bytes over its bricks; 2: int32 only,
 // encodeContextChannel bytes over its bricks, ContextChannel.h; 3: the same
-// with neighbours across bricks, over its bricks and their places) then
+// with neighbours across bricks, over its bricks and their places; 4: the
+// same payload with the entries coded as labels, coding/LabelCoder.h) then
 // that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
@@ -42,7 +43,7 @@ namespace vdbdag::attributes {
 
 namespace detail {  // the layout above, shared by the writer and the reader
 inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
-inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3;
+inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3, kPlacedLabelCoding = 4;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail

@@ -1,0 +1,114 @@
+// The walk of a placed layout (BrickValueCoder.h: brick instances in
+// attribute order, each with its corner and mirror) shared by the value
+// coders that see neighbours across bricks (BrickValueCoder's coding 3,
+// LabelCoder): brick by brick, each brick's voxels in spatial raster order
+// (x fastest), each with its causal neighbours
+//      this slice:  NW N NE        slice below:  PNW PN
+//                   W  *                         PW  P
+// wherever they were visited before in the same walk (in this brick or in
+// any brick before it), and its entry: the rank of its stored bit
+// (dag_access.h dagStoredBit). A tile (mask 0) is one entry without place.
+#pragma once
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "src/coding/BrickValueCoder.h"
+#include "src/dag/Reflection.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::coding::detail {
+
+// A brick in spatial order: which voxels are visited, their values and the
+// coder's record of each.
+template <typename Rec>
+struct PlacedBrick {
+    uint64_t done = 0;
+    int32_t value[64];
+    Rec rec[64];
+};
+
+template <typename Rec>
+struct PlacedNeighbours {
+    enum Which { W, N, NW, NE, P, PW, PN, PNW };
+    const PlacedBrick<Rec>* brick[8];
+    int bit[8];
+    bool has(Which k) const { return brick[k] != nullptr; }
+    int32_t value(Which k) const { return brick[k]->value[bit[k]]; }
+    const Rec& rec(Which k) const { return brick[k]->rec[bit[k]]; }
+};
+
+struct BrickKey {
+    int32_t x, y, z;
+    bool operator==(const BrickKey&) const = default;
+};
+struct BrickKeyHash {
+    size_t operator()(const BrickKey& k) const {
+        uint64_t h = uint64_t(uint32_t(k.x)) * 0x9E3779B97F4A7C15ull;
+        h ^= uint64_t(uint32_t(k.y)) * 0xC2B2AE3D27D4EB4Full + (h >> 29);
+        h ^= uint64_t(uint32_t(k.z)) * 0x165667B19E3779F9ull + (h >> 32);
+        return size_t(h);
+    }
+};
+
+// tile(entry); voxel(neighbours, entry, value&, rec&) sets the voxel's value
+// (read or decoded) and its record. Throws vdbdag::Error when the layout,
+// its places and `entries` disagree.
+template <typename Rec, typename Tile, typename Voxel>
+void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, Tile&& tile, Voxel&& voxel) {
+    if (places.size() != layout.size()) throw Error("the layout has " + std::to_string(layout.size()) + " bricks, their places " + std::to_string(places.size()));
+    std::unordered_map<BrickKey, uint32_t, BrickKeyHash> slots;  // brick coordinates (index / 4) -> index in `bricks`
+    slots.reserve(layout.size());
+    std::vector<PlacedBrick<Rec>> bricks;
+    bricks.reserve(layout.size());  // `around` points into it
+    uint64_t e = 0;                 // the first entry of the current instance
+    for (size_t b = 0; b < layout.size(); ++b) {
+        const uint64_t mask = layout[b];
+        if (mask == 0) {
+            if (e >= entries) throw Error("the layout holds more entries than the channel");
+            tile(e++);
+            continue;
+        }
+        const BrickPlace& place = places[b];
+        if ((place.x | place.y | place.z) & 3 || place.mirror > 7) throw Error("brick " + std::to_string(b) + " has no brick's place");
+        if (e + uint64_t(std::popcount(mask)) > entries) throw Error("the layout holds more entries than the channel");
+        const int32_t bx = place.x >> 2, by = place.y >> 2, bz = place.z >> 2;
+        if (!slots.emplace(BrickKey{bx, by, bz}, uint32_t(bricks.size())).second) throw Error("two bricks at the same place");
+        bricks.emplace_back();
+        PlacedBrick<Rec>& self = bricks.back();
+        // The bricks around that hold causal neighbours: dx in -1..1, dy and dz in -1..0.
+        const PlacedBrick<Rec>* around[3][2][2];
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 0; ++dy)
+                for (int dz = -1; dz <= 0; ++dz) {
+                    const auto it = slots.find(BrickKey{bx + dx, by + dy, bz + dz});
+                    around[dx + 1][dy + 1][dz + 1] = (dx == 0 && dy == 0 && dz == 0) ? &self : it == slots.end() ? nullptr : &bricks[it->second];
+                }
+        const uint64_t spatial = dag::reflectBrick(mask, place.mirror);
+        PlacedNeighbours<Rec> n;
+        // A neighbour's brick and bit, or null when it is not visited yet.
+        const auto at = [&](typename PlacedNeighbours<Rec>::Which k, int x, int y, int z) {
+            const int ox = x < 0 ? -1 : x > 3 ? 1 : 0, oy = y < 0 ? -1 : 0, oz = z < 0 ? -1 : 0;
+            const PlacedBrick<Rec>* t = around[ox + 1][oy + 1][oz + 1];
+            n.bit[k] = (x & 3) + 4 * (y & 3) + 16 * (z & 3);
+            n.brick[k] = t && (t->done >> n.bit[k] & 1) ? t : nullptr;
+        };
+        using Nb = PlacedNeighbours<Rec>;
+        for (uint64_t bits = spatial; bits; bits &= bits - 1) {
+            const int p = std::countr_zero(bits), x = p & 3, y = (p >> 2) & 3, z = p >> 4;
+            at(Nb::W, x - 1, y, z), at(Nb::N, x, y - 1, z), at(Nb::NW, x - 1, y - 1, z), at(Nb::NE, x + 1, y - 1, z);
+            at(Nb::P, x, y, z - 1), at(Nb::PW, x - 1, y, z - 1), at(Nb::PN, x, y - 1, z - 1), at(Nb::PNW, x - 1, y - 1, z - 1);
+            const unsigned stored = access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), place.mirror);
+            voxel(n, e + uint64_t(std::popcount(mask & ((uint64_t(1) << stored) - 1))), self.value[p], self.rec[p]);
+            self.done |= uint64_t(1) << p;
+        }
+        e += uint64_t(std::popcount(mask));
+    }
+    if (e != entries) throw Error("the layout holds " + std::to_string(e) + " entries, the channel " + std::to_string(entries));
+}
+
+} // namespace vdbdag::coding::detail
