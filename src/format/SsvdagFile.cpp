@@ -35,12 +35,15 @@
 // Strings are u32 length + bytes. Everything little-endian (ByteIO.h).
 #include "src/format/SsvdagFile.h"
 
+#include <limits>
 #include <map>
+#include <optional>
 
 #include "src/attributes/PredictedChannel.h"
 #include "src/attributes/PredictedWindows.h"
 #include "src/attributes/ValueWindows.h"
 #include "src/format/ByteIO.h"
+#include "src/format/DagBounds.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/util/Error.h"
 
@@ -290,6 +293,14 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             for (uint64_t s : dag.levelStart)
                 if (s > dag.inner.size()) throw Error(what + ": " + layer + " level start " + std::to_string(s) + " beyond the inner array");
             encoding::validateCompact(dag, what + " " + layer);
+            // Every voxel must have an OpenVDB (int32) index: refused here,
+            // naming the file, rather than when a decode reaches the voxel.
+            if (const std::optional<IndexBox> box = dagBounds(dag))
+                for (int a = 0; a < 3; ++a)
+                    if (box->min[size_t(a)] < std::numeric_limits<int32_t>::min() || box->max[size_t(a)] > std::numeric_limits<int32_t>::max())
+                        throw Error(what + ": the " + layer + " DAG reaches voxel index " +
+                                    std::to_string(box->min[size_t(a)] < std::numeric_limits<int32_t>::min() ? box->min[size_t(a)] : box->max[size_t(a)]) +
+                                    " on axis " + "xyz"[a] + ", outside OpenVDB's int32 index range; the file is corrupted");
             const encoding::DecodedSize size = encoding::decodedSize(dag);
             if (size.activeVoxels != expectedVoxels)
                 throw Error(what + ": the " + layer + " DAG holds " + std::to_string(size.activeVoxels) + " voxels but the header says " +

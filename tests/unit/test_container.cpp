@@ -752,3 +752,30 @@ TEST(ReadLimits, AnExpandingDagIsRefusedByItsEntriesBeforeDecoding) {
     options.limits.maxMemory = entries + (uint64_t(1) << 20);
     EXPECT_EQ(refusal(options), "");
 }
+
+// A DAG whose origin lies inside int32 but whose voxels reach past it
+// (issue 38 #10): refused when the file is read, naming the file and the
+// index, not when a decode reaches the voxel (the message had no file
+// name, and `info` accepted the file).
+TEST(ReadLimits, VoxelsPastTheInt32IndexRangeAreRefusedWhenRead) {
+    GridRecord record;
+    record.name = "far";
+    record.gridClass = "fog volume";
+    record.vdbDescriptor = {1};
+    record.topology.bricks.push_back({0, 0, 0, ~uint64_t(0)});
+    record.topology.bricks.push_back({8, 0, 0, ~uint64_t(0)});
+    format::SsvdagScene scene;
+    scene.grids.push_back(pipeline::encodeGrid(record));
+    ASSERT_EQ(scene.grids[0].dag.log2Size, 4u);
+    scene.grids[0].dag.origin[0] = 2147483640;  // a multiple of 4 inside int32; the brick at +8 lies past INT32_MAX
+    const auto bytes = format::writeScene(scene);
+    std::string m;
+    try {
+        format::readScene(bytes, "far.ssvdag");
+    } catch (const Error& e) {
+        m = e.what();
+    }
+    EXPECT_EQ(m.rfind("far.ssvdag: grid 0", 0), 0u) << m;
+    EXPECT_NE(m.find("2147483651"), std::string::npos) << m;  // the last voxel index on x: 2147483640 + 11
+    EXPECT_NE(m.find("outside OpenVDB's int32 index range"), std::string::npos) << m;
+}
