@@ -685,12 +685,20 @@ TEST(DicomSeries, ForgedHeadersAreRefusedBeforeGdcmAssertsOnThem) {
                                            {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\xdd\xe0", 4), "a delimiter (FFFE,E0DD) at byte"},
                                            {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\x00\x00", 4), "unknown item tag (FFFE,0000)"},
                                            // GDCM aborts on it (gdcmImplicitDataElement.txx:66, also in gdcmdump)
-                                           {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\x00\xe0", 4), "an item (FFFE,E000) at byte"}}) {
+                                           {std::string("\x10\x00\x10\x00", 4), std::string("\xfe\xff\x00\xe0", 4), "an item (FFFE,E000) at byte"},
+                                           // GDCM guessed its way through it and allocated 2.9 GB (a 483-byte file)
+                                           {std::string("1.2.840.10008.1.2\0", 18), std::string("1.2.841.10008.1.2\0", 18), "its transfer syntax '1.2.841.10008.1.2'"},
+                                           // an element cut off after its tag: GDCM aborts (gdcmExplicitDataElement.txx:104)
+                                           {"", std::string("\x10\x00\x10\x00\x50", 5), "the file ends inside an element"}}) {
         const fs::path dir = freshDir("forged_header");
         std::string forged = bytes;
-        const size_t at = forged.find(c.from);
-        ASSERT_NE(at, std::string::npos) << c.expect;
-        forged.replace(at, c.to.size(), c.to);
+        if (c.from.empty()) {
+            forged += c.to;  // appended
+        } else {
+            const size_t at = forged.find(c.from);
+            ASSERT_NE(at, std::string::npos) << c.expect;
+            forged.replace(at, c.to.size(), c.to);
+        }
         const fs::path bad = dir / "forged.dcm";
         std::ofstream(bad, std::ios::binary) << forged;
         const std::string m = errorOf([&] {
