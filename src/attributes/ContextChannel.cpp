@@ -3,8 +3,6 @@
 
 #include <algorithm>
 #include <numeric>
-#include <tuple>
-#include <utility>
 #include <cstring>
 
 #include "src/coding/BrickValueCoder.h"
@@ -24,7 +22,10 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
     std::vector<int32_t> entries(values.size() / 4);
     std::memcpy(entries.data(), values.data(), values.size());
     int32_t lo = 0, hi = 0;
-    if (!entries.empty()) std::tie(lo, hi) = std::pair(*std::min_element(entries.begin(), entries.end()), *std::max_element(entries.begin(), entries.end()));
+    if (!entries.empty()) {
+        const auto [min, max] = std::minmax_element(entries.begin(), entries.end());
+        lo = *min, hi = *max;
+    }
     // The entries' common step above the minimum (values quantised by
     // --abs-error, or a scanner's): the coder sees (v - min) / step.
     uint64_t step = 0;
@@ -39,15 +40,16 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
         labels           ? coding::encodePlacedLabels(entries, layout, places, int32_t(options.minValue), int32_t(options.maxValue))
         : places.empty() ? coding::encodeBrickValues(entries, layout, options)
                          : coding::encodePlacedBrickValues(entries, layout, places, options);
-    format::ByteWriter w;
-    w.put<uint8_t>(4);
-    w.put<uint32_t>(uint32_t(options.near));
-    w.put<uint32_t>(uint32_t(step));
-    w.put<int32_t>(lo);
-    w.put<int32_t>(hi);
-    w.put<uint64_t>(entries.size());
-    w.putBytes(stream);
-    return std::move(w.bytes());
+    // The header (ContextChannel.h) then the stream, in one allocation.
+    std::vector<uint8_t> out(kHeaderBytes + stream.size());
+    size_t at = 0;
+    const auto put = [&](auto v) {
+        std::memcpy(out.data() + at, &v, sizeof v);
+        at += sizeof v;
+    };
+    put(uint8_t(4)), put(uint32_t(options.near)), put(uint32_t(step)), put(lo), put(hi), put(uint64_t(entries.size()));
+    std::copy(stream.begin(), stream.end(), out.begin() + ptrdiff_t(at));
+    return out;
 }
 
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,

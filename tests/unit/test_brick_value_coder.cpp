@@ -22,6 +22,7 @@
 #include "src/attributes/PredictedWindows.h"
 #include "src/coding/BrickValueCoder.h"
 #include "src/dag/Reflection.h"
+#include "tests/unit/PlacedBoxFixture.h"
 #include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
 
@@ -165,38 +166,15 @@ TEST(BrickValueCoder, PredictedWindowsStoreInt32AsCoding2) {
 namespace vdbdag::coding {
 namespace {
 
-// A dense 32^3 region of full bricks in Morton order (as a DAG's attribute
-// order visits a full box), each with a mirror from a fixed seed, holding a
-// smooth field with noise sampled at each voxel's *spatial* position: the
-// entries are stored in each brick's stored order (dag_access.h
-// dagStoredBit), so the placed coder must undo the mirror to see the field.
-struct PlacedChannel {
-    std::vector<uint64_t> layout;
-    std::vector<BrickPlace> places;
-    std::vector<int32_t> entries;
-};
+using testing::PlacedChannel;
 
+// A smooth field with noise over the placed box (PlacedBoxFixture.h).
 PlacedChannel placedField(uint32_t seed, bool mirrors) {
     std::mt19937 rng(seed);
     std::normal_distribution<double> noise(0.0, 3.0);
-    PlacedChannel c;
-    for (uint32_t m = 0; m < 512; ++m) {  // 8^3 bricks, Morton order
-        int bx = 0, by = 0, bz = 0;
-        for (int k = 0; k < 3; ++k) bx |= int(m >> (3 * k) & 1) << k, by |= int(m >> (3 * k + 1) & 1) << k, bz |= int(m >> (3 * k + 2) & 1) << k;
-        const uint32_t mirror = mirrors ? rng() % 8 : 0;
-        c.layout.push_back(~uint64_t(0));
-        c.places.push_back({4 * bx, 4 * by, 4 * bz, mirror});
-        std::vector<int32_t> brick(64);
-        for (int z = 0; z < 4; ++z)
-            for (int y = 0; y < 4; ++y)
-                for (int x = 0; x < 4; ++x) {
-                    const double X = 4 * bx + x, Y = 4 * by + y, Z = 4 * bz + z;
-                    const double v = 500 + 200 * std::sin(X / 7.0) + 150 * std::cos(Y / 5.0) + 3 * Z + noise(rng);
-                    brick[access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), mirror)] = int32_t(std::lround(v));
-                }
-        c.entries.insert(c.entries.end(), brick.begin(), brick.end());
-    }
-    return c;
+    return testing::placedBox(rng, mirrors, [&](int X, int Y, int Z) {
+        return int32_t(std::lround(500 + 200 * std::sin(X / 7.0) + 150 * std::cos(Y / 5.0) + 3 * Z + noise(rng)));
+    });
 }
 
 TEST(BrickValueCoder, PlacedBricksRoundTripAndSeeAcrossBrickBoundaries) {

@@ -19,17 +19,16 @@
 #include "src/coding/BrickValueCoder.h"
 #include "src/coding/LabelCoder.h"
 #include "src/dag/Reflection.h"
+#include "tests/unit/PlacedBoxFixture.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::coding {
 namespace {
 
-struct Labels {
-    std::vector<uint64_t> layout;
-    std::vector<BrickPlace> places;
-    std::vector<int32_t> entries;
-};
+using Labels = testing::PlacedChannel;
 
+// Voronoi regions of random seeds over the placed box (PlacedBoxFixture.h),
+// every 97th brick (from the 6th) a tile of the first label.
 Labels voronoi(uint32_t seed, int regions) {
     std::mt19937 rng(seed);
     std::vector<std::array<int, 3>> centres(static_cast<size_t>(regions));
@@ -38,33 +37,18 @@ Labels voronoi(uint32_t seed, int regions) {
         centres[size_t(r)] = {int(rng() % 32), int(rng() % 32), int(rng() % 32)};
         ids[size_t(r)] = int32_t(rng() % 200000) - 100000;
     }
-    Labels l;
-    for (uint32_t m = 0; m < 512; ++m) {  // 8^3 bricks in Morton order
-        int bx = 0, by = 0, bz = 0;
-        for (int k = 0; k < 3; ++k) bx |= int(m >> (3 * k) & 1) << k, by |= int(m >> (3 * k + 1) & 1) << k, bz |= int(m >> (3 * k + 2) & 1) << k;
-        const uint32_t mirror = rng() % 8;
-        l.layout.push_back(m % 97 == 5 ? 0 : ~uint64_t(0));  // a few tiles among them
-        l.places.push_back({4 * bx, 4 * by, 4 * bz, mirror});
-        if (l.layout.back() == 0) {
-            l.entries.push_back(ids[0]);
-            continue;
-        }
-        std::vector<int32_t> brick(64);
-        for (int z = 0; z < 4; ++z)
-            for (int y = 0; y < 4; ++y)
-                for (int x = 0; x < 4; ++x) {
-                    const int X = 4 * bx + x, Y = 4 * by + y, Z = 4 * bz + z;
-                    int best = 0, bestD = 1 << 30;
-                    for (int r = 0; r < regions; ++r) {
-                        const auto& c = centres[size_t(r)];
-                        const int d = (X - c[0]) * (X - c[0]) + (Y - c[1]) * (Y - c[1]) + (Z - c[2]) * (Z - c[2]);
-                        if (d < bestD) bestD = d, best = r;
-                    }
-                    brick[access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), mirror)] = ids[size_t(best)];
-                }
-        l.entries.insert(l.entries.end(), brick.begin(), brick.end());
-    }
-    return l;
+    return testing::placedBox(
+        rng, true,
+        [&](int X, int Y, int Z) {
+            int best = 0, bestD = 1 << 30;
+            for (int r = 0; r < regions; ++r) {
+                const auto& c = centres[size_t(r)];
+                const int d = (X - c[0]) * (X - c[0]) + (Y - c[1]) * (Y - c[1]) + (Z - c[2]) * (Z - c[2]);
+                if (d < bestD) bestD = d, best = r;
+            }
+            return ids[size_t(best)];
+        },
+        97, 5, ids[0]);
 }
 
 TEST(LabelCoder, LabelVolumesComeBackExactlyForAFractionOfTheNumericCost) {

@@ -1,0 +1,48 @@
+// Test fixture for the placed value coders (BrickValueCoder, LabelCoder): a
+// dense 32^3 box of full 4^3 bricks in Morton order, as a DAG's attribute
+// order visits a full box, each brick with its place and a mirror drawn
+// from `rng` (0 without mirrors); `value(X, Y, Z)` gives the sample at a
+// spatial voxel, stored at the voxel's stored bit (dag_access.h
+// dagStoredBit), so a coder must undo the mirror to see the field. Every
+// brick m with m % tileEvery == tileAt is a tile holding `tileValue`.
+#pragma once
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "src/coding/BrickValueCoder.h"
+#include "src/dag/Reflection.h"
+
+namespace vdbdag::coding::testing {
+
+struct PlacedChannel {
+    std::vector<uint64_t> layout;
+    std::vector<BrickPlace> places;
+    std::vector<int32_t> entries;
+};
+
+template <typename Value>
+PlacedChannel placedBox(std::mt19937& rng, bool mirrors, Value&& value, uint32_t tileEvery = 0, uint32_t tileAt = 0, int32_t tileValue = 0) {
+    PlacedChannel c;
+    for (uint32_t m = 0; m < 512; ++m) {  // 8^3 bricks, Morton order
+        int bx = 0, by = 0, bz = 0;
+        for (int k = 0; k < 3; ++k) bx |= int(m >> (3 * k) & 1) << k, by |= int(m >> (3 * k + 1) & 1) << k, bz |= int(m >> (3 * k + 2) & 1) << k;
+        const uint32_t mirror = mirrors ? rng() % 8 : 0;
+        const bool tile = tileEvery && m % tileEvery == tileAt;
+        c.layout.push_back(tile ? 0 : ~uint64_t(0));
+        c.places.push_back({4 * bx, 4 * by, 4 * bz, mirror});
+        if (tile) {
+            c.entries.push_back(tileValue);
+            continue;
+        }
+        std::vector<int32_t> brick(64);
+        for (int z = 0; z < 4; ++z)
+            for (int y = 0; y < 4; ++y)
+                for (int x = 0; x < 4; ++x)
+                    brick[access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), mirror)] = value(4 * bx + x, 4 * by + y, 4 * bz + z);
+        c.entries.insert(c.entries.end(), brick.begin(), brick.end());
+    }
+    return c;
+}
+
+} // namespace vdbdag::coding::testing
