@@ -310,7 +310,11 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             // as decoded values, unless they stay in windows, and as the
             // command's own copies.
             checkVoxels(options.limits, size.attributeEntries, what + " " + layer + " layer");
-            const bool decodesValues = vs && !dag.empty() && !options.keepValueWindows;
+            // Values of the layout before windows (one Values or
+            // PredictedValues section) are decoded whole even when windows
+            // are kept: no reader leaves them in the file.
+            const bool wholeValues = find(g, kinds.values, false) || find(g, kinds.predicted, false);
+            const bool decodesValues = vs && !dag.empty() && (!options.keepValueWindows || wholeValues);
             expanded = saturatingAdd(expanded, saturatingMul(size.attributeEntries, decodesValues ? uint64_t(vs) : 0));
             expanded = saturatingAdd(expanded, saturatingMul(size.attributeEntries, uint64_t(std::max(vs, 1u)) * options.limits.valueCopies));
             checkMemory(options.limits, expanded, what, "its sections and decoded values");

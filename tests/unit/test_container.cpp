@@ -28,48 +28,19 @@
 #include "src/pipeline/GridCodec.h"
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
-
-// Records the largest single allocation made while tracking is on, so tests
-// can prove a forged size was rejected before it was allocated.
-namespace {
-std::atomic<bool> gTrackAllocations{false};
-std::atomic<size_t> gLargestAllocation{0};
-}  // namespace
-
-void* operator new(size_t n) {
-    if (gTrackAllocations.load(std::memory_order_relaxed)) {
-        size_t prev = gLargestAllocation.load(std::memory_order_relaxed);
-        while (n > prev && !gLargestAllocation.compare_exchange_weak(prev, n)) {
-        }
-    }
-    if (void* p = std::malloc(n ? n : 1)) return p;
-    throw std::bad_alloc();
-}
-void* operator new[](size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, size_t) noexcept { std::free(p); }
-void operator delete[](void* p, size_t) noexcept { std::free(p); }
+#include "tests/unit/AllocationProbe.h"
 
 namespace fs = std::filesystem;
 using namespace vdbdag;
 using format::Section;
 using format::SectionKind;
+using test::AllocationProbe;
 
 namespace {
 
 // Layout constants as documented in SsvdagContainer.cpp.
 constexpr size_t kHeader = 16, kEntry = 48;
 constexpr size_t kKindAt = 0, kCodecAt = 8, kReservedAt = 12, kOffsetAt = 16, kStoredAt = 24, kRawAt = 32, kSumAt = 40;
-
-struct AllocationProbe {
-    AllocationProbe() {
-        gLargestAllocation = 0;
-        gTrackAllocations = true;
-    }
-    ~AllocationProbe() { gTrackAllocations = false; }
-    size_t largest() const { return gLargestAllocation.load(); }
-};
 
 template <typename T>
 T load(const std::vector<uint8_t>& b, size_t at) {
@@ -692,101 +663,4 @@ TEST(Container, SceneReaderNeverInflatesUnknownSections) {
     const size_t last = sectionCount(bad) - 1;
     bad[load<uint64_t>(bad, entryAt(last) + kOffsetAt)] ^= 1;
     EXPECT_THROW(format::readScene(bad, "corrupt"), Error);
-}
-
-// ---- read limits (--max-memory, --max-voxels) --------------------------------
-
-// A few kilobytes may hold a genuine zstd frame of any size in a known
-// section: what the table declares is weighed against --max-memory before
-// anything is inflated.
-TEST(ReadLimits, DeclaredSectionSizesAreWeighedBeforeAnyIsInflated) {
-    const std::vector<Section> sections{{SectionKind::DagInner, 0, std::vector<uint8_t>(size_t(64) << 20, 0)}};
-    const auto bytes = format::writeContainer(sections);
-    ASSERT_LT(bytes.size(), size_t(64) << 10);
-    format::ReadLimits limits;
-    limits.maxMemory = uint64_t(16) << 20;
-    {
-        AllocationProbe probe;
-        try {
-            format::readContainer(bytes, "bomb.ssvdag", false, limits);
-            ADD_FAILURE() << "a 64 MiB section passed a 16 MiB limit";
-        } catch (const Error& e) {
-            const std::string m = e.what();
-            EXPECT_EQ(m.rfind("bomb.ssvdag: ", 0), 0u) << m;
-            EXPECT_NE(m.find("--max-memory"), std::string::npos) << m;
-            EXPECT_EQ(m.find('\n'), std::string::npos) << m;
-        }
-        EXPECT_LT(probe.largest(), size_t(1) << 20) << "inflated before the check";
-    }
-    limits.maxMemory = uint64_t(65) << 20;
-    EXPECT_EQ(format::readContainer(bytes, "bomb.ssvdag", false, limits).front().data.size(), size_t(64) << 20);
-}
-
-// A DAG shares its subtrees, so its file can stand for far more voxels than
-// it holds: a solid 64^3 block of full bricks (262,144 entries, a closed
-// form) is a few hundred bytes. --max-voxels and --max-memory refuse it by
-// the entries the DAG implies, before any is decoded.
-TEST(ReadLimits, AnExpandingDagIsRefusedByItsEntriesBeforeDecoding) {
-    GridRecord record;
-    record.name = "block";
-    record.gridClass = "fog volume";
-    record.vdbDescriptor = {1};
-    for (int z = 0; z < 64; z += 4)
-        for (int y = 0; y < 64; y += 4)
-            for (int x = 0; x < 64; x += 4) record.topology.bricks.push_back({x, y, z, ~uint64_t(0)});
-    format::SsvdagScene scene;
-    scene.grids.push_back(pipeline::encodeGrid(record));
-    const auto bytes = format::writeScene(scene);
-    ASSERT_LT(bytes.size(), size_t(4096));
-    const uint64_t entries = 64 * 64 * 64;
-    auto refusal = [&](const format::ReadOptions& options) -> std::string {
-        try {
-            format::readScene(bytes, "block.ssvdag", options);
-        } catch (const Error& e) {
-            return e.what();
-        }
-        return "";
-    };
-    format::ReadOptions options;
-    options.limits.maxVoxels = entries - 1;
-    std::string m = refusal(options);
-    EXPECT_NE(m.find("--max-voxels"), std::string::npos) << m;
-    EXPECT_NE(m.find(std::to_string(entries)), std::string::npos) << m;
-    EXPECT_EQ(m.rfind("block.ssvdag: grid 0", 0), 0u) << m;
-    options.limits.maxVoxels = entries;
-    EXPECT_EQ(refusal(options), "");
-    // Memory: a decode that builds one copy of every (1-byte, topology-only) value needs at least `entries` bytes beyond the sections.
-    options.limits.valueCopies = 1;
-    options.limits.maxMemory = entries - 1;
-    m = refusal(options);
-    EXPECT_NE(m.find("--max-memory"), std::string::npos) << m;
-    options.limits.maxMemory = entries + (uint64_t(1) << 20);
-    EXPECT_EQ(refusal(options), "");
-}
-
-// A DAG whose origin lies inside int32 but whose voxels reach past it
-// (issue 38 #10): refused when the file is read, naming the file and the
-// index, not when a decode reaches the voxel (the message had no file
-// name, and `info` accepted the file).
-TEST(ReadLimits, VoxelsPastTheInt32IndexRangeAreRefusedWhenRead) {
-    GridRecord record;
-    record.name = "far";
-    record.gridClass = "fog volume";
-    record.vdbDescriptor = {1};
-    record.topology.bricks.push_back({0, 0, 0, ~uint64_t(0)});
-    record.topology.bricks.push_back({8, 0, 0, ~uint64_t(0)});
-    format::SsvdagScene scene;
-    scene.grids.push_back(pipeline::encodeGrid(record));
-    ASSERT_EQ(scene.grids[0].dag.log2Size, 4u);
-    scene.grids[0].dag.origin[0] = 2147483640;  // a multiple of 4 inside int32; the brick at +8 lies past INT32_MAX
-    const auto bytes = format::writeScene(scene);
-    std::string m;
-    try {
-        format::readScene(bytes, "far.ssvdag");
-    } catch (const Error& e) {
-        m = e.what();
-    }
-    EXPECT_EQ(m.rfind("far.ssvdag: grid 0", 0), 0u) << m;
-    EXPECT_NE(m.find("2147483651"), std::string::npos) << m;  // the last voxel index on x: 2147483640 + 11
-    EXPECT_NE(m.find("outside OpenVDB's int32 index range"), std::string::npos) << m;
 }
