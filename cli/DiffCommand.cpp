@@ -9,6 +9,7 @@
 
 #include "cli/Commands.h"
 #include "cli/JsonReport.h"
+#include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
@@ -31,6 +32,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
         std::vector<std::string> grids;
         bool onlyDifferences = false, json = false, force = false;
         uint64_t maxCells = 20'000'000;
+        ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("diff", "Compare two volumes voxel by voxel (.vdb, .ssvdag or a dense scan); exit 0 if they are the same, 1 if they differ, 2 on an error");
@@ -48,6 +50,7 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--compressor", opt->compressor, "zlib or lz4")->capture_default_str();
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");
+    opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         setFailureExitCode(2);  // 1 means "they differ", as for diff and cmp
         setActivity(opt->a, "comparing");
@@ -58,6 +61,10 @@ void addDiffCommand(CLI::App& app, int& exitCode) {
         options.onlyDifferences = opt->onlyDifferences;
         options.maxCells = opt->maxCells;
         options.compressor = opt->compressor;
+        // Each .ssvdag side is decoded, copied into a grid record and built
+        // as an OpenVDB grid, and both are held at once: half the memory each.
+        options.limits = opt->limits.limits(2);
+        options.limits.maxMemory /= 2;
         options.pairing = opt->pair == "name" ? bridge::DiffPairing::Name : opt->pair == "order" ? bridge::DiffPairing::Order : bridge::DiffPairing::Auto;
         const bridge::DiffReport r = bridge::diffVolumes(opt->a, opt->b, opt->output, options);
         static const char* kStatus[4] = {"same", "value_differs", "only_in_a", "only_in_b"};

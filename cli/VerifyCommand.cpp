@@ -18,6 +18,7 @@
 #include "cli/Commands.h"
 #include "cli/JsonReport.h"
 #include "cli/MemoryBudget.h"
+#include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "src/pipeline/CubeEncoder.h"
 #include "src/pipeline/GridCodec.h"
@@ -36,6 +37,7 @@ struct VerifyOptions {
     std::string input, scratch, encoded;
     bool json = false, noSymmetry = false, topologyOnly = false;
     uint64_t memoryLimit = 0;
+    ReadLimitOptions limits;  // what the .ssvdag file may expand to (a file from elsewhere, --encoded)
 };
 
 struct Verified {
@@ -59,6 +61,7 @@ struct RemovedAfterwards {
 void compareByCubes(const VerifyOptions& opt, const std::string& encoded, Progress& progress, uint64_t from, uint64_t units, Verified& out) {
     format::ReadOptions readOptions;
     readOptions.keepValueWindows = true;
+    readOptions.limits = opt.limits.limits(0);  // compared cube by cube: no copy of the whole
     const format::SsvdagScene scene = format::readSceneFile(encoded, readOptions);
     out.grids = scene.grids.size();
     std::string step;
@@ -138,6 +141,7 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--scratch", opt->scratch, "folder for the encoded file and the scratch files while verifying (default: the system's temporary folder)")
         ->check(CLI::ExistingDirectory);
     cmd->add_flag("--json", opt->json, "print JSON");
+    opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "verifying");
         if (opt->json) setQuiet(true);

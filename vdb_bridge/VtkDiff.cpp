@@ -317,8 +317,8 @@ DiffReport diffVolumes(const std::string& pathA, const std::string& pathB, const
         if (ext != ".vtu" && ext != ".vtm") throw Error(output + ": a diff is written as .vtu (one grid) or .vtm (several grids)");
     }
     const detail::Compressor compressor = detail::parseCompressor(options.compressor);
-    const std::vector<LoadedGrid> gridsA = detail::loadGrids(pathA, options.grids);
-    const std::vector<LoadedGrid> gridsB = detail::loadGrids(pathB, options.grids);
+    const std::vector<LoadedGrid> gridsA = detail::loadGrids(pathA, options.grids, options.limits);
+    const std::vector<LoadedGrid> gridsB = detail::loadGrids(pathB, options.grids, options.limits);
     DiffReport report;
     const std::vector<std::pair<size_t, size_t>> pairing = pairGrids(gridsA, gridsB, pathA, pathB, options.pairing, report);
     const size_t pairs = pairing.size();

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "src/format/ReadLimits.h"
+
 namespace vdbdag::bridge {
 
 // How grids of A and B are paired (`--pair`): Auto pairs the two grids of
@@ -36,6 +38,9 @@ struct DiffOptions {
     bool onlyDifferences = false;    // write only cells whose status is not 0
     uint64_t maxCells = 20'000'000;  // per written block
     std::string compressor = "zlib";
+    // What each .ssvdag side may expand to (`--max-voxels`, `--max-memory`),
+    // weighed before it is decoded.
+    format::ReadLimits limits;
 };
 
 struct GridDiff {
