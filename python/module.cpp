@@ -154,6 +154,15 @@ PYBIND11_MODULE(_vdbdag, m) {
         .def("grid", [](const std::shared_ptr<vdbdag::File>& f, const std::string& name) { return PyGrid{f, &f->grid(name)}; }, py::arg("name"))
         .def("__repr__", [](const vdbdag::File& f) { return "<vdbdag.File '" + f.path() + "'>"; });
 
-    m.def("open", [](const std::string& path) { return std::make_shared<vdbdag::File>(vdbdag::File::open(path)); }, py::arg("path"),
-          "opens a .ssvdag file (raises vdbdag.Error with a one-line message)");
+    m.def(
+        "open",
+        [](const std::string& path, uint64_t maxVoxels, uint64_t maxMemory) {
+            vdbdag::OpenLimits limits;
+            limits.maxVoxels = maxVoxels;
+            limits.maxMemory = maxMemory;
+            return std::make_shared<vdbdag::File>(vdbdag::File::open(path, limits));
+        },
+        py::arg("path"), py::arg("max_voxels") = vdbdag::OpenLimits{}.maxVoxels, py::arg("max_memory") = 0,
+        "opens a .ssvdag file (raises vdbdag.Error with a one-line message); refuses a file that would decode to more than max_voxels "
+        "entries in a layer or hold more than max_memory bytes (0: three quarters of the memory the process may use)");
 }

@@ -145,11 +145,25 @@ private:
     const detail::GridData* data_;
 };
 
+// What a file may make the reader hold before open() refuses it: a forged
+// file of a few kilobytes can claim sections of gigabytes or a DAG standing
+// for 2^60 voxels. Both are weighed before anything is inflated or decoded.
+struct OpenLimits {
+    // Entries of any one layer of a grid (each voxel of a brick; a tile
+    // once). The default, 2^36, is a 4096^3 dense block.
+    uint64_t maxVoxels = uint64_t(1) << 36;
+    // Bytes of the inflated sections and decoded values; 0: three quarters
+    // of the physical memory, or of the process's memory limit when lower.
+    uint64_t maxMemory = 0;
+};
+
 class VDBDAG_API File {
 public:
-    // Maps the file and checks it (format version, checksums, every DAG);
-    // throws vdbdag::Error with a one-line message naming the file.
-    static File open(const std::string& path);
+    // Maps the file and checks it (format version, checksums, every DAG)
+    // within `limits`; throws vdbdag::Error with a one-line message naming
+    // the file (and the limit a file would exceed).
+    static File open(const std::string& path, const OpenLimits& limits);
+    static File open(const std::string& path);  // within the default OpenLimits
     size_t gridCount() const;
     const Grid& grid(size_t index) const;
     const Grid& grid(const std::string& name) const;  // the first grid of that name

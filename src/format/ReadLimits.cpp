@@ -1,11 +1,53 @@
 // See ReadLimits.h.
 #include "src/format/ReadLimits.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
+#include <fstream>
 
 #include "src/util/Error.h"
 
 namespace vdbdag::format {
+namespace {
+
+uint64_t cgroupLimit() {
+    std::ifstream in("/sys/fs/cgroup/memory.max");
+    std::string text;
+    if (!(in >> text) || text == "max") return UINT64_MAX;
+    try {
+        return std::stoull(text);
+    } catch (...) {
+        return UINT64_MAX;
+    }
+}
+
+// Address space the process already uses (its libraries, thread stacks):
+// an address-space limit leaves only the rest.
+uint64_t addressSpaceInUse() {
+    std::ifstream in("/proc/self/statm");
+    uint64_t pages = 0;
+    if (!(in >> pages)) return 0;
+    const long size = sysconf(_SC_PAGE_SIZE);
+    return pages * uint64_t(size > 0 ? size : 4096);
+}
+
+} // namespace
+
+uint64_t defaultReadMemory() {
+    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    uint64_t available = pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) : uint64_t(8) << 30;
+    for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+        rlimit r{};
+        if (getrlimit(resource, &r) != 0 || r.rlim_cur == RLIM_INFINITY) continue;
+        const uint64_t inUse = resource == RLIMIT_AS ? addressSpaceInUse() : 0;
+        available = std::min<uint64_t>(available, r.rlim_cur > inUse ? r.rlim_cur - inUse : 0);
+    }
+    available = std::min(available, cgroupLimit());
+    return available / 4 * 3;
+}
 
 std::string describeBytes(uint64_t bytes) {
     const char* units[] = {"bytes", "KB", "MB", "GB", "TB", "PB", "EB"};

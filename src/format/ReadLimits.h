@@ -23,6 +23,15 @@ struct ReadLimits {
     unsigned valueCopies = 0;
 };
 
+// Voxels a reader accepts unless told otherwise (`--max-voxels`): 2^36, the
+// voxels of a 4096^3 dense block, far past any file of one's own.
+inline constexpr uint64_t kDefaultMaxVoxels = uint64_t(1) << 36;
+
+// Memory a reader accepts unless told otherwise (`--max-memory`): three
+// quarters of the physical memory, or of what the process's address-space
+// (beyond what it maps already), data or cgroup limit leaves when lower.
+uint64_t defaultReadMemory();
+
 // "1.5 GB"-style figure for messages.
 std::string describeBytes(uint64_t bytes);
 

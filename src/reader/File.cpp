@@ -9,6 +9,7 @@
 #include "src/attributes/ValueWindows.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/format/DagBounds.h"
+#include "src/format/ReadLimits.h"
 #include "src/format/SsvdagContainer.h"
 #include "src/reader/GridData.h"
 
@@ -50,9 +51,13 @@ void Layer::value(uint64_t entry, uint8_t* out, size_t& hint) const {
     std::memcpy(out, flat_.data() + entry * vs, vs);
 }
 
-std::shared_ptr<FileData> FileData::read(const std::string& path) {
+static_assert(OpenLimits{}.maxVoxels == format::kDefaultMaxVoxels, "the public default is the command line's");
+
+std::shared_ptr<FileData> FileData::read(const std::string& path, const OpenLimits& limits) {
     format::ReadOptions options;
     options.keepValueWindows = true;  // decoded when first asked for
+    options.limits.maxVoxels = limits.maxVoxels;
+    options.limits.maxMemory = limits.maxMemory ? limits.maxMemory : format::defaultReadMemory();
     format::SsvdagScene scene = format::readSceneFile(path, options);
     auto file = std::make_shared<FileData>();
     file->path = path;
@@ -80,7 +85,8 @@ std::shared_ptr<FileData> FileData::read(const std::string& path) {
 
 } // namespace detail
 
-File File::open(const std::string& path) { return File(detail::FileData::read(path)); }
+File File::open(const std::string& path, const OpenLimits& limits) { return File(detail::FileData::read(path, limits)); }
+File File::open(const std::string& path) { return open(path, OpenLimits{}); }
 
 size_t File::gridCount() const { return data_->grids.size(); }
 

@@ -48,7 +48,7 @@ struct FileData {
     std::string path;
     std::vector<std::unique_ptr<GridData>> data;
     std::vector<Grid> grids;
-    static std::shared_ptr<FileData> read(const std::string& path);
+    static std::shared_ptr<FileData> read(const std::string& path, const OpenLimits& limits);
 };
 
 } // namespace vdbdag::detail

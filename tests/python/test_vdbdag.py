@@ -143,6 +143,20 @@ def test_errors_are_vdbdag_errors(work):
     assert not os.path.exists(os.path.join(work, "x.ssvdag"))
 
 
+def test_open_refuses_a_file_beyond_its_limits(work):
+    """max_voxels and max_memory: pyopenvdb's active voxel count of the
+    level set (no tiles) is the threshold; the error names the file."""
+    path = encoded(work, sphere_file(work))
+    ref = openvdb.read(sphere_file(work), "sphere")
+    n = ref.activeVoxelCount()
+    with pytest.raises(vdbdag.Error, match="max-voxels") as e:
+        vdbdag.open(path, max_voxels=n - 1)
+    assert path in str(e.value)
+    assert vdbdag.open(path, max_voxels=n).grid("sphere").name == "sphere"
+    with pytest.raises(vdbdag.Error, match="max-memory"):
+        vdbdag.open(path, max_memory=1024)
+
+
 def test_lossy_encode_keeps_its_bound(work):
     vdb = sphere_file(work)
     out = os.path.join(work, "lossy.ssvdag")

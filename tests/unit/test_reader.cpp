@@ -225,6 +225,41 @@ TEST(Reader, GridFactsAndTypedValues) {
     std::filesystem::remove(path);
 }
 
+// OpenLimits (issue 38: one limit mechanism, the library too): a file whose
+// layer holds more entries than maxVoxels, or whose sections would take more
+// than maxMemory, is refused on open, naming the file; the brute-force count
+// of the active voxels and tiles is the threshold.
+TEST(Reader, OpenRefusesAFileBeyondItsLimits) {
+    std::mt19937 rng(4);
+    Case c = shell(ValueType::Float, "density", rng, [](double d, std::mt19937&, uint8_t* out) {
+        const float v = float(d);
+        std::memcpy(out, &v, 4);
+    });
+    const auto path = writeFile({{&c, false}}, {}, "reader_limits");  // no inactive layer
+    const uint64_t entries = c.active.voxels.size() + c.active.tiles.size();  // a tile is one entry
+    ASSERT_GT(entries, 1000u);
+    auto refusal = [&](const OpenLimits& limits) -> std::string {
+        try {
+            (void)File::open(path.string(), limits);
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "";
+    };
+    OpenLimits limits;
+    limits.maxVoxels = entries - 1;
+    std::string m = refusal(limits);
+    EXPECT_EQ(m.rfind(path.string(), 0), 0u) << m;
+    EXPECT_NE(m.find("max-voxels"), std::string::npos) << m;
+    limits.maxVoxels = entries;
+    EXPECT_EQ(refusal(limits), "");
+    limits.maxMemory = 1024;  // less than the file's DAG alone
+    m = refusal(limits);
+    EXPECT_EQ(m.rfind(path.string(), 0), 0u) << m;
+    EXPECT_NE(m.find("max-memory"), std::string::npos) << m;
+    std::filesystem::remove(path);
+}
+
 TEST(Reader, OpenNamesTheFileInItsError) {
     const std::string missing = (std::filesystem::temp_directory_path() / "no_such_reader_file.ssvdag").string();
     try {
