@@ -10,6 +10,7 @@
 #include "cli/JsonReport.h"
 #include "cli/RunContext.h"
 #include "cli/DenseInputOptions.h"
+#include "cli/ReadLimitOptions.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
@@ -24,6 +25,7 @@ void addImportCommand(CLI::App& app, int& exitCode) {
         std::string input, output;
         bool json = false, force = false;
         DenseInputOptions dense;
+        ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("import", "Convert a dense scan (.raw, .nrrd, .nhdr, .mhd, .mha, .nii, or one DICOM series: a folder, .dcm or DICOMDIR with --series) into a .vdb grid");
@@ -32,6 +34,7 @@ void addImportCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
+    opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         opt->input = opt->dense.takeInputs(opt->inputs);
         setActivity(opt->input, "importing");
@@ -39,7 +42,9 @@ void addImportCommand(CLI::App& app, int& exitCode) {
         if (bridge::denseFormatOf(opt->input) == bridge::DenseFormat::None)
             throw Error(opt->input + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz, .hdr or DICOM)");
         checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".vdb"}, "import", opt->force});
-        const bridge::DenseImportResult imported = bridge::importDense(opt->input, opt->dense.resolve(opt->input));
+        bridge::DenseImportOptions denseOptions = opt->dense.resolve(opt->input);
+        denseOptions.limits = opt->limits.limits(1);  // the grid record, then the OpenVDB grid written
+        const bridge::DenseImportResult imported = bridge::importDense(opt->input, denseOptions);
         {
             Progress progress("import: writing " + opt->output, 1);
             bridge::exportVdb(imported.volume, opt->output);

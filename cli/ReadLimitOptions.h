@@ -1,5 +1,5 @@
 // `--max-voxels N` and `--max-memory SIZE` for the commands that expand a
-// .ssvdag (decode, export, info, render, verify, diff): what a file from elsewhere may
+// .ssvdag (decode, export, info, render, verify, diff) or import a scan: what a file from elsewhere may
 // make vdbdag hold before it is refused (format/ReadLimits.h).
 #pragma once
 #include <cstdint>

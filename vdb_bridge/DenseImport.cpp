@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <limits>
 
+#include <fmt/core.h>
 #include <openvdb/openvdb.h>
 #include <tbb/parallel_for.h>
 
@@ -370,6 +371,33 @@ DenseImportResult importRescaled(const DenseVolume& v, const Thresholds& th, boo
 
 } // namespace
 
+// What importing `volumes` volumes like `v` will hold at least, weighed
+// against options.limits from the header alone (a forged header of a few
+// hundred bytes may declare 65535x65535 pixels, a gzip NRRD of 1 MB a
+// billion samples): the slab of slices read at a time, and - unless the
+// samples go cube by cube to a scratch file or thresholds drop some - every
+// sample as a grid value (4 bytes, 8 for 64-bit and u32 samples, per
+// component), its bricks, and the caller's copies. What the data file shows
+// (too short, missing) is said first: it is the more precise answer.
+void checkImportLimits(const DenseVolume& v, bool thresholds, const DenseImportOptions& options, uint64_t volumes) {
+    using format::saturatingAdd;
+    using format::saturatingMul;
+    { openSliceReader(v); }  // first what the data file itself shows (too short, missing, a gzip stream that cannot hold the samples)
+    const format::ReadLimits& limits = options.limits;
+    const uint64_t samples = saturatingMul(v.sampleCount(), volumes);
+    format::checkVoxels(limits, samples, v.headerPath);
+    const uint64_t sampleSize = sampleBytes(v.type) * std::max(1u, v.componentsInFile());
+    uint64_t bytes = saturatingMul(saturatingMul(v.sliceSamples(), uint64_t(std::min<int64_t>(kSlab, std::max<int64_t>(v.dims[2], 1)))), sampleSize);
+    const bool byCubes = !options.cubesNear.empty() && v.components == 1;
+    if (!byCubes && !thresholds) {
+        const uint64_t valueSize = uint64_t(sampleBytes(v.type) == 8 || v.type == SampleType::U32 ? 8 : 4) * std::max(1u, v.components);
+        const uint64_t perSample = valueSize * (1 + limits.valueCopies) + sizeof(Brick) / 64;
+        bytes = saturatingAdd(bytes, saturatingMul(samples, perSample));
+    }
+    format::checkMemory(limits, bytes, v.headerPath, fmt::format("its {} samples of {}x{}x{}{}", samples, v.dims[0], v.dims[1], v.dims[2],
+                                                                  volumes > 1 ? fmt::format(" in {} volumes", volumes) : std::string()));
+}
+
 int64_t volumeCountOf(const std::string& path) {
     switch (denseFormatOf(path)) {
         case DenseFormat::Nifti: return niftiVolumeCount(path);
@@ -411,6 +439,11 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
         if (volumes > 1) {
             if (options.backgroundBelow || options.backgroundAbove)
                 throw Error(path + ": background thresholds apply to one volume of a 4-D file: pick it with --volume N");
+            {
+                DenseImportOptions first = options;
+                first.volume = 0;
+                checkImportLimits(describeDense(path, first), false, options, uint64_t(volumes));
+            }
             DenseImportResult all;
             for (int64_t t = 0; t < volumes; ++t) {
                 DenseImportOptions one = options;
@@ -444,6 +477,7 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
     }
     if (th.below && th.above && th.aboveValue < th.belowValue)
         throw Error(path + ": --background-above is below --background-below: every sample would become background");
+    checkImportLimits(v, th.any(), options, 1);
     const bool p = options.showProgress;
     if (v.components != 1) {
         if (v.components != 3) throw Error(path + ": " + std::to_string(v.components) + " components per sample are not supported (1 and 3 are)");

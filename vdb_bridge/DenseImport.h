@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "src/format/ReadLimits.h"
 #include "src/volume/CubeSource.h"
 #include "src/volume/GridRecord.h"
 #include "vdb_bridge/DenseVolume.h"
@@ -56,6 +57,12 @@ struct DenseImportOptions {
     // samples go once to a scratch file beside this path (ScratchFile.h)
     // instead of memory. Ignored for vector and colour scans.
     std::string cubesNear;
+    // What the scan may make the import hold (`--max-voxels`, `--max-memory`
+    // of `import`): its samples and what they become are weighed against
+    // these, from the header, before any sample is read. `valueCopies`: the
+    // caller's copies of every value beyond the grid record (`import` builds
+    // an OpenVDB grid from it).
+    format::ReadLimits limits = format::defaultReadLimits(1);
 };
 
 struct ThresholdReport {

@@ -216,6 +216,7 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
     info.columns = uint32_t((*cols)[0]);
 
     // The pixel data element itself (the header read stops before it).
+    uint64_t nativePixelBytes = 0;  // the length of native (not encapsulated) pixel data, else 0
     {
         gdcm::Reader pixels;
         pixels.SetFileName(path.c_str());
@@ -246,6 +247,7 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
             const gdcm::VL vl = p.GetDataElement(pixelData).GetVL();
             const bool bigEndian = file.GetHeader().GetDataSetTransferSyntax() == gdcm::TransferSyntax::ExplicitVRBigEndian;
             if (!vl.IsUndefined() && uint32_t(vl) > 0) info.damaged = checkNativeLength(path, uint32_t(vl), bigEndian);
+            if (!vl.IsUndefined()) nativePixelBytes = uint32_t(vl);
         }
     }
 
@@ -307,6 +309,15 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
 
     const auto nf = f.numbers(ds, 0x0028, 0x0008);
     const int64_t frameCount = nf && nf->size() == 1 && (*nf)[0] >= 1 ? int64_t((*nf)[0]) : 1;
+    // Native pixel data must hold every pixel the header declares: a forged
+    // 65535x65535 header over 64 bytes of pixels is damaged here, before a
+    // reader reserves gigabytes for its slices.
+    if (nativePixelBytes && info.damaged.empty() && info.bitsAllocated % 8 == 0) {
+        const uint64_t need = uint64_t(info.rows) * info.columns * std::max(1u, info.samplesPerPixel) * (info.bitsAllocated / 8) * uint64_t(frameCount);
+        if (nativePixelBytes < need)
+            info.damaged = fmt::format("is damaged: its pixel data hold {} bytes, fewer than the {} its {} frame(s) of {}x{} pixels need", nativePixelBytes,
+                                       need, frameCount, info.columns, info.rows);
+    }
     gdcm::SmartPointer<gdcm::SequenceOfItems> sharedSq, perFrameSq;
     const gdcm::DataSet* shared = firstItem(ds, 0x5200, 0x9229, sharedSq);
     if (ds.FindDataElement(gdcm::Tag(0x5200, 0x9230))) perFrameSq = ds.GetDataElement(gdcm::Tag(0x5200, 0x9230)).GetValueAsSQ();

@@ -49,6 +49,14 @@ uint64_t defaultReadMemory() {
     return available / 4 * 3;
 }
 
+ReadLimits defaultReadLimits(unsigned valueCopies) {
+    ReadLimits l;
+    l.maxVoxels = kDefaultMaxVoxels;
+    l.maxMemory = defaultReadMemory();
+    l.valueCopies = valueCopies;
+    return l;
+}
+
 std::string describeBytes(uint64_t bytes) {
     const char* units[] = {"bytes", "KB", "MB", "GB", "TB", "PB", "EB"};
     double v = double(bytes);

@@ -32,6 +32,9 @@ inline constexpr uint64_t kDefaultMaxVoxels = uint64_t(1) << 36;
 // (beyond what it maps already), data or cgroup limit leaves when lower.
 uint64_t defaultReadMemory();
 
+// Both defaults, for a command that builds `valueCopies` copies of every value.
+ReadLimits defaultReadLimits(unsigned valueCopies = 0);
+
 // "1.5 GB"-style figure for messages.
 std::string describeBytes(uint64_t bytes);
 

@@ -7,10 +7,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cstdint>
 #include <string>
 
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include "tests/unit/CliRunner.h"
 
@@ -174,3 +176,96 @@ TEST(HostileDense, HeaderTextInMessagesHasItsControlCharactersEscaped) {
     EXPECT_NE(r.err.find("a\\x00hidden.raw"), std::string::npos) << r.err;
     fs::remove_all(d);
 }
+
+namespace {
+
+// An explicit VR little-endian DICOM file of one CT slice: the elements a
+// series needs, in tag order, then `pixelBytes` of native pixel data
+// (explicit VR: 2-byte lengths; OB/OW: 4-byte ones).
+std::string forgedCtSlice(uint16_t rows, uint16_t cols, uint32_t pixelBytes) {
+    std::string out(128, '\0');
+    out += "DICM";
+    auto element = [&](uint16_t g, uint16_t e, const char* vr, const std::string& value) {
+        std::string v = value;
+        if (v.size() % 2) v += std::string(vr) == "UI" ? '\0' : ' ';
+        out.append(reinterpret_cast<const char*>(&g), 2).append(reinterpret_cast<const char*>(&e), 2).append(vr, 2);
+        const bool longForm = std::string(vr) == "OB" || std::string(vr) == "OW";
+        if (longForm) {
+            const uint32_t n = uint32_t(v.size());
+            out.append(2, '\0').append(reinterpret_cast<const char*>(&n), 4);
+        } else {
+            const uint16_t n = uint16_t(v.size());
+            out.append(reinterpret_cast<const char*>(&n), 2);
+        }
+        out += v;
+    };
+    auto us = [](uint16_t v) { return std::string(reinterpret_cast<const char*>(&v), 2); };
+    const std::string sop = "1.2.840.10008.5.1.4.1.1.2", instance = "1.2.3.4.5.6.7";
+    element(0x0002, 0x0001, "OB", std::string("\0\1", 2));
+    element(0x0002, 0x0002, "UI", sop);
+    element(0x0002, 0x0003, "UI", instance);
+    element(0x0002, 0x0010, "UI", "1.2.840.10008.1.2.1");
+    element(0x0008, 0x0016, "UI", sop);
+    element(0x0008, 0x0018, "UI", instance);
+    element(0x0008, 0x0060, "CS", "CT");
+    element(0x0020, 0x000d, "UI", "1.2.3.4.5.1");
+    element(0x0020, 0x000e, "UI", "1.2.3.4.5.2");
+    element(0x0020, 0x0032, "DS", "0\\0\\0");
+    element(0x0020, 0x0037, "DS", "1\\0\\0\\0\\1\\0");
+    element(0x0028, 0x0002, "US", us(1));
+    element(0x0028, 0x0004, "CS", "MONOCHROME2");
+    element(0x0028, 0x0010, "US", us(rows));
+    element(0x0028, 0x0011, "US", us(cols));
+    element(0x0028, 0x0030, "DS", "1\\1");
+    element(0x0028, 0x0100, "US", us(16));
+    element(0x0028, 0x0101, "US", us(12));
+    element(0x0028, 0x0102, "US", us(11));
+    element(0x0028, 0x0103, "US", us(0));
+    element(0x7fe0, 0x0010, "OW", std::string(pixelBytes, '\0'));
+    return out;
+}
+
+} // namespace
+
+// Issue 38 #7: an 844-byte DICOM declaring 65535x65535 pixels answered "out
+// of memory while importing" (its slice was reserved before its pixel data
+// were measured). The pixel data's length against the header is checked when
+// the series is read; the same file with its 2x2 pixels is read (the forging
+// is right), which pydicom-free bytes make the reference here.
+TEST(HostileDense, ADicomHeaderDeclaringMorePixelsThanItHoldsIsRefusedBeforeAllocating) {
+    const fs::path d = freshDir("dicom_pixels");
+    write(d / "big.dcm", forgedCtSlice(65535, 65535, 64));
+    write(d / "ok.dcm", forgedCtSlice(2, 2, 8));
+    for (const std::string verb : {"encode", "import"}) {
+        const fs::path o = d / (verb == "encode" ? "o.ssvdag" : "o.vdb");
+        expectOneLineRefusal(capped(verb + " " + (d / "big.dcm").string() + " -o " + o.string()), "big.dcm", "its pixel data hold 64 bytes", o);
+        const auto r = capped(verb + " " + (d / "ok.dcm").string() + " -o " + o.string());
+        EXPECT_EQ(r.exitCode, 0) << verb << ": " << r.err;
+        fs::remove(o);
+    }
+    fs::remove_all(d);
+}
+
+// Issue 38 #7: a 1 MB gzip NRRD of 1000^3 samples made `import` use 5.9 GB.
+// What the samples become is weighed from the header against --max-memory
+// (default: three quarters of what the process may use) and --max-voxels
+// before any is read: one line naming the file, under a 1 GB cap too.
+TEST(HostileDense, AScanBeyondTheReadLimitsIsRefusedFromItsHeader) {
+    const fs::path d = freshDir("gzip_bomb");
+    {
+        gzFile gz = gzopen((d / "zeros.raw.gz").c_str(), "wb1");
+        ASSERT_NE(gz, nullptr);
+        const std::string slice(1000 * 1000, '\0');
+        for (int z = 0; z < 1000; ++z) ASSERT_EQ(gzwrite(gz, slice.data(), unsigned(slice.size())), int(slice.size()));
+        gzclose(gz);
+    }
+    ASSERT_LT(fs::file_size(d / "zeros.raw.gz"), uintmax_t(8) << 20);
+    write(d / "bomb.nhdr", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 1000 1000 1000\nendian: little\nencoding: gzip\ndata file: zeros.raw.gz\n\n");
+    const std::string in = (d / "bomb.nhdr").string();
+    const fs::path o = d / "o.vdb";
+    expectOneLineRefusal(capped("import " + in + " -o " + o.string()), "bomb.nhdr", "--max-memory", o);
+    expectOneLineRefusal(capped("import " + in + " -o " + o.string() + " --max-memory 100M"), "bomb.nhdr", "--max-memory", o);
+    expectOneLineRefusal(capped("import " + in + " -o " + o.string() + " --max-voxels 999999999"), "bomb.nhdr", "--max-voxels", o);
+    fs::remove_all(d);
+}
+
