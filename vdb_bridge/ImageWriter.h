@@ -1,8 +1,9 @@
-// Writes a rendered frame through OpenImageIO (in libvdbdag_images.so,
-// loaded at the first picture): .png (8-bit sRGB colour), .exr (float R, G,
-// B, A, depth Z and world normal N.x, N.y, N.z), or any other extension
-// OpenImageIO knows (.jpg, .tif: colour only). Atomic: the file appears
-// complete or not at all.
+// Writes a rendered frame: .png (8-bit sRGB colour) by vdbdag itself
+// (PngFile.h: zlib only, no OpenImageIO mapped); .exr (float R, G, B, A,
+// depth Z and world normal N.x, N.y, N.z) or any other extension
+// OpenImageIO knows (.jpg, .tif: colour only) through OpenImageIO, in
+// libvdbdag_images.so, loaded at the first such picture. Atomic: the file
+// appears complete or not at all, every write checked (a full disk).
 #pragma once
 #include <string>
 

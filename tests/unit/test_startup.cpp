@@ -46,7 +46,10 @@ bool loadedOpenImageIO(const std::string& linkerTrace) { return linkerTrace.find
 
 } // namespace
 
-TEST(Startup, OnlyCommandsThatWriteAPictureLoadOpenImageIO) {
+// A PNG is written by vdbdag itself (zlib): only .exr and other formats load
+// OpenImageIO's hundreds of libraries (issue 38 #9: a render under a 1 GB
+// address-space cap failed mapping them).
+TEST(Startup, OnlyCommandsThatWriteAnExrOrOtherPictureLoadOpenImageIO) {
     const fs::path encoded = encodedBall();
     for (const std::string& args : std::vector<std::string>{"--version", "info " + encoded.string(), "verify " + (workDir() / "ball.vdb").string() + " --encoded " + encoded.string(),
                                    "decode " + encoded.string() + " -o " + (workDir() / "back.vdb").string() + " -f"}) {
@@ -55,11 +58,31 @@ TEST(Startup, OnlyCommandsThatWriteAPictureLoadOpenImageIO) {
         EXPECT_NE(r.err.find("calling init"), std::string::npos) << "no linker trace: the check would prove nothing";
         EXPECT_FALSE(loadedOpenImageIO(r.err)) << args;
     }
-    const fs::path png = workDir() / "ball.png";
-    const CommandResult r = runCli("render " + encoded.string() + " -o " + png.string() + " --backend cpu --width 32 --height 24", "env LD_DEBUG=files ");
+    const fs::path png = workDir() / "ball.png", exr = workDir() / "ball.exr";
+    CommandResult r = runCli("render " + encoded.string() + " -o " + png.string() + " -f --backend cpu --width 32 --height 24", "env LD_DEBUG=files ");
+    ASSERT_EQ(r.exitCode, 0) << r.err.substr(0, 2000);
+    EXPECT_NE(r.err.find("calling init"), std::string::npos) << "no linker trace: the check would prove nothing";
+    EXPECT_FALSE(loadedOpenImageIO(r.err));
+    EXPECT_TRUE(fs::exists(png));
+    r = runCli("render " + encoded.string() + " -o " + exr.string() + " -f --backend cpu --width 32 --height 24", "env LD_DEBUG=files ");
     ASSERT_EQ(r.exitCode, 0) << r.err.substr(0, 2000);
     EXPECT_TRUE(loadedOpenImageIO(r.err));
-    EXPECT_TRUE(fs::exists(png));
+    EXPECT_TRUE(fs::exists(exr));
+}
+
+// Issue 38 #9: a PNG render under a 1 GB address-space cap (an embedded
+// renderer's), then under 256 MB; OpenImageIO's own reader checks the file.
+TEST(Startup, APngRenderFitsUnderASmallAddressSpaceCap) {
+    const fs::path encoded = encodedBall();
+    for (const char* cap : {"1048576", "262144"}) {
+        const fs::path png = workDir() / (std::string("capped_") + cap + ".png");
+        const CommandResult r = runShell(std::string("ulimit -v ") + cap + "; " + VDBDAG_BINARY + " render " + encoded.string() + " -o " + png.string() +
+                                         " -f --backend cpu --width 64 --height 64");
+        EXPECT_EQ(r.exitCode, 0) << cap << ": " << r.err;
+        const CommandResult check = runShell("iinfo -v " + png.string());
+        EXPECT_EQ(check.exitCode, 0) << check.out << check.err;
+        EXPECT_NE(check.out.find("3 channel, uint8 png"), std::string::npos) << check.out;
+    }
 }
 
 TEST(Startup, RenderWithoutTheImageModuleIsAOneLineErrorAndWritesNothing) {
@@ -67,7 +90,7 @@ TEST(Startup, RenderWithoutTheImageModuleIsAOneLineErrorAndWritesNothing) {
     const fs::path alone = workDir() / "alone";
     fs::create_directories(alone);
     fs::copy_file(VDBDAG_BINARY, alone / "vdbdag", fs::copy_options::overwrite_existing);
-    const fs::path png = workDir() / "nothing.png";
+    const fs::path png = workDir() / "nothing.exr";  // a PNG needs no module
     const auto before = std::distance(fs::directory_iterator(workDir()), fs::directory_iterator());
     const CommandResult r = runShell((alone / "vdbdag").string() + " render " + encoded.string() + " -o " + png.string() + " --backend cpu --width 16 --height 16");
     EXPECT_EQ(r.exitCode, 1);

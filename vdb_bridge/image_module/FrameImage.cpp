@@ -7,14 +7,10 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "vdb_bridge/detail/Srgb.h"
 #include "vdb_bridge/image_module/ImageModule.h"
 
 namespace {
-
-float linearToSrgb(float c) {
-    c = std::clamp(std::isfinite(c) ? c : 0.f, 0.f, 1.f);
-    return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1 / 2.4f) - 0.055f;
-}
 
 std::string lowerExtension(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();
@@ -50,7 +46,7 @@ bool writeFrame(const std::string& path, const vdbdag::trace::Image& image, std:
         OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
         spec.attribute("oiio:ColorSpace", "sRGB");
         std::vector<uint8_t> data(pixels * 3);
-        for (size_t i = 0; i < pixels * 3; ++i) data[i] = uint8_t(std::lround(linearToSrgb(image.rgb[i]) * 255.f));
+        for (size_t i = 0; i < pixels * 3; ++i) data[i] = vdbdag::bridge::detail::srgbByte(image.rgb[i]);
         ok = out->open(path, spec) && out->write_image(OIIO::TypeDesc::UINT8, data.data()) && out->close();
     }
     if (!ok) {
