@@ -28,11 +28,13 @@ JOBS=${JOBS:-2}
 CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVDBDAG_BUILD_FUZZERS=ON -DVDBDAG_BUILD_TESTS=OFF >/dev/null
 cmake --build build-fuzz -j"$JOBS" --target "${TARGETS[@]}" make_seed_corpus
 [ -n "${FUZZ_RUNS:-}" ] && rm -rf build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/corpus_scan_headers build-fuzz/corpus_int_volume_coder
-mkdir -p build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/artifacts
-build-fuzz/make_seed_corpus build-fuzz/corpus_reader build-fuzz/corpus_sections
+mkdir -p build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/corpus_scan_headers build-fuzz/artifacts
+# Valid files, and the forged files of the tests (an expansion, a legacy
+# Values section, voxels past INT32_MAX, DICOM headers claiming more pixels
+# than they hold).
+build-fuzz/make_seed_corpus build-fuzz/corpus_reader build-fuzz/corpus_sections build-fuzz/corpus_scan_headers
 # Scan seeds: a format byte (0 NRRD, 1 MetaImage, 2 NIfTI, 3 gzip NIfTI, 4
 # DICOM) and the first 64 KiB of a real file of that format.
-mkdir -p build-fuzz/corpus_scan_headers
 seed() {  # KIND FILE
   [ -f "$2" ] || return 0
   { printf "\\$(printf '%03o' "$1")"; head -c 65000 "$2"; } > "build-fuzz/corpus_scan_headers/seed_$1_$(basename "$2")"
@@ -44,6 +46,8 @@ for f in "$DATA"/medical/nifti/*.nii.gz; do
   [ -f "$f" ] && { printf '\002'; zcat "$f" | head -c 65000 || true; } > "build-fuzz/corpus_scan_headers/seed_2_$(basename "$f" .gz)"
 done
 for f in $(ls "$DATA"/medical/dicom/rsna_2/PET 2>/dev/null | head -3); do seed 4 "$DATA/medical/dicom/rsna_2/PET/$f"; done
+# The forged NRRD of the tests: a billion samples in a gzip stream it does not have.
+printf '\000NRRD0004\ntype: uint8\ndimension: 3\nsizes: 1000 1000 1000\nendian: little\nencoding: gzip\n\n' > build-fuzz/corpus_scan_headers/forged_gzip_sizes
 # Raw: format byte 5, the file name (its layout), a NUL, the samples.
 { printf '\005vol_4x4x4_uint16le\000'; printf '%0128d' 7; } > build-fuzz/corpus_scan_headers/seed_5_raw_u16
 { printf '\005ct_8x2x2_float32\000'; printf '%0128d' 3; } > build-fuzz/corpus_scan_headers/seed_5_raw_f32

@@ -81,7 +81,13 @@ void readAll(std::span<const uint8_t> bytes, bool deep) {
             __builtin_trap();
     if (!deep) return;
     try {
-        const format::SsvdagScene scene = format::sectionsToScene(std::move(sections), "fuzz");
+        // As a command reads a file from elsewhere: within read limits (a
+        // forged expansion or a legacy Values section may decode to far more
+        // than the fuzzer's memory; the limits refuse it before decoding).
+        format::ReadOptions options;
+        options.limits.maxVoxels = uint64_t(1) << 22;
+        options.limits.maxMemory = uint64_t(512) << 20;
+        const format::SsvdagScene scene = format::sectionsToScene(std::move(sections), "fuzz", options);
         for (const auto& grid : scene.grids) {
             // An expansion bomb (a few KB that decode to 2^40 bricks) is a
             // valid file the readers bound by --max-voxels; the walk below is

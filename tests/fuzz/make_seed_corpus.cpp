@@ -10,10 +10,12 @@
 #include <vector>
 
 #include "src/format/SsvdagFile.h"
+#include "src/format/TraceableValues.h"
 #include "src/pipeline/GridCodec.h"
+#include "tests/tools/ForgedDicom.h"
 
 int main(int argc, char** argv) {
-    if (argc < 2) return 2;  // usage: make_seed_corpus READER_DIR [SECTIONS_DIR]
+    if (argc < 2) return 2;  // usage: make_seed_corpus READER_DIR [SECTIONS_DIR [SCAN_HEADERS_DIR]]
     using namespace vdbdag;
     GridRecord record;
     record.name = "seed";
@@ -84,6 +86,42 @@ int main(int argc, char** argv) {
                 .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
         }
     }
+    // The forged files of the read-limit tests (tests/unit/test_read_limits.cpp):
+    // an expansion (a solid 256^3 block of full bricks, 2^24 entries in a few
+    // hundred bytes), the same with its values in one legacy Values section
+    // (palettes, decoded whole), and a DAG whose voxels reach past INT32_MAX.
+    {
+        GridRecord block;
+        block.name = "block";
+        block.gridClass = "fog volume";
+        block.valueType = ValueType::Float;
+        block.background.assign(4, 0);
+        block.vdbDescriptor = {1};
+        for (int z = 0; z < 256; z += 4)
+            for (int y = 0; y < 256; y += 4)
+                for (int x = 0; x < 256; x += 4) block.topology.bricks.push_back({x, y, z, ~uint64_t(0)});
+        block.values.bricks.assign(block.topology.bricks.size() * 64 * 4, 0);
+        format::SsvdagScene forged;
+        forged.grids.push_back(pipeline::encodeGrid(block));
+        const auto expansion = format::writeScene(forged);
+        std::ofstream(std::string(argv[1]) + "/forged_expansion.ssvdag", std::ios::binary)
+            .write(reinterpret_cast<const char*>(expansion.data()), std::streamsize(expansion.size()));
+        format::EncodedGrid& g = forged.grids[0];
+        g.values = format::traceableValues(g);
+        g.valueWindows = {};
+        g.predictedValues.clear();
+        const auto legacy = format::writeScene(forged);
+        std::ofstream(std::string(argv[1]) + "/forged_legacy_values.ssvdag", std::ios::binary)
+            .write(reinterpret_cast<const char*>(legacy.data()), std::streamsize(legacy.size()));
+        GridRecord far = record;
+        far.name = "far";
+        format::SsvdagScene farScene;
+        farScene.grids.push_back(pipeline::encodeGrid(far));
+        farScene.grids[0].dag.origin[0] = 2147483640;  // voxels past INT32_MAX
+        const auto farBytes = format::writeScene(farScene);
+        std::ofstream(std::string(argv[1]) + "/forged_far.ssvdag", std::ios::binary)
+            .write(reinterpret_cast<const char*>(farBytes.data()), std::streamsize(farBytes.size()));
+    }
     // The same scene in the checksum-free section framing of fuzz_ssvdag_sections.
     if (argc > 2) {
         const auto sections = format::sceneToSections(scene);
@@ -98,6 +136,14 @@ int main(int argc, char** argv) {
         }
         std::ofstream(std::string(argv[2]) + "/seed_sections", std::ios::binary)
             .write(reinterpret_cast<const char*>(framed.data()), std::streamsize(framed.size()));
+    }
+    // Forged DICOM files of the hostile-input tests for fuzz_scan_headers
+    // (format byte 4): a 65535x65535 header over 64 bytes of pixels, and
+    // the same slice with its 2x2 pixels.
+    if (argc > 3) {
+        for (const auto& [name, bytes] : {std::pair{"forged_huge_slice", testing::forgedCtSlice(65535, 65535, 64)},
+                                          std::pair{"forged_small_slice", testing::forgedCtSlice(2, 2, 8)}})
+            std::ofstream(std::string(argv[3]) + "/" + name, std::ios::binary) << '\004' << bytes;
     }
     return 0;
 }
