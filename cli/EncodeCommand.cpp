@@ -40,6 +40,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         std::string input, output;
         std::vector<std::string> grids;
         bool force = false, noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
+        bool svdagStats = false;
         int placementTrials = 1;
         uint64_t memoryLimit = 0;
         std::string scratch;
@@ -59,6 +60,9 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "plain SVDAG: merge identical subtrees only");
     cmd->add_flag("--no-compress", opt->noCompress, "store sections without zstd");
     cmd->add_flag("--no-predict", opt->noPredict, "integer values: always palettes, never the brick predictor");
+    cmd->add_flag("--svdag-stats", opt->svdagStats,
+                  "also reduce each layer without symmetry and store the plain SVDAG's node counts, which `info` shows beside the SVO's and "
+                  "SSVDAG's (a second reduction; `info IN.vdb` computes them anyway)");
     cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the one whose file is smallest; each codes the values again (1-64)")->check(CLI::Range(1, 64));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
@@ -163,7 +167,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         encodeOptions.symmetry = !opt->noSymmetry;
         encodeOptions.placementTrials = opt->placementTrials;
         encodeOptions.predictIntegers = !opt->noPredict;
-        encodeOptions.computeSvdagStats = !getenv("NOSV");  // cheap next to I/O; lets `info` show all three node counts
+        encodeOptions.computeSvdagStats = opt->svdagStats;
         if (opt->absError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Absolute, opt->absError};
         if (opt->relError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Relative, opt->relError};
         encodeOptions.colourBits = opt->colourBits;

@@ -148,7 +148,8 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
             exitCode = 0;
             return;
         }
-        if (const bridge::DenseFormat f = bridge::denseFormatOf(opt->input); f != bridge::DenseFormat::None && f != bridge::DenseFormat::Raw) {
+        if (const bridge::DenseFormat f = bridge::denseFormatOf(opt->input); f != bridge::DenseFormat::None) {
+            // A .raw file by the layout its name gives (describeRaw says what is missing).
             // describeDense describes a 4-D NIfTI file by its first volume.
             nlohmann::json report = scanHeaderReport(opt->input, bridge::describeDense(opt->input, bridge::DenseImportOptions{}));
             if (opt->json) printJson(report);

@@ -50,6 +50,27 @@ struct IndexBBox {
 namespace detail {
 struct GridData;
 struct FileData;
+
+// The value type (the table above, in the file's order) whose C++ type T
+// is; -1 for any other type (a user's Vec3f, say), which value<T> takes by
+// its size as the value's raw bits.
+template <typename T>
+constexpr int valueTypeCodeOf() {
+    if constexpr (std::is_same_v<T, float>) return 0;
+    else if constexpr (std::is_same_v<T, double>) return 1;
+    else if constexpr (std::is_same_v<T, int32_t>) return 2;
+    else if constexpr (std::is_same_v<T, int64_t>) return 3;
+    else if constexpr (std::is_same_v<T, bool>) return 4;
+    else if constexpr (std::is_same_v<T, std::array<float, 3>>) return 6;
+    else if constexpr (std::is_same_v<T, std::array<double, 3>>) return 7;
+    else if constexpr (std::is_same_v<T, std::array<int32_t, 3>>) return 8;
+    else return -1;
+}
+
+// Throws vdbdag::Error unless a T of value type `code` (valueTypeCodeOf)
+// and `size` bytes may be read from `grid`: the grid's own type, or any
+// other type of the value's size.
+VDBDAG_API void checkValueType(const GridData* grid, int code, size_t size);
 } // namespace detail
 
 // Random access to one grid's voxels. Cheap to make (make one per thread);
@@ -61,15 +82,17 @@ public:
     bool isActive(int64_t i, int64_t j, int64_t k);
     // The value's bytes (valueSize() of them; none for a mask grid).
     void valueBytes(int64_t i, int64_t j, int64_t k, void* out);
-    // The value as T, whose size must be the grid's value size (see the
-    // table above; throws vdbdag::Error otherwise).
+    // The value as T: the C++ type of the grid's value type (the table
+    // above), or a type of another name with the value's size (its raw
+    // bits, e.g. openvdb::Vec3f for vec3s). Throws vdbdag::Error otherwise:
+    // value<float> of an int32 grid is refused, not the int's bits.
     template <typename T>
     T value(int64_t i, int64_t j, int64_t k) {
         static_assert(std::is_trivially_copyable_v<T>);
         if constexpr (std::is_same_v<T, bool>) {
             if (maskGrid()) return isActive(i, j, k);
         }
-        checkValueSize(sizeof(T));
+        detail::checkValueType(grid_, detail::valueTypeCodeOf<T>(), sizeof(T));
         T out;
         valueBytes(i, j, k, &out);
         return out;
@@ -112,7 +135,6 @@ private:
     friend class Grid;
     explicit Accessor(const detail::GridData* grid) : grid_(grid) {}
     bool maskGrid() const;
-    void checkValueSize(size_t size) const;
     const detail::GridData* grid_;
     Path active_, inactive_;
 };
@@ -132,7 +154,7 @@ public:
     template <typename T>
     T background() const {
         static_assert(std::is_trivially_copyable_v<T>);
-        if (sizeof(T) != valueSize()) throw Error("grid '" + name() + "': background asked as a " + std::to_string(sizeof(T)) + "-byte value, the grid holds " + valueType());
+        detail::checkValueType(data_, detail::valueTypeCodeOf<T>(), sizeof(T));
         T out;
         backgroundBytes(&out);
         return out;

@@ -117,6 +117,8 @@ std::string foreignFormatOf(std::span<const uint8_t> b, const std::string& name)
     else if (starts(128, "DICM")) what = "a DICOM file", also = scan;
     else if (starts(344, "n+1") || starts(344, "ni1") || starts(4, "n+2")) what = "a NIfTI file", also = scan;
     else if (starts(0, "\x1f\x8b")) what = "gzip-compressed data (a .nii.gz or .nrrd, if it is a scan)", also = scan;
+    else if (name.size() > 4 && (name.ends_with(".raw") || name.ends_with(".RAW")))
+        what = "a raw volume (by its name; its layout from the name, e.g. ct_512x512x300_int16le.raw, or --dims/--type)", also = scan;
     if (what.empty()) return "";
     return ": it is " + what + ", which `vdbdag encode " + name + " -o OUT.ssvdag` reads" + also;
 }

@@ -120,10 +120,12 @@ void Accessor::valueBytes(int64_t i, int64_t j, int64_t k, void* out) {
 unsigned Accessor::valueSize() const { return grid_->valueSize; }
 bool Accessor::maskGrid() const { return grid_->grid.record.valueType == ValueType::Mask; }
 
-void Accessor::checkValueSize(size_t size) const {
-    if (size != grid_->valueSize)
-        throw Error("grid '" + grid_->grid.record.name + "': a " + std::to_string(size) + "-byte value asked of a " +
-                    valueTypeName(grid_->grid.record.valueType) + " grid (" + std::to_string(grid_->valueSize) + " bytes)");
+void detail::checkValueType(const GridData* grid, int code, size_t size) {
+    const ValueType held = grid->grid.record.valueType;
+    if (code >= 0 ? code == int(held) : size == grid->valueSize) return;
+    const std::string asked = code >= 0 ? std::string(valueTypeName(ValueType(code))) : "a " + std::to_string(size) + "-byte type";
+    throw Error("grid '" + grid->grid.record.name + "': a value asked as " + asked + " of a " + valueTypeName(held) + " grid (" +
+                std::to_string(grid->valueSize) + " bytes; use its own type)");
 }
 
 } // namespace vdbdag

@@ -91,7 +91,7 @@ void encodeFile(benchmark::State& state, bool topologyOnly) {
     for (auto _ : state) {
         const auto imported = vdbdag::bridge::importVdb(sphereFile(), options);
         vdbdag::pipeline::EncodeOptions encodeOptions;
-        encodeOptions.computeSvdagStats = true;  // as the CLI does
+        encodeOptions.computeSvdagStats = false;  // as the CLI does by default
         const auto scene = vdbdag::pipeline::encodeVolume(imported.volume, encodeOptions);
         const auto data = vdbdag::format::writeScene(scene);
         vdbdag::writeFileAtomically(out, data);

@@ -102,6 +102,18 @@ TEST(Cli, EncodeDecodeVerifyInfoOnASphere) {
     const auto& leafLevel = vdbInfo["grids"][0]["levels"][0];
     EXPECT_GE(leafLevel["svo_nodes"].get<uint64_t>(), leafLevel["svdag_nodes"].get<uint64_t>());
     EXPECT_GE(leafLevel["svdag_nodes"].get<uint64_t>(), leafLevel["stored_nodes"].get<uint64_t>());
+    // The plain SVDAG's counts are a second reduction, stored only on
+    // request (`encode --svdag-stats`, issue 41: no hidden pass), and then
+    // the counts `info` computes from the .vdb.
+    EXPECT_FALSE(info["grids"][0]["levels"][0].contains("svdag_nodes")) << info["grids"][0]["levels"][0].dump();
+    const fs::path withStats = workDir() / "ball_stats.ssvdag";
+    ASSERT_EQ(runCli("encode " + in.string() + " -o " + withStats.string() + " -f --svdag-stats").exitCode, 0);
+    r = runCli("info " + withStats.string() + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto statsInfo = nlohmann::json::parse(r.out);
+    ASSERT_EQ(statsInfo["grids"][0]["levels"].size(), vdbInfo["grids"][0]["levels"].size());
+    for (size_t l = 0; l < statsInfo["grids"][0]["levels"].size(); ++l)
+        EXPECT_EQ(statsInfo["grids"][0]["levels"][l]["svdag_nodes"], vdbInfo["grids"][0]["levels"][l]["svdag_nodes"]) << l;
 }
 
 TEST(Cli, TopologyOnlyEncodingDecodesToAMaskGridWithTheSameVoxels) {

@@ -435,6 +435,11 @@ TEST(Container, NotAnSsvdagFile) {
     named({}, 0, "NRRD0004\n", "a NRRD file");
     named(std::vector<uint8_t>(352, 0), 344, "n+1", "a NIfTI file");
     named(std::vector<uint8_t>(200, 0), 128, "DICM", "a DICOM file");
+    // A raw volume has no magic: by its name.
+    const std::vector<uint8_t> samples(64, 7);
+    const std::string e = errorOf(samples, "ct_4x4x4_uint8.raw");
+    EXPECT_NE(e.find("not an .ssvdag file: it is a raw volume"), std::string::npos) << e;
+    EXPECT_NE(e.find("vdbdag encode ct_4x4x4_uint8.raw -o OUT.ssvdag"), std::string::npos) << e;
 }
 
 // ---- files ----------------------------------------------------------------------

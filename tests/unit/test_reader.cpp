@@ -260,6 +260,41 @@ TEST(Reader, OpenRefusesAFileBeyondItsLimits) {
     std::filesystem::remove(path);
 }
 
+// value<T> and background<T> take the grid's own C++ type (or a type of
+// another name with the value's size, read as its bits); a type of the table
+// that is not the grid's is refused (issue 41: value<float> of an int32
+// grid returned the int's bits, 7.9e-43 for 564).
+TEST(Reader, ValuesAreReadAsTheGridsOwnTypeOnly) {
+    std::mt19937 rng(5);
+    Case c = shell(ValueType::Int32, "labels", rng, [](double d, std::mt19937&, uint8_t* out) {
+        const int32_t v = int32_t(std::lround(d * 100.0)) + 564;
+        std::memcpy(out, &v, 4);
+    });
+    const auto path = writeFile({{&c, false}}, {}, "reader_types");
+    const File file = File::open(path.string());
+    const Grid& g = file.grid("labels");
+    Accessor a = g.accessor();
+    const auto& p = c.active.voxels[7];
+    int32_t want = 0;
+    std::memcpy(&want, c.active.voxelValues.data() + 7 * 4, 4);
+    EXPECT_EQ(a.value<int32_t>(p[0], p[1], p[2]), want);
+    struct Bits {
+        uint8_t b[4];
+    };
+    const Bits bits = a.value<Bits>(p[0], p[1], p[2]);  // another name, the value's size: its bits
+    EXPECT_EQ(std::memcmp(bits.b, &want, 4), 0);
+    try {
+        (void)a.value<float>(p[0], p[1], p[2]);
+        ADD_FAILURE() << "value<float> of an int32 grid was answered";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("asked as float of a int32 grid"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW((void)a.value<int64_t>(p[0], p[1], p[2]), Error);
+    EXPECT_THROW((void)g.background<float>(), Error);
+    EXPECT_EQ(g.background<int32_t>(), 0);
+    std::filesystem::remove(path);
+}
+
 TEST(Reader, OpenNamesTheFileInItsError) {
     const std::string missing = (std::filesystem::temp_directory_path() / "no_such_reader_file.ssvdag").string();
     try {

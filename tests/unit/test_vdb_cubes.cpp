@@ -143,7 +143,7 @@ TEST(VdbCubes, EverySharedDataFileGivesTheInMemoryBytes) {
     const auto files = vdbdag::testing::sharedVdbFiles();
     if (files.empty()) GTEST_SKIP() << "../shared/data not present";
     pipeline::EncodeOptions options;
-    options.computeSvdagStats = true;  // as the CLI encodes
+    options.computeSvdagStats = true;  // as `encode --svdag-stats` (the extra reduction, on both paths)
     for (const auto& f : files) {
         SCOPED_TRACE(f.string());
         const std::vector<uint8_t> whole = inMemoryFile(f, {}, options);
