@@ -91,11 +91,11 @@ struct CompactRecord {
         r.residual = residual, r.sign = sign;
         return r;
     }
-    static CompactRecord of(const SampleRecord& r) {
-        CompactRecord c;
-        for (size_t k = 0; k < size_t(kPredictors); ++k) c.err[k] = uint16_t(std::min<uint32_t>(r.err[k], 65535));
-        c.residual = uint16_t(std::min<uint32_t>(r.residual, 65535)), c.sign = r.sign;
-        return c;
+    // Written field by field where it lives: a temporary copied over it
+    // stalled on its own partial stores (store-to-load forwarding).
+    void set(const SampleRecord& r) {
+        for (size_t k = 0; k < size_t(kPredictors); ++k) err[k] = uint16_t(std::min<uint32_t>(r.err[k], 65535));
+        residual = uint16_t(std::min<uint32_t>(r.residual, 65535)), sign = r.sign;
     }
 };
 
@@ -150,7 +150,7 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             SampleRecord r;
             learn(pr, decoded, r);
             value = int32_t(decoded);
-            rec = CompactRecord::of(r);
+            rec.set(r);
             last = decoded;
             lastRec = r;
         });
