@@ -1,11 +1,14 @@
 // `vdbdag decode IN.ssvdag -o OUT.vdb`, or to a dense scan file
 // (OUT.nrrd|.nhdr|.mha|.mhd|.nii|.nii.gz|.raw) with the scan's own sample
 // type, extent and patient space (vdb_bridge/DenseExport.h).
+#include <chrono>
 #include <filesystem>
 
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/JsonReport.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "src/pipeline/GridCodec.h"
@@ -79,7 +82,7 @@ bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& inp
 void addDecodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::string input, output, grid;
-        bool force = false, storedValues = false;
+        bool force = false, storedValues = false, json = false;
         ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
@@ -91,9 +94,26 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
                   "scan output of a rescaled scan (DICOM, NIfTI scl_slope) to .nrrd/.nhdr/.mha/.mhd/.raw: write the stored integers, with the rescale as "
                   "key/value pairs, instead of the grid's values (NIfTI always holds the stored integers and the rescale)");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
+    cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "decoding");
+        if (opt->json) setQuiet(true);
+        const auto start = std::chrono::steady_clock::now();
+        std::vector<std::string> notes;
+        size_t gridCount = 0;
+        uint64_t activeVoxels = 0;
+        // The summary line (or JSON) once the output is in place, as encode prints one.
+        auto summary = [&] {
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            std::error_code ec;
+            const uint64_t bytes = std::filesystem::file_size(opt->output, ec);
+            const nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"grids", gridCount}, {"active_voxels", activeVoxels},
+                                        {"output_bytes", ec ? 0 : bytes}, {"seconds", seconds}, {"notes", notes}};
+            if (opt->json) printJson(report);
+            else fmt::print("{} -> {}: {} grid(s), {} active voxels, {} bytes in {:.2f} s\n", opt->input, opt->output, gridCount, activeVoxels,
+                            ec ? 0 : bytes, seconds);
+        };
         const bool dense = bridge::isDenseOutput(opt->output);
         const bool nano = lowerExtension(opt->output) == ".nvdb";
         if (!dense && !nano && lowerExtension(opt->output) != ".vdb")
@@ -102,7 +122,6 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         if (!dense && opt->storedValues) throw Error(opt->output + ": --stored-values applies to scan outputs (a .vdb or .nvdb file holds the grid's values)");
         bridge::DenseExportOptions denseOptions;
         denseOptions.storedValues = opt->storedValues;
-        std::vector<std::string> notes;
         // What changed on the way out, one line each (not silenced by -q: a value written otherwise than stored).
         auto printNotes = [&] {
             for (const std::string& n : notes) fmt::print(stderr, "{}: note: {}\n", opt->output, n);
@@ -125,8 +144,11 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         Progress progress("decode: reading " + std::filesystem::path(opt->input).filename().string(), 1000);
         {
             const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);
+            gridCount = scene.grids.size();
+            for (const auto& g : scene.grids) activeVoxels += g.activeVoxels;
             if (dense && decodeDenseByCubes(scene, opt->input, opt->output, opt->grid, denseOptions, notes)) {
                 printNotes();
+                summary();
                 exitCode = 0;
                 return;
             }
@@ -155,6 +177,7 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
         else bridge::exportVdb(volume, opt->output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
         progress.finish();
         printNotes();
+        summary();
         exitCode = 0;
     });
 }

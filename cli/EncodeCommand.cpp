@@ -34,6 +34,27 @@
 #include "vdb_bridge/VdbImport.h"
 
 namespace vdbdag::cli {
+namespace {
+
+// IN.ssvdag beside the input: its name without its extension (.nii.gz,
+// .raw.gz and the like count as one), a folder's name for a folder.
+std::string defaultOutputFor(const std::string& input) {
+    std::filesystem::path p(input);
+    if (!p.has_filename()) p = p.parent_path();  // "dir/"
+    std::string name = p.filename().string();
+    std::error_code ec;
+    if (!std::filesystem::is_directory(p, ec)) {
+        std::string lower = name;
+        std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        if (lower.size() > 3 && lower.ends_with(".gz")) name.resize(name.size() - 3);
+        if (const size_t dot = name.rfind('.'); dot != std::string::npos && dot > 0) name.resize(dot);
+    }
+    if (name.empty() || name == "." || name == "..") throw Error(input + ": no name to make the output's from; give -o OUT.ssvdag");
+    return (p.parent_path() / (name + ".ssvdag")).string();
+}
+
+} // namespace
+
 void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::vector<std::string> inputs;
@@ -54,7 +75,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb or NanoVDB .nvdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha/.nii scan, or one DICOM series) into an .ssvdag file");
     cmd->add_option("input", opt->inputs, "input .vdb or .nvdb file or dense scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
-    cmd->add_option("-o,--output", opt->output, "output .ssvdag file")->required();
+    cmd->add_option("-o,--output", opt->output, "output .ssvdag file (default: the input's name with .ssvdag, beside it: ct.nii.gz -> ct.ssvdag, a DICOM folder dir/ -> dir.ssvdag)");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_option("--grid", opt->grids, "encode only grids with this name (repeatable)");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "plain SVDAG: merge identical subtrees only");
@@ -88,6 +109,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     opt->dense.addTo(*cmd);
     cmd->callback([opt, &exitCode] {
         opt->input = opt->dense.takeInputs(opt->inputs);
+        if (opt->output.empty()) opt->output = defaultOutputFor(opt->input);
         setActivity(opt->input, "encoding");
         const auto start = std::chrono::steady_clock::now();
         std::optional<tbb::global_control> threads;

@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "cli/ByteSize.h"
 #include "cli/Commands.h"
 #include "cli/JsonReport.h"
 #include "cli/ReadLimitOptions.h"
@@ -55,7 +56,7 @@ void addExportCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--grid", opt->grids, "export only the grids with this name (repeatable)");
     cmd->add_option("--bbox", opt->bbox, "index-space box X0,Y0,Z0,X1,Y1,Z1 (inclusive): clip, and in a .vtm write it as an image");
     cmd->add_option("--max-cells", opt->maxCells, "stop if an unstructured block would exceed this many cells")->capture_default_str();
-    cmd->add_option("--max-bytes", opt->maxBytes, "stop if an image block would exceed this many bytes")->capture_default_str();
+    cmd->add_option("--max-bytes", opt->maxBytes, "stop if an image block would exceed this many bytes, e.g. 600M")->capture_default_str()->transform(byteSize());
     cmd->add_option("--compressor", opt->compressor, "zlib or lz4")->capture_default_str();
     cmd->add_flag("--structure", opt->structure, "write the DAG's structure: a block per level, a cell per node instance");
     cmd->add_option("--max-instances", opt->maxInstances, "--structure: past this many instances, write one cell per unique node")->capture_default_str();

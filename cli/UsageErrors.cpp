@@ -133,6 +133,22 @@ int answerParseError(CLI::App& app, const CLI::ParseError& e, int argc, char** a
         }
         if (!words.empty()) return usageLine(who, "unexpected argument '" + words.front() + "'");
     }
+    // A word outside an option's set (CLI11: "--view: fornt not in {iso,front,back,side,top}"): the closest member.
+    if (const size_t colon = message.find(": "), notIn = message.rfind(" not in {");
+        colon != std::string::npos && notIn != std::string::npos && notIn > colon && message.back() == '}') {
+        const std::string option = message.substr(0, colon), value = message.substr(colon + 2, notIn - colon - 2);
+        std::vector<std::string> members;
+        std::string list = message.substr(notIn + 9, message.size() - notIn - 10);
+        for (size_t at = 0; at <= list.size();) {
+            const size_t comma = std::min(list.find(',', at), list.size());
+            members.push_back(list.substr(at, comma - at));
+            at = comma + 1;
+        }
+        std::string listed;
+        for (const std::string& m : members) listed += (listed.empty() ? "" : ", ") + m;
+        const std::string guess = closestName(value, members);
+        return usageLine(who, option + ": '" + value + "' is not one of " + listed + (guess.empty() ? "" : "; did you mean '" + guess + "'?"));
+    }
     return usageLine(who, message);
 }
 

@@ -323,7 +323,7 @@ TEST(Cli, UsageMistakesAreOneLineWithASuggestionAndExitTwo) {
                                             {"", "a command is required"},
                                             {"encode " + ball + " -o x.ssvdag --abs-eror 0.1", "unknown option '--abs-eror'; did you mean '--abs-error'?"},
                                             {"render x.ssvdag -o x.png --widht=8", "unknown option '--widht'; did you mean '--width'?"},
-                                            {"encode " + ball, "--output is required"},
+                                            {"render x.ssvdag -o x.png --view fornt", "--view: 'fornt' is not one of iso, front, back, side, top; did you mean 'front'?"},
                                             {"help encdoe", "'encdoe' is not a command; did you mean 'encode'?"},
                                             // sizes (issue 38: -1, 0 and 23 digits were taken)
                                             {"encode " + ball + " -o x.ssvdag --memory-limit -1", "'-1' is not a size"},
@@ -567,3 +567,52 @@ TEST(Cli, EveryCommandsHelpShowsAnExampleAndItsDefaults) {
     EXPECT_NE(render.out.find("--width INT:INT in [1 - 16384]=1024"), std::string::npos) << render.out;
     EXPECT_NE(render.out.find("--view TEXT:{iso,front,back,side,top}=iso"), std::string::npos) << render.out;
 }
+
+// Without -o, encode writes IN.ssvdag beside the input (the name without its
+// extension; .nii.gz counts as one), and like any new output it never
+// replaces a file there without --force (issue 42 #4).
+TEST(Cli, EncodeWithoutAnOutputWritesBesideTheInput) {
+    const fs::path dir = workDir() / "default_name";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::copy_file(sphereFile(), dir / "ball.vdb");
+    CommandResult r = runCli("encode " + (dir / "ball.vdb").string());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "ball.ssvdag"));
+    EXPECT_NE(r.out.find((dir / "ball.ssvdag").string()), std::string::npos) << r.out;
+    r = runCli("encode " + (dir / "ball.vdb").string());
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("already exists"), std::string::npos) << r.err;
+    {
+        std::ofstream raw(dir / "ct_4x4x4_uint8.raw", std::ios::binary);
+        raw << std::string(64, '\3');
+    }
+    r = runCli("encode " + (dir / "ct_4x4x4_uint8.raw").string());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "ct_4x4x4_uint8.ssvdag"));
+    fs::remove_all(dir);
+}
+
+// decode says what it wrote (a line, or --json), and export's --max-bytes
+// takes a size with its unit as the other size options do (issue 42 #4).
+TEST(Cli, DecodeReportsWhatItWroteAndSizesTakeUnits) {
+    const fs::path encoded = workDir() / "report_ball.ssvdag", back = workDir() / "report_ball.vdb";
+    ASSERT_EQ(runCli("encode " + sphereFile().string() + " -o " + encoded.string() + " -f").exitCode, 0);
+    CommandResult r = runCli("decode " + encoded.string() + " -o " + back.string() + " -f --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(report["output_bytes"].get<uint64_t>(), fs::file_size(back));
+    openvdb::initialize();
+    openvdb::io::File file(back.string());
+    file.open();
+    uint64_t active = 0;
+    const openvdb::GridPtrVecPtr grids = file.getGrids();
+    for (const auto& g : *grids) active += g->activeVoxelCount();
+    file.close();
+    EXPECT_EQ(report["active_voxels"].get<uint64_t>(), active);
+    r = runCli("decode " + encoded.string() + " -o " + back.string() + " -f");
+    EXPECT_NE(r.out.find(back.string()), std::string::npos) << r.out;
+    r = runCli("export " + encoded.string() + " -o " + (workDir() / "report_ball.vti").string() + " -f --max-bytes 600M");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+}
+
