@@ -15,6 +15,7 @@
 #include "cli/ReadLimitOptions.h"
 #include "cli/RenderBackend.h"
 #include "src/format/SsvdagFile.h"
+#include "src/trace/FogDensity.h"
 #include "src/trace/Camera.h"
 #include "src/trace/RenderGrid.h"
 #include "src/util/Error.h"
@@ -76,7 +77,9 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--device", opt->device, "Vulkan device index (see `vdbdag devices`)");
     cmd->add_option("--lod-pixels", opt->lodPixels, "stop descending where a node projects smaller than this many pixels (0: off)")->check(finiteNumber())->check(CLI::Range(0.0, 1e6));
     cmd->add_flag("--shadows", opt->shadows, "cast a shadow ray towards the light");
-    cmd->add_option("--density-scale", opt->densityScale, "fog: extinction per voxel length at the largest density")->check(finiteNumber())->check(CLI::Range(0.0, 1e6));
+    cmd->add_option("--density-scale", opt->densityScale,
+                    "fog: extinction per voxel length at the largest density (default: the scale at which the median optical depth of the "
+                    "camera's rays through the fog is 1)")->check(finiteNumber())->check(CLI::Range(0.0, 1e6));
     cmd->add_option("--frames", opt->frames, "render this many frames and report the median time")->check(CLI::Range(1, 1000));
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");
@@ -98,6 +101,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         if (cmdDensityScaleGiven && !grid.fog)
             throw Error(opt->input + ": --density-scale applies to fog shading, and grid '" + chosen->record.name + "' is shown as " +
                         trace::shadingOf(grid) + " (use --shading fog)");
+        if (opt->shadows && grid.fog)
+            throw Error(opt->input + ": --shadows applies to surfaces; grid '" + chosen->record.name + "' is shown as fog, which has no shadows yet");
         if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");
         const trace::GridFrame frame(grid.indexToWorld);
         trace::Camera camera = trace::frameBounds(frame, grid.cellLo, grid.cellHi, opt->width, opt->height, opt->fov,
@@ -113,7 +118,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         trace::RenderOptions options;
         options.lodPixels = opt->lodPixels;
         options.shadows = opt->shadows;
-        options.densityScale = opt->densityScale;
+        options.densityScale = cmdDensityScaleGiven || !grid.fog ? opt->densityScale : trace::autoDensityScale(grid, camera, opt->densityScale);
 
         auto backend = makeRenderBackend(opt->backend, opt->device);
         std::vector<double> times;
@@ -133,7 +138,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                              {"frames", opt->frames},      {"ms_per_frame", ms},            {"ms_min", times.front()},
                              {"ms_max", times.back()},     {"primary_rays", stats.primaryRays}, {"secondary_rays", stats.secondaryRays},
                              {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows},
-                             {"shading", trace::shadingOf(grid)},
+                             {"shading", trace::shadingOf(grid)}, {"density_scale", grid.fog ? nlohmann::json(options.densityScale) : nlohmann::json()},
                              {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}, {"target", {camera.target.x, camera.target.y, camera.target.z}},
                                          {"up", {camera.up.x, camera.up.y, camera.up.z}}}}};
             printJson(j);

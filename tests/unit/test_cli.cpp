@@ -616,3 +616,21 @@ TEST(Cli, DecodeReportsWhatItWroteAndSizesTakeUnits) {
     EXPECT_EQ(r.exitCode, 0) << r.err;
 }
 
+
+// Every render option takes effect or is refused: --shadows on a fog (it
+// was silently ignored: 0 shadow rays); the default fog density scale is
+// reported (issue 42 #2).
+TEST(Cli, ShadowsOnAFogAreRefusedAndTheFogScaleIsReported) {
+    const fs::path fog = fs::path(VDBDAG_SOURCE_DIR) / "tests" / "golden" / "fog.vdb", encoded = workDir() / "fog_shadows.ssvdag";
+    ASSERT_EQ(runCli("encode " + fog.string() + " -o " + encoded.string() + " -f").exitCode, 0);
+    const fs::path png = workDir() / "fog_shadows.png";
+    CommandResult r = runCli("render " + encoded.string() + " -o " + png.string() + " -f --backend cpu --width 16 --height 16 --shadows");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("no shadows"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(png));
+    r = runCli("render " + encoded.string() + " -o " + png.string() + " -f --backend cpu --width 16 --height 16 --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["shading"], "fog");
+    EXPECT_GT(j["density_scale"].get<double>(), 0.0);
+}
