@@ -9,13 +9,16 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/GlobalOptions.h"
 #include "cli/JsonReport.h"
 #include "cli/RunContext.h"
 #include "cli/FiniteNumber.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RenderBackend.h"
 #include "src/format/SsvdagFile.h"
+#include "src/format/DagBounds.h"
 #include "src/trace/FogDensity.h"
+#include "src/trace/Projection.h"
 #include "src/trace/Camera.h"
 #include "src/trace/RenderGrid.h"
 #include "src/util/Error.h"
@@ -43,11 +46,24 @@ std::vector<double> parseNumbers(const std::string& text, size_t count, const st
     return values;
 }
 
+// An integer or float grid, neither a level set nor a fog, whose every voxel
+// of its bounding box is active (at least 16^3 of them): a scan.
+bool denseScalarScan(const format::EncodedGrid& grid) {
+    const ValueType t = grid.record.valueType;
+    if (t != ValueType::Int32 && t != ValueType::Int64 && t != ValueType::Float && t != ValueType::Double) return false;
+    if (grid.record.gridClass == "level set" || grid.record.gridClass == "fog volume") return false;
+    const std::optional<format::IndexBox> box = format::dagBounds(grid.dag);
+    if (!box || grid.activeVoxels < 4096) return false;
+    uint64_t volume = 1;
+    for (int a = 0; a < 3; ++a) volume *= uint64_t(box->max[size_t(a)] - box->min[size_t(a)] + 1);
+    return volume == grid.activeVoxels;
+}
+
 } // namespace
 
 void addRenderCommand(CLI::App& app, int& exitCode) {
     struct Options {
-        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto";
+        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window;
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
         bool shadows = false, json = false, force = false;
@@ -69,9 +85,12 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         ->capture_default_str();
     cmd->add_option("--shading", opt->shading,
                     "auto (level sets as surfaces; fog volumes, by class or by content (densities >= 0, background 0), as fog; else voxels coloured by "
-                    "value), fog, surface or values")
-        ->check(CLI::IsMember({"auto", "fog", "surface", "values"}))
+                    "value), fog, surface, values, or mip (the largest value along each ray, air transparent; the CPU tracer)")
+        ->check(CLI::IsMember({"auto", "fog", "surface", "values", "mip"}))
         ->capture_default_str();
+    cmd->add_option("--window", opt->window,
+                    "mip: LOW,HIGH, the values shown black to white (LOW and below transparent; default: Otsu's threshold of the pixels' "
+                    "maxima to their 99.5th percentile)");
     cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(finiteNumber())->check(CLI::Range(1.0, 170.0));
     cmd->add_option("--backend", opt->backend, "vulkan, cpu, or auto (a Vulkan GPU when there is one, else the CPU tracer; a software Vulkan device such as lavapipe only with --backend vulkan)")->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
     cmd->add_option("--device", opt->device, "Vulkan device index (see `vdbdag devices`)");
@@ -96,11 +115,23 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             if (opt->grid.empty() || g.record.name == opt->grid) { chosen = &g; break; }
         if (!chosen) throw Error(opt->input + ": no grid named '" + opt->grid + "'");
         if (chosen->dag.empty()) throw Error(opt->input + ": grid '" + chosen->record.name + "' is empty: nothing to render");
-        const trace::RenderGrid grid = trace::makeRenderGrid(*chosen, trace::parseShading(opt->shading));
+        trace::Shading shading = trace::parseShading(opt->shading);
+        // A dense scan (every voxel of its box active: a CT's air too) shown
+        // as voxel blocks is an opaque box: by default it is projected (MIP),
+        // its air transparent. Not with --backend vulkan, which has no MIP yet.
+        if (shading == trace::Shading::Auto && opt->backend != "vulkan" && denseScalarScan(*chosen)) {
+            shading = trace::Shading::Mip;
+            note("grid '" + chosen->record.name + "' is a dense scan: shown as a maximum intensity projection (--shading values for its voxels)");
+        }
+        const trace::RenderGrid grid = trace::makeRenderGrid(*chosen, shading);
         // Every option takes effect or is refused.
         if (cmdDensityScaleGiven && !grid.fog)
             throw Error(opt->input + ": --density-scale applies to fog shading, and grid '" + chosen->record.name + "' is shown as " +
                         trace::shadingOf(grid) + " (use --shading fog)");
+        if (!opt->window.empty() && !grid.mip) throw Error(opt->input + ": --window applies to --shading mip");
+        if (grid.mip && opt->backend == "vulkan")
+            throw Error(opt->input + ": --shading mip is rendered by the CPU tracer only for now (use --backend cpu or auto)");
+        if (grid.mip && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading mip");
         if (opt->shadows && grid.fog)
             throw Error(opt->input + ": --shadows applies to surfaces; grid '" + chosen->record.name + "' is shown as fog, which has no shadows yet");
         if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");
@@ -120,7 +151,16 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         options.shadows = opt->shadows;
         options.densityScale = cmdDensityScaleGiven || !grid.fog ? opt->densityScale : trace::autoDensityScale(grid, camera, opt->densityScale);
 
-        auto backend = makeRenderBackend(opt->backend, opt->device);
+        if (grid.mip) {
+            if (!opt->window.empty()) {
+                const auto w = parseNumbers(opt->window, 2, "--window");
+                if (!(w[1] > w[0])) throw Error("--window: HIGH must be greater than LOW");
+                options.window = std::pair{w[0], w[1]};
+            } else {
+                options.window = trace::automaticWindow(trace::maximaAlongRays(grid, camera));
+            }
+        }
+        auto backend = makeRenderBackend(grid.mip ? "cpu" : opt->backend, opt->device);
         std::vector<double> times;
         trace::Image image;
         trace::RenderStats stats;
@@ -139,6 +179,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                              {"ms_max", times.back()},     {"primary_rays", stats.primaryRays}, {"secondary_rays", stats.secondaryRays},
                              {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows},
                              {"shading", trace::shadingOf(grid)}, {"density_scale", grid.fog ? nlohmann::json(options.densityScale) : nlohmann::json()},
+                             {"window", options.window ? nlohmann::json({options.window->first, options.window->second}) : nlohmann::json()},
                              {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}, {"target", {camera.target.x, camera.target.y, camera.target.z}},
                                          {"up", {camera.up.x, camera.up.y, camera.up.z}}}}};
             printJson(j);

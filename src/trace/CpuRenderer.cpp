@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "src/trace/DagTracer.h"
+#include "src/trace/Projection.h"
 #include "src/trace/SurfaceHit.h"
 
 namespace vdbdag::trace {
@@ -48,6 +49,15 @@ std::optional<glm::dvec3> storedNormal(const RenderGrid& grid, const RayHit& hit
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {
     const auto start = std::chrono::steady_clock::now();
+    if (grid.mip) {
+        Image image = renderMip(grid, camera, options.window).image;
+        if (stats) {
+            stats->primaryRays = uint64_t(camera.width) * uint64_t(camera.height);
+            stats->secondaryRays = 0;
+            stats->milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        }
+        return image;
+    }
     const GridFrame frame(grid.indexToWorld);
     TraceOptions traceOptions;
     if (options.lodPixels > 0) traceOptions.lodScale = options.lodPixels * camera.pixelAngle() / frame.voxelSize();

@@ -27,12 +27,13 @@ std::array<double, 3> decodeValue(ValueType type, const uint8_t* bytes) { return
 Shading parseShading(const std::string& text) {
     if (text == "auto") return Shading::Auto;
     if (text == "fog") return Shading::Fog;
+    if (text == "mip") return Shading::Mip;
     if (text == "surface") return Shading::Surface;
     if (text == "values") return Shading::Values;
-    throw Error("--shading: '" + text + "' is not auto, fog, surface or values");
+    throw Error("--shading: '" + text + "' is not auto, fog, surface, values or mip");
 }
 
-const char* shadingOf(const RenderGrid& grid) { return grid.fog ? "fog" : grid.levelSet ? "surface" : "values"; }
+const char* shadingOf(const RenderGrid& grid) { return grid.mip ? "mip" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values"; }
 
 RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
     RenderGrid out;
@@ -78,6 +79,11 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
         out.levelSet = scalarFloat && out.values && (isLevelSetClass || (lo < 0 && background > 0));
         break;
     case Shading::Values: break;
+    case Shading::Mip:
+        if (valueSize(out.valueType) == 0 || (out.valueType == ValueType::Vec3S || out.valueType == ValueType::Vec3D || out.valueType == ValueType::Vec3I) || out.valueType == ValueType::Bool)
+            throw Error("grid '" + grid.record.name + "' holds " + valueTypeName(out.valueType) + " values: a maximum intensity projection needs scalar values");
+        out.mip = true;
+        break;
     }
     if (grid.normals && grid.normals->entryCount() > 0) out.normals = &*grid.normals;
     if (out.levelSet && out.values) out.inside = std::make_shared<const InsideBits>(insideBitsOf(*out.values, out.valueType));

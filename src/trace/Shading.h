@@ -3,6 +3,9 @@
 // base colours from values, Lambert with one directional light, and the
 // emission-absorption step of fog volumes.
 #pragma once
+#include <optional>
+#include <utility>
+
 #include <glm/glm.hpp>
 
 #include "src/trace/RenderGrid.h"
@@ -15,6 +18,9 @@ struct RenderOptions {
     bool shadows = false;       // secondary ray towards the light
     double densityScale = 0.08; // fog: extinction per voxel length at the grid's largest density
     glm::dvec3 background{0.10, 0.11, 0.13};
+    // --shading mip: the display window [low, high] (Projection.h; chosen
+    // from the image when absent).
+    std::optional<std::pair<double, double>> window;
 };
 
 using access::kAmbient;

@@ -1,0 +1,87 @@
+// See Projection.h.
+#include "src/trace/Projection.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "src/trace/DagTracer.h"
+
+namespace vdbdag::trace {
+
+std::vector<double> maximaAlongRays(const RenderGrid& grid, const Camera& camera) {
+    const GridFrame frame(grid.indexToWorld);
+    const DagTracer tracer(*grid.dag);
+    std::vector<double> maxima(size_t(camera.width) * size_t(camera.height), std::numeric_limits<double>::quiet_NaN());
+    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& rows) {
+        size_t hint = 0;
+        for (int py = rows.begin(); py != rows.end(); ++py)
+            for (int px = 0; px < camera.width; ++px) {
+                glm::dvec3 eye, dir;
+                camera.pixelRay(px, py, eye, dir);
+                double best = -std::numeric_limits<double>::infinity();
+                bool met = false;
+                tracer.forEachSegment(frame.toCellRay(eye, dir), [&](const RayHit& box, double) {
+                    const double v = grid.values ? valueAsDoubles(grid, box.attribute, hint)[0] : 1.0;
+                    if (!std::isnan(v)) best = std::max(best, v), met = true;
+                    return false;
+                });
+                if (met) maxima[size_t(py) * size_t(camera.width) + size_t(px)] = best;
+            }
+    });
+    return maxima;
+}
+
+std::pair<double, double> automaticWindow(const std::vector<double>& maxima) {
+    std::vector<double> v;
+    v.reserve(maxima.size());
+    for (const double m : maxima)
+        if (std::isfinite(m)) v.push_back(m);
+    if (v.empty()) return {0, 1};
+    std::sort(v.begin(), v.end());
+    const double lo = v.front(), hi = v[std::min(v.size() - 1, size_t(double(v.size()) * 0.995))];
+    if (!(hi > lo)) return {lo - 1, lo};  // one value: shown, white
+    // Otsu's threshold over 256 bins of [lo, hi]: the split that maximises
+    // the between-class variance (air against what is in it).
+    constexpr int kBins = 256;
+    std::array<double, kBins> count{};
+    for (const double x : v) count[size_t(std::clamp(int((x - lo) / (hi - lo) * kBins), 0, kBins - 1))] += 1;
+    double total = 0, sum = 0;
+    for (int b = 0; b < kBins; ++b) total += count[size_t(b)], sum += b * count[size_t(b)];
+    double weight0 = 0, sum0 = 0, bestVariance = -1;
+    int threshold = 0;
+    for (int b = 0; b < kBins - 1; ++b) {
+        weight0 += count[size_t(b)];
+        sum0 += b * count[size_t(b)];
+        const double weight1 = total - weight0;
+        if (weight0 == 0 || weight1 == 0) continue;
+        const double mean0 = sum0 / weight0, mean1 = (sum - sum0) / weight1;
+        const double variance = weight0 * weight1 * (mean0 - mean1) * (mean0 - mean1);
+        if (variance > bestVariance) bestVariance = variance, threshold = b;
+    }
+    return {lo + (hi - lo) * double(threshold + 1) / kBins, hi};
+}
+
+Projection renderMip(const RenderGrid& grid, const Camera& camera, std::optional<std::pair<double, double>> window) {
+    const std::vector<double> maxima = maximaAlongRays(grid, camera);
+    Projection out;
+    std::tie(out.low, out.high) = window ? *window : automaticWindow(maxima);
+    out.image.resize(camera.width, camera.height);
+    const double span = out.high > out.low ? out.high - out.low : 1;
+    for (size_t i = 0; i < maxima.size(); ++i) {
+        const double m = maxima[i];
+        if (!(m > out.low)) continue;  // a miss, NaN, or at or below the window: transparent
+        // Linear light whose sRGB code is proportional to the window position.
+        const double g = std::clamp((m - out.low) / span, 0.0, 1.0);
+        const float grey = float(g <= 0.04045 ? g / 12.92 : std::pow((g + 0.055) / 1.055, 2.4));
+        for (int c = 0; c < 3; ++c) out.image.rgb[3 * i + size_t(c)] = grey;
+        out.image.alpha[i] = 1;
+    }
+    return out;
+}
+
+} // namespace vdbdag::trace

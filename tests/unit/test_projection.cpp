@@ -1,0 +1,166 @@
+// Maximum intensity projection (src/trace/Projection.h, `render --shading
+// mip`) against a brute force: every voxel of a dense block as a world-space
+// box (OpenVDB's voxel-centred convention: index i covers [i - 0.5, i + 0.5]
+// times the voxel size), each pixel's ray tested against all of them by the
+// slab method, the largest value of the boxes it crosses.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+
+#include <OpenImageIO/imageio.h>
+#include <openvdb/openvdb.h>
+
+#include <fstream>
+
+#include "src/pipeline/GridCodec.h"
+#include "src/trace/Camera.h"
+#include "src/trace/CpuRenderer.h"
+#include "src/trace/Projection.h"
+#include "src/trace/RenderGrid.h"
+#include "tests/unit/CliRunner.h"
+#include "vdb_bridge/VdbImport.h"
+
+namespace fs = std::filesystem;
+using namespace vdbdag;
+
+namespace {
+
+constexpr double kVoxel = 0.5;
+constexpr int kNx = 12, kNy = 10, kNz = 8;
+
+// The ray's parameter interval inside the box, or none (slab method).
+bool crosses(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& lo, const glm::dvec3& hi) {
+    double t0 = 0, t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0) {
+            if (o[a] < lo[a] || o[a] > hi[a]) return false;
+            continue;
+        }
+        double ta = (lo[a] - o[a]) / d[a], tb = (hi[a] - o[a]) / d[a];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta), t1 = std::min(t1, tb);
+    }
+    return t1 > t0;
+}
+
+} // namespace
+
+TEST(Projection, MaximaEqualABruteForceOverTheDenseBlock) {
+    openvdb::initialize();
+    auto grid = openvdb::Int32Grid::create(0);
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(kVoxel));
+    grid->setName("block");
+    std::mt19937 rng(9);
+    std::vector<int32_t> values(size_t(kNx) * kNy * kNz);
+    auto acc = grid->getAccessor();
+    for (int z = 0; z < kNz; ++z)
+        for (int y = 0; y < kNy; ++y)
+            for (int x = 0; x < kNx; ++x) {
+                const int32_t v = int32_t(rng() % 2000) - 1000;
+                values[size_t((z * kNy + y) * kNx + x)] = v;
+                acc.setValueOn(openvdb::Coord(x, y, z), v);
+            }
+    const fs::path path = fs::temp_directory_path() / ("vdbdag_mip_" + std::to_string(::getpid()) + ".vdb");
+    {
+        openvdb::io::File file(path.string());
+        file.write({grid});
+    }
+    const GridRecord record = bridge::importVdb(path.string(), {}).volume.grids.at(0);
+    fs::remove(path);
+    const format::EncodedGrid encoded = pipeline::encodeGrid(record);
+    const trace::RenderGrid render = trace::makeRenderGrid(encoded, trace::Shading::Mip);
+    ASSERT_TRUE(render.mip);
+    trace::Camera camera;
+    camera.width = 40, camera.height = 30;
+    camera.eye = {9.3, 7.1, -6.4};
+    camera.target = {2.8, 2.3, 1.9};
+    camera.up = {0.1, 1.0, 0.05};
+    camera.fovDegrees = 50;
+    const std::vector<double> maxima = trace::maximaAlongRays(render, camera);
+    size_t met = 0, differ = 0;
+    for (int py = 0; py < camera.height; ++py)
+        for (int px = 0; px < camera.width; ++px) {
+            glm::dvec3 o, d;
+            camera.pixelRay(px, py, o, d);
+            double best = -std::numeric_limits<double>::infinity();
+            for (int z = 0; z < kNz; ++z)
+                for (int y = 0; y < kNy; ++y)
+                    for (int x = 0; x < kNx; ++x) {
+                        const glm::dvec3 lo = glm::dvec3(x - 0.5, y - 0.5, z - 0.5) * kVoxel, hi = glm::dvec3(x + 0.5, y + 0.5, z + 0.5) * kVoxel;
+                        if (crosses(o, d, lo, hi)) best = std::max(best, double(values[size_t((z * kNy + y) * kNx + x)]));
+                    }
+            const double got = maxima[size_t(py) * size_t(camera.width) + size_t(px)];
+            if (std::isinf(best)) {
+                EXPECT_TRUE(std::isnan(got)) << px << "," << py << ": " << got;
+                continue;
+            }
+            ++met;
+            differ += got != best;
+        }
+    EXPECT_GT(met, size_t(camera.width * camera.height / 4));
+    EXPECT_EQ(differ, 0u) << "of " << met << " pixels that meet the block";
+    // The image: transparent at or below the window's low end, grey above.
+    const trace::Projection p = trace::renderMip(render, camera, std::pair{0.0, 1000.0});
+    for (size_t i = 0; i < maxima.size(); ++i) EXPECT_EQ(p.image.alpha[i] > 0, maxima[i] > 0.0) << i;
+}
+
+// The automatic window of a two-level picture (air and tissue): its low end
+// lies between the two (Otsu), so the air is transparent.
+TEST(Projection, TheAutomaticWindowSeparatesAirFromTissue) {
+    std::vector<double> maxima(1000, -1000.0);
+    for (size_t i = 0; i < 300; ++i) maxima[i] = 40.0 + double(i % 50);
+    maxima.push_back(std::numeric_limits<double>::quiet_NaN());
+    const auto [low, high] = trace::automaticWindow(maxima);
+    EXPECT_GT(low, -1000.0);
+    EXPECT_LT(low, 40.0);
+    EXPECT_GE(high, 80.0);
+    EXPECT_LE(high, 89.0);
+}
+
+// `render` of a dense scan with the default shading (issue 42: a CT
+// rendered as an opaque box): a maximum intensity projection whose air is
+// transparent. A 48^3 int16 scan of a ball (1000) in air (-1000): the
+// covered pixels (alpha read back by OpenImageIO) are those whose ray meets
+// the ball, far fewer than the box's, which `--shading values` covers.
+TEST(Projection, ADenseScanRendersByDefaultAsAProjectionWithTransparentAir) {
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_mip_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path raw = dir / "ball_48x48x48_int16le.raw", ss = dir / "ball.ssvdag";
+    {
+        std::vector<int16_t> samples(48 * 48 * 48);
+        for (int z = 0; z < 48; ++z)
+            for (int y = 0; y < 48; ++y)
+                for (int x = 0; x < 48; ++x) {
+                    const double r = std::sqrt((x - 23.5) * (x - 23.5) + (y - 23.5) * (y - 23.5) + (z - 23.5) * (z - 23.5));
+                    samples[size_t((z * 48 + y) * 48 + x)] = int16_t(r < 12 ? 1000 : -1000);
+                }
+        std::ofstream(raw, std::ios::binary).write(reinterpret_cast<const char*>(samples.data()), std::streamsize(samples.size() * 2));
+    }
+    ASSERT_EQ(vdbdag::testing::runCli("encode " + raw.string() + " -o " + ss.string()).exitCode, 0);
+    auto covered = [&](const std::string& extra, std::string* err) {
+        const fs::path exr = dir / "r.exr";
+        const vdbdag::testing::CommandResult r = vdbdag::testing::runCli("render " + ss.string() + " -o " + exr.string() + " -f --width 64 --height 64 " + extra);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        if (err) *err = r.err;
+        auto in = OIIO::ImageInput::open(exr.string());
+        if (!in) return -1.0;
+        std::vector<float> a(64 * 64);
+        const int alpha = in->spec().alpha_channel;
+        if (alpha < 0 || !in->read_image(0, 0, alpha, alpha + 1, OIIO::TypeDesc::FLOAT, a.data())) return -1.0;
+        in->close();
+        size_t n = 0;
+        for (const float v : a) n += v > 0;
+        return double(n) / double(a.size());
+    };
+    std::string note;
+    const double projected = covered("", &note), box = covered("--shading values", nullptr);
+    EXPECT_NE(note.find("maximum intensity projection"), std::string::npos) << note;
+    EXPECT_GT(projected, 0.02);
+    EXPECT_LE(projected, 0.85 * box) << projected << " of the pixels against the box's " << box;
+    fs::remove_all(dir);
+}
