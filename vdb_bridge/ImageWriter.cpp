@@ -19,7 +19,7 @@ void writeImage(const std::string& path, const trace::Image& image) {
     if (lowerExtension(path) == ".png") {
         std::vector<uint8_t> rgb(image.rgb.size());
         for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = detail::srgbByte(image.rgb[i]);
-        writeFileAtomically(path, encodePng(image.width, image.height, rgb));
+        writeStreamAtomically(path, [&](std::ostream& out) { writePng(out, image.width, image.height, rgb); });
         return;
     }
     const detail::ImageModule& module = detail::imageModule(path);

@@ -493,10 +493,16 @@ TEST(Cli, AFogOfUnknownClassRendersAsFogAndEveryRenderOptionTakesEffect) {
     CommandResult r = runCli("render " + a.string() + " -o " + pa.string() + size);
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["shading"], "fog");
-    r = runCli("render " + b.string() + " -o " + pb.string() + size + " --density-scale 0.08");
+    r = runCli("render " + b.string() + " -o " + pb.string() + size);
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["shading"], "fog");
     EXPECT_EQ(fileBytes(pa), fileBytes(pb)) << "the class-unknown fog must render as the fog volume does";
+    // --density-scale takes effect on a fog (the default is chosen from the view).
+    const fs::path ps = workDir() / "fog_scaled.png";
+    r = runCli("render " + b.string() + " -o " + ps.string() + size + " --density-scale 0.5");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["density_scale"].get<double>(), 0.5);
+    EXPECT_NE(fileBytes(ps), fileBytes(pb));
     r = runCli("render " + b.string() + " -o " + pv.string() + size + " --shading values");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["shading"], "values");

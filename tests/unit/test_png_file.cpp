@@ -46,7 +46,7 @@ TEST(PngFile, EveryPixelReadsBackWithOpenImageIO) {
         int w, h;
     };
     // 1x1; odd widths; a smooth gradient (Sub/Up/Paeth win) and noise (None
-    // wins); 1100x700 noise spans several 1 MiB IDAT chunks.
+    // wins); 1100x700 noise spans several 64 KiB IDAT chunks.
     for (const Size s : {Size{1, 1}, Size{7, 3}, Size{64, 64}, Size{333, 17}, Size{1100, 700}}) {
         for (const bool noise : {false, true}) {
             std::vector<uint8_t> rgb(size_t(s.w) * size_t(s.h) * 3);
