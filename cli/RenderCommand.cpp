@@ -23,6 +23,7 @@
 #include "src/trace/RenderGrid.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
+#include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/ImageWriter.h"
 
 namespace vdbdag::cli {
@@ -136,8 +137,15 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             throw Error(opt->input + ": --shadows applies to surfaces; grid '" + chosen->record.name + "' is shown as fog, which has no shadows yet");
         if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");
         const trace::GridFrame frame(grid.indexToWorld);
-        trace::Camera camera = trace::frameBounds(frame, grid.cellLo, grid.cellHi, opt->width, opt->height, opt->fov,
-                                                  {trace::parseUpAxis(opt->up), trace::parseView(opt->view)});
+        trace::ViewSpec view{trace::parseUpAxis(opt->up), trace::parseView(opt->view)};
+        // A scan in patient space (LPS: x left, y posterior, z superior; RAS
+        // flips x and y) is shown head up from the front unless told otherwise.
+        if (!cmdUpGiven && !cmdViewGiven && opt->camera.empty())
+            if (const std::optional<bridge::ScanProvenance> scan = bridge::scanProvenanceOf(chosen->record); scan && (scan->space == "LPS" || scan->space == "RAS")) {
+                view = {2, scan->space == "LPS" ? trace::View::Front : trace::View::Back};
+                note("grid '" + chosen->record.name + "' is a scan in " + scan->space + " space: shown head up, from the front (--up/--view to change)");
+            }
+        trace::Camera camera = trace::frameBounds(frame, grid.cellLo, grid.cellHi, opt->width, opt->height, opt->fov, view);
         if (!opt->camera.empty()) {
             const auto v = parseNumbers(opt->camera, 9, "--camera");
             camera.eye = {v[0], v[1], v[2]};

@@ -17,6 +17,8 @@
 
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 #include "src/pipeline/GridCodec.h"
 #include "src/trace/Camera.h"
 #include "src/trace/CpuRenderer.h"
@@ -162,5 +164,36 @@ TEST(Projection, ADenseScanRendersByDefaultAsAProjectionWithTransparentAir) {
     EXPECT_NE(note.find("maximum intensity projection"), std::string::npos) << note;
     EXPECT_GT(projected, 0.02);
     EXPECT_LE(projected, 0.85 * box) << projected << " of the pixels against the box's " << box;
+    fs::remove_all(dir);
+}
+
+// A scan in patient space is shown head up from the front (issue 42 #3): a
+// NRRD in LPS (x left, y posterior, z superior) renders by default with the
+// image's up along +z and the eye on the anterior side (y below the
+// target's); --up/--view still choose.
+TEST(Projection, AScanInPatientSpaceIsShownHeadUpFromTheFront) {
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_lps_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path nrrd = dir / "head.nrrd", ss = dir / "head.ssvdag";
+    {
+        std::ofstream f(nrrd, std::ios::binary);
+        f << "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\nsizes: 20 24 28\n"
+             "space directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (0,0,0)\nendian: little\nencoding: raw\n\n";
+        std::vector<int16_t> samples(20 * 24 * 28);
+        for (size_t i = 0; i < samples.size(); ++i) samples[i] = int16_t(i % 97 < 40 ? -1000 : 500);
+        f.write(reinterpret_cast<const char*>(samples.data()), std::streamsize(samples.size() * 2));
+    }
+    ASSERT_EQ(vdbdag::testing::runCli("encode " + nrrd.string() + " -o " + ss.string()).exitCode, 0);
+    const fs::path png = dir / "r.png";
+    vdbdag::testing::CommandResult r = vdbdag::testing::runCli("render " + ss.string() + " -o " + png.string() + " -f --width 16 --height 16 --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    nlohmann::json camera = nlohmann::json::parse(r.out)["camera"];
+    EXPECT_EQ(camera["up"], nlohmann::json({0.0, 0.0, 1.0})) << camera.dump();
+    EXPECT_LT(camera["eye"][1].get<double>(), camera["target"][1].get<double>()) << camera.dump();
+    EXPECT_NE(r.err.find("head up"), std::string::npos) << r.err;
+    r = vdbdag::testing::runCli("render " + ss.string() + " -o " + png.string() + " -f --width 16 --height 16 --json --up y");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    camera = nlohmann::json::parse(r.out)["camera"];
+    EXPECT_NE(camera["up"], nlohmann::json({0.0, 0.0, 1.0})) << camera.dump();
     fs::remove_all(dir);
 }
