@@ -21,6 +21,8 @@
 #include "cli/SceneReport.h"
 #include "cli/JsonReport.h"
 #include "src/pipeline/GridCodec.h"
+#include "vdb_bridge/InputScene.h"
+#include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/DicomSeries.h"
 #include "vdb_bridge/NiftiHeader.h"
@@ -158,7 +160,25 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
             return;
         }
         nlohmann::json report;
-        if (!isVdbFile(opt->input)) {
+        if (bridge::inputKindOf(opt->input) == bridge::InputKind::NanoVdb) {
+            // NanoVDB: read through NanoVDB's converter as `encode` reads it,
+            // then the DAG figures of its encoding in memory.
+            const bridge::ImportResult imported = bridge::importNanoVdb(opt->input);
+            pipeline::EncodeOptions options;
+            options.symmetry = !opt->noSymmetry;
+            options.computeSvdagStats = true;
+            const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, options);
+            const std::vector<uint8_t> encoded = format::writeScene(scene);
+            report = sceneReport(scene, encoded, opt->input, true);
+            report["format"] = "nvdb";
+            report["input_bytes"] = std::filesystem::file_size(opt->input);
+            for (size_t g = 0; g < scene.grids.size(); ++g) {
+                const format::GridSummary summary = format::summarizeGrid(scene.grids[g]);
+                const std::string what = opt->input + " grid " + std::to_string(g);
+                addGridHeader(report["grids"][g], scene.grids[g].record, bridge::gridHeaderFacts(scene.grids[g].record, summary.indexBox, what), summary,
+                              false);
+            }
+        } else if (!isVdbFile(opt->input)) {
             const std::vector<uint8_t> bytes = format::readFileBytes(opt->input);
             // Nothing decoded but what is printed: value windows stay as
             // they are in the file (their range is read window by window)

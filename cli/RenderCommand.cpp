@@ -25,6 +25,7 @@
 #include "src/util/OutputPath.h"
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/ImageWriter.h"
+#include "vdb_bridge/InputScene.h"
 
 namespace vdbdag::cli {
 namespace {
@@ -72,7 +73,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("render", "Trace an .ssvdag file without decompressing it and write an image");
-    cmd->add_option("input", opt->input, "input .ssvdag file")->required();
+    cmd->add_option("input", opt->input, "input .ssvdag file (or a .vdb, .nvdb or scan, encoded in memory first)")->required();
     cmd->add_option("-o,--output", opt->output, "output image (.png: 8-bit sRGB; .exr: float colour, alpha, depth Z, normal N)")->required();
     cmd->add_option("--grid", opt->grid, "grid to render (default: the first)");
     cmd->add_option("--width", opt->width, "image width")->check(CLI::Range(1, 16384));
@@ -110,7 +111,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         checkOutputPath(opt->output, {opt->input}, {{".png", ".exr"}, "render", opt->force});
         format::ReadOptions readOptions;
         readOptions.limits = opt->limits.limits(0);  // traced where it lies, compressed
-        const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);
+        // A .vdb, .nvdb or scan is encoded in memory first, as `encode` would.
+        const format::SsvdagScene scene = bridge::sceneOfInput(opt->input, readOptions);
         const format::EncodedGrid* chosen = nullptr;
         for (const format::EncodedGrid& g : scene.grids)
             if (opt->grid.empty() || g.record.name == opt->grid) { chosen = &g; break; }

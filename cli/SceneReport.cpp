@@ -224,9 +224,11 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
 }
 
 std::string formatSceneReport(const nlohmann::json& r) {
-    const bool vdb = r.value("format", "ssvdag") == "vdb";
-    std::string out = vdb ? fmt::format("{}: OpenVDB file, {} bytes, {} grid(s); encoded in memory as .ssvdag: {} bytes\n", r["input"].get<std::string>(),
-                                        r["input_bytes"].get<uint64_t>(), r["grids"].size(), r["ssvdag_bytes"].get<uint64_t>())
+    const std::string format = r.value("format", "ssvdag");
+    const bool vdb = format == "vdb" || format == "nvdb";
+    std::string out = vdb ? fmt::format("{}: {} file, {} bytes, {} grid(s); encoded in memory as .ssvdag: {} bytes\n", r["input"].get<std::string>(),
+                                        format == "vdb" ? "OpenVDB" : "NanoVDB", r["input_bytes"].get<uint64_t>(), r["grids"].size(),
+                                        r["ssvdag_bytes"].get<uint64_t>())
                           : fmt::format("{}: .ssvdag file (format {}), {} bytes, {} grid(s)\n", r["input"].get<std::string>(),
                                         r.value("format_version", 0u), r["ssvdag_bytes"].get<uint64_t>(), r["grids"].size());
     if (r.contains("file_metadata"))

@@ -109,9 +109,9 @@ std::string foreignFormatOf(std::span<const uint8_t> b, const std::string& name)
         return b.size() >= at + n && std::memcmp(b.data() + at, text, n) == 0;
     };
     std::string what, also;
-    const std::string scan = " (`info`, `diff` and `import` take it as it is)";
-    if (starts(0, "\x20\x42\x44\x56")) what = "an OpenVDB .vdb file", also = " (`info`, `diff` and `verify` take it as it is)";  // magic 0x56444220, LE
-    else if (starts(0, "NanoVDB")) what = "a NanoVDB file";
+    const std::string scan = " (`info`, `diff`, `render` and `import` take it as it is)";
+    if (starts(0, "\x20\x42\x44\x56")) what = "an OpenVDB .vdb file", also = " (`info`, `diff`, `verify` and `render` take it as it is)";  // magic 0x56444220, LE
+    else if (starts(0, "NanoVDB")) what = "a NanoVDB file", also = " (`info`, `diff` and `render` take it as it is)";
     else if (starts(0, "NRRD000")) what = "a NRRD file", also = scan;
     else if (starts(0, "ObjectType") || starts(0, "NDims")) what = "a MetaImage header", also = scan;
     else if (starts(128, "DICM")) what = "a DICOM file", also = scan;

@@ -10,6 +10,8 @@
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
 #include "vdb_bridge/DenseImport.h"
+#include "vdb_bridge/InputScene.h"
+#include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/detail/GridBuilder.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/VdbFile.h"
@@ -54,6 +56,16 @@ std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std
         return out;
     }
     if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a .vdb or .ssvdag file");
+    if (inputKindOf(path) == InputKind::NanoVdb) {  // NanoVDB: through NanoVDB's converter, as `encode` reads it
+        ImportResult imported = importNanoVdb(path);
+        std::vector<std::string> names;
+        for (const auto& g : imported.volume.grids) names.push_back(g.name);
+        checkNames(path, names, onlyGrids);
+        for (size_t i = 0; i < imported.volume.grids.size(); ++i)
+            if (selected(onlyGrids, imported.volume.grids[i].name))
+                out.push_back({i, buildGrid(imported.volume.grids[i], path + ": grid " + std::to_string(i))});
+        return out;
+    }
     if (isSsvdagPath(path)) {
         format::ReadOptions readOptions;
         readOptions.limits = limits;
