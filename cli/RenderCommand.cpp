@@ -2,6 +2,8 @@
 // DAG directly (CPU reference tracer or the Vulkan backend) and writes the
 // frame through OpenImageIO; prints rays/s and ms per frame.
 #include <algorithm>
+#include <cstring>
+#include <unordered_set>
 #include <cmath>
 #include <sstream>
 
@@ -61,11 +63,32 @@ bool denseScalarScan(const format::EncodedGrid& grid) {
     return volume == grid.activeVoxels;
 }
 
+// An integer grid of at most 256 distinct values (an atlas, a
+// segmentation), 0 among them: labels rather than intensities. From the
+// decoded values (a grid read whole); false when there are none.
+bool looksLikeLabels(const format::EncodedGrid& grid) {
+    const unsigned vs = grid.record.valueType == ValueType::Int32 ? 4 : grid.record.valueType == ValueType::Int64 ? 8 : 0;
+    if (!vs || grid.attributes.empty()) return false;
+    std::unordered_set<int64_t> seen;
+    for (size_t at = 0; at + vs <= grid.attributes.size(); at += vs) {
+        int64_t v = 0;
+        if (vs == 4) {
+            int32_t w;
+            std::memcpy(&w, grid.attributes.data() + at, 4);
+            v = w;
+        } else {
+            std::memcpy(&v, grid.attributes.data() + at, 8);
+        }
+        if (seen.insert(v).second && seen.size() > 256) return false;
+    }
+    return seen.count(0) > 0;
+}
+
 } // namespace
 
 void addRenderCommand(CLI::App& app, int& exitCode) {
     struct Options {
-        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window;
+        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels;
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
         bool shadows = false, json = false, force = false;
@@ -87,12 +110,14 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         ->capture_default_str();
     cmd->add_option("--shading", opt->shading,
                     "auto (level sets as surfaces; fog volumes, by class or by content (densities >= 0, background 0), as fog; else voxels coloured by "
-                    "value), fog, surface, values, or mip (the largest value along each ray, air transparent; the CPU tracer)")
-        ->check(CLI::IsMember({"auto", "fog", "surface", "values", "mip"}))
+                    "value; a dense scan as mip, or as labels when it holds few integer values), fog, surface, values, mip (the largest value "
+                    "along each ray, air transparent) or labels (the first labelled voxel, a colour per label); mip and labels on the CPU tracer")
+        ->check(CLI::IsMember({"auto", "fog", "surface", "values", "mip", "labels"}))
         ->capture_default_str();
     cmd->add_option("--window", opt->window,
                     "mip: LOW,HIGH, the values shown black to white (LOW and below transparent; default: Otsu's threshold of the pixels' "
                     "maxima to their 99.5th percentile)");
+    cmd->add_option("--labels", opt->labels, "labels: the labels shown, e.g. 3,17 (default: every one but 0 and the background)");
     cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(finiteNumber())->check(CLI::Range(1.0, 170.0));
     cmd->add_option("--backend", opt->backend, "vulkan, cpu, or auto (a Vulkan GPU when there is one, else the CPU tracer; a software Vulkan device such as lavapipe only with --backend vulkan)")->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
     cmd->add_option("--device", opt->device, "Vulkan device index (see `vdbdag devices`)");
@@ -123,8 +148,10 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         // as voxel blocks is an opaque box: by default it is projected (MIP),
         // its air transparent. Not with --backend vulkan, which has no MIP yet.
         if (shading == trace::Shading::Auto && opt->backend != "vulkan" && denseScalarScan(*chosen)) {
-            shading = trace::Shading::Mip;
-            note("grid '" + chosen->record.name + "' is a dense scan: shown as a maximum intensity projection (--shading values for its voxels)");
+            shading = looksLikeLabels(*chosen) ? trace::Shading::Labels : trace::Shading::Mip;
+            note("grid '" + chosen->record.name + "' is a dense scan: shown as " +
+                 (shading == trace::Shading::Labels ? std::string("labels, a colour each") : std::string("a maximum intensity projection")) +
+                 " (--shading values for its voxels)");
         }
         const trace::RenderGrid grid = trace::makeRenderGrid(*chosen, shading);
         // Every option takes effect or is refused.
@@ -132,9 +159,11 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             throw Error(opt->input + ": --density-scale applies to fog shading, and grid '" + chosen->record.name + "' is shown as " +
                         trace::shadingOf(grid) + " (use --shading fog)");
         if (!opt->window.empty() && !grid.mip) throw Error(opt->input + ": --window applies to --shading mip");
-        if (grid.mip && opt->backend == "vulkan")
-            throw Error(opt->input + ": --shading mip is rendered by the CPU tracer only for now (use --backend cpu or auto)");
-        if (grid.mip && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading mip");
+        if (!opt->labels.empty() && !grid.labels) throw Error(opt->input + ": --labels applies to --shading labels");
+        const bool cpuOnly = grid.mip || grid.labels;
+        if (cpuOnly && opt->backend == "vulkan")
+            throw Error(opt->input + ": --shading " + trace::shadingOf(grid) + " is rendered by the CPU tracer only for now (use --backend cpu or auto)");
+        if (cpuOnly && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
         if (opt->shadows && grid.fog)
             throw Error(opt->input + ": --shadows applies to surfaces; grid '" + chosen->record.name + "' is shown as fog, which has no shadows yet");
         if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");
@@ -170,7 +199,12 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                 options.window = trace::automaticWindow(trace::maximaAlongRays(grid, camera));
             }
         }
-        auto backend = makeRenderBackend(grid.mip ? "cpu" : opt->backend, opt->device);
+        if (grid.labels && !opt->labels.empty())
+            for (const double l : parseNumbers(opt->labels, size_t(std::count(opt->labels.begin(), opt->labels.end(), ',') + 1), "--labels")) {
+                if (l != std::trunc(l)) throw Error("--labels: " + std::to_string(l) + " is not an integer");
+                options.labels.push_back(int64_t(l));
+            }
+        auto backend = makeRenderBackend(cpuOnly ? "cpu" : opt->backend, opt->device);
         std::vector<double> times;
         trace::Image image;
         trace::RenderStats stats;

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "src/trace/DagTracer.h"
+#include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/trace/SurfaceHit.h"
 
@@ -49,8 +50,8 @@ std::optional<glm::dvec3> storedNormal(const RenderGrid& grid, const RayHit& hit
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {
     const auto start = std::chrono::steady_clock::now();
-    if (grid.mip) {
-        Image image = renderMip(grid, camera, options.window).image;
+    if (grid.mip || grid.labels) {
+        Image image = grid.mip ? renderMip(grid, camera, options.window).image : renderLabels(grid, camera, options);
         if (stats) {
             stats->primaryRays = uint64_t(camera.width) * uint64_t(camera.height);
             stats->secondaryRays = 0;

@@ -28,12 +28,13 @@ Shading parseShading(const std::string& text) {
     if (text == "auto") return Shading::Auto;
     if (text == "fog") return Shading::Fog;
     if (text == "mip") return Shading::Mip;
+    if (text == "labels") return Shading::Labels;
     if (text == "surface") return Shading::Surface;
     if (text == "values") return Shading::Values;
-    throw Error("--shading: '" + text + "' is not auto, fog, surface, values or mip");
+    throw Error("--shading: '" + text + "' is not auto, fog, surface, values, mip or labels");
 }
 
-const char* shadingOf(const RenderGrid& grid) { return grid.mip ? "mip" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values"; }
+const char* shadingOf(const RenderGrid& grid) { return grid.labels ? "labels" : grid.mip ? "mip" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values"; }
 
 RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
     RenderGrid out;
@@ -83,6 +84,12 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
         if (valueSize(out.valueType) == 0 || (out.valueType == ValueType::Vec3S || out.valueType == ValueType::Vec3D || out.valueType == ValueType::Vec3I) || out.valueType == ValueType::Bool)
             throw Error("grid '" + grid.record.name + "' holds " + valueTypeName(out.valueType) + " values: a maximum intensity projection needs scalar values");
         out.mip = true;
+        break;
+    case Shading::Labels:
+        if (out.valueType != ValueType::Int32 && out.valueType != ValueType::Int64)
+            throw Error("grid '" + grid.record.name + "' holds " + valueTypeName(out.valueType) + " values: labels are integers");
+        out.labels = true;
+        out.labelBackground = int64_t(background);
         break;
     }
     if (grid.normals && grid.normals->entryCount() > 0) out.normals = &*grid.normals;

@@ -39,6 +39,8 @@ struct RenderGrid {
     std::shared_ptr<const InsideBits> inside;
     bool fog = false;       // grid class "fog volume": emission-absorption
     bool mip = false;       // --shading mip: the largest value along each ray (Projection.h)
+    bool labels = false;    // --shading labels: the first labelled voxel, a colour per label (LabelRender.h)
+    int64_t labelBackground = 0;  // the grid's background value: unlabelled, as 0 is
     ValueColouring colouring = ValueColouring::None;
     double valueMin = 0, valueMax = 1;  // over the stored values (finite ones)
     std::array<double, 16> indexToWorld{};
@@ -52,15 +54,16 @@ struct RenderGrid {
 // anything else as voxel blocks coloured by value. The others force one
 // (Fog needs float or double values: Error otherwise).
 // Mip: the maximum intensity projection of a scalar grid (Projection.h).
-enum class Shading { Auto, Fog, Surface, Values, Mip };
-// Parses "auto"/"fog"/"surface"/"values"/"mip" (Error otherwise).
+// Labels: an integer grid of labels (LabelRender.h).
+enum class Shading { Auto, Fog, Surface, Values, Mip, Labels };
+// Parses "auto"/"fog"/"surface"/"values"/"mip"/"labels" (Error otherwise).
 Shading parseShading(const std::string& text);
 
 // Chooses the shading (see Shading) from the grid's class, type, name and
 // values (colour grids are vec3 grids named like Cd, color, colour, rgb, or
 // any vec3i grid). `grid` must outlive the result.
 RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading = Shading::Auto);
-// What the grid is shown as: "fog", "surface" (level set), "mip" or "values".
+// What the grid is shown as: "fog", "surface" (level set), "mip", "labels" or "values".
 const char* shadingOf(const RenderGrid& grid);
 
 // A stored value as up to three doubles (scalars in [0]).

@@ -5,6 +5,7 @@
 #pragma once
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -21,6 +22,8 @@ struct RenderOptions {
     // --shading mip: the display window [low, high] (Projection.h; chosen
     // from the image when absent).
     std::optional<std::pair<double, double>> window;
+    // --shading labels: the labels shown (`--labels`; empty: every one but 0 and the background).
+    std::vector<int64_t> labels;
 };
 
 using access::kAmbient;

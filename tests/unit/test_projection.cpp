@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -22,6 +23,7 @@
 #include "src/pipeline/GridCodec.h"
 #include "src/trace/Camera.h"
 #include "src/trace/CpuRenderer.h"
+#include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/trace/RenderGrid.h"
 #include "tests/unit/CliRunner.h"
@@ -35,8 +37,8 @@ namespace {
 constexpr double kVoxel = 0.5;
 constexpr int kNx = 12, kNy = 10, kNz = 8;
 
-// The ray's parameter interval inside the box, or none (slab method).
-bool crosses(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& lo, const glm::dvec3& hi) {
+// Whether the ray crosses the box (slab method), and where it enters it.
+bool crosses(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& lo, const glm::dvec3& hi, double* entry = nullptr) {
     double t0 = 0, t1 = std::numeric_limits<double>::infinity();
     for (int a = 0; a < 3; ++a) {
         if (d[a] == 0) {
@@ -47,42 +49,52 @@ bool crosses(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& lo, con
         if (ta > tb) std::swap(ta, tb);
         t0 = std::max(t0, ta), t1 = std::min(t1, tb);
     }
+    if (entry) *entry = t0;
     return t1 > t0;
 }
 
-} // namespace
-
-TEST(Projection, MaximaEqualABruteForceOverTheDenseBlock) {
+// A 12x10x8 int32 block (voxel 0.5) of the values `value(x, y, z)`,
+// imported through OpenVDB and encoded.
+template <typename Value>
+format::EncodedGrid denseBlock(Value&& value) {
     openvdb::initialize();
     auto grid = openvdb::Int32Grid::create(0);
     grid->setTransform(openvdb::math::Transform::createLinearTransform(kVoxel));
     grid->setName("block");
-    std::mt19937 rng(9);
-    std::vector<int32_t> values(size_t(kNx) * kNy * kNz);
     auto acc = grid->getAccessor();
     for (int z = 0; z < kNz; ++z)
         for (int y = 0; y < kNy; ++y)
-            for (int x = 0; x < kNx; ++x) {
-                const int32_t v = int32_t(rng() % 2000) - 1000;
-                values[size_t((z * kNy + y) * kNx + x)] = v;
-                acc.setValueOn(openvdb::Coord(x, y, z), v);
-            }
-    const fs::path path = fs::temp_directory_path() / ("vdbdag_mip_" + std::to_string(::getpid()) + ".vdb");
+            for (int x = 0; x < kNx; ++x) acc.setValueOn(openvdb::Coord(x, y, z), value(x, y, z));
+    const fs::path path = fs::temp_directory_path() / ("vdbdag_block_" + std::to_string(::getpid()) + ".vdb");
     {
         openvdb::io::File file(path.string());
         file.write({grid});
     }
     const GridRecord record = bridge::importVdb(path.string(), {}).volume.grids.at(0);
     fs::remove(path);
-    const format::EncodedGrid encoded = pipeline::encodeGrid(record);
-    const trace::RenderGrid render = trace::makeRenderGrid(encoded, trace::Shading::Mip);
-    ASSERT_TRUE(render.mip);
+    return pipeline::encodeGrid(record);
+}
+
+trace::Camera obliqueCamera() {
     trace::Camera camera;
     camera.width = 40, camera.height = 30;
     camera.eye = {9.3, 7.1, -6.4};
     camera.target = {2.8, 2.3, 1.9};
     camera.up = {0.1, 1.0, 0.05};
     camera.fovDegrees = 50;
+    return camera;
+}
+
+} // namespace
+
+TEST(Projection, MaximaEqualABruteForceOverTheDenseBlock) {
+    std::mt19937 rng(9);
+    std::vector<int32_t> values(size_t(kNx) * kNy * kNz);
+    for (int32_t& v : values) v = int32_t(rng() % 2000) - 1000;
+    const format::EncodedGrid encoded = denseBlock([&](int x, int y, int z) { return values[size_t((z * kNy + y) * kNx + x)]; });
+    const trace::RenderGrid render = trace::makeRenderGrid(encoded, trace::Shading::Mip);
+    ASSERT_TRUE(render.mip);
+    const trace::Camera camera = obliqueCamera();
     const std::vector<double> maxima = trace::maximaAlongRays(render, camera);
     size_t met = 0, differ = 0;
     for (int py = 0; py < camera.height; ++py)
@@ -197,3 +209,54 @@ TEST(Projection, AScanInPatientSpaceIsShownHeadUpFromTheFront) {
     EXPECT_NE(camera["up"], nlohmann::json({0.0, 0.0, 1.0})) << camera.dump();
     fs::remove_all(dir);
 }
+
+// Labels (src/trace/LabelRender.h, `--shading labels`) against a brute
+// force: each pixel's label is that of the shown voxel its ray enters first
+// (every box tested by the slab method), for all labels but 0 and for a
+// chosen few; distinct labels get distinct colours.
+TEST(LabelRender, FirstLabelsEqualABruteForceOverTheDenseBlock) {
+    const auto labelAt = [](int x, int y, int z) -> int32_t {
+        if (x >= 2 && x < 6 && y >= 1 && y < 5 && z >= 1 && z < 4) return 3;
+        if (x >= 5 && x < 10 && y >= 4 && y < 9 && z >= 3 && z < 7) return 17;
+        if ((x + y + z) % 7 == 0) return 5;
+        return 0;
+    };
+    const format::EncodedGrid encoded = denseBlock(labelAt);
+    const trace::RenderGrid grid = trace::makeRenderGrid(encoded, trace::Shading::Labels);
+    ASSERT_TRUE(grid.labels);
+    const trace::Camera camera = obliqueCamera();
+    for (const std::vector<int64_t>& shown : {std::vector<int64_t>{}, std::vector<int64_t>{17}, std::vector<int64_t>{3, 5}}) {
+        const std::vector<std::optional<trace::LabelHit>> hits = trace::firstLabels(grid, camera, shown);
+        size_t met = 0, differ = 0;
+        for (int py = 0; py < camera.height; ++py)
+            for (int px = 0; px < camera.width; ++px) {
+                glm::dvec3 o, d;
+                camera.pixelRay(px, py, o, d);
+                double bestT = std::numeric_limits<double>::infinity();
+                int32_t want = 0;
+                for (int z = 0; z < kNz; ++z)
+                    for (int y = 0; y < kNy; ++y)
+                        for (int x = 0; x < kNx; ++x) {
+                            const int32_t l = labelAt(x, y, z);
+                            const bool isShown = shown.empty() ? l != 0 : std::find(shown.begin(), shown.end(), int64_t(l)) != shown.end();
+                            double t = 0;
+                            if (isShown && crosses(o, d, glm::dvec3(x - 0.5, y - 0.5, z - 0.5) * kVoxel, glm::dvec3(x + 0.5, y + 0.5, z + 0.5) * kVoxel, &t) &&
+                                t < bestT)
+                                bestT = t, want = l;
+                        }
+                const auto& got = hits[size_t(py) * size_t(camera.width) + size_t(px)];
+                if (std::isinf(bestT)) {
+                    EXPECT_FALSE(got.has_value()) << px << "," << py;
+                    continue;
+                }
+                ++met;
+                differ += !got || got->label != want;
+            }
+        EXPECT_GT(met, 20u) << shown.size();
+        EXPECT_EQ(differ, 0u) << "of " << met << " pixels, " << shown.size() << " labels chosen";
+    }
+    EXPECT_NE(trace::labelColour(3), trace::labelColour(5));
+    EXPECT_NE(trace::labelColour(5), trace::labelColour(17));
+    EXPECT_EQ(trace::labelColour(17), trace::labelColour(17));
+}
+
