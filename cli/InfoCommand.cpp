@@ -122,27 +122,104 @@ std::string formatScanHeaderReport(const nlohmann::json& r) {
 
 } // namespace
 
+namespace {
+
+struct InfoOptions {
+    std::vector<std::string> inputs;
+    bool json = false, noSymmetry = false, values = false;
+    ReadLimitOptions limits;
+};
+
+// One input's report and its text (a scan's header, a .nvdb, an .ssvdag or a .vdb).
+std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, const std::string& input) {
+    if (const bridge::DenseFormat f = bridge::denseFormatOf(input); f != bridge::DenseFormat::None) {
+        // A .raw file by the layout its name gives (describeRaw says what is missing).
+        // describeDense describes a 4-D NIfTI file by its first volume.
+        nlohmann::json report = scanHeaderReport(input, bridge::describeDense(input, bridge::DenseImportOptions{}));
+        return {report, formatScanHeaderReport(report)};
+    }
+    nlohmann::json report;
+    if (bridge::inputKindOf(input) == bridge::InputKind::NanoVdb) {
+        // NanoVDB: read through NanoVDB's converter as `encode` reads it,
+        // then the DAG figures of its encoding in memory.
+        const bridge::ImportResult imported = bridge::importNanoVdb(input);
+        pipeline::EncodeOptions options;
+        options.symmetry = !opt.noSymmetry;
+        options.computeSvdagStats = true;
+        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, options);
+        const std::vector<uint8_t> encoded = format::writeScene(scene);
+        report = sceneReport(scene, encoded, input, true);
+        report["format"] = "nvdb";
+        report["input_bytes"] = std::filesystem::file_size(input);
+        for (size_t g = 0; g < scene.grids.size(); ++g) {
+            const format::GridSummary summary = format::summarizeGrid(scene.grids[g]);
+            const std::string what = input + " grid " + std::to_string(g);
+            addGridHeader(report["grids"][g], scene.grids[g].record, bridge::gridHeaderFacts(scene.grids[g].record, summary.indexBox, what), summary,
+                          false);
+        }
+    } else if (!isVdbFile(input)) {
+        const std::vector<uint8_t> bytes = format::readFileBytes(input);
+        // Nothing decoded but what is printed: value windows stay as
+        // they are in the file (their range is read window by window)
+        // unless --values asks for the channels' statistics.
+        format::ReadOptions readOptions;
+        readOptions.limits = opt.limits.limits(0);
+        readOptions.keepValueWindows = !opt.values;
+        const format::SsvdagScene scene = format::readScene(bytes, input, readOptions);
+        report = sceneReport(scene, bytes, input, opt.values);
+        report["format"] = "ssvdag";
+        report["input_bytes"] = bytes.size();
+        for (size_t g = 0; g < scene.grids.size(); ++g) {
+            const format::EncodedGrid& grid = scene.grids[g];
+            const std::string what = input + " grid " + std::to_string(g);
+            const format::GridSummary summary = format::summarizeGrid(grid);
+            addGridHeader(report["grids"][g], grid.record, bridge::gridHeaderFacts(grid.record, summary.indexBox, what), summary, false);
+        }
+        report["file_metadata"] = metadataJson(bridge::fileMetadataEntries(scene.fileMetadata, input + " file metadata"));
+    } else {
+        // OpenVDB's own figures (the reference vdb_print shows), then the
+        // DAG figures of its encoding in memory.
+        const uint64_t fileBytes = std::filesystem::file_size(input);  // never read whole here: OpenVDB reads it
+        const bridge::VdbFileFacts facts = bridge::vdbFileFacts(input);
+        const bridge::ImportResult imported = bridge::importVdb(input);
+        pipeline::EncodeOptions options;
+        options.symmetry = !opt.noSymmetry;
+        options.computeSvdagStats = true;
+        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, options);
+        const std::vector<uint8_t> encoded = format::writeScene(scene);
+        report = sceneReport(scene, encoded, input, true);
+        report["format"] = "vdb";
+        report["input_bytes"] = fileBytes;
+        if (facts.grids.size() != scene.grids.size()) throw Error(input + ": internal error: grids read twice differ in number");
+        for (size_t g = 0; g < facts.grids.size(); ++g) {
+            const bridge::VdbGridFacts& f = facts.grids[g];
+            GridRecord header = f.header;
+            header.background = scene.grids[g].record.background;
+            addGridHeader(report["grids"][g], header, f.facts, f.summary, true);
+        }
+        report["file_metadata"] = metadataJson(facts.fileMetadata);
+    }
+    addVersions(report);  // the text names the format version too
+    return {report, formatSceneReport(report)};
+}
+
+} // namespace
+
 void addInfoCommand(CLI::App& app, int& exitCode) {
-    struct Options {
-        std::vector<std::string> inputs;
-        std::string input;
-        bool json = false, noSymmetry = false, values = false;
-        ReadLimitOptions limits;
-    };
-    auto opt = std::make_shared<Options>();
-    CLI::App* cmd = app.add_subcommand("info", "Print per-grid DAG statistics and section sizes of a .ssvdag or .vdb file (or a scan's header, or the series of DICOM input)");
-    cmd->add_option("input", opt->inputs, ".ssvdag or .vdb file, a scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
-    cmd->add_flag("--json", opt->json, "print JSON");
+    auto opt = std::make_shared<InfoOptions>();
+    CLI::App* cmd = app.add_subcommand("info", "Print per-grid DAG statistics and section sizes of .ssvdag, .vdb or .nvdb files (or a scan's header, or the series of DICOM input)");
+    cmd->add_option("input", opt->inputs, ".ssvdag, .vdb or .nvdb files, scans, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
+    cmd->add_flag("--json", opt->json, "print JSON (an array for several inputs)");
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "for .vdb input: report the plain SVDAG encoding");
     cmd->add_flag("--values", opt->values,
                   "for .ssvdag input: also each value channel's statistics (entries, distinct values, palette blocks) and the size traceable in "
                   "memory; decodes every value (slower)");
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
-        DenseInputOptions dicomInputs;
-        opt->input = dicomInputs.takeInputs(opt->inputs);
-        setActivity(opt->input, "reading");
-        if (bridge::denseFormatOf(opt->input) == bridge::DenseFormat::Dicom) {
+        if (bridge::denseFormatOf(opt->inputs.front()) == bridge::DenseFormat::Dicom) {
+            DenseInputOptions dicomInputs;
+            const std::string input = dicomInputs.takeInputs(opt->inputs);  // several: one set of DICOM input
+            setActivity(input, "reading");
             nlohmann::json report = dicomReport(bridge::dicomInputName(opt->inputs), bridge::scanDicom(opt->inputs));
             // Descriptions may be Latin-1 (Specific Character Set): never throw on them.
             if (opt->json) printJson(report);
@@ -150,79 +227,19 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
             exitCode = 0;
             return;
         }
-        if (const bridge::DenseFormat f = bridge::denseFormatOf(opt->input); f != bridge::DenseFormat::None) {
-            // A .raw file by the layout its name gives (describeRaw says what is missing).
-            // describeDense describes a 4-D NIfTI file by its first volume.
-            nlohmann::json report = scanHeaderReport(opt->input, bridge::describeDense(opt->input, bridge::DenseImportOptions{}));
-            if (opt->json) printJson(report);
-            else fmt::print("{}", formatScanHeaderReport(report));
-            exitCode = 0;
-            return;
+        // Several files (`info *.vdb`): each described in turn.
+        nlohmann::json all = nlohmann::json::array();
+        std::string text;
+        for (const std::string& input : opt->inputs) {
+            if (bridge::denseFormatOf(input) == bridge::DenseFormat::Dicom)
+                throw Error(input + ": DICOM input is described alone (or with more DICOM input, as one set)");
+            setActivity(input, "reading");
+            auto [report, lines] = describeInput(*opt, input);
+            text += (text.empty() ? "" : "\n") + lines;
+            all.push_back(std::move(report));
         }
-        nlohmann::json report;
-        if (bridge::inputKindOf(opt->input) == bridge::InputKind::NanoVdb) {
-            // NanoVDB: read through NanoVDB's converter as `encode` reads it,
-            // then the DAG figures of its encoding in memory.
-            const bridge::ImportResult imported = bridge::importNanoVdb(opt->input);
-            pipeline::EncodeOptions options;
-            options.symmetry = !opt->noSymmetry;
-            options.computeSvdagStats = true;
-            const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, options);
-            const std::vector<uint8_t> encoded = format::writeScene(scene);
-            report = sceneReport(scene, encoded, opt->input, true);
-            report["format"] = "nvdb";
-            report["input_bytes"] = std::filesystem::file_size(opt->input);
-            for (size_t g = 0; g < scene.grids.size(); ++g) {
-                const format::GridSummary summary = format::summarizeGrid(scene.grids[g]);
-                const std::string what = opt->input + " grid " + std::to_string(g);
-                addGridHeader(report["grids"][g], scene.grids[g].record, bridge::gridHeaderFacts(scene.grids[g].record, summary.indexBox, what), summary,
-                              false);
-            }
-        } else if (!isVdbFile(opt->input)) {
-            const std::vector<uint8_t> bytes = format::readFileBytes(opt->input);
-            // Nothing decoded but what is printed: value windows stay as
-            // they are in the file (their range is read window by window)
-            // unless --values asks for the channels' statistics.
-            format::ReadOptions readOptions;
-            readOptions.limits = opt->limits.limits(0);
-            readOptions.keepValueWindows = !opt->values;
-            const format::SsvdagScene scene = format::readScene(bytes, opt->input, readOptions);
-            report = sceneReport(scene, bytes, opt->input, opt->values);
-            report["format"] = "ssvdag";
-            report["input_bytes"] = bytes.size();
-            for (size_t g = 0; g < scene.grids.size(); ++g) {
-                const format::EncodedGrid& grid = scene.grids[g];
-                const std::string what = opt->input + " grid " + std::to_string(g);
-                const format::GridSummary summary = format::summarizeGrid(grid);
-                addGridHeader(report["grids"][g], grid.record, bridge::gridHeaderFacts(grid.record, summary.indexBox, what), summary, false);
-            }
-            report["file_metadata"] = metadataJson(bridge::fileMetadataEntries(scene.fileMetadata, opt->input + " file metadata"));
-        } else {
-            // OpenVDB's own figures (the reference vdb_print shows), then the
-            // DAG figures of its encoding in memory.
-            const uint64_t fileBytes = std::filesystem::file_size(opt->input);  // never read whole here: OpenVDB reads it
-            const bridge::VdbFileFacts facts = bridge::vdbFileFacts(opt->input);
-            const bridge::ImportResult imported = bridge::importVdb(opt->input);
-            pipeline::EncodeOptions options;
-            options.symmetry = !opt->noSymmetry;
-            options.computeSvdagStats = true;
-            const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, options);
-            const std::vector<uint8_t> encoded = format::writeScene(scene);
-            report = sceneReport(scene, encoded, opt->input, true);
-            report["format"] = "vdb";
-            report["input_bytes"] = fileBytes;
-            if (facts.grids.size() != scene.grids.size()) throw Error(opt->input + ": internal error: grids read twice differ in number");
-            for (size_t g = 0; g < facts.grids.size(); ++g) {
-                const bridge::VdbGridFacts& f = facts.grids[g];
-                GridRecord header = f.header;
-                header.background = scene.grids[g].record.background;
-                addGridHeader(report["grids"][g], header, f.facts, f.summary, true);
-            }
-            report["file_metadata"] = metadataJson(facts.fileMetadata);
-        }
-        addVersions(report);  // the text names the format version too
-        if (opt->json) printJson(report);
-        else fmt::print("{}", formatSceneReport(report));
+        if (opt->json) printJson(all.size() == 1 ? all[0] : all);
+        else fmt::print("{}", text);
         exitCode = 0;
     });
 }

@@ -74,3 +74,30 @@ TEST(AnyInput, InfoAndDiffTakeANanoVdbFile) {
     EXPECT_TRUE(nlohmann::json::parse(r.out)["identical"].get<bool>());
     fs::remove_all(workDir());
 }
+
+// `info a.vdb b.nvdb c.ssvdag` describes each (issue 42 #4; it was refused):
+// the text one after the other, --json an array in the order given, each
+// with OpenVDB's active voxel count of its source.
+TEST(AnyInput, InfoDescribesSeveralFilesInTurn) {
+    const fs::path fog = fs::path(VDBDAG_SOURCE_DIR) / "tests" / "golden" / "fog.vdb", ss = workDir() / "several.ssvdag";
+    ASSERT_EQ(runCli("encode " + fog.string() + " -o " + ss.string() + " -f").exitCode, 0);
+    const CommandResult r = runCli("info " + kLevelSet.string() + " " + ss.string() + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json all = nlohmann::json::parse(r.out);
+    ASSERT_TRUE(all.is_array());
+    ASSERT_EQ(all.size(), 2u);
+    EXPECT_EQ(all[0]["format"], "vdb");
+    EXPECT_EQ(all[1]["format"], "ssvdag");
+    openvdb::initialize();
+    for (const auto& [index, path] : {std::pair{0, kLevelSet}, std::pair{1, fog}}) {
+        openvdb::io::File file(path.string());
+        file.open();
+        const openvdb::GridPtrVecPtr grids = file.getGrids();
+        file.close();
+        EXPECT_EQ(all[size_t(index)]["grids"][0]["active_voxels"].get<uint64_t>(), (*grids)[0]->activeVoxelCount()) << path;
+    }
+    const CommandResult text = runCli("info " + kLevelSet.string() + " " + ss.string());
+    EXPECT_NE(text.out.find(kLevelSet.string() + ": OpenVDB file"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find(ss.string() + ": .ssvdag file"), std::string::npos) << text.out;
+    fs::remove_all(workDir());
+}

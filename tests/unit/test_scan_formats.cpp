@@ -591,8 +591,8 @@ np.ascontiguousarray(np.transpose(a[..., 3], (2, 1, 0))).tofile(d + '/alpha.expe
 
 // A .raw volume whose name gives its layout is a scan like the others:
 // `info` describes it from the name (dims and type, a closed form here), and
-// a command that reads .ssvdag files names it as a raw volume and says which
-// command takes it, rather than "bad magic" (issue 38 #10).
+// a command that reads .ssvdag files only (decode) names it as a raw volume
+// and says which command takes it, rather than "bad magic" (issue 38 #10).
 TEST(ScanFormats, ARawVolumeIsDescribedByItsNameAndNamedWhereItIsNotRead) {
     const fs::path raw = workDir() / "ct_6x5x4_int16le.raw";
     std::ofstream(raw, std::ios::binary) << std::string(6 * 5 * 4 * 2, '\1');
@@ -601,10 +601,12 @@ TEST(ScanFormats, ARawVolumeIsDescribedByItsNameAndNamedWhereItIsNotRead) {
     const nlohmann::json h = nlohmann::json::parse(info.out);
     EXPECT_EQ(h["dims"], nlohmann::json({6, 5, 4})) << info.out;
     EXPECT_EQ(h["sample_type"], "i16") << info.out;
-    const CommandResult render = runCli("render " + raw.string() + " -o " + (workDir() / "raw.png").string() + " -f --backend cpu");
-    EXPECT_EQ(render.exitCode, 1);
-    EXPECT_EQ(std::count(render.err.begin(), render.err.end(), '\n'), 1) << render.err;
-    EXPECT_NE(render.err.find("it is a raw volume"), std::string::npos) << render.err;
-    EXPECT_NE(render.err.find("vdbdag encode " + raw.string()), std::string::npos) << render.err;
-    EXPECT_FALSE(fs::exists(workDir() / "raw.png"));
+    const fs::path vdb = workDir() / "raw_decoded.vdb";
+    fs::remove(vdb);
+    const CommandResult decode = runCli("decode " + raw.string() + " -o " + vdb.string());
+    EXPECT_EQ(decode.exitCode, 1);
+    EXPECT_EQ(std::count(decode.err.begin(), decode.err.end(), '\n'), 1) << decode.err;
+    EXPECT_NE(decode.err.find("it is a raw volume"), std::string::npos) << decode.err;
+    EXPECT_NE(decode.err.find("vdbdag encode " + raw.string()), std::string::npos) << decode.err;
+    EXPECT_FALSE(fs::exists(vdb));
 }
