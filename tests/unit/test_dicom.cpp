@@ -768,7 +768,8 @@ TEST(DicomCli, AListOfFilesIsOneSet) {
 // a 1.5 GB address-space cap it is skipped as not DICOM, with the reason.
 TEST(DicomSeries, BytesThatReadAsAHugeElementAreNotDicomAndCostNothing) {
     const fs::path dir = freshDir("not_dicom_huge");
-    std::ofstream(dir / "junk.bin", std::ios::binary) << std::string("dataOBfile") + std::string(95, '\x17') + "[";
+    // (Its OB's reserved bytes are zero: non-zero ones are refused before the length is read.)
+    std::ofstream(dir / "junk.bin", std::ios::binary) << std::string("dataOB", 6) + std::string(2, '\0') + "le" + std::string(95, '\x17') + "[";
     const auto r = runShell("ulimit -v 1500000; " + std::string(VDBDAG_BINARY) + " info " + quote(dir) + " --json");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const nlohmann::json info = nlohmann::json::parse(r.out);

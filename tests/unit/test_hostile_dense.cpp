@@ -222,3 +222,24 @@ TEST(HostileDense, AScanBeyondTheReadLimitsIsRefusedFromItsHeader) {
     fs::remove_all(d);
 }
 
+
+// Found by the short fuzz run with the forged slices as seeds: GDCM asserts
+// (gdcmVR16ExplicitDataElement.txx:117) on an explicit-VR element whose two
+// reserved bytes are not zero, and on pixel data whose VR it cannot read
+// ("O\xF7"), even when it stops there. Both are refused by the element walk
+// first: one line naming the file, no "crashed".
+TEST(HostileDense, DicomElementsGdcmWouldAssertOnAreRefusedFirst) {
+    const fs::path d = freshDir("dicom_reserved");
+    const std::string good = forgedCtSlice(2, 2, 8), pixels("\xe0\x7f\x10\x00OW\0\0", 8);
+    const size_t at = good.find(pixels);
+    ASSERT_NE(at, std::string::npos);
+    std::string reserved = good, badVr = good;
+    reserved[at + 6] = '\x57', reserved[at + 7] = '\xf7';
+    badVr[at + 5] = '\xf7', badVr[at + 6] = '\x57', badVr[at + 7] = '\xf7';
+    write(d / "reserved.dcm", reserved);
+    write(d / "badvr.dcm", badVr);
+    const fs::path o = d / "o.ssvdag";
+    expectOneLineRefusal(capped("encode " + (d / "reserved.dcm").string() + " -o " + o.string()), "reserved.dcm", "non-zero reserved bytes", o);
+    expectOneLineRefusal(capped("encode " + (d / "badvr.dcm").string() + " -o " + o.string()), "badvr.dcm", "no valid VR", o);
+    fs::remove_all(d);
+}

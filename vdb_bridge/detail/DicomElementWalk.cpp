@@ -199,6 +199,9 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
             static const std::set<std::string> longVr{"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
             if (longVr.count(vr)) {
                 if (!readAt(pos, h, 12)) return fmt::format("element ({:04X},{:04X}) at byte {} is cut off", group, element, pos);
+                // Two reserved bytes follow these VRs; GDCM asserts that they are zero (gdcmVR16ExplicitDataElement.txx:117).
+                if (h[6] != 0 || h[7] != 0)
+                    return fmt::format("element ({:04X},{:04X}) at byte {} has non-zero reserved bytes after its VR {}", group, element, pos, vr);
                 length = le ? uint32_t(h[8]) | uint32_t(h[9]) << 8 | uint32_t(h[10]) << 16 | uint32_t(h[11]) << 24 : u32(h + 8);
                 header = 12;
             } else {
@@ -212,6 +215,11 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         if (inMeta && length == 0xFFFFFFFFu)  // GDCM asserts on it too
             return fmt::format("file meta element ({:04X},{:04X}) at byte {} has an undefined length", group, element, pos);
         const bool pixelData = group == kPixelGroup && element == 0x0010 && frames.size() == 1;
+        // Under an explicit transfer syntax GDCM reads the pixel data's own
+        // VR even when it stops there, and asserts on one it cannot read as
+        // OB/OW-like (a VR such as "O\xF7" and non-zero reserved bytes).
+        if (pixelData && !declaredImplicit && !explicitVr)
+            return fmt::format("the pixel data at byte {} has no valid VR under an explicit transfer syntax", pos);
         if (beforePixels && pixelData) return "";
         if (pixels && pixelData && !pixels->found) {
             pixels->found = true;
