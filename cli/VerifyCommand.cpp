@@ -25,7 +25,10 @@
 #include "src/util/Error.h"
 #include "src/util/Progress.h"
 #include "src/util/TemporaryFiles.h"
+#include "vdb_bridge/InputScene.h"
+#include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/VdbCompare.h"
+#include "vdb_bridge/VdbExport.h"
 #include "vdb_bridge/VdbCubes.h"
 #include "vdb_bridge/VdbImport.h"
 #include "vdb_bridge/VdbStreamCompare.h"
@@ -126,12 +129,25 @@ Verified verifyWhole(const VerifyOptions& opt) {
     return {bridge::compareWithFile(opt.input, decoded, !opt.topologyOnly), bytes.size(), decoded.grids.size()};
 }
 
+// A NanoVDB file: its grids as NanoVDB's converter reads them (as `encode`
+// reads it) go to a temporary .vdb in the scratch folder, which is verified
+// as any .vdb is.
+Verified verifyNanoVdb(const VerifyOptions& opt) {
+    if (!opt.encoded.empty()) throw Error(opt.input + ": --encoded compares with a .vdb file; verify a .nvdb alone");
+    const std::filesystem::path folder = opt.scratch.empty() ? std::filesystem::temp_directory_path() : std::filesystem::path(opt.scratch);
+    const RemovedAfterwards vdb(temporaryNameFor((folder / std::filesystem::path(opt.input).filename()).string(), ".vdb"));
+    bridge::exportVdb(bridge::importNanoVdb(opt.input).volume, vdb.path);
+    VerifyOptions asVdb = opt;
+    asVdb.input = vdb.path;
+    return bridge::canReadVdbByCubes(asVdb.input) ? verifyByCubes(asVdb) : verifyWhole(asVdb);
+}
+
 } // namespace
 
 void addVerifyCommand(CLI::App& app, int& exitCode) {
     auto opt = std::make_shared<VerifyOptions>();
     CLI::App* cmd = app.add_subcommand("verify", "Check that a .vdb file survives the round trip through .ssvdag bit for bit (or that an .ssvdag file holds it), region by region");
-    cmd->add_option("input", opt->input, "input .vdb file")->required();
+    cmd->add_option("input", opt->input, "input .vdb file (or a NanoVDB .nvdb, as its grids read through NanoVDB)")->required();
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "verify the plain SVDAG encoding");
     cmd->add_flag("--topology-only", opt->topologyOnly, "verify the geometry-only encoding (topology and headers)");
     cmd->add_option("--encoded", opt->encoded, "compare this .ssvdag file (e.g. what `encode` wrote) with the input, instead of encoding one")
@@ -145,7 +161,8 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
     cmd->callback([opt, &exitCode] {
         setActivity(opt->input, "verifying");
         if (opt->json) setQuiet(true);
-        const Verified verified = !opt->encoded.empty()                   ? verifyEncoded(*opt)
+        const Verified verified = bridge::inputKindOf(opt->input) == bridge::InputKind::NanoVdb ? verifyNanoVdb(*opt)
+                                  : !opt->encoded.empty()                   ? verifyEncoded(*opt)
                                   : bridge::canReadVdbByCubes(opt->input) ? verifyByCubes(*opt)
                                                                           : verifyWhole(*opt);
         const bridge::CompareResult& result = verified.result;

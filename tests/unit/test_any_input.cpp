@@ -1,7 +1,8 @@
 // Every readable input everywhere (issue 42 #4): `render` takes a .vdb, a
 // .nvdb or a scan (encoded in memory, vdb_bridge/InputScene.h) and draws
-// the same picture as for the .ssvdag `encode` writes; `info` and `diff`
-// take a NanoVDB file, read through NanoVDB, against OpenVDB's own counts.
+// the same picture as for the .ssvdag `encode` writes; `info`, `diff` and
+// `verify` take a NanoVDB file, read through NanoVDB, against OpenVDB's own
+// counts.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -51,7 +52,7 @@ TEST(AnyInput, RenderOfAVdbIsTheRenderOfItsSsvdag) {
     EXPECT_EQ(r.exitCode, 0) << r.err;
 }
 
-TEST(AnyInput, InfoAndDiffTakeANanoVdbFile) {
+TEST(AnyInput, InfoDiffAndVerifyTakeANanoVdbFile) {
     const fs::path ss = workDir() / "ls_nano.ssvdag", nano = workDir() / "ls.nvdb";
     ASSERT_EQ(runCli("encode " + kLevelSet.string() + " -o " + ss.string() + " -f").exitCode, 0);
     ASSERT_EQ(runCli("decode " + ss.string() + " -o " + nano.string() + " -f").exitCode, 0);
@@ -72,6 +73,13 @@ TEST(AnyInput, InfoAndDiffTakeANanoVdbFile) {
     r = runCli("diff " + nano.string() + " " + kLevelSet.string() + " --json");
     EXPECT_EQ(r.exitCode, 0) << r.err << r.out;
     EXPECT_TRUE(nlohmann::json::parse(r.out)["identical"].get<bool>());
+    // verify: its grids, as NanoVDB reads them, survive the round trip; no temporary is left.
+    const fs::path scratch = workDir() / "scratch";
+    fs::create_directories(scratch);
+    r = runCli("verify " + nano.string() + " --json --scratch " + scratch.string());
+    EXPECT_EQ(r.exitCode, 0) << r.err << r.out;
+    EXPECT_TRUE(nlohmann::json::parse(r.out)["identical"].get<bool>());
+    EXPECT_TRUE(fs::is_empty(scratch));
     fs::remove_all(workDir());
 }
 
