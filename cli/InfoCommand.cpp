@@ -8,6 +8,7 @@
 // skipped.
 #include <cmath>
 #include <filesystem>
+#include <tuple>
 #include <fstream>
 
 #include "src/util/Error.h"
@@ -130,6 +131,17 @@ struct InfoOptions {
     ReadLimitOptions limits;
 };
 
+// A volume read from a .vdb or .nvdb as `encode` would write it (with the
+// plain SVDAG's counts `info` shows), in memory: the scene and its report.
+std::pair<format::SsvdagScene, nlohmann::json> encodedReport(const InfoOptions& opt, const Volume& volume, const std::string& input) {
+    pipeline::EncodeOptions options;
+    options.symmetry = !opt.noSymmetry;
+    options.computeSvdagStats = true;
+    format::SsvdagScene scene = pipeline::encodeVolume(volume, options);
+    nlohmann::json report = sceneReport(scene, format::writeScene(scene), input, true);
+    return {std::move(scene), std::move(report)};
+}
+
 // One input's report and its text (a scan's header, a .nvdb, an .ssvdag or a .vdb).
 std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, const std::string& input) {
     if (const bridge::DenseFormat f = bridge::denseFormatOf(input); f != bridge::DenseFormat::None) {
@@ -142,13 +154,8 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
     if (bridge::inputKindOf(input) == bridge::InputKind::NanoVdb) {
         // NanoVDB: read through NanoVDB's converter as `encode` reads it,
         // then the DAG figures of its encoding in memory.
-        const bridge::ImportResult imported = bridge::importNanoVdb(input);
-        pipeline::EncodeOptions options;
-        options.symmetry = !opt.noSymmetry;
-        options.computeSvdagStats = true;
-        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, options);
-        const std::vector<uint8_t> encoded = format::writeScene(scene);
-        report = sceneReport(scene, encoded, input, true);
+        format::SsvdagScene scene;
+        std::tie(scene, report) = encodedReport(opt, bridge::importNanoVdb(input).volume, input);
         report["format"] = "nvdb";
         report["input_bytes"] = std::filesystem::file_size(input);
         for (size_t g = 0; g < scene.grids.size(); ++g) {
@@ -181,13 +188,8 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
         // DAG figures of its encoding in memory.
         const uint64_t fileBytes = std::filesystem::file_size(input);  // never read whole here: OpenVDB reads it
         const bridge::VdbFileFacts facts = bridge::vdbFileFacts(input);
-        const bridge::ImportResult imported = bridge::importVdb(input);
-        pipeline::EncodeOptions options;
-        options.symmetry = !opt.noSymmetry;
-        options.computeSvdagStats = true;
-        const format::SsvdagScene scene = pipeline::encodeVolume(imported.volume, options);
-        const std::vector<uint8_t> encoded = format::writeScene(scene);
-        report = sceneReport(scene, encoded, input, true);
+        format::SsvdagScene scene;
+        std::tie(scene, report) = encodedReport(opt, bridge::importVdb(input).volume, input);
         report["format"] = "vdb";
         report["input_bytes"] = fileBytes;
         if (facts.grids.size() != scene.grids.size()) throw Error(input + ": internal error: grids read twice differ in number");

@@ -20,7 +20,6 @@
 #include "src/format/SsvdagFile.h"
 #include "src/format/DagBounds.h"
 #include "src/trace/FogDensity.h"
-#include "src/trace/Projection.h"
 #include "src/trace/Camera.h"
 #include "src/trace/RenderGrid.h"
 #include "src/util/Error.h"
@@ -190,14 +189,10 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         options.shadows = opt->shadows;
         options.densityScale = cmdDensityScaleGiven || !grid.fog ? opt->densityScale : trace::autoDensityScale(grid, camera, opt->densityScale);
 
-        if (grid.mip) {
-            if (!opt->window.empty()) {
-                const auto w = parseNumbers(opt->window, 2, "--window");
-                if (!(w[1] > w[0])) throw Error("--window: HIGH must be greater than LOW");
-                options.window = std::pair{w[0], w[1]};
-            } else {
-                options.window = trace::automaticWindow(trace::maximaAlongRays(grid, camera));
-            }
+        if (grid.mip && !opt->window.empty()) {  // else the renderer chooses it from the image (RenderStats::window)
+            const auto w = parseNumbers(opt->window, 2, "--window");
+            if (!(w[1] > w[0])) throw Error("--window: HIGH must be greater than LOW");
+            options.window = std::pair{w[0], w[1]};
         }
         if (grid.labels && !opt->labels.empty())
             for (const double l : parseNumbers(opt->labels, size_t(std::count(opt->labels.begin(), opt->labels.end(), ',') + 1), "--labels")) {
@@ -223,7 +218,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                              {"ms_max", times.back()},     {"primary_rays", stats.primaryRays}, {"secondary_rays", stats.secondaryRays},
                              {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows},
                              {"shading", trace::shadingOf(grid)}, {"density_scale", grid.fog ? nlohmann::json(options.densityScale) : nlohmann::json()},
-                             {"window", options.window ? nlohmann::json({options.window->first, options.window->second}) : nlohmann::json()},
+                             {"window", stats.window ? nlohmann::json({stats.window->first, stats.window->second}) : nlohmann::json()},
                              {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}, {"target", {camera.target.x, camera.target.y, camera.target.z}},
                                          {"up", {camera.up.x, camera.up.y, camera.up.z}}}}};
             printJson(j);

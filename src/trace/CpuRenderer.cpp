@@ -51,8 +51,17 @@ std::optional<glm::dvec3> storedNormal(const RenderGrid& grid, const RayHit& hit
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {
     const auto start = std::chrono::steady_clock::now();
     if (grid.mip || grid.labels) {
-        Image image = grid.mip ? renderMip(grid, camera, options.window).image : renderLabels(grid, camera, options);
+        Image image;
+        std::optional<std::pair<double, double>> window;
+        if (grid.mip) {
+            Projection p = renderMip(grid, camera, options.window);
+            image = std::move(p.image);
+            window = std::pair{p.low, p.high};
+        } else {
+            image = renderLabels(grid, camera, options);
+        }
         if (stats) {
+            stats->window = window;
             stats->primaryRays = uint64_t(camera.width) * uint64_t(camera.height);
             stats->secondaryRays = 0;
             stats->milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -4,6 +4,9 @@
 // face), optional shadow rays, LOD cut-off; fog volumes by emission-absorption
 // along every occupied box the ray crosses (the DAG skips empty space).
 #pragma once
+#include <optional>
+#include <utility>
+
 #include "src/trace/Camera.h"
 #include "src/trace/Image.h"
 #include "src/trace/RenderGrid.h"
@@ -14,6 +17,7 @@ namespace vdbdag::trace {
 struct RenderStats {
     uint64_t primaryRays = 0, secondaryRays = 0;
     double milliseconds = 0;
+    std::optional<std::pair<double, double>> window;  // --shading mip: the display window used (given or chosen)
 };
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats = nullptr);

@@ -4,36 +4,21 @@
 #include <algorithm>
 #include <cmath>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#include "src/trace/DagTracer.h"
+#include "src/trace/PixelSegments.h"
 
 namespace vdbdag::trace {
 
 std::vector<std::optional<LabelHit>> firstLabels(const RenderGrid& grid, const Camera& camera, const std::vector<int64_t>& shown) {
-    const GridFrame frame(grid.indexToWorld);
-    const DagTracer tracer(*grid.dag);
     std::vector<std::optional<LabelHit>> hits(size_t(camera.width) * size_t(camera.height));
     const auto isShown = [&](int64_t label) {
         if (!shown.empty()) return std::find(shown.begin(), shown.end(), label) != shown.end();
         return label != 0 && label != grid.labelBackground;
     };
-    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& rows) {
-        size_t hint = 0;
-        for (int py = rows.begin(); py != rows.end(); ++py)
-            for (int px = 0; px < camera.width; ++px) {
-                glm::dvec3 eye, dir;
-                camera.pixelRay(px, py, eye, dir);
-                std::optional<LabelHit>& out = hits[size_t(py) * size_t(camera.width) + size_t(px)];
-                tracer.forEachSegment(frame.toCellRay(eye, dir), [&](const RayHit& box, double) {
-                    const double v = grid.values ? valueAsDoubles(grid, box.attribute, hint)[0] : 1.0;
-                    const int64_t label = std::isfinite(v) ? int64_t(v) : 0;
-                    if (!isShown(label)) return false;
-                    out = LabelHit{box, label};
-                    return true;
-                });
-            }
+    forEachPixelSegment(grid, camera, [&](size_t pixel, const RayHit& box, double v) {
+        const int64_t label = std::isfinite(v) ? int64_t(v) : 0;
+        if (!isShown(label)) return false;
+        hits[pixel] = LabelHit{box, label};
+        return true;
     });
     return hits;
 }

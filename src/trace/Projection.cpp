@@ -6,32 +6,16 @@
 #include <cmath>
 #include <limits>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#include "src/trace/DagTracer.h"
+#include "src/trace/PixelSegments.h"
 
 namespace vdbdag::trace {
 
 std::vector<double> maximaAlongRays(const RenderGrid& grid, const Camera& camera) {
-    const GridFrame frame(grid.indexToWorld);
-    const DagTracer tracer(*grid.dag);
     std::vector<double> maxima(size_t(camera.width) * size_t(camera.height), std::numeric_limits<double>::quiet_NaN());
-    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& rows) {
-        size_t hint = 0;
-        for (int py = rows.begin(); py != rows.end(); ++py)
-            for (int px = 0; px < camera.width; ++px) {
-                glm::dvec3 eye, dir;
-                camera.pixelRay(px, py, eye, dir);
-                double best = -std::numeric_limits<double>::infinity();
-                bool met = false;
-                tracer.forEachSegment(frame.toCellRay(eye, dir), [&](const RayHit& box, double) {
-                    const double v = grid.values ? valueAsDoubles(grid, box.attribute, hint)[0] : 1.0;
-                    if (!std::isnan(v)) best = std::max(best, v), met = true;
-                    return false;
-                });
-                if (met) maxima[size_t(py) * size_t(camera.width) + size_t(px)] = best;
-            }
+    forEachPixelSegment(grid, camera, [&](size_t pixel, const RayHit&, double v) {
+        double& m = maxima[pixel];
+        if (!std::isnan(v) && (std::isnan(m) || v > m)) m = v;
+        return false;
     });
     return maxima;
 }

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "src/format/SsvdagFile.h"
-#include "src/format/TraceableValues.h"
 #include "src/pipeline/GridCodec.h"
 #include "tests/tools/ForgedDicom.h"
+#include "tests/tools/ForgedScenes.h"
 
 int main(int argc, char** argv) {
     if (argc < 2) return 2;  // usage: make_seed_corpus READER_DIR [SECTIONS_DIR [SCAN_HEADERS_DIR]]
@@ -91,25 +91,12 @@ int main(int argc, char** argv) {
     // hundred bytes), the same with its values in one legacy Values section
     // (palettes, decoded whole), and a DAG whose voxels reach past INT32_MAX.
     {
-        GridRecord block;
-        block.name = "block";
-        block.gridClass = "fog volume";
-        block.valueType = ValueType::Float;
-        block.background.assign(4, 0);
-        block.vdbDescriptor = {1};
-        for (int z = 0; z < 256; z += 4)
-            for (int y = 0; y < 256; y += 4)
-                for (int x = 0; x < 256; x += 4) block.topology.bricks.push_back({x, y, z, ~uint64_t(0)});
-        block.values.bricks.assign(block.topology.bricks.size() * 64 * 4, 0);
         format::SsvdagScene forged;
-        forged.grids.push_back(pipeline::encodeGrid(block));
+        forged.grids.push_back(pipeline::encodeGrid(vdbdag::testing::solidFloatBlock("block", 256)));
         const auto expansion = format::writeScene(forged);
         std::ofstream(std::string(argv[1]) + "/forged_expansion.ssvdag", std::ios::binary)
             .write(reinterpret_cast<const char*>(expansion.data()), std::streamsize(expansion.size()));
-        format::EncodedGrid& g = forged.grids[0];
-        g.values = format::traceableValues(g);
-        g.valueWindows = {};
-        g.predictedValues.clear();
+        vdbdag::testing::useLegacyValues(forged.grids[0]);
         const auto legacy = format::writeScene(forged);
         std::ofstream(std::string(argv[1]) + "/forged_legacy_values.ssvdag", std::ios::binary)
             .write(reinterpret_cast<const char*>(legacy.data()), std::streamsize(legacy.size()));

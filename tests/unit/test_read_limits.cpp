@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "src/format/SsvdagFile.h"
-#include "src/format/TraceableValues.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
+#include "tests/tools/ForgedScenes.h"
 #include "tests/unit/AllocationProbe.h"
 
 using namespace vdbdag;
@@ -120,27 +120,15 @@ TEST(ReadLimits, VoxelsPastTheInt32IndexRangeAreRefusedWhenRead) {
 // of them without weighing them (issue 38 #3: a 1.6 KB file took 4.2 GB
 // under --max-memory 100M). A solid 128^3 float block, 8 MiB of values.
 TEST(ReadLimits, ValuesOfTheLayoutBeforeWindowsAreWeighedWhenWindowsAreKept) {
-    GridRecord record;
-    record.name = "legacy";
-    record.gridClass = "fog volume";
-    record.valueType = ValueType::Float;
-    record.background.assign(4, 0);
-    record.vdbDescriptor = {1};
-    for (int z = 0; z < 128; z += 4)
-        for (int y = 0; y < 128; y += 4)
-            for (int x = 0; x < 128; x += 4) record.topology.bricks.push_back({x, y, z, ~uint64_t(0)});
+    GridRecord record = vdbdag::testing::solidFloatBlock("legacy", 128);
     const uint64_t entries = uint64_t(128) * 128 * 128;
-    record.values.bricks.resize(entries * 4);
     for (uint64_t i = 0; i < entries; ++i) {
         const float v = float(i % 7) * 0.25f;
         std::memcpy(record.values.bricks.data() + i * 4, &v, 4);
     }
     format::SsvdagScene scene;
     scene.grids.push_back(pipeline::encodeGrid(record));
-    format::EncodedGrid& grid = scene.grids[0];
-    grid.values = format::traceableValues(grid);
-    grid.valueWindows = {};
-    grid.predictedValues.clear();
+    vdbdag::testing::useLegacyValues(scene.grids[0]);
     const auto bytes = format::writeScene(scene);
     bool hasPalette = false;
     for (const Section& s : format::readContainer(bytes, "legacy"))

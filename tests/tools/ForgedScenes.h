@@ -1,0 +1,37 @@
+// Scenes the read-limit tests and the fuzz seed corpus forge alike
+// (tests/unit/test_read_limits.cpp, tests/fuzz/make_seed_corpus.cpp).
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "src/format/SsvdagFile.h"
+#include "src/format/TraceableValues.h"
+#include "src/volume/GridRecord.h"
+
+namespace vdbdag::testing {
+
+// A solid side^3 fog block of full 4^3 bricks (side a multiple of 4), its
+// float values all 0 (the caller may set them, in brick order).
+inline GridRecord solidFloatBlock(const std::string& name, int side) {
+    GridRecord block;
+    block.name = name;
+    block.gridClass = "fog volume";
+    block.valueType = ValueType::Float;
+    block.background.assign(4, 0);
+    block.vdbDescriptor = {1};
+    for (int z = 0; z < side; z += 4)
+        for (int y = 0; y < side; y += 4)
+            for (int x = 0; x < side; x += 4) block.topology.bricks.push_back({x, y, z, ~uint64_t(0)});
+    block.values.bricks.assign(block.topology.bricks.size() * 64 * 4, 0);
+    return block;
+}
+
+// The grid's values as files before value windows stored them: one palette
+// (Values) section, which a reader decodes whole.
+inline void useLegacyValues(format::EncodedGrid& grid) {
+    grid.values = format::traceableValues(grid);
+    grid.valueWindows = {};
+    grid.predictedValues.clear();
+}
+
+} // namespace vdbdag::testing
