@@ -9,7 +9,6 @@
 #include <cmath>
 #include <filesystem>
 #include <tuple>
-#include <fstream>
 
 #include "src/util/Error.h"
 
@@ -33,16 +32,6 @@
 namespace vdbdag::cli {
 
 namespace {
-// OpenVDB files start with the int32 magic 0x56444220 ("VDB " read
-// little-endian). Only a regular file is opened to look (a FIFO or a device
-// goes on to readFileBytes, which refuses it without blocking).
-bool isVdbFile(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) return false;
-    std::ifstream in(path, std::ios::binary);
-    char magic[4] = {};
-    return in.read(magic, 4) && magic[0] == 0x20 && magic[1] == 0x42 && magic[2] == 0x44 && magic[3] == 0x56;
-}
 
 nlohmann::json dicomReport(const std::string& input, const bridge::DicomScan& scan) {
     nlohmann::json series = nlohmann::json::array();
@@ -151,7 +140,10 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
         return {report, formatScanHeaderReport(report)};
     }
     nlohmann::json report;
-    if (bridge::inputKindOf(input) == bridge::InputKind::NanoVdb) {
+    // By magic number (bridge::inputKindOf; only a regular file is opened to
+    // look: a FIFO or a device goes on to readFileBytes, which refuses it).
+    const bridge::InputKind kind = bridge::inputKindOf(input);
+    if (kind == bridge::InputKind::NanoVdb) {
         // NanoVDB: read through NanoVDB's converter as `encode` reads it,
         // then the DAG figures of its encoding in memory.
         format::SsvdagScene scene;
@@ -164,7 +156,7 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
             addGridHeader(report["grids"][g], scene.grids[g].record, bridge::gridHeaderFacts(scene.grids[g].record, summary.indexBox, what), summary,
                           false);
         }
-    } else if (!isVdbFile(input)) {
+    } else if (kind != bridge::InputKind::Vdb) {
         const std::vector<uint8_t> bytes = format::readFileBytes(input);
         // Nothing decoded but what is printed: value windows stay as
         // they are in the file (their range is read window by window)
