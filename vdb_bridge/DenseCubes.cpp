@@ -18,14 +18,7 @@ template <typename S, typename V>
 class DenseCubes final : public CubeSource {
 public:
     DenseCubes(const DenseVolume& v, const SampleRule<S, V>& rule, DenseCubeScratch scratch, const GridRecord& header)
-        : rule_(rule), scratch_(std::move(scratch)), dims_(v.dims) {
-        header_.name = header.name;
-        header_.gridClass = header.gridClass;
-        header_.valueType = header.valueType;
-        header_.indexToWorld = header.indexToWorld;
-        header_.vdbDescriptor = header.vdbDescriptor;
-        header_.background = header.background;
-    }
+        : rule_(rule), scratch_(std::move(scratch)), dims_(v.dims), header_(headerOf(header)) {}
     const GridRecord& header() const override { return header_; }
     LayerSummary summary(Layer layer) override { return layer == Layer::Active ? scratch_.summary : LayerSummary{}; }
 

@@ -92,6 +92,7 @@ void describeGrid(const DenseVolume& v, const V& background, const Thresholds* t
     record.gridClass = openvdb::GridBase::gridClassToString(grid->getGridClass());
     record.indexToWorld = detail::indexToWorldOf(*grid);
     record.vdbDescriptor = detail::descriptorOf(*grid);
+    record.rescale = detail::rescaleOf(*grid);
     const auto* bg = reinterpret_cast<const uint8_t*>(&background);
     record.background.assign(bg, bg + sizeof(V));
 }

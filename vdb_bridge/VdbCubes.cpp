@@ -335,6 +335,7 @@ VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options,
         header.gridClass = openvdb::GridBase::gridClassToString(base->getGridClass());
         header.indexToWorld = detail::indexToWorldOf(*base);
         header.vdbDescriptor = detail::descriptorOf(*base);
+        header.rescale = detail::rescaleOf(*base);
         const bool supported = detail::dispatchGridType(*base, [&](const auto& typed, ValueType type) {
             if (!scratch) scratch = std::make_shared<ScratchFile>(near, scratchInMemory);
             using GridT = std::decay_t<decltype(typed)>;

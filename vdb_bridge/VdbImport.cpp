@@ -151,6 +151,7 @@ ImportResult detail::importGrids(const openvdb::GridPtrVec& fileGrids, const ope
         }
         record.indexToWorld = detail::indexToWorldOf(*base);
         record.vdbDescriptor = detail::descriptorOf(*base);
+        record.rescale = detail::rescaleOf(*base);
         result.volume.grids.push_back(std::move(record));
     }
     if (options.normals && std::none_of(result.volume.grids.begin(), result.volume.grids.end(), [](const GridRecord& g) { return g.normals.has_value(); })) {

@@ -16,7 +16,7 @@ constexpr size_t kHeaderBytes = 1 + 4 + 4 + 4 + 4 + 8;
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                          bool labels) {
+                                          bool labels, coding::BrickOrder order) {
     if (labels && places.empty()) throw Error("internal error: labels are coded with their bricks' places");
     if (values.size() % 4) throw Error("internal error: a context-coded channel holds int32 entries");
     std::vector<int32_t> entries(values.size() / 4);
@@ -37,9 +37,9 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
     options.minValue = step > 1 ? 0 : lo;
     options.maxValue = step > 1 ? (int64_t(hi) - lo) / int64_t(step) : hi;
     const std::vector<uint8_t> stream =
-        labels           ? coding::encodePlacedLabels(entries, layout, places, int32_t(options.minValue), int32_t(options.maxValue))
+        labels           ? coding::encodePlacedLabels(entries, layout, places, order, int32_t(options.minValue), int32_t(options.maxValue))
         : places.empty() ? coding::encodeBrickValues(entries, layout, options)
-                         : coding::encodePlacedBrickValues(entries, layout, places, options);
+                         : coding::encodePlacedBrickValues(entries, layout, places, order, options);
     // The header (ContextChannel.h) then the stream, in one allocation.
     std::vector<uint8_t> out(kHeaderBytes + stream.size());
     size_t at = 0;
@@ -53,7 +53,7 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
 }
 
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places, bool labels) {
+                                          std::span<const coding::BrickPlace> places, bool labels, coding::BrickOrder order) {
     format::ByteReader r(payload, what);
     const uint8_t valueSize = r.get<uint8_t>();
     if (valueSize != 4) r.fail("a context-coded channel of " + std::to_string(valueSize) + "-byte values (4 expected)");
@@ -73,9 +73,9 @@ std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std:
     std::vector<int32_t> decoded(static_cast<size_t>(entries));
     if (labels && (near || places.empty())) r.fail("labels coded near-lossless or without places");
     if (labels)
-        coding::decodePlacedLabels(payload.subspan(kHeaderBytes), layout, places, int32_t(options.minValue), int32_t(options.maxValue), decoded, what);
+        coding::decodePlacedLabels(payload.subspan(kHeaderBytes), layout, places, order, int32_t(options.minValue), int32_t(options.maxValue), decoded, what);
     else if (places.empty()) coding::decodeBrickValues(payload.subspan(kHeaderBytes), layout, options, decoded, what);
-    else coding::decodePlacedBrickValues(payload.subspan(kHeaderBytes), layout, places, options, decoded, what);
+    else coding::decodePlacedBrickValues(payload.subspan(kHeaderBytes), layout, places, order, options, decoded, what);
     if (step > 1)
         for (int32_t& v : decoded) v = int32_t(lo + int64_t(v) * step);
     std::vector<uint8_t> out(decoded.size() * 4);

@@ -26,17 +26,19 @@ namespace vdbdag::attributes {
 
 // `values`: n little-endian int32 entries; `layout` as encodePredicted's.
 // With `places` (one per layout entry), neighbours come from the bricks
-// around too (coding 3, encodePlacedBrickValues); without, from each brick
-// alone (coding 2).
+// around too (codings 6 and 3, encodePlacedBrickValues, its bricks visited
+// in `order`); without, from each brick alone (coding 2).
 // With `labels` (and places), the entries are coded as categories by
-// coding/LabelCoder.h (coding 4).
+// coding/LabelCoder.h (codings 7 and 4).
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
-                                          std::span<const coding::BrickPlace> places = {}, bool labels = false);
+                                          std::span<const coding::BrickPlace> places = {}, bool labels = false,
+                                          coding::BrickOrder order = coding::BrickOrder::Spatial);
 
 // Inverse (`places` given exactly when the payload was coded with them);
 // validates the payload against `layout` and `entries` (throws
 // vdbdag::Error starting with `what`).
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places = {}, bool labels = false);
+                                          std::span<const coding::BrickPlace> places = {}, bool labels = false,
+                                          coding::BrickOrder order = coding::BrickOrder::Spatial);
 
 } // namespace vdbdag::attributes

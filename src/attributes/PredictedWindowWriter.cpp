@@ -13,6 +13,7 @@
 #include "src/attributes/ContextChannel.h"
 #include "src/attributes/PaletteCompressor.h"
 #include "src/attributes/PredictedChannel.h"
+#include "src/attributes/RescaledFloats.h"
 #include "src/format/ByteIO.h"
 #include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
@@ -40,7 +41,7 @@ bool looksLikeLabels(std::span<const uint8_t> values) {
 // bricks when their places are known, and as labels too when the window
 // looks like labels), int64 brick MED residuals (zstd's estimate).
 std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                uint32_t vs) {
+                                uint32_t vs, const std::optional<ValueRescale>& rescale) {
     std::vector<uint8_t> best = serializePalette(compressPalette(values, vs));
     uint64_t bestSize = format::zstdFastSize(best);
     uint8_t coding = detail::kPaletteCoding;
@@ -48,15 +49,20 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         if (size >= bestSize) return;
         best = std::move(payload), bestSize = size, coding = kind;
     };
-    if (vs == 4) {
+    if (rescale) {  // float32 entries: their palettes or their lattice's integers
+        if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *rescale)) {
+            const uint64_t size = integers->size();
+            consider(std::move(*integers), size, detail::kRescaledFloatCoding);
+        }
+    } else if (vs == 4) {
         const bool placed = !places.empty();
         std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places);
         const uint64_t size = numeric.size();
-        consider(std::move(numeric), size, placed ? detail::kPlacedContextCoding : detail::kContextCoding);
+        consider(std::move(numeric), size, placed ? detail::kSpatialContextCoding : detail::kContextCoding);
         if (placed && looksLikeLabels(values)) {
             std::vector<uint8_t> labels = encodeContextChannel(values, layout, places, true);
             const uint64_t labelSize = labels.size();
-            consider(std::move(labels), labelSize, detail::kPlacedLabelCoding);
+            consider(std::move(labels), labelSize, detail::kSpatialLabelCoding);
         }
     } else {
         std::vector<uint8_t> predicted = encodePredicted(values, vs, layout);
@@ -72,9 +78,11 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
 
 } // namespace
 
-PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory)
-    : valueSize_(valueSize), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
+PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory,
+                                             std::optional<ValueRescale> rescale)
+    : valueSize_(valueSize), rescale_(rescale), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
     if (valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
+    if (rescale && valueSize != 4) throw Error("internal error: rescaled predicted windows hold float32 entries");
     const uint8_t zeros[kHeaderBytes] = {};
     if (!spillNear.empty()) {
         spill_ = std::make_shared<ScratchFile>(spillNear, spillInMemory);
@@ -99,6 +107,7 @@ void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const
     if (!layout.empty()) {
         if (!places.empty() && places.size() != layout.size()) throw Error("internal error: a layout and its places differ in length");
         if (placed_ && *placed_ != !places.empty()) throw Error("internal error: brick places given in some calls only");
+        if (rescale_ && places.empty()) throw Error("internal error: rescaled floats are coded with their bricks' places");
         placed_ = !places.empty();
     }
     size_t at = 0;  // byte position in `values`
@@ -145,7 +154,7 @@ void PredictedWindowWriter::codePending() {
     std::vector<std::vector<uint8_t>> stored(pending_.size());
     std::vector<uint64_t> rawBytes(pending_.size());
     tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
-        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, pending_[i].places, valueSize_);
+        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, pending_[i].places, valueSize_, rescale_);
         std::vector<uint8_t>().swap(pending_[i].values);
         std::vector<uint64_t>().swap(pending_[i].layout);
         std::vector<coding::BrickPlace>().swap(pending_[i].places);
@@ -223,8 +232,8 @@ ValueWindowsPayload PredictedWindowWriter::finish() {
 }
 
 std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            std::span<const coding::BrickPlace> places) {
-    PredictedWindowWriter writer(valueSize, 0);
+                                            std::span<const coding::BrickPlace> places, std::optional<ValueRescale> rescale) {
+    PredictedWindowWriter writer(valueSize, 0, "", 0, rescale);
     writer.add(values, layout, places);
     return std::move(writer.finish().bytes);
 }

@@ -8,6 +8,7 @@
 
 #include "src/attributes/ContextChannel.h"
 #include "src/attributes/PredictedChannel.h"
+#include "src/attributes/RescaledFloats.h"
 #include "src/format/ByteIO.h"
 #include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
@@ -77,12 +78,21 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
     }
     const std::span<const uint64_t> bricks = layout.subspan(size_t(e.firstBrick), size_t(e.bricks));
     if (raw[0] == detail::kPredictedCoding) return decodePredicted(body, dir.valueSize, bricks, where);
-    if (raw[0] == detail::kContextCoding || raw[0] == detail::kPlacedContextCoding || raw[0] == detail::kPlacedLabelCoding) {
+    const uint8_t c = raw[0];
+    if (c == detail::kContextCoding || c == detail::kPlacedContextCoding || c == detail::kPlacedLabelCoding || c == detail::kSpatialContextCoding ||
+        c == detail::kSpatialLabelCoding) {
         if (dir.valueSize != 4) throw Error(where + ": a context-coded window of " + std::to_string(dir.valueSize) + "-byte values (int32 only)");
-        if (raw[0] == detail::kContextCoding) return decodeContextChannel(body, bricks, e.entries, where);
+        if (c == detail::kContextCoding) return decodeContextChannel(body, bricks, e.entries, where);
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
+        const bool spatial = c == detail::kSpatialContextCoding || c == detail::kSpatialLabelCoding;
         return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
-                                    raw[0] == detail::kPlacedLabelCoding);
+                                    c == detail::kPlacedLabelCoding || c == detail::kSpatialLabelCoding,
+                                    spatial ? coding::BrickOrder::Spatial : coding::BrickOrder::Attribute);
+    }
+    if (raw[0] == detail::kRescaledFloatCoding) {
+        if (dir.valueSize != 4) throw Error(where + ": rescaled floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
+        if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
+        return decodeRescaledFloats(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)));
     }
     throw Error(where + ": unknown coding " + std::to_string(raw[0]));
 }

@@ -1,6 +1,8 @@
 // An integer value channel (int32 / int64) at rest in windows, each coded
 // on its own as whichever is smaller: its palettes (PaletteChannel.h) or its
-// brick-predicted residuals (PredictedChannel.h). The windowed form of both,
+// brick-predicted residuals (PredictedChannel.h). A float32 channel whose
+// values lie on a rescale lattice (GridRecord::rescale) too: its windows
+// are palettes or the lattice's integers (RescaledFloats.h). The windowed form of both,
 // so an encoder of a dense scan holds one window per core, never the whole
 // channel (ValueWindows.h does the same for palettes alone).
 //
@@ -23,8 +25,11 @@
 // entries; 1: encodePredicted bytes over its bricks; 2: int32 only,
 // encodeContextChannel bytes over its bricks, ContextChannel.h; 3: the same
 // with neighbours across bricks, over its bricks and their places; 4: the
-// same payload with the entries coded as labels, coding/LabelCoder.h) then
-// that payload;
+// same payload with the entries coded as labels, coding/LabelCoder.h; 5:
+// float32 only, encodeRescaledFloats bytes over its bricks and their
+// places, RescaledFloats.h; 6 and 7: codings 3 and 4 with the bricks
+// visited in spatial order, coding::BrickOrder, which a writer writes
+// today) then that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -38,20 +43,24 @@
 #include <vector>
 
 #include "src/attributes/ValueWindows.h"
+#include "src/volume/GridRecord.h"
 
 namespace vdbdag::attributes {
 
 namespace detail {  // the layout above, shared by the writer and the reader
 inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
-inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3, kPlacedLabelCoding = 4;
+inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3, kPlacedLabelCoding = 4,
+                         kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail
 
 class PredictedWindowWriter {
 public:
-    // As ValueWindowWriter's (`valueSize` 4 or 8).
-    explicit PredictedWindowWriter(uint32_t valueSize, unsigned parallel = 0, const std::string& spillNear = "", uint64_t spillInMemory = 0);
+    // As ValueWindowWriter's (`valueSize` 4 or 8). With `rescale`, the
+    // entries are float32 believed to lie on that lattice, and need places.
+    explicit PredictedWindowWriter(uint32_t valueSize, unsigned parallel = 0, const std::string& spillNear = "", uint64_t spillInMemory = 0,
+                                   std::optional<ValueRescale> rescale = std::nullopt);
     // `values`: the entries of the brick instances `layout` describes (per
     // instance in attribute order its stored mask, 0 for a solid node),
     // continuing the previous call; `places`: where each lies
@@ -77,6 +86,7 @@ private:
     };
     void codePending();
     uint32_t valueSize_;
+    std::optional<ValueRescale> rescale_;
     unsigned parallel_;
     uint64_t entries_ = 0, windows_ = 0;
     std::vector<Window> pending_;  // full windows not yet coded, and the one filling (last)
@@ -92,7 +102,7 @@ private:
 
 // All at once.
 std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            std::span<const coding::BrickPlace> places = {});
+                                            std::span<const coding::BrickPlace> places = {}, std::optional<ValueRescale> rescale = std::nullopt);
 
 // The entries in attribute order; validates the payload against `layout`
 // (the DAG's attributeLayout) and throws vdbdag::Error starting with `what`.

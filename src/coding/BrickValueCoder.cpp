@@ -100,13 +100,13 @@ struct CompactRecord {
 };
 
 template <typename Step>
-void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, const IntCoderOptions& options, Models& models,
-                Step&& step) {
+void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
+                Models& models, Step&& step) {
     int64_t last = 0;  // the previous entry visited, and its record
     SampleRecord lastRec{};
     using Nb = PlacedNeighbours<CompactRecord>;
     walkPlacedBricks<CompactRecord>(
-        layout, places, entries,
+        layout, places, entries, order,
         [&](uint64_t entry) {  // a tile: one entry, no neighbours
             Neighbourhood n;
             n.W = n.N = n.NW = n.NE = n.P = n.PW = n.PN = n.PNW = last;
@@ -176,13 +176,14 @@ void decodeBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t>
 }
 
 std::vector<uint8_t> encodePlacedBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
-                                             const IntCoderOptions& options, std::vector<int32_t>* reconstructed) {
-    return encodeSamples(entries, options, reconstructed, [&](Models& models, auto&& step) { walkPlaced(layout, places, entries.size(), options, models, step); });
+                                             BrickOrder order, const IntCoderOptions& options, std::vector<int32_t>* reconstructed) {
+    return encodeSamples(entries, options, reconstructed,
+                         [&](Models& models, auto&& step) { walkPlaced(layout, places, entries.size(), order, options, models, step); });
 }
 
-void decodePlacedBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
+void decodePlacedBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order,
                              const IntCoderOptions& options, std::span<int32_t> out, const std::string& what) {
-    decodeSamples(bytes, options, out, what, [&](Models& models, auto&& step) { walkPlaced(layout, places, out.size(), options, models, step); });
+    decodeSamples(bytes, options, out, what, [&](Models& models, auto&& step) { walkPlaced(layout, places, out.size(), order, options, models, step); });
 }
 
 } // namespace vdbdag::coding

@@ -43,10 +43,10 @@ struct Candidates {
 };
 
 template <typename Code>
-void walkLabels(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, Code&& code) {
+void walkLabels(std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order, uint64_t entries, Code&& code) {
     using Nb = PlacedNeighbours<uint8_t>;
     walkPlacedBricks<uint8_t>(
-        layout, places, entries, [&](uint64_t entry) { code(Candidates{}, entry); },
+        layout, places, entries, order, [&](uint64_t entry) { code(Candidates{}, entry); },
         [&](const Nb& nb, uint64_t entry, int32_t& value, uint8_t&) {
             Candidates c;
             std::array<int32_t, 8> seen{};
@@ -73,13 +73,13 @@ unsigned bitsFor(int32_t minValue, int32_t maxValue) {
 } // namespace
 
 std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
-                                        int32_t minValue, int32_t maxValue) {
+                                        BrickOrder order, int32_t minValue, int32_t maxValue) {
     if (minValue > maxValue) throw Error("label coder: an empty range");
     std::vector<uint8_t> out;
     RangeEncoder rc(out);
     auto m = std::make_unique<LabelModels>();
     const unsigned bits = bitsFor(minValue, maxValue);
-    walkLabels(layout, places, entries.size(), [&](const Candidates& c, uint64_t entry) {
+    walkLabels(layout, places, order, entries.size(), [&](const Candidates& c, uint64_t entry) {
         const int32_t v = entries[entry];
         if (v < minValue || v > maxValue) throw Error("label coder: label " + std::to_string(v) + " lies outside its range");
         const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
@@ -106,14 +106,14 @@ std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::s
     return out;
 }
 
-void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places, int32_t minValue,
-                        int32_t maxValue, std::span<int32_t> out, const std::string& what) {
+void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order,
+                        int32_t minValue, int32_t maxValue, std::span<int32_t> out, const std::string& what) {
     if (minValue > maxValue) throw Error(what + ": an empty label range");
     RangeDecoder rc(bytes);
     auto m = std::make_unique<LabelModels>();
     const unsigned bits = bitsFor(minValue, maxValue);
     try {
-        walkLabels(layout, places, out.size(), [&](const Candidates& c, uint64_t entry) {
+        walkLabels(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry) {
             const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
             int32_t v = 0;
             bool found = false;

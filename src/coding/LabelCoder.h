@@ -13,8 +13,8 @@
 //     recently (unary, a model per rank), or, when it is none of them, its
 //     offset from minValue in as many bits as the range needs.
 // An adaptive binary range coder (RangeCoder.h) codes every bit. The
-// predicted window coding 4 (attributes/PredictedWindows.h) when it is the
-// smallest (docs/CODING.md).
+// predicted window coding 7 (4 in the layout's brick order,
+// attributes/PredictedWindows.h) when it is the smallest (docs/CODING.md).
 #pragma once
 #include <cstdint>
 #include <span>
@@ -27,11 +27,11 @@ namespace vdbdag::coding {
 
 // Every entry must lie in [minValue, maxValue] (throws vdbdag::Error).
 std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
-                                        int32_t minValue, int32_t maxValue);
+                                        BrickOrder order, int32_t minValue, int32_t maxValue);
 
 // Throws vdbdag::Error naming `what` on a corrupt stream (a label outside
 // the range, too few or unused bytes); never reads outside `bytes`.
-void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places, int32_t minValue,
-                        int32_t maxValue, std::span<int32_t> out, const std::string& what);
+void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order,
+                        int32_t minValue, int32_t maxValue, std::span<int32_t> out, const std::string& what);
 
 } // namespace vdbdag::coding

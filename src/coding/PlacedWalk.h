@@ -2,18 +2,21 @@
 // attribute order, each with its corner and mirror) shared by the value
 // coders that see neighbours across bricks (BrickValueCoder's coding 3,
 // LabelCoder): brick by brick, each brick's voxels in spatial raster order
-// (x fastest), each with its causal neighbours
+// (x fastest), in the layout's order or in spatial order (BrickOrder), each
+// with its causal neighbours
 //      this slice:  NW N NE        slice below:  PNW PN
 //                   W  *                         PW  P
 // wherever they were visited before in the same walk (in this brick or in
 // any brick before it), and its entry: the rank of its stored bit
 // (dag_access.h dagStoredBit). A tile (mask 0) is one entry without place.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
 #include <span>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -55,27 +58,72 @@ struct BrickKeyHash {
     }
 };
 
+// Whether corner p comes before corner q in Morton order (z's bit above
+// y's above x's at each level, coordinates as unsigned after flipping the
+// sign bit): the axis whose coordinates differ in the highest bit decides.
+// Morton order is monotone: a corner below another on every axis comes
+// first, so W, N, P and their diagonals towards the origin always precede.
+inline bool mortonLess(const BrickPlace& p, const BrickPlace& q) {
+    const uint32_t a[3] = {uint32_t(p.z) ^ 0x80000000u, uint32_t(p.y) ^ 0x80000000u, uint32_t(p.x) ^ 0x80000000u};
+    const uint32_t b[3] = {uint32_t(q.z) ^ 0x80000000u, uint32_t(q.y) ^ 0x80000000u, uint32_t(q.x) ^ 0x80000000u};
+    int axis = 0;
+    uint32_t highest = a[0] ^ b[0];
+    for (int k = 1; k < 3; ++k) {
+        const uint32_t d = a[k] ^ b[k];
+        if (highest < d && highest < (highest ^ d)) axis = k, highest = d;  // d's top bit is above highest's
+    }
+    return a[axis] < b[axis];
+}
+
+// The instances' visiting order: the layout's own (BrickOrder::Attribute),
+// or (BrickOrder::Spatial) its tiles in layout order, then its bricks in
+// the Morton order of their corners. `first[b]`: instance b's first entry.
+// Throws vdbdag::Error when the layout holds more than `entries` entries.
+inline std::vector<uint32_t> placedVisitOrder(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order,
+                                              std::vector<uint64_t>& first) {
+    if (layout.size() > UINT32_MAX) throw Error("more than 2^32 brick instances in one call");
+    first.resize(layout.size());
+    uint64_t e = 0;
+    for (size_t b = 0; b < layout.size(); ++b) {
+        first[b] = e;
+        e += layout[b] ? uint64_t(std::popcount(layout[b])) : 1;
+        if (e > entries) throw Error("the layout holds more entries than the channel");
+    }
+    std::vector<uint32_t> visit(layout.size());
+    for (size_t b = 0; b < layout.size(); ++b) visit[b] = uint32_t(b);
+    if (order == BrickOrder::Spatial)
+        std::stable_sort(visit.begin(), visit.end(), [&](uint32_t a, uint32_t b) {
+            const bool tileA = layout[a] == 0, tileB = layout[b] == 0;
+            if (tileA || tileB) return tileA && !tileB;
+            return mortonLess(places[a], places[b]);
+        });
+    return visit;
+}
+
 // tile(entry); voxel(neighbours, entry, value&, rec&) sets the voxel's value
-// (read or decoded) and its record. Throws vdbdag::Error when the layout,
-// its places and `entries` disagree.
+// (read or decoded) and its record, visiting the instances in `order`.
+// Throws vdbdag::Error when the layout, its places and `entries` disagree.
 template <typename Rec, typename Tile, typename Voxel>
-void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, Tile&& tile, Voxel&& voxel) {
+void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, Tile&& tile,
+                      Voxel&& voxel) {
     if (places.size() != layout.size()) throw Error("the layout has " + std::to_string(layout.size()) + " bricks, their places " + std::to_string(places.size()));
+    std::vector<uint64_t> first;
+    const std::vector<uint32_t> visit = placedVisitOrder(layout, places, entries, order, first);
     std::unordered_map<BrickKey, uint32_t, BrickKeyHash> slots;  // brick coordinates (index / 4) -> index in `bricks`
     slots.reserve(layout.size());
     std::vector<PlacedBrick<Rec>> bricks;
     bricks.reserve(layout.size());  // `around` points into it
-    uint64_t e = 0;                 // the first entry of the current instance
-    for (size_t b = 0; b < layout.size(); ++b) {
+    uint64_t total = 0;
+    for (const uint32_t b : visit) {
         const uint64_t mask = layout[b];
+        const uint64_t e = first[b];  // the instance's first entry
         if (mask == 0) {
-            if (e >= entries) throw Error("the layout holds more entries than the channel");
-            tile(e++);
+            tile(e);
+            ++total;
             continue;
         }
         const BrickPlace& place = places[b];
         if ((place.x | place.y | place.z) & 3 || place.mirror > 7) throw Error("brick " + std::to_string(b) + " has no brick's place");
-        if (e + uint64_t(std::popcount(mask)) > entries) throw Error("the layout holds more entries than the channel");
         const int32_t bx = place.x >> 2, by = place.y >> 2, bz = place.z >> 2;
         if (!slots.emplace(BrickKey{bx, by, bz}, uint32_t(bricks.size())).second) throw Error("two bricks at the same place");
         bricks.emplace_back();
@@ -106,9 +154,9 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
             voxel(n, e + uint64_t(std::popcount(mask & ((uint64_t(1) << stored) - 1))), self.value[p], self.rec[p]);
             self.done |= uint64_t(1) << p;
         }
-        e += uint64_t(std::popcount(mask));
+        total += uint64_t(std::popcount(mask));
     }
-    if (e != entries) throw Error("the layout holds " + std::to_string(e) + " entries, the channel " + std::to_string(entries));
+    if (total != entries) throw Error("the layout holds " + std::to_string(total) + " entries, the channel " + std::to_string(entries));
 }
 
 } // namespace vdbdag::coding::detail

@@ -18,7 +18,7 @@ std::vector<uint64_t> attributeLayout(const CompactDag& dag);
 // accumulated down to it; a solid node's place is zero): what the value
 // coder of int32 windows needs for neighbours across bricks
 // (coding/BrickValueCoder.h). Empty unless `valueSize` is 4: only int32
-// windows use them.
+// windows and rescaled float32 ones use them.
 std::vector<coding::BrickPlace> attributePlaces(const CompactDag& dag, uint32_t valueSize);
 
 } // namespace vdbdag::encoding

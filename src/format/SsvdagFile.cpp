@@ -332,8 +332,10 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             if ((predictedSection || windowSection || predictedWindowSection) && (!vs || dag.empty()))
                 throw Error(what + ": unexpected " + layer + " values section for a grid without values");
             if (predictedSection || predictedWindowSection) {
-                if (grid.record.valueType != ValueType::Int32 && grid.record.valueType != ValueType::Int64)
-                    throw Error(what + ": predicted values for a " + valueTypeName(grid.record.valueType) + " grid");
+                // Integers; float32 too in windows (their lattice's integers, coding 5).
+                const ValueType type = grid.record.valueType;
+                if (type != ValueType::Int32 && type != ValueType::Int64 && !(predictedWindowSection && type == ValueType::Float))
+                    throw Error(what + ": predicted values for a " + valueTypeName(type) + " grid");
                 if (predictedSection) {
                     predicted = std::move(predictedSection->data);
                     attributes = attributes::decodePredicted(predicted, vs, encoding::attributeLayout(dag), what + " " + layer + " values");

@@ -346,7 +346,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     // like colours (clustered over the whole channel), are gathered whole.
     const bool lossy = options.tolerance.mode != attributes::ScalarTolerance::Mode::Exact;
     const bool streamValues = vs > 0 && !isColourGrid(source.header(), options) && (!lossy || team.size() == 1);
-    const bool predicted = usesPredictedWindows(source.header().valueType, options);
+    const bool predicted = usesPredictedWindows(source.header(), options);
     // Gathers the layer into windows (on process 0: all of them).
     auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries,
                            attributes::ScalarQuantizer* quantizer) {
@@ -387,7 +387,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
             std::optional<std::decay_t<decltype(writer)>> whole;
             if (team.isRoot()) {
                 if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::PredictedWindowWriter>)
-                    whole.emplace(vs, inFlight, budget.spillNear, budget.spillInMemory);
+                    whole.emplace(vs, inFlight, budget.spillNear, budget.spillInMemory, valueLattice(source.header(), options));
                 else
                     whole.emplace(vs, expected, inFlight, budget.spillNear, budget.spillInMemory);
             }
@@ -402,7 +402,8 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
             return whole->finish();
         };
         if (predicted) {
-            attributes::PredictedWindowWriter writer(vs, inFlight, team.size() == 1 ? budget.spillNear : "", budget.spillInMemory);
+            attributes::PredictedWindowWriter writer(vs, inFlight, team.size() == 1 ? budget.spillNear : "", budget.spillInMemory,
+                                                     valueLattice(source.header(), options));
             stream.predicted = &writer;
             return run(writer);
         }
@@ -449,7 +450,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
                 trial.windows = streamLayer(Layer::Inactive, layerPlan, dag, entries, nullptr);
             } else {
                 trial.attributes = gatherLayer(source, Layer::Inactive, layerPlan, dag, vs, budget, team, options.onStepProgress);
-                if (team.isRoot()) codeInactiveValues(dag, trial, source.header().valueType, options);
+                if (team.isRoot()) codeInactiveValues(dag, trial, source.header(), options);
             }
             return trial.storedBytes();
         };

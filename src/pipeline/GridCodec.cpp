@@ -65,12 +65,13 @@ namespace {
 // A layer's values at rest: an integer channel (unless --no-predict) in
 // predicted windows, each window predicted or palette-coded, whichever is
 // smaller; anything else in palette windows.
-attributes::ValueWindowsPayload codeValues(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, ValueType type,
+attributes::ValueWindowsPayload codeValues(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, const GridRecord& header,
                                            const EncodeOptions& options) {
     attributes::ValueWindowsPayload out;
-    if (usesPredictedWindows(type, options)) {
+    const ValueType type = header.valueType;
+    if (usesPredictedWindows(header, options)) {
         out.bytes = attributes::encodePredictedWindows(attributes, valueSize(type), encoding::attributeLayout(dag),
-                                                       encoding::attributePlaces(dag, valueSize(type)));
+                                                       encoding::attributePlaces(dag, valueSize(type)), valueLattice(header, options));
         out.predicted = true;
     } else {
         out.bytes = attributes::encodeValueWindows(attributes, valueSize(type));
@@ -161,12 +162,7 @@ encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options) {
     format::EncodedGrid out;
     // The header only: copying the voxels first would double peak memory.
-    out.record.name = grid.name;
-    out.record.gridClass = grid.gridClass;
-    out.record.valueType = grid.valueType;
-    out.record.indexToWorld = grid.indexToWorld;
-    out.record.vdbDescriptor = grid.vdbDescriptor;
-    out.record.background = grid.background;
+    out.record = headerOf(grid);
     out.symmetry = options.symmetry;
     return out;
 }
@@ -182,11 +178,11 @@ void codeActiveValues(const encoding::CompactDag& dag, CodedValues& coded, const
     coded.lossy = attributes::applyScalarTolerance(coded.attributes, type, options.tolerance);
     if (isColourGrid(header, options))
         coded.colour = attributes::quantiseColours(coded.attributes, type, options.colourBits, "grid '" + header.name + "'");
-    coded.windows = codeValues(dag, coded.attributes, type, options);
+    coded.windows = codeValues(dag, coded.attributes, header, options);
 }
 
-void codeInactiveValues(const encoding::CompactDag& dag, CodedValues& coded, ValueType type, const EncodeOptions& options) {
-    coded.windows = codeValues(dag, coded.attributes, type, options);
+void codeInactiveValues(const encoding::CompactDag& dag, CodedValues& coded, const GridRecord& header, const EncodeOptions& options) {
+    coded.windows = codeValues(dag, coded.attributes, header, options);
 }
 
 void storeActiveValues(format::EncodedGrid& out, CodedValues&& coded) {
@@ -202,8 +198,14 @@ void storeInactiveValues(format::EncodedGrid& out, CodedValues&& coded) {
     out.inactiveValueWindows = std::move(coded.windows);
 }
 
-bool usesPredictedWindows(ValueType type, const EncodeOptions& options) {
-    return options.predictIntegers && (type == ValueType::Int32 || type == ValueType::Int64);
+std::optional<ValueRescale> valueLattice(const GridRecord& grid, const EncodeOptions& options) {
+    if (!options.predictIntegers || grid.valueType != ValueType::Float || options.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
+        return std::nullopt;
+    return grid.rescale;
+}
+
+bool usesPredictedWindows(const GridRecord& grid, const EncodeOptions& options) {
+    return (options.predictIntegers && (grid.valueType == ValueType::Int32 || grid.valueType == ValueType::Int64)) || valueLattice(grid, options);
 }
 
 bool isColourGrid(const GridRecord& grid, const EncodeOptions& options) {
@@ -261,7 +263,7 @@ format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& 
         const CandidateValues inactive{[&](const encoding::CompactDag& dag, const std::array<int64_t, 3>&) {
                                            trial = {};
                                            trial.attributes = gatherAttributes(dag, grid.inactiveTopology, grid.inactiveValues, vs);
-                                           codeInactiveValues(dag, trial, grid.valueType, options);
+                                           codeInactiveValues(dag, trial, grid, options);
                                            return trial.storedBytes();
                                        },
                                        [&] { kept = std::move(trial); }};

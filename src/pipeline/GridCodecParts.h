@@ -55,16 +55,19 @@ encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t
 // An EncodedGrid with `grid`'s header and nothing else.
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options);
 
-// Whether a channel of `type` is stored in predicted windows (integers,
-// unless --no-predict) rather than palette windows.
-bool usesPredictedWindows(ValueType type, const EncodeOptions& options);
+// The lattice a float channel of `grid` is tried on (GridRecord::rescale,
+// when its values are kept exactly, unless --no-predict).
+std::optional<ValueRescale> valueLattice(const GridRecord& grid, const EncodeOptions& options);
+// Whether a channel of `grid` is stored in predicted windows (integers, and
+// floats with a lattice; unless --no-predict) rather than palette windows.
+bool usesPredictedWindows(const GridRecord& grid, const EncodeOptions& options);
 
 // From coded.attributes (attribute order of `dag`): the lossy settings
 // (tolerance, colours), then the value windows (predicted windows for
 // integers). `header`: the grid's name, type and class.
 void codeActiveValues(const encoding::CompactDag& dag, CodedValues& coded, const GridRecord& header, const EncodeOptions& options);
 // The same for an inactive layer (never lossy).
-void codeInactiveValues(const encoding::CompactDag& dag, CodedValues& coded, ValueType type, const EncodeOptions& options);
+void codeInactiveValues(const encoding::CompactDag& dag, CodedValues& coded, const GridRecord& header, const EncodeOptions& options);
 
 // Moves a layer's coded values into `out`.
 void storeActiveValues(format::EncodedGrid& out, CodedValues&& coded);

@@ -1,4 +1,4 @@
-// Names of the value types, as OpenVDB spells them.
+// Names of the value types, as OpenVDB spells them; a grid's header.
 #include "src/volume/GridRecord.h"
 
 namespace vdbdag {
@@ -31,6 +31,18 @@ unsigned valueSize(ValueType type) {
         case ValueType::Vec3I: return 12;
     }
     return 0;
+}
+
+GridRecord headerOf(const GridRecord& grid) {
+    GridRecord out;
+    out.name = grid.name;
+    out.gridClass = grid.gridClass;
+    out.valueType = grid.valueType;
+    out.indexToWorld = grid.indexToWorld;
+    out.vdbDescriptor = grid.vdbDescriptor;
+    out.background = grid.background;
+    out.rescale = grid.rescale;
+    return out;
 }
 
 } // namespace vdbdag

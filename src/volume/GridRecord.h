@@ -50,6 +50,16 @@ struct GridNormals {
     uint64_t oneSided = 0;        // gradient entries where a band edge forced a one-sided difference
 };
 
+// Float values on a lattice: each is float(round_to_double(k * slope) +
+// intercept) for an integer k, as a rescaled scan's are (value = sample x
+// slope + intercept, vdb_bridge's DenseImport). A hint to the value coder,
+// which codes the k instead (attributes/RescaledFloats.h) where every value
+// of a window checks out; never trusted beyond that.
+struct ValueRescale {
+    double slope = 1, intercept = 0;
+    bool operator==(const ValueRescale&) const = default;
+};
+
 struct GridRecord {
     std::string name;        // may be empty; names may repeat within a file
     std::string gridClass;   // "level set", "fog volume", "staggered", "unknown"
@@ -69,7 +79,13 @@ struct GridRecord {
     // Optional exact normals for shading (`encode --normals K`).
     using Normals = GridNormals;
     std::optional<Normals> normals;
+    // Float grids only: the lattice the values are believed to lie on.
+    std::optional<ValueRescale> rescale;
 };
+
+// Everything but the voxels (topologies, values, normals): what
+// CubeSource::header() holds, copied without the voxels.
+GridRecord headerOf(const GridRecord& grid);
 
 // A whole .vdb file: its grids in file order and its file-level metadata
 // (OpenVDB's own MetaMap serialisation, opaque like vdbDescriptor; empty

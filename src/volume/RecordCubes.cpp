@@ -18,14 +18,7 @@ struct CellLess {
 
 class RecordCubes final : public CubeSource {
 public:
-    explicit RecordCubes(const GridRecord& grid) : grid_(grid) {
-        header_.name = grid.name;
-        header_.gridClass = grid.gridClass;
-        header_.valueType = grid.valueType;
-        header_.indexToWorld = grid.indexToWorld;
-        header_.vdbDescriptor = grid.vdbDescriptor;
-        header_.background = grid.background;
-    }
+    explicit RecordCubes(const GridRecord& grid) : grid_(grid), header_(headerOf(grid)) {}
     const GridRecord& header() const override { return header_; }
 
     LayerSummary summary(Layer layer) override {

@@ -2,7 +2,8 @@
 // first 8 bytes choose a small shape (up to 16^3; for the brick coder, byte
 // 7 odd, a layout of up to 16 bricks whose masks come from the data, tiles
 // among them; byte 7 & 2, the bricks placed side by side with mirrors; & 4
-// as well, lossless, coded as labels), the sample range and near; the rest is (a) a stream to
+// as well, lossless, coded as labels; & 8, the bricks visited in the
+// layout's order rather than spatially), the sample range and near; the rest is (a) a stream to
 // decode, which must throw vdbdag::Error or give samples inside the range,
 // never crash or read out of bounds, and (b) the samples of a volume to
 // encode, whose decode must give every sample back (within near).
@@ -43,15 +44,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (bricks && (data[7] & 2))
         for (unsigned b = 0; b < layout.size(); ++b) places.push_back({int32_t(4 * (b % 4)), int32_t(4 * (b / 4)), 0, uint32_t(data[(b % 6) + 1] % 8)});
     const bool labels = !places.empty() && (data[7] & 4) && o.near == 0;  // byte 7 & 4: coded as labels (LabelCoder)
+    const BrickOrder order = data[7] & 8 ? BrickOrder::Attribute : BrickOrder::Spatial;  // byte 7 & 8: the layout's brick order
     const auto decode = [&](std::span<const uint8_t> stream, std::vector<int32_t>& out) {
-        if (labels) decodePlacedLabels(stream, layout, places, int32_t(o.minValue), int32_t(o.maxValue), out, "fuzz");
-        else if (!places.empty()) decodePlacedBrickValues(stream, layout, places, o, out, "fuzz");
+        if (labels) decodePlacedLabels(stream, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue), out, "fuzz");
+        else if (!places.empty()) decodePlacedBrickValues(stream, layout, places, order, o, out, "fuzz");
         else if (bricks) decodeBrickValues(stream, layout, o, out, "fuzz");
         else decodeIntVolume(stream, shape, o, out);
     };
     const auto encode = [&](const std::vector<int32_t>& samples) {
-        if (labels) return encodePlacedLabels(samples, layout, places, int32_t(o.minValue), int32_t(o.maxValue));
-        if (!places.empty()) return encodePlacedBrickValues(samples, layout, places, o);
+        if (labels) return encodePlacedLabels(samples, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue));
+        if (!places.empty()) return encodePlacedBrickValues(samples, layout, places, order, o);
         return bricks ? encodeBrickValues(samples, layout, o) : encodeIntVolume(samples, shape, o);
     };
     const uint64_t count = bricks ? layoutEntryCount(layout) : shape.count();

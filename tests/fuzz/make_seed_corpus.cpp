@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "src/attributes/RescaledFloats.h"
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "tests/tools/ForgedDicom.h"
@@ -59,6 +60,20 @@ int main(int argc, char** argv) {
         (i + 1 < entries ? ints.values.bricks : ints.values.tiles).insert(i + 1 < entries ? ints.values.bricks.end() : ints.values.tiles.end(), p, p + 4);
     }
     scene.grids.push_back(pipeline::encodeGrid(ints));
+    // The same as a rescaled scan's floats: a PredictedWindows section of a
+    // float grid, its window coded as the lattice's integers (coding 5).
+    GridRecord rescaled = ints;
+    rescaled.name = "rescaled";
+    rescaled.valueType = ValueType::Float;
+    rescaled.rescale = ValueRescale{2.0222414, -3.0};
+    for (auto* values : {&rescaled.values.bricks, &rescaled.values.tiles})
+        for (size_t at = 0; at + 4 <= values->size(); at += 4) {
+            int32_t k;
+            std::memcpy(&k, values->data() + at, 4);
+            const float f = attributes::rescaledFloat(k, *rescaled.rescale);
+            std::memcpy(values->data() + at, &f, 4);
+        }
+    scene.grids.push_back(pipeline::encodeGrid(rescaled));
     int n = 0;
     for (bool compress : {true, false}) {
         format::ContainerOptions options;

@@ -6,6 +6,7 @@
 // dagStoredBit), so a coder must undo the mirror to see the field. Every
 // brick m with m % tileEvery == tileAt is a tile holding `tileValue`.
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -43,6 +44,22 @@ PlacedChannel placedBox(std::mt19937& rng, bool mirrors, Value&& value, uint32_t
         c.entries.insert(c.entries.end(), brick.begin(), brick.end());
     }
     return c;
+}
+
+// The same instances in the reverse order (each brick's entries kept), as
+// a DAG visits a box under a mirror on every axis: from the far corner.
+inline PlacedChannel reversedBricks(const PlacedChannel& c) {
+    PlacedChannel out;
+    std::vector<size_t> first;
+    size_t e = 0;
+    for (const uint64_t mask : c.layout) first.push_back(e), e += mask ? size_t(std::popcount(mask)) : 1;
+    for (size_t b = c.layout.size(); b-- > 0;) {
+        out.layout.push_back(c.layout[b]);
+        out.places.push_back(c.places[b]);
+        const size_t n = c.layout[b] ? size_t(std::popcount(c.layout[b])) : 1;
+        out.entries.insert(out.entries.end(), c.entries.begin() + long(first[b]), c.entries.begin() + long(first[b] + n));
+    }
+    return out;
 }
 
 } // namespace vdbdag::coding::testing

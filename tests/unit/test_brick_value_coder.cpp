@@ -177,6 +177,26 @@ PlacedChannel placedField(uint32_t seed, bool mirrors) {
     });
 }
 
+// A layout visited from the far corner (as a DAG under mirrors visits its
+// children): in the layout's order a brick's W, N and P bricks come after
+// it; in spatial order the walk is the forward box's, byte for byte, and
+// smaller.
+TEST(BrickValueCoder, SpatialOrderUndoesALayoutVisitedFromTheFarCorner) {
+    const PlacedChannel forward = placedField(13, true);
+    const PlacedChannel backward = testing::reversedBricks(forward);
+    IntCoderOptions o;
+    o.minValue = -100, o.maxValue = 1100;
+    const std::vector<uint8_t> spatial = encodePlacedBrickValues(backward.entries, backward.layout, backward.places, BrickOrder::Spatial, o);
+    const std::vector<uint8_t> layoutOrder = encodePlacedBrickValues(backward.entries, backward.layout, backward.places, BrickOrder::Attribute, o);
+    EXPECT_EQ(spatial, encodePlacedBrickValues(forward.entries, forward.layout, forward.places, BrickOrder::Spatial, o));
+    EXPECT_LT(spatial.size(), layoutOrder.size() * 95 / 100);
+    for (const BrickOrder order : {BrickOrder::Spatial, BrickOrder::Attribute}) {
+        std::vector<int32_t> back(backward.entries.size());
+        decodePlacedBrickValues(order == BrickOrder::Spatial ? spatial : layoutOrder, backward.layout, backward.places, order, o, back, "order");
+        EXPECT_EQ(back, backward.entries);
+    }
+}
+
 TEST(BrickValueCoder, PlacedBricksRoundTripAndSeeAcrossBrickBoundaries) {
     for (bool mirrors : {false, true}) {
         const PlacedChannel c = placedField(9, mirrors);
@@ -184,9 +204,9 @@ TEST(BrickValueCoder, PlacedBricksRoundTripAndSeeAcrossBrickBoundaries) {
             IntCoderOptions o;
             o.minValue = -100, o.maxValue = 1100, o.near = near;
             std::vector<int32_t> reconstructed;
-            const std::vector<uint8_t> bytes = encodePlacedBrickValues(c.entries, c.layout, c.places, o, &reconstructed);
+            const std::vector<uint8_t> bytes = encodePlacedBrickValues(c.entries, c.layout, c.places, BrickOrder::Spatial, o, &reconstructed);
             std::vector<int32_t> back(c.entries.size());
-            decodePlacedBrickValues(bytes, c.layout, c.places, o, back, "placed");
+            decodePlacedBrickValues(bytes, c.layout, c.places, BrickOrder::Spatial, o, back, "placed");
             EXPECT_EQ(back, reconstructed);
             size_t outside = 0;
             for (size_t i = 0; i < back.size(); ++i) outside += std::abs(int64_t(back[i]) - c.entries[i]) > near;
@@ -206,16 +226,16 @@ TEST(BrickValueCoder, PlacesThatAreNoBricksAreRefused) {
     o.minValue = -100, o.maxValue = 1100;
     PlacedChannel twice = c;
     twice.places[7] = twice.places[3];
-    EXPECT_THROW(encodePlacedBrickValues(twice.entries, twice.layout, twice.places, o), Error);
+    EXPECT_THROW(encodePlacedBrickValues(twice.entries, twice.layout, twice.places, BrickOrder::Spatial, o), Error);
     PlacedChannel off = c;
     off.places[5].x += 1;
-    EXPECT_THROW(encodePlacedBrickValues(off.entries, off.layout, off.places, o), Error);
+    EXPECT_THROW(encodePlacedBrickValues(off.entries, off.layout, off.places, BrickOrder::Spatial, o), Error);
     PlacedChannel fewer = c;
     fewer.places.pop_back();
-    EXPECT_THROW(encodePlacedBrickValues(fewer.entries, fewer.layout, fewer.places, o), Error);
-    const std::vector<uint8_t> bytes = encodePlacedBrickValues(c.entries, c.layout, c.places, o);
+    EXPECT_THROW(encodePlacedBrickValues(fewer.entries, fewer.layout, fewer.places, BrickOrder::Spatial, o), Error);
+    const std::vector<uint8_t> bytes = encodePlacedBrickValues(c.entries, c.layout, c.places, BrickOrder::Spatial, o);
     std::vector<int32_t> back(c.entries.size());
-    EXPECT_THROW(decodePlacedBrickValues(bytes, twice.layout, twice.places, o, back, "twice"), Error);
+    EXPECT_THROW(decodePlacedBrickValues(bytes, twice.layout, twice.places, BrickOrder::Spatial, o, back, "twice"), Error);
 }
 
 } // namespace

@@ -4,8 +4,8 @@
 // of what the numeric coder of the same entries costs (labels have no
 // magnitude to predict); a label outside the range is refused; corrupt
 // streams are refused or give labels inside the range, never more. Through
-// encodePredictedWindows with places, a label window is stored as coding 4
-// and decodes exactly.
+// encodePredictedWindows with places, a label window is stored as coding 7
+// and decodes exactly; one of coding 4 (an older writer's) still does.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +15,7 @@
 #include <random>
 #include <vector>
 
+#include "src/attributes/ContextChannel.h"
 #include "src/attributes/PredictedWindows.h"
 #include "src/coding/BrickValueCoder.h"
 #include "src/coding/LabelCoder.h"
@@ -55,13 +56,13 @@ TEST(LabelCoder, LabelVolumesComeBackExactlyForAFractionOfTheNumericCost) {
     for (int regions : {1, 12, 60}) {
         const Labels l = voronoi(uint32_t(regions), regions);
         const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
-        const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, *lo, *hi);
+        const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, BrickOrder::Spatial, *lo, *hi);
         std::vector<int32_t> back(l.entries.size());
-        decodePlacedLabels(bytes, l.layout, l.places, *lo, *hi, back, "labels");
+        decodePlacedLabels(bytes, l.layout, l.places, BrickOrder::Spatial, *lo, *hi, back, "labels");
         EXPECT_EQ(back, l.entries) << regions;
         IntCoderOptions o;
         o.minValue = *lo, o.maxValue = *hi;
-        const size_t numeric = encodePlacedBrickValues(l.entries, l.layout, l.places, o).size();
+        const size_t numeric = encodePlacedBrickValues(l.entries, l.layout, l.places, BrickOrder::Spatial, o).size();
         if (regions > 1) EXPECT_LT(bytes.size() * 2, numeric) << regions << " regions: labels " << bytes.size() << ", numeric " << numeric;
         else EXPECT_LT(bytes.size(), 100u);  // one label: next to nothing
     }
@@ -70,33 +71,69 @@ TEST(LabelCoder, LabelVolumesComeBackExactlyForAFractionOfTheNumericCost) {
 TEST(LabelCoder, OutOfRangeLabelsAndCorruptStreamsAreRefused) {
     const Labels l = voronoi(3, 20);
     const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
-    EXPECT_THROW(encodePlacedLabels(l.entries, l.layout, l.places, *lo + 1, *hi), Error);
-    const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, *lo, *hi);
+    EXPECT_THROW(encodePlacedLabels(l.entries, l.layout, l.places, BrickOrder::Spatial, *lo + 1, *hi), Error);
+    const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, BrickOrder::Spatial, *lo, *hi);
     std::vector<int32_t> back(l.entries.size());
-    EXPECT_THROW(decodePlacedLabels(std::vector<uint8_t>(bytes.begin(), bytes.begin() + ptrdiff_t(bytes.size() / 2)), l.layout, l.places, *lo, *hi, back, "half"),
+    EXPECT_THROW(decodePlacedLabels(std::vector<uint8_t>(bytes.begin(), bytes.begin() + ptrdiff_t(bytes.size() / 2)), l.layout, l.places, BrickOrder::Spatial, *lo, *hi, back, "half"),
                  Error);
     std::mt19937 rng(4);
     for (int trial = 0; trial < 20; ++trial) {
         std::vector<uint8_t> garbage(bytes.size());
         for (auto& b : garbage) b = uint8_t(rng());
         try {
-            decodePlacedLabels(garbage, l.layout, l.places, *lo, *hi, back, "garbage");
+            decodePlacedLabels(garbage, l.layout, l.places, BrickOrder::Spatial, *lo, *hi, back, "garbage");
             for (int32_t v : back) ASSERT_TRUE(v >= *lo && v <= *hi);
         } catch (const Error&) {
         }
     }
 }
 
-TEST(LabelCoder, PredictedWindowsStoreLabelsAsCoding4) {
+TEST(LabelCoder, PredictedWindowsStoreLabelsAsCoding7) {
     const Labels l = voronoi(5, 30);
     std::vector<uint8_t> bytes(l.entries.size() * 4);
     std::memcpy(bytes.data(), l.entries.data(), bytes.size());
     const std::vector<uint8_t> windows = attributes::encodePredictedWindows(bytes, 4, l.layout, l.places);
     const attributes::WindowDirectory dir = attributes::readPredictedWindowDirectory(windows, 4, l.layout, "test");
     ASSERT_EQ(dir.windows.size(), 1u);
-    EXPECT_EQ(windows[size_t(dir.windows[0].offset)], attributes::detail::kPlacedLabelCoding);
+    EXPECT_EQ(windows[size_t(dir.windows[0].offset)], attributes::detail::kSpatialLabelCoding);
     EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, l.layout, "test", l.places), bytes);
     EXPECT_THROW(attributes::decodePredictedWindows(windows, 4, l.layout, "test", {}), Error);  // a label window needs its places
+}
+
+// One predicted window of `entries` int32 entries, stored as it is, with
+// the raw bytes `raw` (coding byte, payload): the layout of FORMAT.md 8.1
+// written out by hand, as a writer before codings 6 and 7 wrote it.
+std::vector<uint8_t> oneWindowByHand(std::span<const uint8_t> raw, uint64_t entries) {
+    std::vector<uint8_t> out;
+    const auto put = [&](auto v) {
+        const auto* p = reinterpret_cast<const uint8_t*>(&v);
+        out.insert(out.end(), p, p + sizeof v);
+    };
+    put(uint32_t(4)), put(entries), put(uint64_t(1) << 22), put(uint64_t(1));
+    out.insert(out.end(), raw.begin(), raw.end());
+    put(uint64_t(raw.size())), put(uint64_t(raw.size())), put(entries);
+    return out;
+}
+
+// Windows of codings 3 and 4 (bricks in the layout's order, what files
+// before codings 6 and 7 hold) still read, on a layout whose bricks come
+// from the far corner, so that the two orders differ.
+TEST(LabelCoder, WindowsInTheLayoutsBrickOrderStillRead) {
+    const Labels l = testing::reversedBricks(voronoi(7, 12));
+    std::vector<uint8_t> bytes(l.entries.size() * 4);
+    std::memcpy(bytes.data(), l.entries.data(), bytes.size());
+    for (const bool labels : {false, true}) {
+        std::vector<uint8_t> raw{labels ? attributes::detail::kPlacedLabelCoding : attributes::detail::kPlacedContextCoding};
+        const std::vector<uint8_t> payload = attributes::encodeContextChannel(bytes, l.layout, l.places, labels, BrickOrder::Attribute);
+        raw.insert(raw.end(), payload.begin(), payload.end());
+        EXPECT_EQ(attributes::decodePredictedWindows(oneWindowByHand(raw, l.entries.size()), 4, l.layout, "old", l.places), bytes) << "labels " << labels;
+        // The same payload read in spatial order is another walk: it must not give the entries back.
+        raw[0] = labels ? attributes::detail::kSpatialLabelCoding : attributes::detail::kSpatialContextCoding;
+        try {
+            EXPECT_NE(attributes::decodePredictedWindows(oneWindowByHand(raw, l.entries.size()), 4, l.layout, "misread", l.places), bytes);
+        } catch (const Error&) {
+        }
+    }
 }
 
 } // namespace

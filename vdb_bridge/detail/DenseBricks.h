@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "src/attributes/RescaledFloats.h"
 #include "src/util/ScratchFile.h"
 #include "src/volume/CubeSource.h"
 #include "vdb_bridge/DenseVolume.h"
@@ -55,6 +56,7 @@ struct SampleRule {
     V convert(S s) const {
         if (!rescaled) return V(s);
         if constexpr (std::is_integral_v<V>) return V(int64_t(s) * int64_t(slope) + int64_t(intercept));
+        else if constexpr (std::is_same_v<V, float> && std::is_integral_v<S>) return attributes::rescaledFloat(int64_t(s), {slope, intercept});  // the lattice the value coder checks
         else return V(double(s) * slope + intercept);
     }
     bool missing(int64_t z) const { return !missingSlices.empty() && std::binary_search(missingSlices.begin(), missingSlices.end(), z); }

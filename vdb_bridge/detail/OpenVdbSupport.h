@@ -3,8 +3,10 @@
 // (de)serialisation. Not to be included outside vdb_bridge/ and tests/.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -90,6 +92,19 @@ inline openvdb::GridBase::Ptr readDescriptor(const std::vector<uint8_t>& bytes, 
     } catch (const std::ios_base::failure& e) {
         throw Error(what + ": grid descriptor is corrupted (" + oneLine(e.what()) + ")");
     }
+}
+
+// The lattice a float grid's values are believed to lie on
+// (GridRecord::rescale): a scan's rescale as DenseImport records it in the
+// grid's metadata. None for other grids or unusable numbers.
+inline std::optional<ValueRescale> rescaleOf(const openvdb::GridBase& grid) {
+    if (!grid.isType<openvdb::FloatGrid>()) return std::nullopt;
+    const auto slope = grid.getMetadata<openvdb::DoubleMetadata>("source_rescale_slope");
+    const auto intercept = grid.getMetadata<openvdb::DoubleMetadata>("source_rescale_intercept");
+    if (!slope) return std::nullopt;
+    const ValueRescale r{slope->value(), intercept ? intercept->value() : 0.0};
+    if (!std::isfinite(r.slope) || r.slope == 0 || !std::isfinite(r.intercept)) return std::nullopt;
+    return r;
 }
 
 // OpenVDB's own serialisation of an empty copy of `grid` (metadata,
