@@ -13,6 +13,11 @@
 namespace vdbdag::attributes {
 namespace {
 constexpr size_t kHeaderBytes = 1 + 4 + 4 + 4 + 4 + 8;
+// The model generation of a window's coding (coding/IntVolumeCoder.h):
+// 1 for bricks in spatial order (codings 5, 6), 0 for the codings before.
+int modelOf(std::span<const coding::BrickPlace> places, coding::BrickOrder order) {
+    return !places.empty() && order == coding::BrickOrder::Spatial ? 1 : 0;
+}
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
@@ -36,6 +41,7 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
     coding::IntCoderOptions options;
     options.minValue = step > 1 ? 0 : lo;
     options.maxValue = step > 1 ? (int64_t(hi) - lo) / int64_t(step) : hi;
+    options.model = modelOf(places, order);
     const std::vector<uint8_t> stream =
         labels           ? coding::encodePlacedLabels(entries, layout, places, order, int32_t(options.minValue), int32_t(options.maxValue))
         : places.empty() ? coding::encodeBrickValues(entries, layout, options)
@@ -58,6 +64,7 @@ std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std:
     const uint8_t valueSize = r.get<uint8_t>();
     if (valueSize != 4) r.fail("a context-coded channel of " + std::to_string(valueSize) + "-byte values (4 expected)");
     coding::IntCoderOptions options;
+    options.model = modelOf(places, order);
     const uint32_t near = r.get<uint32_t>();
     if (near > (1u << 20)) r.fail("a near-lossless bound of " + std::to_string(near) + " (at most 2^20)");
     options.near = int32_t(near);

@@ -13,7 +13,8 @@
 // values quantised by --abs-error), i32 minValue, i32 maxValue (the
 // entries' range, which bounds every prediction and the residuals' modulo;
 // step divides maxValue - minValue), u64 n (entries), then the coder's
-// stream to the end.
+// stream to the end. The stream's model generation follows from the walk:
+// 1 with places in spatial order (codings 5, 6), else 0 (codings 2, 3).
 #pragma once
 #include <cstdint>
 #include <span>

@@ -20,6 +20,7 @@ inline void checkRange(const IntCoderOptions& options) {
     if (options.minValue > options.maxValue || options.minValue < INT32_MIN || options.maxValue > INT32_MAX)
         throw Error("value coder: the sample range must be a non-empty part of int32");
     if (options.near < 0 || options.near > 1 << 20) throw Error("value coder: near must lie in 0..2^20");
+    if (options.model < 0 || options.model > 1) throw Error("value coder: model generation " + std::to_string(options.model) + " (0 or 1)");
 }
 
 // `walk(models, step)` runs the walk; step(context, signs, prediction, index).
@@ -28,7 +29,7 @@ std::vector<uint8_t> encodeSamples(std::span<const int32_t> samples, const IntCo
     checkRange(options);
     std::vector<uint8_t> out;
     RangeEncoder rc(out);
-    auto models = std::make_unique<Models>();
+    auto models = std::make_unique<Models>(options.model);
     const int64_t step = 2 * int64_t(options.near) + 1;
     if (reconstructed) reconstructed->resize(samples.size());
     walk(*models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
@@ -52,7 +53,7 @@ template <typename Walk>
 void decodeSamples(std::span<const uint8_t> bytes, const IntCoderOptions& options, std::span<int32_t> out, const std::string& what, Walk&& walk) {
     checkRange(options);
     RangeDecoder rc(bytes);
-    auto models = std::make_unique<Models>();
+    auto models = std::make_unique<Models>(options.model);
     const int64_t step = 2 * int64_t(options.near) + 1;
     try {
         walk(*models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {

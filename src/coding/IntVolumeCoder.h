@@ -50,6 +50,10 @@ struct IntCoderOptions {
     int64_t minValue = INT32_MIN, maxValue = INT32_MAX;
     // 0: lossless; n > 0: |decoded - original| <= n for every sample.
     int32_t near = 0;
+    // The model's generation (SamplePredictor.h): 0, bias correction per
+    // activity context (window codings 2-4 of files written before 2026-12-05);
+    // 1, per activity context and texture (codings 5 and 6, and this coder).
+    int model = 1;
 };
 
 // Codes `samples` (shape.count() of them, raster order). With near > 0,

@@ -1,6 +1,8 @@
 // The per-sample model of the integer value coders (docs/CODING.md): six
 // predictions from a causal 3-D neighbourhood blended by their local errors,
-// an activity context, bias correction, and the residual's binary coding.
+// an activity context, bias correction (per activity context, generation 0,
+// or per activity context and texture, generation 1), and the residual's
+// binary coding.
 // IntVolumeCoder walks a raster box with it, BrickValueCoder the 4^3 bricks
 // of a DAG's attribute order; both hand it the same neighbourhood
 //      this slice:  NW N NE        previous slice:  PNW PN
@@ -23,6 +25,7 @@ inline constexpr int kPredictors = 6;
 inline constexpr int kContexts = 44;    // residual-activity buckets: half bit lengths
 inline constexpr int kMaxLength = 40;   // bit length of a residual magnitude (|e| < 2^34 fits)
 inline constexpr int kBiasWindow = 64;  // bias statistics are halved at this count
+inline constexpr int kTextures = 64;    // 6 neighbours above or not above the blend
 
 // What a coded sample leaves for its neighbours: each predictor's error and
 // the final residual's magnitude and sign.
@@ -32,18 +35,33 @@ struct SampleRecord {
     int8_t sign = 0;  // -1, 0, 1
 };
 
+// A bias correction's statistics: the summed error of the blend and how
+// many samples it sums (both halved every kBiasWindow samples).
+struct BiasCell {
+    int64_t sum = 0;
+    int32_t count = 0;
+};
+
 // The models of one activity context.
 struct ContextModels {
     std::array<BitModel, 27> zero, sign;                        // by the signs of W's, N's and P's residuals
     std::array<BitModel, kMaxLength + 1> length;                // unary bit length
     std::array<std::array<BitModel, 4>, kMaxLength + 1> high;   // the two bits below the leading one, as a prefix tree
-    int64_t biasSum = 0;
-    int32_t biasCount = 0;
+    BiasCell bias;                                              // generation 0's bias correction
 };
 
 struct Models {
+    explicit Models(int generation) : textureBias(generation >= 1) {}
+    bool textureBias;  // generation 1: the bias corrections below, not the contexts' own
     std::array<ContextModels, kContexts> ctx;
     std::array<std::array<BitModel, kMaxLength + 1>, kMaxLength + 1> low;  // [length][bit]: the remaining bits
+    // Generation 1's bias corrections, per activity context and texture:
+    // which of W, N, P, NW, NE, PN lie above the blend (CALIC's texture
+    // context in 3-D). A blend under-shoots an edge on the side its
+    // neighbours lie, and by an amount the activity scales; one correction
+    // per context cannot see which side. On the shared scans 1-2.4 % smaller
+    // (tooth the most: 637,721 -> 622,454 bytes in raster order).
+    std::array<BiasCell, size_t(kContexts) * kTextures> bias;
 };
 
 inline uint32_t saturate(int64_t v) { return v > int64_t(UINT32_MAX) ? UINT32_MAX : uint32_t(v); }
@@ -90,6 +108,7 @@ struct Prediction {
     std::array<int64_t, kPredictors> p{};
     int64_t blend = 0, value = 0;  // value: the final prediction
     ContextModels* ctx = nullptr;
+    BiasCell* bias = nullptr;
     unsigned signs = 0;
 };
 
@@ -115,7 +134,15 @@ inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxV
     const int length = 64 - std::countl_zero(activity);
     const int context = std::min(kContexts - 1, 2 * length + (length >= 2 ? int(activity >> (length - 2)) & 1 : 0));
     out.ctx = &models.ctx[size_t(context)];
-    const int64_t bias = out.ctx->biasCount ? divRound(out.ctx->biasSum, out.ctx->biasCount) : 0;
+    if (models.textureBias) {
+        const int64_t b = out.blend;
+        const unsigned texture = unsigned(n.W > b) | unsigned(n.N > b) << 1 | unsigned(n.P > b) << 2 | unsigned(n.NW > b) << 3 | unsigned(n.NE > b) << 4 |
+                                 unsigned(n.PN > b) << 5;
+        out.bias = &models.bias[size_t(context) * kTextures + texture];
+    } else {
+        out.bias = &out.ctx->bias;
+    }
+    const int64_t bias = out.bias->count ? divRound(out.bias->sum, out.bias->count) : 0;
     out.value = std::clamp(out.blend + bias, minValue, maxValue);
     out.signs = unsigned(9 * (rP.sign + 1) + 3 * (rW.sign + 1) + (rN.sign + 1));
     return out;
@@ -127,11 +154,11 @@ inline void learn(const Prediction& pr, int64_t value, SampleRecord& r) {
     for (size_t k = 0; k < size_t(kPredictors); ++k) r.err[k] = saturate(std::abs(pr.p[k] - value));
     r.residual = saturate(std::abs(value - pr.value));
     r.sign = int8_t((value > pr.value) - (value < pr.value));
-    ContextModels& c = *pr.ctx;
-    c.biasSum += value - pr.blend;
-    if (++c.biasCount == kBiasWindow) {
-        c.biasSum = divRound(c.biasSum, 2);
-        c.biasCount /= 2;
+    BiasCell& c = *pr.bias;
+    c.sum += value - pr.blend;
+    if (++c.count == kBiasWindow) {
+        c.sum = divRound(c.sum, 2);
+        c.count /= 2;
     }
 }
 

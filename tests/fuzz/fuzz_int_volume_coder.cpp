@@ -3,7 +3,8 @@
 // 7 odd, a layout of up to 16 bricks whose masks come from the data, tiles
 // among them; byte 7 & 2, the bricks placed side by side with mirrors; & 4
 // as well, lossless, coded as labels; & 8, the bricks visited in the
-// layout's order rather than spatially), the sample range and near; the rest is (a) a stream to
+// layout's order rather than spatially), the sample range, near and the
+// model generation; the rest is (a) a stream to
 // decode, which must throw vdbdag::Error or give samples inside the range,
 // never crash or read out of bounds, and (b) the samples of a volume to
 // encode, whose decode must give every sample back (within near).
@@ -28,6 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     o.minValue = data[4] & 1 ? -(int64_t(1) << (bits - 1)) : 0;
     o.maxValue = std::min<int64_t>(INT32_MAX, o.minValue + (int64_t(1) << bits) - 1);
     o.near = data[5] % 4 == 0 ? data[6] % 5 : 0;
+    o.model = (data[5] >> 7) & 1;  // byte 5's top bit: the model generation
     const std::span<const uint8_t> rest(data + 8, size - 8);
     const bool bricks = data[7] & 1;
     std::vector<uint64_t> layout;

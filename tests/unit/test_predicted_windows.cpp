@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <fstream>
 #include <random>
+#include <string>
 
 #include <tbb/global_control.h>
 
@@ -196,3 +198,39 @@ TEST(PredictedWindows, SharesPutTogetherGiveTheSingleWritersBytes) {
         EXPECT_TRUE(root.finish().bytes == whole) << "shares cut at " << ::testing::PrintToString(cuts);
     }
 }
+
+namespace {
+
+// tests/golden/predicted_window_coding3.bin: one int32 channel's predicted
+// windows as the writer of 189fcf6 (2026-12-04) wrote them, before bricks
+// were visited in spatial order and before the texture bias (one window of
+// coding 3, the model of generation 0), written by a program linked with
+// that commit's core library: a smooth noisy field over a 16^3 box of full
+// bricks in reverse Morton order with random mirrors. Layout: u64 n, n x u64
+// masks, n x BrickPlace (4 x u32), the 64 n int32 entries, u64 w, w bytes of
+// the PredictedWindows payload.
+TEST(PredictedWindows, AWindowOfTheWriterBeforeSpatialOrderStillReads) {
+    std::ifstream in(std::string(VDBDAG_SOURCE_DIR) + "/tests/golden/predicted_window_coding3.bin", std::ios::binary);
+    ASSERT_TRUE(in);
+    const auto read = [&](void* to, size_t bytes) { in.read(static_cast<char*>(to), std::streamsize(bytes)); };
+    uint64_t n = 0;
+    read(&n, 8);
+    ASSERT_EQ(n, 64u);
+    std::vector<uint64_t> layout(n);
+    std::vector<coding::BrickPlace> places(n);
+    std::vector<uint8_t> entries(size_t(64 * 4 * n));
+    read(layout.data(), 8 * n), read(places.data(), sizeof(coding::BrickPlace) * n), read(entries.data(), entries.size());
+    uint64_t w = 0;
+    read(&w, 8);
+    std::vector<uint8_t> windows(w);
+    read(windows.data(), w);
+    ASSERT_TRUE(in);
+    const attributes::WindowDirectory dir = attributes::readPredictedWindowDirectory(windows, 4, layout, "golden");
+    ASSERT_EQ(dir.windows.size(), 1u);
+    EXPECT_EQ(attributes::windowRawBytes(windows, dir.windows[0], "golden").at(0), attributes::detail::kPlacedContextCoding);
+    EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, layout, "golden", places), entries);
+    // Today's writer codes the same entries in spatial order, smaller.
+    EXPECT_LT(attributes::encodePredictedWindows(entries, 4, layout, places).size(), windows.size());
+}
+
+} // namespace
