@@ -35,20 +35,38 @@ bool looksLikeLabels(std::span<const uint8_t> values) {
     return repeats * 4 >= (n - 1) * 3;
 }
 
-// A window's raw bytes: its coding byte, then the smallest of its palettes
-// (by zstd's fast estimate) and its entries coded from their neighbours:
-// int32 context-modelled (range coded already; with neighbours across
-// bricks when their places are known, and as labels too when the window
-// looks like labels), int64 brick MED residuals (zstd's estimate).
+// Whether a window's palettes are not worth building: estimated from its
+// first sixteenth, 16 times the sample's palettes (zstd's fast estimate)
+// exceed 1.5 times the best coding found. A palette's indices grow with its
+// entries and only its material array is shared, so the estimate errs high
+// by at most that array; a scan's noise never lets palettes win, and
+// building them was a tenth of an encode. Small windows and windows that
+// look like labels build theirs.
+bool palettesCannotWin(std::span<const uint8_t> values, uint32_t vs, uint64_t bestSize, bool labelsLike) {
+    constexpr size_t kSampleEntries = size_t(1) << 14;  // the smallest sample worth estimating from
+    const size_t n = values.size() / vs;
+    if (labelsLike || bestSize == UINT64_MAX || n / 16 < kSampleEntries) return false;
+    const uint64_t sample = format::zstdFastSize(serializePalette(compressPalette(values.first(n / 16 * vs), vs)));
+    return 16 * sample > bestSize + bestSize / 2;
+}
+
+// A window's raw bytes: its coding byte, then the smallest of its entries
+// coded from their neighbours (int32 context-modelled, range coded already,
+// with neighbours across bricks when their places are known, and as labels
+// too when the window looks like labels; int64 brick MED residuals, by
+// zstd's estimate; a rescaled float32 window's integers) and its palettes
+// (by zstd's fast estimate; they win a tie), unless a sample says they
+// cannot win.
 std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
                                 uint32_t vs, const std::optional<ValueRescale>& rescale) {
-    std::vector<uint8_t> best = serializePalette(compressPalette(values, vs));
-    uint64_t bestSize = format::zstdFastSize(best);
+    std::vector<uint8_t> best;
+    uint64_t bestSize = UINT64_MAX;
     uint8_t coding = detail::kPaletteCoding;
     const auto consider = [&](std::vector<uint8_t>&& payload, uint64_t size, uint8_t kind) {
-        if (size >= bestSize) return;
+        if (size > bestSize || (size == bestSize && kind != detail::kPaletteCoding)) return;
         best = std::move(payload), bestSize = size, coding = kind;
     };
+    bool labelsLike = false;
     if (rescale) {  // float32 entries: their palettes or their lattice's integers
         if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *rescale)) {
             const uint64_t size = integers->size();
@@ -59,7 +77,8 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places);
         const uint64_t size = numeric.size();
         consider(std::move(numeric), size, placed ? detail::kSpatialContextCoding : detail::kContextCoding);
-        if (placed && looksLikeLabels(values)) {
+        labelsLike = placed && looksLikeLabels(values);
+        if (labelsLike) {
             std::vector<uint8_t> labels = encodeContextChannel(values, layout, places, true);
             const uint64_t labelSize = labels.size();
             consider(std::move(labels), labelSize, detail::kSpatialLabelCoding);
@@ -68,6 +87,11 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         std::vector<uint8_t> predicted = encodePredicted(values, vs, layout);
         const uint64_t size = format::zstdFastSize(predicted);
         consider(std::move(predicted), size, detail::kPredictedCoding);
+    }
+    if (!palettesCannotWin(values, vs, bestSize, labelsLike)) {
+        std::vector<uint8_t> palette = serializePalette(compressPalette(values, vs));
+        const uint64_t size = format::zstdFastSize(palette);
+        consider(std::move(palette), size, detail::kPaletteCoding);
     }
     std::vector<uint8_t> raw;
     raw.reserve(best.size() + 1);
