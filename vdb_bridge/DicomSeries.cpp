@@ -37,113 +37,34 @@
 #include "src/util/Error.h"
 #include "vdb_bridge/DicomTags.h"
 #include "vdb_bridge/detail/DicomElementWalk.h"
+#include "vdb_bridge/detail/DicomFileHeader.h"
 
 namespace vdbdag::bridge {
 namespace {
 
 namespace fs = std::filesystem;
-using Vec3 = std::array<double, 3>;
+using detail::cross;
+using detail::dicomdirFiles;
+using detail::dot;
+using detail::elementLengthProblem;
+using detail::Fields;
+using detail::FileInfo;
+using detail::Frame;
+using detail::kPixelGroup;
+using detail::norm;
+using detail::quietGdcm;
+using detail::readFile;
+using detail::scaled;
+using detail::sub;
+using detail::trim;
+using detail::Vec3;
 
-// GDCM reports problems on std::cerr unless told not to; vdbdag reports
-// them itself, as one-line errors.
-void quietGdcm() {
-    static const bool done = [] {
-        gdcm::Trace::DebugOff();
-        gdcm::Trace::WarningOff();
-        gdcm::Trace::ErrorOff();
-        return true;
-    }();
-    (void)done;
-}
 
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 cross(const Vec3& a, const Vec3& b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
-Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3 scaled(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
-
-std::string trim(std::string s) {
-    const auto junk = [](char c) { return c == ' ' || c == '\0' || c == '\t' || c == '\r' || c == '\n'; };
-    while (!s.empty() && junk(s.back())) s.pop_back();
-    size_t i = 0;
-    while (i < s.size() && junk(s[i])) ++i;
-    return s.substr(i);
-}
-
-// "a\b\c" (DS, IS) as numbers; nullopt when any value is not a number.
-std::optional<std::vector<double>> parseNumbers(const std::string& text) {
-    std::vector<double> out;
-    if (trim(text).empty()) return out;
-    size_t start = 0;
-    while (start <= text.size()) {
-        const size_t end = std::min(text.find('\\', start), text.size());
-        std::string item = trim(text.substr(start, end - start));
-        if (!item.empty() && item[0] == '+') item.erase(0, 1);
-        double v = 0;
-        const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
-        if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || !std::isfinite(v)) return std::nullopt;
-        out.push_back(v);
-        start = end + 1;
-    }
-    return out;
-}
 
 std::string formatNumber(double v) { return fmt::format("{:.6g}", v); }
 std::string formatVec(const Vec3& v) { return fmt::format("({:.6g}, {:.6g}, {:.6g})", v[0], v[1], v[2]); }
 
-// One element of a data set (top level or an item's), as text.
-class Fields {
-public:
-    explicit Fields(const gdcm::File& file) { filter_.SetFile(file); }
-    std::string text(const gdcm::DataSet& ds, uint16_t group, uint16_t element) const {
-        const gdcm::Tag tag(group, element);
-        if (!ds.FindDataElement(tag)) return "";
-        const gdcm::DataElement& de = ds.GetDataElement(tag);
-        if (de.IsEmpty()) return "";
-        return trim(filter_.ToString(de));
-    }
-    // Empty when absent; nullopt when present but not numbers.
-    std::optional<std::vector<double>> numbers(const gdcm::DataSet& ds, uint16_t group, uint16_t element) const {
-        return parseNumbers(text(ds, group, element));
-    }
 
-private:
-    gdcm::StringFilter filter_;
-};
-
-// The first item of sequence (group, element) in `ds`, or null.
-const gdcm::DataSet* firstItem(const gdcm::DataSet& ds, uint16_t group, uint16_t element, gdcm::SmartPointer<gdcm::SequenceOfItems>& keep) {
-    const gdcm::Tag tag(group, element);
-    if (!ds.FindDataElement(tag)) return nullptr;
-    keep = ds.GetDataElement(tag).GetValueAsSQ();
-    if (!keep || keep->GetNumberOfItems() < 1) return nullptr;
-    return &keep->GetItem(1).GetNestedDataSet();
-}
-
-// A candidate slice: one file, or one frame of a multi-frame file.
-struct Frame {
-    std::string file;
-    uint32_t frame = 0;
-    bool multiFrame = false;
-    Vec3 position{0, 0, 0};
-    std::array<double, 6> orientation{1, 0, 0, 0, 1, 0};
-    double rowSpacing = 1, columnSpacing = 1;  // Pixel Spacing [0], [1]
-    bool pixelSpacingGiven = false;
-    double thickness = 0;  // 0: not given
-    double slope = 1, intercept = 0;
-};
-
-// What every frame of one file shares.
-struct FileInfo {
-    std::string file;
-    std::string seriesUid, modality, description;
-    int64_t seriesNumber = 0;
-    uint32_t rows = 0, columns = 0;
-    unsigned bitsAllocated = 0, bitsStored = 0, pixelRepresentation = 0, samplesPerPixel = 1;
-    std::string photometric;
-    std::string damaged;  // why its pixel data cannot be read (a truncated file), or ""
-    std::vector<HeaderField> tags;  // DicomTags.h, from the top-level data set
-};
 
 struct Group {
     DicomSeriesInfo info;
@@ -165,274 +86,7 @@ struct ScanState {
     std::vector<Group> groups;  // parallel to scan.series
 };
 
-std::string sopClassName(const std::string& uid) {
-    gdcm::UIDs u;
-    if (!uid.empty() && u.SetFromUID(uid.c_str()) && u.GetName()) return std::string(u.GetName()) + " (" + uid + ")";
-    return uid.empty() ? std::string("no SOP Class UID") : uid;
-}
 
-bool startsWith(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
-
-// A SOP class that is not a greyscale image stack however it looks.
-std::string nonImageClass(const std::string& sop) {
-    if (sop == "1.2.840.10008.5.1.4.1.1.66.4") return "a DICOM-SEG segmentation object, not an image series";
-    if (startsWith(sop, "1.2.840.10008.5.1.4.1.1.88.")) return "a structured report (SR), not an image";
-    if (startsWith(sop, "1.2.840.10008.5.1.4.1.1.11.")) return "a presentation state, not an image";
-    if (startsWith(sop, "1.2.840.10008.5.1.4.1.1.104.")) return "an encapsulated document, not an image";
-    if (startsWith(sop, "1.2.840.10008.5.1.4.1.1.481.") && sop != "1.2.840.10008.5.1.4.1.1.481.1" && sop != "1.2.840.10008.5.1.4.1.1.481.2")
-        return "a radiotherapy object (" + sopClassName(sop) + "), not an image";
-    if (sop == "1.2.840.10008.5.1.4.1.1.66" || startsWith(sop, "1.2.840.10008.5.1.4.1.1.66."))
-        return "a non-image object (" + sopClassName(sop) + ")";
-    if (sop == "1.2.840.10008.1.3.10") return "a DICOMDIR (media directory), not an image";
-    return "";
-}
-
-constexpr uint16_t kPixelGroup = 0x7fe0;
-using detail::checkNativeLength;
-using detail::elementLengthProblem;
-
-
-// Reads one file's header into `frames` (one per frame); returns the reason
-// to skip it, or "" when it is an image.
-std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>& frames) {
-    quietGdcm();
-    if (const std::string bad = elementLengthProblem(path, true); !bad.empty())
-        return bad.rfind("not a DICOM file", 0) == 0 ? bad : "corrupt DICOM: " + bad;
-    gdcm::Reader reader;
-    reader.SetFileName(path.c_str());
-    // GDCM reads the element it stops at: the pixel data are skipped, not
-    // loaded (their length is checked below).
-    if (!reader.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008), {gdcm::Tag(kPixelGroup, 0x0010)})) return "not a DICOM file (or unreadable)";
-    const gdcm::File& file = reader.GetFile();
-    const gdcm::DataSet& ds = file.GetDataSet();
-    const Fields f(file);
-    std::string sop = f.text(ds, 0x0008, 0x0016);
-    if (sop.empty()) sop = trim(f.text(file.GetHeader(), 0x0002, 0x0002));
-    if (const std::string why = nonImageClass(sop); !why.empty()) return why;
-    const auto rows = f.numbers(ds, 0x0028, 0x0010), cols = f.numbers(ds, 0x0028, 0x0011);
-    if (!rows || !cols || rows->size() != 1 || cols->size() != 1 || (*rows)[0] < 1 || (*cols)[0] < 1)
-        return "no image (no Rows/Columns; SOP class " + sopClassName(sop) + ")";
-    info.rows = uint32_t((*rows)[0]);
-    info.columns = uint32_t((*cols)[0]);
-
-    // The pixel data element itself (the header read stops before it).
-    uint64_t nativePixelBytes = 0;  // the length of native (not encapsulated) pixel data, else 0
-    {
-        gdcm::Reader pixels;
-        pixels.SetFileName(path.c_str());
-        const std::set<gdcm::Tag> tags{gdcm::Tag(kPixelGroup, 0x0008), gdcm::Tag(kPixelGroup, 0x0009), gdcm::Tag(kPixelGroup, 0x0010)};
-        // A file whose header reads but whose pixel data does not is part of
-        // its series all the same (damaged): the series is refused naming it,
-        // rather than showing a gap.
-        // GDCM would allocate a declared pixel length past the file's end
-        // before reading it: such a file is damaged without asking GDCM.
-        uint64_t declaredPixels = 0;
-        const std::string bad = elementLengthProblem(path, false, &declaredPixels);
-        if (!bad.empty()) {
-            const bool bigEndian = file.GetHeader().GetDataSetTransferSyntax() == gdcm::TransferSyntax::ExplicitVRBigEndian;
-            if (declaredPixels) info.damaged = checkNativeLength(path, uint32_t(declaredPixels), bigEndian);
-            if (info.damaged.empty()) info.damaged = "is corrupt: " + bad;
-        }
-        const bool read = bad.empty() && pixels.ReadSelectedTags(tags, false);
-        const gdcm::DataSet& p = pixels.GetFile().GetDataSet();
-        const gdcm::Tag pixelData(kPixelGroup, 0x0010);
-        if (!bad.empty()) {
-            // damaged, named above
-        } else if (!read) {
-            info.damaged = "is truncated or corrupt: its pixel data cannot be read";
-        } else {
-            if (p.FindDataElement(gdcm::Tag(kPixelGroup, 0x0008)) || p.FindDataElement(gdcm::Tag(kPixelGroup, 0x0009)))
-                return "float or double pixel data (Float/Double Float Pixel Data) is not supported";
-            if (!p.FindDataElement(pixelData)) return "no pixel data (SOP class " + sopClassName(sop) + ")";
-            const gdcm::VL vl = p.GetDataElement(pixelData).GetVL();
-            const bool bigEndian = file.GetHeader().GetDataSetTransferSyntax() == gdcm::TransferSyntax::ExplicitVRBigEndian;
-            if (!vl.IsUndefined() && uint32_t(vl) > 0) info.damaged = checkNativeLength(path, uint32_t(vl), bigEndian);
-            if (!vl.IsUndefined()) nativePixelBytes = uint32_t(vl);
-        }
-    }
-
-    info.file = path;
-    info.seriesUid = f.text(ds, 0x0020, 0x000e);
-    if (info.seriesUid.empty()) return "no Series Instance UID";
-    info.modality = f.text(ds, 0x0008, 0x0060);
-    info.description = f.text(ds, 0x0008, 0x103e);
-    if (const auto n = f.numbers(ds, 0x0020, 0x0011); n && n->size() == 1) info.seriesNumber = int64_t((*n)[0]);
-    const auto number = [&](uint16_t g, uint16_t e, unsigned fallback) {
-        const auto v = f.numbers(ds, g, e);
-        return v && v->size() == 1 && (*v)[0] >= 0 ? unsigned((*v)[0]) : fallback;
-    };
-    info.bitsAllocated = number(0x0028, 0x0100, 0);
-    info.bitsStored = number(0x0028, 0x0101, 0);
-    info.pixelRepresentation = number(0x0028, 0x0103, 0);
-    info.samplesPerPixel = number(0x0028, 0x0002, 1);
-    info.photometric = f.text(ds, 0x0028, 0x0004);
-    info.tags = dicomTagsOf([&](uint16_t group, uint16_t element) { return f.text(ds, group, element); });
-
-    // Geometry, rescale: from `where` (a functional group item or the top level).
-    const auto readPlane = [&](const gdcm::DataSet* posDs, const gdcm::DataSet* oriDs, const gdcm::DataSet* pixDs, const gdcm::DataSet* resDs,
-                               Frame& fr, bool& havePosition, bool& haveOrientation) -> std::string {
-        if (posDs) {
-            const auto p = f.numbers(*posDs, 0x0020, 0x0032);
-            if (!p) return "unreadable Image Position (Patient)";
-            if (p->size() == 3) { fr.position = {(*p)[0], (*p)[1], (*p)[2]}; havePosition = true; }
-            else if (!p->empty()) return "Image Position (Patient) does not hold 3 numbers";
-        }
-        if (oriDs) {
-            const auto o = f.numbers(*oriDs, 0x0020, 0x0037);
-            if (!o) return "unreadable Image Orientation (Patient)";
-            if (o->size() == 6) { std::copy(o->begin(), o->end(), fr.orientation.begin()); haveOrientation = true; }
-            else if (!o->empty()) return "Image Orientation (Patient) does not hold 6 numbers";
-        }
-        if (pixDs) {
-            auto s = f.numbers(*pixDs, 0x0028, 0x0030);
-            if (!s || s->size() != 2) s = f.numbers(*pixDs, 0x0018, 0x1164);  // Imager Pixel Spacing
-            if (s && s->size() == 2 && (*s)[0] > 0 && (*s)[1] > 0) {
-                fr.rowSpacing = (*s)[0];
-                fr.columnSpacing = (*s)[1];
-                fr.pixelSpacingGiven = true;
-            }
-            if (const auto t = f.numbers(*pixDs, 0x0018, 0x0050); t && t->size() == 1 && (*t)[0] > 0) fr.thickness = (*t)[0];
-        }
-        if (resDs) {
-            const auto a = f.numbers(*resDs, 0x0028, 0x1053), b = f.numbers(*resDs, 0x0028, 0x1052);
-            if (!a || !b || a->size() > 1 || b->size() > 1) return "unreadable Rescale Slope/Intercept";
-            if (a->size() == 1) fr.slope = (*a)[0];
-            if (b->size() == 1) fr.intercept = (*b)[0];
-        }
-        return "";
-    };
-
-    Frame base;
-    base.file = path;
-    bool basePos = false, baseOri = false;
-    if (std::string why = readPlane(&ds, &ds, &ds, &ds, base, basePos, baseOri); !why.empty()) return why;
-
-    const auto nf = f.numbers(ds, 0x0028, 0x0008);
-    const int64_t frameCount = nf && nf->size() == 1 && (*nf)[0] >= 1 ? int64_t((*nf)[0]) : 1;
-    // Native pixel data must hold every pixel the header declares: a forged
-    // 65535x65535 header over 64 bytes of pixels is damaged here, before a
-    // reader reserves gigabytes for its slices.
-    if (nativePixelBytes && info.damaged.empty() && info.bitsAllocated % 8 == 0) {
-        const uint64_t need = uint64_t(info.rows) * info.columns * std::max(1u, info.samplesPerPixel) * (info.bitsAllocated / 8) * uint64_t(frameCount);
-        if (nativePixelBytes < need)
-            info.damaged = fmt::format("is damaged: its pixel data hold {} bytes, fewer than the {} its {} frame(s) of {}x{} pixels need", nativePixelBytes,
-                                       need, frameCount, info.columns, info.rows);
-    }
-    gdcm::SmartPointer<gdcm::SequenceOfItems> sharedSq, perFrameSq;
-    const gdcm::DataSet* shared = firstItem(ds, 0x5200, 0x9229, sharedSq);
-    if (ds.FindDataElement(gdcm::Tag(0x5200, 0x9230))) perFrameSq = ds.GetDataElement(gdcm::Tag(0x5200, 0x9230)).GetValueAsSQ();
-
-    if (perFrameSq && perFrameSq->GetNumberOfItems() > 0) {
-        // Enhanced multi-frame: each frame's plane from its functional
-        // groups, falling back on the shared ones.
-        if (int64_t(perFrameSq->GetNumberOfItems()) != frameCount)
-            return fmt::format("multi-frame file with {} frames but {} Per-frame Functional Groups items", frameCount, perFrameSq->GetNumberOfItems());
-        for (int64_t k = 0; k < frameCount; ++k) {
-            const gdcm::DataSet& item = perFrameSq->GetItem(size_t(k + 1)).GetNestedDataSet();
-            Frame fr = base;
-            fr.frame = uint32_t(k);
-            fr.multiFrame = true;
-            bool havePos = basePos, haveOri = baseOri;
-            std::vector<gdcm::SmartPointer<gdcm::SequenceOfItems>> keep(8);
-            const auto group = [&](uint16_t g, uint16_t e, size_t slot) -> const gdcm::DataSet* {
-                if (const gdcm::DataSet* d = firstItem(item, g, e, keep[slot])) return d;
-                return shared ? firstItem(*shared, g, e, keep[slot + 4]) : nullptr;
-            };
-            const gdcm::DataSet* pos = group(0x0020, 0x9113, 0);
-            const gdcm::DataSet* ori = group(0x0020, 0x9116, 1);
-            const gdcm::DataSet* pix = group(0x0028, 0x9110, 2);
-            const gdcm::DataSet* res = group(0x0028, 0x9145, 3);
-            if (std::string why = readPlane(pos, ori, pix, res, fr, havePos, haveOri); !why.empty()) return fmt::format("frame {}: {}", k + 1, why);
-            if (!havePos || !haveOri) return fmt::format("multi-frame file: frame {} has no Plane Position/Orientation", k + 1);
-            frames.push_back(fr);
-        }
-        return "";
-    }
-    if (!basePos || !baseOri) return "no Image Position/Orientation (Patient) (SOP class " + sopClassName(sop) + "), so no place in a volume";
-    if (frameCount == 1) {
-        frames.push_back(base);
-        return "";
-    }
-    // Multi-frame without per-frame positions: frames stepped along the
-    // normal by Spacing Between Slices (or the RT Grid Frame Offset Vector).
-    const Vec3 r{base.orientation[0], base.orientation[1], base.orientation[2]}, c{base.orientation[3], base.orientation[4], base.orientation[5]};
-    Vec3 n = cross(r, c);
-    const double nn = norm(n);
-    if (!(nn > 0)) return "degenerate Image Orientation (Patient)";
-    n = scaled(n, 1 / nn);
-    std::vector<double> offsets;
-    if (const auto sbs = f.numbers(ds, 0x0018, 0x0088); sbs && sbs->size() == 1 && (*sbs)[0] != 0) {
-        for (int64_t k = 0; k < frameCount; ++k) offsets.push_back(double(k) * (*sbs)[0]);
-    } else if (const auto g = f.numbers(ds, 0x3004, 0x000c); g && int64_t(g->size()) == frameCount) {
-        offsets = *g;
-    } else {
-        return fmt::format("multi-frame file with {} frames but no per-frame positions (Per-frame Functional Groups) nor Spacing Between Slices; not supported",
-                           frameCount);
-    }
-    for (int64_t k = 0; k < frameCount; ++k) {
-        Frame fr = base;
-        fr.frame = uint32_t(k);
-        fr.multiFrame = true;
-        for (int a = 0; a < 3; ++a) fr.position[size_t(a)] += offsets[size_t(k)] * n[size_t(a)];
-        frames.push_back(fr);
-    }
-    return "";
-}
-
-// The files a DICOMDIR lists (Referenced File ID, relative to its folder).
-std::vector<std::string> dicomdirFiles(const std::string& path, std::vector<std::string>& skipped) {
-    quietGdcm();
-    if (const std::string bad = elementLengthProblem(path); !bad.empty()) throw Error(path + ": corrupt DICOMDIR: " + bad);
-    gdcm::Reader reader;
-    reader.SetFileName(path.c_str());
-    if (!reader.Read()) throw Error(path + ": not a readable DICOMDIR");
-    const gdcm::File& file = reader.GetFile();
-    const gdcm::DataSet& ds = file.GetDataSet();
-    const Fields f(file);
-    const gdcm::Tag records(0x0004, 0x1220);
-    if (!ds.FindDataElement(records)) throw Error(path + ": a DICOMDIR without a Directory Record Sequence");
-    const gdcm::SmartPointer<gdcm::SequenceOfItems> sq = ds.GetDataElement(records).GetValueAsSQ();
-    const fs::path folder = fs::path(path).parent_path();
-    std::vector<std::string> out;
-    std::set<std::string> seen;
-    for (size_t i = 1; sq && i <= sq->GetNumberOfItems(); ++i) {
-        const std::string id = f.text(sq->GetItem(i).GetNestedDataSet(), 0x0004, 0x1500);
-        if (id.empty()) continue;
-        fs::path p = folder;
-        bool outside = false;
-        size_t start = 0;
-        while (start <= id.size()) {
-            const size_t end = std::min(id.find('\\', start), id.size());
-            const std::string part = trim(id.substr(start, end - start));
-            if (part == ".." || part.find('/') != std::string::npos) outside = true;  // file IDs never leave the DICOMDIR's folder
-            if (!part.empty() && !outside) {
-                fs::path next = p / part;
-                std::error_code ec;
-                if (!fs::exists(next, ec)) {  // media file IDs are upper case; the disk may not be
-                    for (const auto& e : fs::directory_iterator(p, ec)) {
-                        std::string a = e.path().filename().string(), b = part;
-                        std::transform(a.begin(), a.end(), a.begin(), [](unsigned char ch) { return char(std::toupper(ch)); });
-                        std::transform(b.begin(), b.end(), b.begin(), [](unsigned char ch) { return char(std::toupper(ch)); });
-                        if (a == b) { next = e.path(); break; }
-                    }
-                }
-                p = next;
-            }
-            start = end + 1;
-        }
-        std::error_code ec;
-        if (outside) {
-            skipped.push_back(path + ": its file ID '" + id + "' leads out of its folder; not read");
-            continue;
-        }
-        if (!fs::is_regular_file(p, ec)) {
-            skipped.push_back(p.string() + ": listed in " + path + " but missing");
-            continue;
-        }
-        if (seen.insert(p.string()).second) out.push_back(p.string());
-    }
-    return out;
-}
 
 bool isDicomdirName(const fs::path& p) {
     std::string name = p.filename().string();
