@@ -1,6 +1,7 @@
-// See DicomSeries.h. GDCM reads the headers (gdcm::Reader up to the Pixel
-// Data, then a second look for the Pixel Data element itself) once the
-// element walk (detail/DicomElementWalk.h) has passed the file; native pixel
+// See DicomSeries.h. GDCM reads the headers (detail/DicomFileHeader.h:
+// gdcm::Reader up to the Pixel Data, then a second look for the Pixel Data
+// element itself) once the element walk (detail/DicomElementWalk.h) has
+// passed the file; native pixel
 // data are read where the walk found them, compressed ones are decoded by
 // gdcm::ImageReader (any transfer syntax it supports).
 // Every file, or every frame of a multi-frame file, becomes one candidate
