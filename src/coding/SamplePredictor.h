@@ -77,15 +77,13 @@ inline int64_t med(int64_t w, int64_t n, int64_t nw) {
 // A predictor's weight from its summed local errors E: 2^26 / (1 + E)^2 + 1
 // (E capped at 2^13), from a table: the blend's only divisions otherwise.
 // 2^26 keeps the weighted sum of six int32 predictions inside int64.
-inline int64_t weightOf(uint64_t errors) {
-    constexpr uint32_t kWeightCap = 1u << 13;
-    static const std::vector<uint32_t> table = [] {
-        std::vector<uint32_t> t(kWeightCap + 1);
-        for (uint64_t e = 0; e <= kWeightCap; ++e) t[e] = uint32_t((uint64_t(1) << 26) / ((1 + e) * (1 + e))) + 1;
-        return t;
-    }();
-    return table[errors < kWeightCap ? errors : kWeightCap];
-}
+inline constexpr uint32_t kWeightCap = 1u << 13;
+inline constexpr std::array<uint32_t, kWeightCap + 1> kWeights = [] {
+    std::array<uint32_t, kWeightCap + 1> t{};
+    for (uint64_t e = 0; e <= kWeightCap; ++e) t[e] = uint32_t((uint64_t(1) << 26) / ((1 + e) * (1 + e))) + 1;
+    return t;
+}();
+inline int64_t weightOf(uint64_t errors) { return kWeights[errors < kWeightCap ? errors : kWeightCap]; }
 
 // The neighbourhood of one sample: values (substitutes where missing) and
 // the records of W, N and P (a default record where missing). Every walk
@@ -118,7 +116,7 @@ inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxV
     out.p = {inPlane, n.W + n.N + n.P - n.NW - n.PW - n.PN + n.PNW, n.P + inPlane - med(n.PW, n.PN, n.PNW), n.W + n.NE - n.N, n.N + n.P - n.PN,
              n.W + n.P - n.PW};
     for (int64_t& q : out.p) q = std::clamp(q, minValue, maxValue);  // a prediction outside the range helps no one
-    const SampleRecord none{};
+    static constexpr SampleRecord none{};
     const SampleRecord& rW = n.rW ? *n.rW : none;
     const SampleRecord& rN = n.rN ? *n.rN : none;
     const SampleRecord& rP = n.rP ? *n.rP : none;
