@@ -87,7 +87,7 @@ bool looksLikeLabels(const format::EncodedGrid& grid) {
 
 void addRenderCommand(CLI::App& app, int& exitCode) {
     struct Options {
-        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels;
+        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels, iso;
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
         bool shadows = false, json = false, force = false;
@@ -110,13 +110,15 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--shading", opt->shading,
                     "auto (level sets as surfaces; fog volumes, by class or by content (densities >= 0, background 0), as fog; else voxels coloured by "
                     "value; a dense scan as mip, or as labels when it holds few integer values), fog, surface, values, mip (the largest value "
-                    "along each ray, air transparent) or labels (the first labelled voxel, a colour per label); mip and labels on the CPU tracer")
-        ->check(CLI::IsMember({"auto", "fog", "surface", "values", "mip", "labels"}))
+                    "along each ray, air transparent), labels (the first labelled voxel, a colour per label) or iso (the surface where the value first "
+                    "reaches --iso); mip, labels and iso on the CPU tracer")
+        ->check(CLI::IsMember({"auto", "fog", "surface", "values", "mip", "labels", "iso"}))
         ->capture_default_str();
     cmd->add_option("--window", opt->window,
                     "mip: LOW,HIGH, the values shown black to white (LOW and below transparent; default: Otsu's threshold of the pixels' "
                     "maxima to their 99.5th percentile)");
     cmd->add_option("--labels", opt->labels, "labels: the labels shown, e.g. 3,17 (default: every one but 0 and the background)");
+    cmd->add_option("--iso", opt->iso, "iso: the surface's value, e.g. 300 for a CT's bone (default: Otsu's threshold of the values, air against tissue)");
     cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(finiteNumber())->check(CLI::Range(1.0, 170.0));
     cmd->add_option("--backend", opt->backend, "vulkan, cpu, or auto (a Vulkan GPU when there is one, else the CPU tracer; a software Vulkan device such as lavapipe only with --backend vulkan)")->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
     cmd->add_option("--device", opt->device, "Vulkan device index (see `vdbdag devices`)");
@@ -159,7 +161,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                         trace::shadingOf(grid) + " (use --shading fog)");
         if (!opt->window.empty() && !grid.mip) throw Error(opt->input + ": --window applies to --shading mip");
         if (!opt->labels.empty() && !grid.labels) throw Error(opt->input + ": --labels applies to --shading labels");
-        const bool cpuOnly = grid.mip || grid.labels;
+        if (!opt->iso.empty() && !grid.iso) throw Error(opt->input + ": --iso applies to --shading iso");
+        const bool cpuOnly = grid.mip || grid.labels || grid.iso;
         if (cpuOnly && opt->backend == "vulkan")
             throw Error(opt->input + ": --shading " + trace::shadingOf(grid) + " is rendered by the CPU tracer only for now (use --backend cpu or auto)");
         if (cpuOnly && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
@@ -194,6 +197,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             if (!(w[1] > w[0])) throw Error("--window: HIGH must be greater than LOW");
             options.window = std::pair{w[0], w[1]};
         }
+        if (grid.iso && !opt->iso.empty()) options.iso = parseNumbers(opt->iso, 1, "--iso")[0];
         if (grid.labels && !opt->labels.empty())
             for (const double l : parseNumbers(opt->labels, size_t(std::count(opt->labels.begin(), opt->labels.end(), ',') + 1), "--labels")) {
                 if (l != std::trunc(l)) throw Error("--labels: " + std::to_string(l) + " is not an integer");
@@ -219,6 +223,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                              {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows},
                              {"shading", trace::shadingOf(grid)}, {"density_scale", grid.fog ? nlohmann::json(options.densityScale) : nlohmann::json()},
                              {"window", stats.window ? nlohmann::json({stats.window->first, stats.window->second}) : nlohmann::json()},
+                             {"iso", stats.iso ? nlohmann::json(*stats.iso) : nlohmann::json()},
                              {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}, {"target", {camera.target.x, camera.target.y, camera.target.z}},
                                          {"up", {camera.up.x, camera.up.y, camera.up.z}}}}};
             printJson(j);

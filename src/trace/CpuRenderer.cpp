@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "src/trace/DagTracer.h"
+#include "src/trace/IsoSurface.h"
 #include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/trace/SurfaceHit.h"
@@ -50,18 +51,23 @@ std::optional<glm::dvec3> storedNormal(const RenderGrid& grid, const RayHit& hit
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {
     const auto start = std::chrono::steady_clock::now();
-    if (grid.mip || grid.labels) {
+    if (grid.mip || grid.labels || grid.iso) {
         Image image;
         std::optional<std::pair<double, double>> window;
+        std::optional<double> iso;
         if (grid.mip) {
             Projection p = renderMip(grid, camera, options.window);
             image = std::move(p.image);
             window = std::pair{p.low, p.high};
+        } else if (grid.iso) {
+            iso = options.iso ? *options.iso : automaticIso(grid);
+            image = renderIso(grid, camera, options, *iso);
         } else {
             image = renderLabels(grid, camera, options);
         }
         if (stats) {
             stats->window = window;
+            stats->iso = iso;
             stats->primaryRays = uint64_t(camera.width) * uint64_t(camera.height);
             stats->secondaryRays = 0;
             stats->milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -18,6 +18,7 @@ struct RenderStats {
     uint64_t primaryRays = 0, secondaryRays = 0;
     double milliseconds = 0;
     std::optional<std::pair<double, double>> window;  // --shading mip: the display window used (given or chosen)
+    std::optional<double> iso;                        // --shading iso: the surface's value (given or chosen)
 };
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats = nullptr);

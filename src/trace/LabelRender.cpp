@@ -14,7 +14,7 @@ std::vector<std::optional<LabelHit>> firstLabels(const RenderGrid& grid, const C
         if (!shown.empty()) return std::find(shown.begin(), shown.end(), label) != shown.end();
         return label != 0 && label != grid.labelBackground;
     };
-    forEachPixelSegment(grid, camera, [&](size_t pixel, const RayHit& box, double v) {
+    forEachPixelSegment(grid, camera, [&](size_t pixel, const RayHit& box, double v, double) {
         const int64_t label = std::isfinite(v) ? int64_t(v) : 0;
         if (!isShown(label)) return false;
         hits[pixel] = LabelHit{box, label};

@@ -1,6 +1,6 @@
 // Every pixel's ray through a grid's occupied boxes (DagTracer::forEachSegment),
 // rows of pixels in parallel: the walk shared by the renderings that look at
-// values along the whole ray (Projection.h, LabelRender.h).
+// values along the whole ray (Projection.h, LabelRender.h, IsoSurface.h).
 #pragma once
 #include <cstddef>
 
@@ -13,9 +13,11 @@
 
 namespace vdbdag::trace {
 
-// visit(pixel, box, value) for each box along pixel's ray, in order, with
-// the box's scalar value (1 when the grid stores none); returning true ends
-// that ray. Calls for different pixels may run at once.
+// visit(pixel, box, value, tLeave) for each box along pixel's ray, in
+// order, with the box's scalar value (1 when the grid stores none) and the
+// ray parameter where the ray leaves it; returning true ends that ray.
+// Calls for different pixels may run at once; one pixel's all come from
+// one thread.
 template <typename Visit>
 void forEachPixelSegment(const RenderGrid& grid, const Camera& camera, Visit&& visit) {
     const GridFrame frame(grid.indexToWorld);
@@ -27,8 +29,8 @@ void forEachPixelSegment(const RenderGrid& grid, const Camera& camera, Visit&& v
                 glm::dvec3 eye, dir;
                 camera.pixelRay(px, py, eye, dir);
                 const size_t pixel = size_t(py) * size_t(camera.width) + size_t(px);
-                tracer.forEachSegment(frame.toCellRay(eye, dir), [&](const RayHit& box, double) {
-                    return visit(pixel, box, grid.values ? valueAsDoubles(grid, box.attribute, hint)[0] : 1.0);
+                tracer.forEachSegment(frame.toCellRay(eye, dir), [&](const RayHit& box, double tLeave) {
+                    return visit(pixel, box, grid.values ? valueAsDoubles(grid, box.attribute, hint)[0] : 1.0, tLeave);
                 });
             }
     });

@@ -12,7 +12,7 @@ namespace vdbdag::trace {
 
 std::vector<double> maximaAlongRays(const RenderGrid& grid, const Camera& camera) {
     std::vector<double> maxima(size_t(camera.width) * size_t(camera.height), std::numeric_limits<double>::quiet_NaN());
-    forEachPixelSegment(grid, camera, [&](size_t pixel, const RayHit&, double v) {
+    forEachPixelSegment(grid, camera, [&](size_t pixel, const RayHit&, double v, double) {
         double& m = maxima[pixel];
         if (!std::isnan(v) && (std::isnan(m) || v > m)) m = v;
         return false;

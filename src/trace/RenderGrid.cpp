@@ -29,12 +29,15 @@ Shading parseShading(const std::string& text) {
     if (text == "fog") return Shading::Fog;
     if (text == "mip") return Shading::Mip;
     if (text == "labels") return Shading::Labels;
+    if (text == "iso") return Shading::Iso;
     if (text == "surface") return Shading::Surface;
     if (text == "values") return Shading::Values;
-    throw Error("--shading: '" + text + "' is not auto, fog, surface, values, mip or labels");
+    throw Error("--shading: '" + text + "' is not auto, fog, surface, values, mip, labels or iso");
 }
 
-const char* shadingOf(const RenderGrid& grid) { return grid.labels ? "labels" : grid.mip ? "mip" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values"; }
+const char* shadingOf(const RenderGrid& grid) {
+    return grid.labels ? "labels" : grid.mip ? "mip" : grid.iso ? "iso" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values";
+}
 
 RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
     RenderGrid out;
@@ -81,9 +84,11 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
         break;
     case Shading::Values: break;
     case Shading::Mip:
+    case Shading::Iso:
         if (valueSize(out.valueType) == 0 || (out.valueType == ValueType::Vec3S || out.valueType == ValueType::Vec3D || out.valueType == ValueType::Vec3I) || out.valueType == ValueType::Bool)
-            throw Error("grid '" + grid.record.name + "' holds " + valueTypeName(out.valueType) + " values: a maximum intensity projection needs scalar values");
-        out.mip = true;
+            throw Error("grid '" + grid.record.name + "' holds " + valueTypeName(out.valueType) + " values: " +
+                        (shading == Shading::Mip ? "a maximum intensity projection" : "an isosurface") + " needs scalar values");
+        (shading == Shading::Mip ? out.mip : out.iso) = true;
         break;
     case Shading::Labels:
         if (out.valueType != ValueType::Int32 && out.valueType != ValueType::Int64)

@@ -24,6 +24,8 @@ struct RenderOptions {
     std::optional<std::pair<double, double>> window;
     // --shading labels: the labels shown (`--labels`; empty: every one but 0 and the background).
     std::vector<int64_t> labels;
+    // --shading iso: the surface's value (`--iso`; IsoSurface.h's automaticIso when absent).
+    std::optional<double> iso;
 };
 
 using access::kAmbient;

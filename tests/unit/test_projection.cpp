@@ -23,6 +23,7 @@
 #include "src/pipeline/GridCodec.h"
 #include "src/trace/Camera.h"
 #include "src/trace/CpuRenderer.h"
+#include "src/trace/IsoSurface.h"
 #include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/trace/RenderGrid.h"
@@ -176,6 +177,19 @@ TEST(Projection, ADenseScanRendersByDefaultAsAProjectionWithTransparentAir) {
     EXPECT_NE(note.find("maximum intensity projection"), std::string::npos) << note;
     EXPECT_GT(projected, 0.02);
     EXPECT_LE(projected, 0.85 * box) << projected << " of the pixels against the box's " << box;
+    // The isosurface of the ball's rim covers what the projection does
+    // (the ball, seen whole); --iso applies to --shading iso only.
+    EXPECT_NEAR(covered("--shading iso --iso 0", nullptr), projected, 0.01);
+    const vdbdag::testing::CommandResult json = vdbdag::testing::runCli("render " + ss.string() + " -o " + (dir / "i.png").string() +
+                                                                        " -f --width 32 --height 32 --shading iso --json");
+    ASSERT_EQ(json.exitCode, 0) << json.err;
+    const double chosen = nlohmann::json::parse(json.out).at("iso").get<double>();
+    EXPECT_GT(chosen, -1000.0);
+    EXPECT_LT(chosen, 1000.0);
+    const vdbdag::testing::CommandResult refused = vdbdag::testing::runCli("render " + ss.string() + " -o " + (dir / "j.png").string() + " --iso 5");
+    EXPECT_NE(refused.exitCode, 0);
+    EXPECT_NE(refused.err.find("--iso applies to --shading iso"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(dir / "j.png"));
     fs::remove_all(dir);
 }
 
@@ -260,3 +274,57 @@ TEST(LabelRender, FirstLabelsEqualABruteForceOverTheDenseBlock) {
     EXPECT_EQ(trace::labelColour(17), trace::labelColour(17));
 }
 
+
+// Isosurfaces (src/trace/IsoSurface.h, `--shading iso`) against a brute
+// force over 10^4 rays: each pixel's hit is the voxel reaching the value
+// that its ray enters first (every box tested by the slab method), at two
+// values; the interpolated crossing lies between the centres of that voxel
+// and the one before it; the image is lit where the brute force meets one.
+TEST(IsoSurface, FirstCrossingsEqualABruteForceOverTheDenseBlock) {
+    const auto valueAt = [](int x, int y, int z) -> int32_t {
+        const double r = std::sqrt((x - 5.5) * (x - 5.5) + (y - 4.5) * (y - 4.5) + (z - 3.5) * (z - 3.5));
+        return int32_t(std::lround(1000 - 180 * r + 37 * ((x * 7 + y * 3 + z * 5) % 4)));
+    };
+    const format::EncodedGrid encoded = denseBlock(valueAt);
+    const trace::RenderGrid grid = trace::makeRenderGrid(encoded, trace::Shading::Iso);
+    ASSERT_TRUE(grid.iso);
+    trace::Camera camera = obliqueCamera();
+    camera.width = 100, camera.height = 100;
+    for (const double iso : {400.0, 733.5}) {
+        const std::vector<std::optional<trace::IsoHit>> hits = trace::firstCrossings(grid, camera, iso);
+        size_t met = 0, differ = 0;
+        for (int py = 0; py < camera.height; ++py)
+            for (int px = 0; px < camera.width; ++px) {
+                glm::dvec3 o, d;
+                camera.pixelRay(px, py, o, d);
+                double bestT = std::numeric_limits<double>::infinity();
+                std::array<int64_t, 3> want{};
+                for (int z = 0; z < kNz; ++z)
+                    for (int y = 0; y < kNy; ++y)
+                        for (int x = 0; x < kNx; ++x) {
+                            double t = 0;
+                            if (valueAt(x, y, z) >= iso &&
+                                crosses(o, d, glm::dvec3(x - 0.5, y - 0.5, z - 0.5) * kVoxel, glm::dvec3(x + 0.5, y + 0.5, z + 0.5) * kVoxel, &t) &&
+                                t < bestT)
+                                bestT = t, want = {x, y, z};
+                        }
+                const auto& got = hits[size_t(py) * size_t(camera.width) + size_t(px)];
+                if (std::isinf(bestT)) {
+                    EXPECT_FALSE(got.has_value()) << px << "," << py;
+                    continue;
+                }
+                ++met;
+                differ += !got || got->box.voxel != want;
+                if (got) EXPECT_GE(valueAt(int(got->box.voxel[0]), int(got->box.voxel[1]), int(got->box.voxel[2])), iso);
+            }
+        EXPECT_GT(met, 200u) << iso;
+        EXPECT_EQ(differ, 0u) << "of " << met << " pixels, iso " << iso;
+        trace::RenderOptions options;
+        const trace::Image image = trace::renderIso(grid, camera, options, iso);
+        for (size_t i = 0; i < hits.size(); ++i) EXPECT_EQ(image.alpha[i] > 0, hits[i].has_value()) << i;
+    }
+    // The default value parts the low values from the high ones.
+    const double automatic = trace::automaticIso(grid);
+    EXPECT_GT(automatic, double(valueAt(0, 0, 0)));
+    EXPECT_LT(automatic, double(valueAt(5, 4, 3)));
+}

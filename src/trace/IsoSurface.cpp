@@ -1,0 +1,108 @@
+// See IsoSurface.h.
+#include "src/trace/IsoSurface.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "src/trace/DagTracer.h"
+#include "src/trace/PixelSegments.h"
+#include "src/trace/Projection.h"
+
+namespace vdbdag::trace {
+
+std::vector<std::optional<IsoHit>> firstCrossings(const RenderGrid& grid, const Camera& camera, double iso) {
+    const size_t pixels = size_t(camera.width) * size_t(camera.height);
+    std::vector<std::optional<IsoHit>> hits(pixels);
+    // Per pixel, the box before on the ray: its value, centre and exit.
+    struct Before {
+        double value = std::numeric_limits<double>::quiet_NaN(), centre = 0, leave = -1;
+    };
+    std::vector<Before> before(pixels);
+    forEachPixelSegment(grid, camera, [&](size_t pixel, const RayHit& box, double v, double tLeave) {
+        Before& b = before[pixel];
+        if (!(v >= iso)) {  // below, or NaN
+            b = {v, 0.5 * (box.t + tLeave), tLeave};
+            return false;
+        }
+        double t = box.t;
+        if (b.value < iso && b.leave == box.t) {  // touching boxes: between their centres
+            const double centre = 0.5 * (box.t + tLeave);
+            t = b.centre + (iso - b.value) / (v - b.value) * (centre - b.centre);
+        }
+        hits[pixel] = IsoHit{box, t};
+        return true;
+    });
+    return hits;
+}
+
+double automaticIso(const RenderGrid& grid) {
+    if (!grid.values || grid.values->entryCount == 0) return 0.5;
+    const uint64_t n = grid.values->entryCount, stride = std::max<uint64_t>(1, n >> 20);
+    std::vector<double> sample;
+    sample.reserve(size_t(n / stride + 1));
+    size_t hint = 0;
+    for (uint64_t e = 0; e < n; e += stride) sample.push_back(valueAsDoubles(grid, e, hint)[0]);
+    return automaticWindow(sample).first;
+}
+
+namespace {
+
+// The values' gradient at a voxel in index space by central differences
+// (one-sided where a neighbour is not stored); nullopt where it vanishes.
+std::optional<glm::dvec3> valueGradient(const RenderGrid& grid, const DagTracer& tracer, const RayHit& hit) {
+    const double centre = valueAsDoubles(grid, hit.attribute)[0];
+    glm::dvec3 g(0);
+    for (int a = 0; a < 3; ++a) {
+        std::array<int64_t, 3> plus = hit.voxel, minus = hit.voxel;
+        ++plus[size_t(a)];
+        --minus[size_t(a)];
+        const auto p = tracer.find(plus), m = tracer.find(minus);
+        if (p && m) g[a] = (valueAsDoubles(grid, *p)[0] - valueAsDoubles(grid, *m)[0]) * 0.5;
+        else if (p) g[a] = valueAsDoubles(grid, *p)[0] - centre;
+        else if (m) g[a] = centre - valueAsDoubles(grid, *m)[0];
+    }
+    const double len = glm::length(g);
+    if (!(len > 0) || !std::isfinite(len)) return std::nullopt;
+    return g / len;
+}
+
+} // namespace
+
+Image renderIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, double iso) {
+    const GridFrame frame(grid.indexToWorld);
+    const DagTracer tracer(*grid.dag);
+    const glm::dvec3 light = defaultLight(camera.eye, camera.target, camera.up);
+    const std::vector<std::optional<IsoHit>> hits = firstCrossings(grid, camera, iso);
+    Image image;
+    image.resize(camera.width, camera.height);
+    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& rows) {
+        for (int py = rows.begin(); py != rows.end(); ++py)
+            for (int px = 0; px < camera.width; ++px) {
+                const size_t i = size_t(py) * size_t(camera.width) + size_t(px);
+                glm::dvec3 colour = options.background;
+                if (const std::optional<IsoHit>& h = hits[i]) {
+                    glm::dvec3 eye, dir;
+                    camera.pixelRay(px, py, eye, dir);
+                    glm::dvec3 normal = -dir;
+                    if (const std::optional<glm::dvec3> g = valueGradient(grid, tracer, h->box)) {
+                        normal = frame.normalToWorld(-*g);
+                    } else if (h->box.faceAxis >= 0) {
+                        glm::dvec3 n(0);
+                        n[h->box.faceAxis] = h->box.faceSign;
+                        normal = frame.normalToWorld(n);
+                    }
+                    if (glm::dot(normal, dir) > 0) normal = -normal;
+                    const double lambert = std::max(0.0, glm::dot(normal, light));
+                    colour = kMaterial * (kAmbient + (1 - kAmbient) * lambert);
+                    image.alpha[i] = 1;
+                    image.depth[i] = float(h->t);
+                    for (int a = 0; a < 3; ++a) image.normal[3 * i + size_t(a)] = float(normal[a]);
+                }
+                for (int a = 0; a < 3; ++a) image.rgb[3 * i + size_t(a)] = float(colour[a]);
+            }
+    });
+    return image;
+}
+
+} // namespace vdbdag::trace
