@@ -12,6 +12,7 @@
 #include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/trace/SurfaceHit.h"
+#include "src/trace/VolumeRender.h"
 
 namespace vdbdag::trace {
 namespace {
@@ -51,7 +52,7 @@ std::optional<glm::dvec3> storedNormal(const RenderGrid& grid, const RayHit& hit
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {
     const auto start = std::chrono::steady_clock::now();
-    if (grid.mip || grid.labels || grid.iso) {
+    if (grid.mip || grid.labels || grid.iso || grid.volume) {
         Image image;
         std::optional<std::pair<double, double>> window;
         std::optional<double> iso;
@@ -59,6 +60,11 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
             Projection p = renderMip(grid, camera, options.window);
             image = std::move(p.image);
             window = std::pair{p.low, p.high};
+        } else if (grid.volume) {
+            TransferFunction tf = automaticTransfer(grid);
+            if (options.window) tf.low = options.window->first, tf.high = options.window->second;
+            image = renderVolume(grid, camera, options, tf);
+            window = std::pair{tf.low, tf.high};
         } else if (grid.iso) {
             iso = options.iso ? *options.iso : automaticIso(grid);
             image = renderIso(grid, camera, options, *iso);

@@ -30,13 +30,14 @@ Shading parseShading(const std::string& text) {
     if (text == "mip") return Shading::Mip;
     if (text == "labels") return Shading::Labels;
     if (text == "iso") return Shading::Iso;
+    if (text == "volume") return Shading::Volume;
     if (text == "surface") return Shading::Surface;
     if (text == "values") return Shading::Values;
-    throw Error("--shading: '" + text + "' is not auto, fog, surface, values, mip, labels or iso");
+    throw Error("--shading: '" + text + "' is not auto, fog, surface, values, mip, labels, iso or volume");
 }
 
 const char* shadingOf(const RenderGrid& grid) {
-    return grid.labels ? "labels" : grid.mip ? "mip" : grid.iso ? "iso" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values";
+    return grid.labels ? "labels" : grid.mip ? "mip" : grid.iso ? "iso" : grid.volume ? "volume" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values";
 }
 
 RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
@@ -85,10 +86,12 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
     case Shading::Values: break;
     case Shading::Mip:
     case Shading::Iso:
+    case Shading::Volume:
         if (valueSize(out.valueType) == 0 || (out.valueType == ValueType::Vec3S || out.valueType == ValueType::Vec3D || out.valueType == ValueType::Vec3I) || out.valueType == ValueType::Bool)
             throw Error("grid '" + grid.record.name + "' holds " + valueTypeName(out.valueType) + " values: " +
-                        (shading == Shading::Mip ? "a maximum intensity projection" : "an isosurface") + " needs scalar values");
-        (shading == Shading::Mip ? out.mip : out.iso) = true;
+                        (shading == Shading::Mip ? "a maximum intensity projection" : shading == Shading::Iso ? "an isosurface" : "volume rendering") +
+                        " needs scalar values");
+        (shading == Shading::Mip ? out.mip : shading == Shading::Iso ? out.iso : out.volume) = true;
         break;
     case Shading::Labels:
         if (out.valueType != ValueType::Int32 && out.valueType != ValueType::Int64)

@@ -20,7 +20,8 @@ struct RenderOptions {
     double densityScale = 0.08; // fog: extinction per voxel length at the grid's largest density
     glm::dvec3 background{0.10, 0.11, 0.13};
     // --shading mip: the display window [low, high] (Projection.h; chosen
-    // from the image when absent).
+    // from the image when absent); --shading volume: the transfer
+    // function's window (VolumeRender.h; chosen from the values).
     std::optional<std::pair<double, double>> window;
     // --shading labels: the labels shown (`--labels`; empty: every one but 0 and the background).
     std::vector<int64_t> labels;

@@ -27,6 +27,7 @@
 #include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/trace/RenderGrid.h"
+#include "src/trace/VolumeRender.h"
 #include "tests/unit/CliRunner.h"
 #include "vdb_bridge/VdbImport.h"
 
@@ -138,11 +139,12 @@ TEST(Projection, TheAutomaticWindowSeparatesAirFromTissue) {
 }
 
 // `render` of a dense scan with the default shading (issue 42: a CT
-// rendered as an opaque box): a maximum intensity projection whose air is
-// transparent. A 48^3 int16 scan of a ball (1000) in air (-1000): the
-// covered pixels (alpha read back by OpenImageIO) are those whose ray meets
-// the ball, far fewer than the box's, which `--shading values` covers.
-TEST(Projection, ADenseScanRendersByDefaultAsAProjectionWithTransparentAir) {
+// rendered as an opaque box): a volume whose air is transparent, as the
+// maximum intensity projection's is. A 48^3 int16 scan of a ball (1000) in
+// air (-1000): the covered pixels (alpha read back by OpenImageIO) are
+// those whose ray meets the ball, far fewer than the box's, which
+// `--shading values` covers.
+TEST(Projection, ADenseScanRendersByDefaultAsAVolumeWithTransparentAir) {
     const fs::path dir = fs::temp_directory_path() / ("vdbdag_mip_cli_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const fs::path raw = dir / "ball_48x48x48_int16le.raw", ss = dir / "ball.ssvdag";
@@ -173,8 +175,9 @@ TEST(Projection, ADenseScanRendersByDefaultAsAProjectionWithTransparentAir) {
         return double(n) / double(a.size());
     };
     std::string note;
-    const double projected = covered("", &note), box = covered("--shading values", nullptr);
-    EXPECT_NE(note.find("maximum intensity projection"), std::string::npos) << note;
+    const double volume = covered("", &note), projected = covered("--shading mip", nullptr), box = covered("--shading values", nullptr);
+    EXPECT_NE(note.find("shown as a volume"), std::string::npos) << note;
+    EXPECT_NEAR(volume, projected, 0.01) << "the ball's pixels, no more";
     EXPECT_GT(projected, 0.02);
     EXPECT_LE(projected, 0.85 * box) << projected << " of the pixels against the box's " << box;
     // The isosurface of the ball's rim covers what the projection does
@@ -327,4 +330,110 @@ TEST(IsoSurface, FirstCrossingsEqualABruteForceOverTheDenseBlock) {
     const double automatic = trace::automaticIso(grid);
     EXPECT_GT(automatic, double(valueAt(0, 0, 0)));
     EXPECT_LT(automatic, double(valueAt(5, 4, 3)));
+}
+
+// Volume rendering (src/trace/VolumeRender.h, `--shading volume`) against a
+// brute force: each pixel's ray against every voxel of the dense block (slab
+// method), the boxes it crosses composited front to back in order of entry
+// through the same transfer function, lit by a central-difference gradient
+// of the dense array itself (not of the DAG's lookups), with the renderer's
+// thresholds (light above 0.01 of opacity, stop under 0.02 transmittance).
+TEST(VolumeRender, CompositingEqualsABruteForceOverTheDenseBlock) {
+    const auto valueAt = [](int x, int y, int z) -> int32_t {
+        const double r = std::sqrt((x - 5.5) * (x - 5.5) + (y - 4.5) * (y - 4.5) + (z - 3.5) * (z - 3.5));
+        return int32_t(std::lround(900 - 150 * r + 29 * ((x * 5 + y * 3 + z * 7) % 5)));
+    };
+    const format::EncodedGrid encoded = denseBlock(valueAt);
+    const trace::RenderGrid grid = trace::makeRenderGrid(encoded, trace::Shading::Volume);
+    ASSERT_TRUE(grid.volume);
+    const trace::Camera camera = obliqueCamera();
+    const trace::TransferFunction tf{200, 900};
+    trace::RenderOptions options;
+    const trace::Image image = trace::renderVolume(grid, camera, options, tf);
+    const glm::dvec3 light = trace::defaultLight(camera.eye, camera.target, camera.up);
+    const auto stored = [&](int x, int y, int z) { return x >= 0 && y >= 0 && z >= 0 && x < kNx && y < kNy && z < kNz; };
+    size_t met = 0;
+    double worst = 0;
+    for (int py = 0; py < camera.height; ++py)
+        for (int px = 0; px < camera.width; ++px) {
+            glm::dvec3 o, d;
+            camera.pixelRay(px, py, o, d);
+            struct Crossing {
+                double t0, t1;
+                int x, y, z;
+            };
+            std::vector<Crossing> crossings;
+            for (int z = 0; z < kNz; ++z)
+                for (int y = 0; y < kNy; ++y)
+                    for (int x = 0; x < kNx; ++x) {
+                        const glm::dvec3 lo = glm::dvec3(x - 0.5, y - 0.5, z - 0.5) * kVoxel, hi = glm::dvec3(x + 0.5, y + 0.5, z + 0.5) * kVoxel;
+                        double t0 = 0;
+                        if (!crosses(o, d, lo, hi, &t0)) continue;
+                        double t1 = std::numeric_limits<double>::infinity();  // the exit
+                        for (int a = 0; a < 3; ++a)
+                            if (d[a] != 0) t1 = std::min(t1, std::max((lo[a] - o[a]) / d[a], (hi[a] - o[a]) / d[a]));
+                        crossings.push_back({t0, t1, x, y, z});
+                    }
+            std::sort(crossings.begin(), crossings.end(), [](const Crossing& a, const Crossing& b) { return a.t0 < b.t0; });
+            double transmittance = 1;
+            glm::dvec3 sum(0);
+            for (const Crossing& c : crossings) {
+                const double v = valueAt(c.x, c.y, c.z), a = tf.opacity(v);
+                if (a <= 0) continue;
+                const double alpha = 1 - std::pow(1 - a, (c.t1 - c.t0) * glm::length(d) / kVoxel);
+                if (!(alpha > 0)) continue;
+                double lit = 1;
+                if (alpha > 0.01) {
+                    glm::dvec3 g(0);
+                    for (int k = 0; k < 3; ++k) {
+                        int p[3] = {c.x, c.y, c.z}, m[3] = {c.x, c.y, c.z};
+                        ++p[k], --m[k];
+                        const bool hp = stored(p[0], p[1], p[2]), hm = stored(m[0], m[1], m[2]);
+                        if (hp && hm) g[k] = (valueAt(p[0], p[1], p[2]) - valueAt(m[0], m[1], m[2])) * 0.5;
+                        else if (hp) g[k] = valueAt(p[0], p[1], p[2]) - v;
+                        else if (hm) g[k] = v - valueAt(m[0], m[1], m[2]);
+                    }
+                    if (glm::length(g) > 0) {
+                        glm::dvec3 n = glm::normalize(-g);
+                        if (glm::dot(n, d) > 0) n = -n;
+                        lit = trace::kAmbient + (1 - trace::kAmbient) * std::max(0.0, glm::dot(n, light));
+                    }
+                }
+                sum += transmittance * alpha * lit * tf.colour(v);
+                transmittance *= 1 - alpha;
+                if (transmittance < 0.02) break;
+            }
+            const size_t i = size_t(py) * size_t(camera.width) + size_t(px);
+            EXPECT_NEAR(image.alpha[i], 1 - transmittance, 1e-5) << px << "," << py;
+            const glm::dvec3 want = sum + transmittance * options.background;
+            for (int a = 0; a < 3; ++a) worst = std::max(worst, std::abs(double(image.rgb[3 * i + size_t(a)]) - want[a]));
+            met += transmittance < 1;
+        }
+    EXPECT_GT(met, 100u);
+    EXPECT_LT(worst, 1e-5) << "largest colour difference over " << met << " covered pixels";
+}
+
+// The default shading of a dense scan in bytes: an 8-bit scan (a ball of
+// noisy tissue in air, at most 256 values with 0 among them) is a volume;
+// a label volume of the same type and shape (three regions) is labels.
+TEST(Projection, AnEightBitScanIsAVolumeAndALabelVolumeIsLabelsByDefault) {
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_u8_default_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::mt19937 rng(4);
+    const auto shadingOf = [&](const std::string& name, auto&& sample) {
+        const fs::path raw = dir / (name + "_40x40x40_uint8.raw");
+        std::vector<uint8_t> samples(40 * 40 * 40);
+        for (int z = 0; z < 40; ++z)
+            for (int y = 0; y < 40; ++y)
+                for (int x = 0; x < 40; ++x) samples[size_t((z * 40 + y) * 40 + x)] = sample(x, y, z);
+        std::ofstream(raw, std::ios::binary).write(reinterpret_cast<const char*>(samples.data()), std::streamsize(samples.size()));
+        const vdbdag::testing::CommandResult r =
+            vdbdag::testing::runCli("render " + raw.string() + " -o " + (dir / (name + ".png")).string() + " -f --width 16 --height 16 --json");
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return r.exitCode == 0 ? nlohmann::json::parse(r.out).at("shading").get<std::string>() : std::string();
+    };
+    const auto r = [](int x, int y, int z) { return std::sqrt((x - 19.5) * (x - 19.5) + (y - 19.5) * (y - 19.5) + (z - 19.5) * (z - 19.5)); };
+    EXPECT_EQ(shadingOf("scan", [&](int x, int y, int z) { return uint8_t(r(x, y, z) < 15 ? 120 + rng() % 60 : rng() % 3); }), "volume");
+    EXPECT_EQ(shadingOf("atlas", [&](int x, int y, int z) { return uint8_t(r(x, y, z) < 8 ? 7 : r(x, y, z) < 15 ? (x < 20 ? 3 : 4) : 0); }), "labels");
+    fs::remove_all(dir);
 }

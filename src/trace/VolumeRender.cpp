@@ -1,0 +1,106 @@
+// See VolumeRender.h.
+#include "src/trace/VolumeRender.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "src/trace/DagTracer.h"
+#include "src/trace/Projection.h"
+
+namespace vdbdag::trace {
+
+double TransferFunction::opacity(double v) const {
+    if (!(v > low)) return 0;
+    const double t = std::min(1.0, (v - low) / (high > low ? high - low : 1));
+    return kMaxOpacity * t * t;
+}
+
+glm::dvec3 TransferFunction::colour(double v) const {
+    const double t = std::clamp((v - low) / (high > low ? high - low : 1), 0.0, 1.0);
+    const glm::dvec3 dark(0.45, 0.12, 0.06), ivory(0.95, 0.90, 0.78);  // linear light
+    return dark + (ivory - dark) * std::sqrt(t);
+}
+
+TransferFunction automaticTransfer(const RenderGrid& grid) {
+    if (!grid.values || grid.values->entryCount == 0) return {};
+    const uint64_t n = grid.values->entryCount, stride = std::max<uint64_t>(1, n >> 20);
+    std::vector<double> sample;
+    sample.reserve(size_t(n / stride + 1));
+    size_t hint = 0;
+    for (uint64_t e = 0; e < n; e += stride) sample.push_back(valueAsDoubles(grid, e, hint)[0]);
+    const auto [low, high] = automaticWindow(sample);
+    return {low, high};
+}
+
+namespace {
+
+// The values' gradient at a voxel in index space by central differences
+// (one-sided where a neighbour is not stored); zero where it vanishes.
+glm::dvec3 valueGradient(const RenderGrid& grid, const DagTracer& tracer, const std::array<int64_t, 3>& voxel, double centre) {
+    glm::dvec3 g(0);
+    for (int a = 0; a < 3; ++a) {
+        std::array<int64_t, 3> plus = voxel, minus = voxel;
+        ++plus[size_t(a)];
+        --minus[size_t(a)];
+        const auto p = tracer.find(plus), m = tracer.find(minus);
+        if (p && m) g[a] = (valueAsDoubles(grid, *p)[0] - valueAsDoubles(grid, *m)[0]) * 0.5;
+        else if (p) g[a] = valueAsDoubles(grid, *p)[0] - centre;
+        else if (m) g[a] = centre - valueAsDoubles(grid, *m)[0];
+    }
+    return g;
+}
+
+} // namespace
+
+Image renderVolume(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const TransferFunction& tf) {
+    const GridFrame frame(grid.indexToWorld);
+    const DagTracer tracer(*grid.dag);
+    const glm::dvec3 light = defaultLight(camera.eye, camera.target, camera.up);
+    Image image;
+    image.resize(camera.width, camera.height);
+    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& rows) {
+        size_t hint = 0;
+        for (int py = rows.begin(); py != rows.end(); ++py)
+            for (int px = 0; px < camera.width; ++px) {
+                const size_t pixel = size_t(py) * size_t(camera.width) + size_t(px);
+                glm::dvec3 eye, dir;
+                camera.pixelRay(px, py, eye, dir);
+                const Ray ray = frame.toCellRay(eye, dir);
+                // The cell ray's parameter per voxel length along it.
+                const double perVoxel = 1 / std::sqrt(ray.direction[0] * ray.direction[0] + ray.direction[1] * ray.direction[1] +
+                                                      ray.direction[2] * ray.direction[2]);
+                double transmittance = 1, firstHit = -1;
+                glm::dvec3 sum(0);
+                tracer.forEachSegment(ray, [&](const RayHit& box, double tLeave) {
+                    const double v = grid.values ? valueAsDoubles(grid, box.attribute, hint)[0] : 1.0;
+                    const double a = tf.opacity(v);
+                    if (a <= 0) return false;
+                    const double alpha = 1 - std::pow(1 - a, (tLeave - box.t) / perVoxel);
+                    if (!(alpha > 0)) return false;
+                    if (firstHit < 0) firstHit = box.t;
+                    double lit = 1;
+                    if (alpha > 0.01) {  // worth a gradient: lit as a surface facing the viewer
+                        glm::dvec3 g = valueGradient(grid, tracer, box.voxel, v);
+                        if (glm::length(g) > 0) {
+                            glm::dvec3 n = frame.normalToWorld(-g);
+                            if (glm::dot(n, dir) > 0) n = -n;
+                            lit = kAmbient + (1 - kAmbient) * std::max(0.0, glm::dot(n, light));
+                        }
+                    }
+                    sum += transmittance * alpha * lit * tf.colour(v);
+                    transmittance *= 1 - alpha;
+                    return transmittance < 0.02;
+                });
+                const glm::dvec3 colour = sum + transmittance * options.background;
+                image.alpha[pixel] = float(1 - transmittance);
+                if (firstHit >= 0) image.depth[pixel] = float(firstHit);
+                for (int c = 0; c < 3; ++c) image.rgb[3 * pixel + size_t(c)] = float(colour[c]);
+            }
+    });
+    return image;
+}
+
+} // namespace vdbdag::trace
