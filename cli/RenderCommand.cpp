@@ -22,6 +22,7 @@
 #include "src/trace/FogDensity.h"
 #include "src/trace/Camera.h"
 #include "src/trace/RenderGrid.h"
+#include "src/trace/SliceView.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
 #include "vdb_bridge/DenseImport.h"
@@ -95,7 +96,7 @@ bool looksLikeLabels(const format::EncodedGrid& grid) {
 
 void addRenderCommand(CLI::App& app, int& exitCode) {
     struct Options {
-        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels, iso;
+        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels, iso, slice;
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
         bool shadows = false, json = false, force = false;
@@ -119,15 +120,16 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                     "auto (level sets as surfaces; fog volumes, by class or by content (densities >= 0, background 0), as fog; else voxels coloured by "
                     "value; a dense scan as volume, or as labels when it holds few integer values), fog, surface, values, mip (the largest value "
                     "along each ray, air transparent), labels (the first labelled voxel, a colour per label), iso (the surface where the value first "
-                    "reaches --iso) or volume (emission-absorption through a transfer function over --window); mip, labels, iso and volume "
-                    "on the CPU tracer")
-        ->check(CLI::IsMember({"auto", "fog", "surface", "values", "mip", "labels", "iso", "volume"}))
+                    "reaches --iso), volume (emission-absorption through a transfer function over --window) or slice (the voxels of --slice in "
+                    "grey); mip, labels, iso, volume and slice on the CPU tracer")
+        ->check(CLI::IsMember({"auto", "fog", "surface", "values", "mip", "labels", "iso", "volume", "slice"}))
         ->capture_default_str();
     cmd->add_option("--window", opt->window,
                     "mip: LOW,HIGH, the values shown black to white (LOW and below transparent; default: Otsu's threshold of the pixels' "
                     "maxima to their 99.5th percentile); volume: LOW,HIGH, the transfer function's ramp (default: Otsu's threshold of the "
                     "values to their 99.5th percentile)");
     cmd->add_option("--labels", opt->labels, "labels: the labels shown, e.g. 3,17 (default: every one but 0 and the background)");
+    cmd->add_option("--slice", opt->slice, "slice: AXIS=INDEX, the voxels shown (z=40: those of index z 40), seen along that axis unless --view/--up/--camera say");
     cmd->add_option("--iso", opt->iso, "iso: the surface's value, e.g. 300 for a CT's bone (default: Otsu's threshold of the values, air against tissue)");
     cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(finiteNumber())->check(CLI::Range(1.0, 170.0));
     cmd->add_option("--backend", opt->backend, "vulkan, cpu, or auto (a Vulkan GPU when there is one, else the CPU tracer; a software Vulkan device such as lavapipe only with --backend vulkan)")->check(CLI::IsMember({"auto", "vulkan", "cpu"}));
@@ -170,10 +172,13 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         if (cmdDensityScaleGiven && !grid.fog)
             throw Error(opt->input + ": --density-scale applies to fog shading, and grid '" + chosen->record.name + "' is shown as " +
                         trace::shadingOf(grid) + " (use --shading fog)");
-        if (!opt->window.empty() && !grid.mip && !grid.volume) throw Error(opt->input + ": --window applies to --shading mip and volume");
+        if (!opt->window.empty() && !grid.mip && !grid.volume && !grid.slice) throw Error(opt->input + ": --window applies to --shading mip, volume and slice");
+        if (!opt->slice.empty() && !grid.slice) throw Error(opt->input + ": --slice applies to --shading slice");
+        if (grid.slice && opt->slice.empty()) throw Error(opt->input + ": --shading slice needs --slice AXIS=INDEX (e.g. z=40)");
+        const std::optional<trace::SlicePlane> slicePlane = grid.slice ? std::optional(trace::parseSlicePlane(opt->slice)) : std::nullopt;
         if (!opt->labels.empty() && !grid.labels) throw Error(opt->input + ": --labels applies to --shading labels");
         if (!opt->iso.empty() && !grid.iso) throw Error(opt->input + ": --iso applies to --shading iso");
-        const bool cpuOnly = grid.mip || grid.labels || grid.iso || grid.volume;
+        const bool cpuOnly = grid.mip || grid.labels || grid.iso || grid.volume || grid.slice;
         if (cpuOnly && opt->backend == "vulkan")
             throw Error(opt->input + ": --shading " + trace::shadingOf(grid) + " is rendered by the CPU tracer only for now (use --backend cpu or auto)");
         if (cpuOnly && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
@@ -184,7 +189,9 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         trace::ViewSpec view{trace::parseUpAxis(opt->up), trace::parseView(opt->view)};
         // A scan in patient space (LPS: x left, y posterior, z superior; RAS
         // flips x and y) is shown head up from the front unless told otherwise.
-        if (!cmdUpGiven && !cmdViewGiven && opt->camera.empty())
+        if (slicePlane && !cmdUpGiven && !cmdViewGiven && opt->camera.empty()) {
+            view = {slicePlane->axis, trace::View::Top};  // straight along the slice's axis
+        } else if (!cmdUpGiven && !cmdViewGiven && opt->camera.empty())
             if (const std::optional<bridge::ScanProvenance> scan = bridge::scanProvenanceOf(chosen->record); scan && (scan->space == "LPS" || scan->space == "RAS")) {
                 view = {2, scan->space == "LPS" ? trace::View::Front : trace::View::Back};
                 note("grid '" + chosen->record.name + "' is a scan in " + scan->space + " space: shown head up, from the front (--up/--view to change)");
@@ -203,7 +210,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         options.shadows = opt->shadows;
         options.densityScale = cmdDensityScaleGiven || !grid.fog ? opt->densityScale : trace::autoDensityScale(grid, camera, opt->densityScale);
 
-        if ((grid.mip || grid.volume) && !opt->window.empty()) {  // else the renderer chooses it from the image (RenderStats::window)
+        if (slicePlane) options.slice = *slicePlane;
+        if ((grid.mip || grid.volume || grid.slice) && !opt->window.empty()) {  // else the renderer chooses it from the image (RenderStats::window)
             const auto w = parseNumbers(opt->window, 2, "--window");
             if (!(w[1] > w[0])) throw Error("--window: HIGH must be greater than LOW");
             options.window = std::pair{w[0], w[1]};

@@ -11,6 +11,7 @@
 #include "src/trace/IsoSurface.h"
 #include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
+#include "src/trace/SliceView.h"
 #include "src/trace/SurfaceHit.h"
 #include "src/trace/VolumeRender.h"
 
@@ -52,12 +53,16 @@ std::optional<glm::dvec3> storedNormal(const RenderGrid& grid, const RayHit& hit
 
 Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, RenderStats* stats) {
     const auto start = std::chrono::steady_clock::now();
-    if (grid.mip || grid.labels || grid.iso || grid.volume) {
+    if (grid.mip || grid.labels || grid.iso || grid.volume || grid.slice) {
         Image image;
         std::optional<std::pair<double, double>> window;
         std::optional<double> iso;
         if (grid.mip) {
             Projection p = renderMip(grid, camera, options.window);
+            image = std::move(p.image);
+            window = std::pair{p.low, p.high};
+        } else if (grid.slice) {
+            Projection p = renderSlice(grid, camera, options.slice, options.window);
             image = std::move(p.image);
             window = std::pair{p.low, p.high};
         } else if (grid.volume) {

@@ -17,7 +17,7 @@ namespace vdbdag::trace {
 struct RenderStats {
     uint64_t primaryRays = 0, secondaryRays = 0;
     double milliseconds = 0;
-    std::optional<std::pair<double, double>> window;  // --shading mip, volume: the window used (given or chosen)
+    std::optional<std::pair<double, double>> window;  // --shading mip, volume, slice: the window used (given or chosen)
     std::optional<double> iso;                        // --shading iso: the surface's value (given or chosen)
 };
 

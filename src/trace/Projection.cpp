@@ -54,18 +54,24 @@ Projection renderMip(const RenderGrid& grid, const Camera& camera, std::optional
     const std::vector<double> maxima = maximaAlongRays(grid, camera);
     Projection out;
     std::tie(out.low, out.high) = window ? *window : automaticWindow(maxima);
-    out.image.resize(camera.width, camera.height);
-    const double span = out.high > out.low ? out.high - out.low : 1;
-    for (size_t i = 0; i < maxima.size(); ++i) {
-        const double m = maxima[i];
-        if (!(m > out.low)) continue;  // a miss, NaN, or at or below the window: transparent
-        // Linear light whose sRGB code is proportional to the window position.
-        const double g = std::clamp((m - out.low) / span, 0.0, 1.0);
-        const float grey = float(g <= 0.04045 ? g / 12.92 : std::pow((g + 0.055) / 1.055, 2.4));
-        for (int c = 0; c < 3; ++c) out.image.rgb[3 * i + size_t(c)] = grey;
-        out.image.alpha[i] = 1;
-    }
+    out.image = windowedGrey(maxima, camera.width, camera.height, out.low, out.high, true);
     return out;
+}
+
+Image windowedGrey(const std::vector<double>& values, int width, int height, double low, double high, bool lowTransparent) {
+    Image image;
+    image.resize(width, height);
+    const double span = high > low ? high - low : 1;
+    for (size_t i = 0; i < values.size(); ++i) {
+        const double m = values[i];
+        if (std::isnan(m) || (lowTransparent && !(m > low))) continue;  // nothing there, or at or below the window: transparent
+        // Linear light whose sRGB code is proportional to the window position.
+        const double g = std::clamp((m - low) / span, 0.0, 1.0);
+        const float grey = float(g <= 0.04045 ? g / 12.92 : std::pow((g + 0.055) / 1.055, 2.4));
+        for (int c = 0; c < 3; ++c) image.rgb[3 * i + size_t(c)] = grey;
+        image.alpha[i] = 1;
+    }
+    return image;
 }
 
 } // namespace vdbdag::trace

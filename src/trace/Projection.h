@@ -27,6 +27,11 @@ struct Projection {
     Image image;
     double low = 0, high = 1;  // the window used
 };
+
+// Per-pixel values (NaN: nothing there) through the window [low, high] as
+// grey levels whose sRGB codes are proportional to the window position;
+// values at or below low are transparent when `lowTransparent`, else black.
+Image windowedGrey(const std::vector<double>& values, int width, int height, double low, double high, bool lowTransparent);
 Projection renderMip(const RenderGrid& grid, const Camera& camera, std::optional<std::pair<double, double>> window = std::nullopt);
 
 } // namespace vdbdag::trace

@@ -31,13 +31,14 @@ Shading parseShading(const std::string& text) {
     if (text == "labels") return Shading::Labels;
     if (text == "iso") return Shading::Iso;
     if (text == "volume") return Shading::Volume;
+    if (text == "slice") return Shading::Slice;
     if (text == "surface") return Shading::Surface;
     if (text == "values") return Shading::Values;
-    throw Error("--shading: '" + text + "' is not auto, fog, surface, values, mip, labels, iso or volume");
+    throw Error("--shading: '" + text + "' is not auto, fog, surface, values, mip, labels, iso, volume or slice");
 }
 
 const char* shadingOf(const RenderGrid& grid) {
-    return grid.labels ? "labels" : grid.mip ? "mip" : grid.iso ? "iso" : grid.volume ? "volume" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values";
+    return grid.labels ? "labels" : grid.mip ? "mip" : grid.iso ? "iso" : grid.volume ? "volume" : grid.slice ? "slice" : grid.fog ? "fog" : grid.levelSet ? "surface" : "values";
 }
 
 RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
@@ -87,11 +88,12 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
     case Shading::Mip:
     case Shading::Iso:
     case Shading::Volume:
+    case Shading::Slice:
         if (valueSize(out.valueType) == 0 || (out.valueType == ValueType::Vec3S || out.valueType == ValueType::Vec3D || out.valueType == ValueType::Vec3I) || out.valueType == ValueType::Bool)
             throw Error("grid '" + grid.record.name + "' holds " + valueTypeName(out.valueType) + " values: " +
-                        (shading == Shading::Mip ? "a maximum intensity projection" : shading == Shading::Iso ? "an isosurface" : "volume rendering") +
+                        (shading == Shading::Mip ? "a maximum intensity projection" : shading == Shading::Iso ? "an isosurface" : shading == Shading::Slice ? "a slice" : "volume rendering") +
                         " needs scalar values");
-        (shading == Shading::Mip ? out.mip : shading == Shading::Iso ? out.iso : out.volume) = true;
+        (shading == Shading::Mip ? out.mip : shading == Shading::Iso ? out.iso : shading == Shading::Slice ? out.slice : out.volume) = true;
         break;
     case Shading::Labels:
         if (out.valueType != ValueType::Int32 && out.valueType != ValueType::Int64)

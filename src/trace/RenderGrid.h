@@ -42,6 +42,7 @@ struct RenderGrid {
     bool labels = false;    // --shading labels: the first labelled voxel, a colour per label (LabelRender.h)
     bool iso = false;       // --shading iso: the first crossing of a value (IsoSurface.h)
     bool volume = false;    // --shading volume: emission-absorption through a transfer function (VolumeRender.h)
+    bool slice = false;     // --shading slice: one plane of voxels, grey (SliceView.h)
     int64_t labelBackground = 0;  // the grid's background value: unlabelled, as 0 is
     ValueColouring colouring = ValueColouring::None;
     double valueMin = 0, valueMax = 1;  // over the stored values (finite ones)
@@ -59,15 +60,16 @@ struct RenderGrid {
 // Labels: an integer grid of labels (LabelRender.h).
 // Iso: the isosurface of a scalar grid at a value (IsoSurface.h).
 // Volume: a scalar grid through a transfer function (VolumeRender.h).
-enum class Shading { Auto, Fog, Surface, Values, Mip, Labels, Iso, Volume };
-// Parses "auto"/"fog"/"surface"/"values"/"mip"/"labels"/"iso"/"volume" (Error otherwise).
+// Slice: one plane of a scalar grid (SliceView.h).
+enum class Shading { Auto, Fog, Surface, Values, Mip, Labels, Iso, Volume, Slice };
+// Parses "auto"/"fog"/"surface"/"values"/"mip"/"labels"/"iso"/"volume"/"slice" (Error otherwise).
 Shading parseShading(const std::string& text);
 
 // Chooses the shading (see Shading) from the grid's class, type, name and
 // values (colour grids are vec3 grids named like Cd, color, colour, rgb, or
 // any vec3i grid). `grid` must outlive the result.
 RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading = Shading::Auto);
-// What the grid is shown as: "fog", "surface" (level set), "mip", "labels", "iso", "volume" or "values".
+// What the grid is shown as: "fog", "surface" (level set), "mip", "labels", "iso", "volume", "slice" or "values".
 const char* shadingOf(const RenderGrid& grid);
 
 // A stored value as up to three doubles (scalars in [0]).

@@ -14,6 +14,12 @@
 
 namespace vdbdag::trace {
 
+// A slice of a grid: the voxels whose index on `axis` (0 x, 1 y, 2 z) is `index`.
+struct SlicePlane {
+    int axis = 2;
+    int64_t index = 0;
+};
+
 struct RenderOptions {
     double lodPixels = 0;       // LOD cut-off: a node smaller than this many pixels is a hit (0: off)
     bool shadows = false;       // secondary ray towards the light
@@ -21,12 +27,15 @@ struct RenderOptions {
     glm::dvec3 background{0.10, 0.11, 0.13};
     // --shading mip: the display window [low, high] (Projection.h; chosen
     // from the image when absent); --shading volume: the transfer
-    // function's window (VolumeRender.h; chosen from the values).
+    // function's window (VolumeRender.h; chosen from the values);
+    // --shading slice: the grey window (SliceView.h).
     std::optional<std::pair<double, double>> window;
     // --shading labels: the labels shown (`--labels`; empty: every one but 0 and the background).
     std::vector<int64_t> labels;
     // --shading iso: the surface's value (`--iso`; IsoSurface.h's automaticIso when absent).
     std::optional<double> iso;
+    // --shading slice: the plane shown (`--slice`; SliceView.h).
+    SlicePlane slice;
 };
 
 using access::kAmbient;
