@@ -22,6 +22,7 @@
 #include "src/trace/FogDensity.h"
 #include "src/trace/Camera.h"
 #include "src/trace/RenderGrid.h"
+#include "src/trace/Legend.h"
 #include "src/trace/SliceView.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
@@ -99,7 +100,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels, iso, slice;
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
-        bool shadows = false, json = false, force = false;
+        bool shadows = false, json = false, force = false, legend = false;
         ReadLimitOptions limits;
     };
     auto opt = std::make_shared<Options>();
@@ -129,6 +130,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                     "maxima to their 99.5th percentile); volume: LOW,HIGH, the transfer function's ramp (default: Otsu's threshold of the "
                     "values to their 99.5th percentile)");
     cmd->add_option("--labels", opt->labels, "labels: the labels shown, e.g. 3,17 (default: every one but 0 and the background)");
+    cmd->add_flag("--legend", opt->legend,
+                  "draw a colour bar with its range in the image's right margin (value shading, mip, slice and volume)");
     cmd->add_option("--slice", opt->slice, "slice: AXIS=INDEX, the voxels shown (z=40: those of index z 40), seen along that axis unless --view/--up/--camera say");
     cmd->add_option("--iso", opt->iso, "iso: the surface's value, e.g. 300 for a CT's bone (default: Otsu's threshold of the values, air against tissue)");
     cmd->add_option("--fov", opt->fov, "vertical field of view in degrees")->check(finiteNumber())->check(CLI::Range(1.0, 170.0));
@@ -174,6 +177,9 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                         trace::shadingOf(grid) + " (use --shading fog)");
         if (!opt->window.empty() && !grid.mip && !grid.volume && !grid.slice) throw Error(opt->input + ": --window applies to --shading mip, volume and slice");
         if (!opt->slice.empty() && !grid.slice) throw Error(opt->input + ": --slice applies to --shading slice");
+        if (opt->legend && !trace::legendScale(grid, std::pair{0.0, 1.0}))
+            throw Error(opt->input + ": --legend applies to value shading, mip, slice and volume, and grid '" + chosen->record.name + "' is shown as " +
+                        trace::shadingOf(grid));
         if (grid.slice && opt->slice.empty()) throw Error(opt->input + ": --shading slice needs --slice AXIS=INDEX (e.g. z=40)");
         const std::optional<trace::SlicePlane> slicePlane = grid.slice ? std::optional(trace::parseSlicePlane(opt->slice)) : std::nullopt;
         if (!opt->labels.empty() && !grid.labels) throw Error(opt->input + ": --labels applies to --shading labels");
@@ -232,6 +238,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         }
         std::sort(times.begin(), times.end());
         const double ms = times[times.size() / 2];
+        if (opt->legend) trace::drawLegend(image, *trace::legendScale(grid, stats.window));
         bridge::writeImage(opt->output, image);
         const double raysPerSecond = double(stats.primaryRays + stats.secondaryRays) / (ms / 1000.0);
         if (opt->json) {

@@ -10,16 +10,19 @@ namespace vdbdag::trace {
 // the nearest doubles to the decimals they stand for.
 static_assert(kAmbient == 0.2 && access::kMaterialRgb[1] == 0.78 && access::kWarmRgb[1] == 0.02 && access::kFogEmissionRgb[2] == 0.95);
 
+glm::dvec3 coolToWarm(double s) {
+    // ParaView's "Cool to Warm", as three stops.
+    s = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
+    const glm::dvec3 cool = rgb(access::kCoolRgb), mid = rgb(access::kMidRgb), warm = rgb(access::kWarmRgb);
+    return s < 0.5 ? glm::mix(cool, mid, s * 2) : glm::mix(mid, warm, s * 2 - 1);
+}
+
 glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute) {
     switch (grid.colouring) {
     case ValueColouring::None: return kMaterial;
     case ValueColouring::Scalar: {
-        // ParaView's "Cool to Warm", as three stops.
         const double v = valueAsDoubles(grid, attribute)[0];
-        double s = (v - grid.valueMin) / (grid.valueMax - grid.valueMin);
-        s = std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : 0.0;
-        const glm::dvec3 cool = rgb(access::kCoolRgb), mid = rgb(access::kMidRgb), warm = rgb(access::kWarmRgb);
-        return s < 0.5 ? glm::mix(cool, mid, s * 2) : glm::mix(mid, warm, s * 2 - 1);
+        return coolToWarm((v - grid.valueMin) / (grid.valueMax - grid.valueMin));
     }
     case ValueColouring::Colour: {
         const auto c = valueAsDoubles(grid, attribute);

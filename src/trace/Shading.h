@@ -46,6 +46,9 @@ constexpr glm::dvec3 rgb(const double (&c)[3]) { return {c[0], c[1], c[2]}; }
 inline const glm::dvec3 kMaterial = rgb(access::kMaterialRgb);
 inline const glm::dvec3 kFogEmission = rgb(access::kFogEmissionRgb);
 
+// The scalar colour map (ParaView's "Cool to Warm") at s in [0, 1] (clamped; NaN: 0).
+glm::dvec3 coolToWarm(double s);
+
 // Linear RGB base colour of a hit's value.
 glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute);
 

@@ -25,6 +25,7 @@
 #include "src/trace/CpuRenderer.h"
 #include "src/trace/IsoSurface.h"
 #include "src/trace/LabelRender.h"
+#include "src/trace/Legend.h"
 #include "src/trace/Projection.h"
 #include "src/trace/RenderGrid.h"
 #include "src/trace/SliceView.h"
@@ -492,4 +493,48 @@ TEST(SliceView, SliceValuesEqualABruteForceOverTheDenseBlock) {
     EXPECT_THROW(trace::parseSlicePlane("z=3.5"), Error);
     EXPECT_EQ(trace::parseSlicePlane("y=-2").axis, 1);
     EXPECT_EQ(trace::parseSlicePlane("y=-2").index, -2);
+}
+
+// The colour bar (src/trace/Legend.h, `render --legend`): down the bar the
+// colours are the scale's, from high at the top to low at the bottom (a
+// grey window: strictly darker going down), with both numbers drawn above
+// and below it; a small image is left alone; the CLI refuses it where no
+// one value map applies.
+TEST(Legend, TheBarShowsTheScaleFromHighToLowWithItsNumbers) {
+    trace::Image image;
+    image.resize(320, 240);
+    const trace::LegendScale scale{-1000, 3000, [](double v) { return glm::dvec3((v + 1000) / 4000); }};
+    trace::drawLegend(image, scale);
+    // The bar: the rightmost opaque column run in the middle of the image.
+    int column = -1;
+    for (int x = image.width - 1; x >= 0 && column < 0; --x)
+        if (image.alpha[size_t(image.height / 2) * size_t(image.width) + size_t(x)] > 0) column = x - 1;
+    ASSERT_GT(column, image.width / 2);
+    std::vector<float> down;
+    for (int y = 0; y < image.height; ++y) {
+        const size_t i = size_t(y) * size_t(image.width) + size_t(column);
+        if (image.alpha[i] > 0 && image.rgb[3 * i] < 1.0f) down.push_back(image.rgb[3 * i]);
+    }
+    ASSERT_GT(down.size(), size_t(image.height / 2));
+    for (size_t k = 1; k < down.size(); ++k) EXPECT_LT(down[k], down[k - 1]) << k;
+    EXPECT_NEAR(down.front(), 1.0, 0.02);
+    EXPECT_NEAR(down.back(), 0.0, 0.02);
+    // Numbers above and below the bar: white pixels in the top and bottom rows of the margin.
+    const auto whiteIn = [&](int y0, int y1) {
+        size_t n = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = image.width / 2; x < image.width; ++x) n += image.rgb[3 * (size_t(y) * size_t(image.width) + size_t(x))] == 1.0f;
+        return n;
+    };
+    EXPECT_GT(whiteIn(0, 12), 10u);
+    EXPECT_GT(whiteIn(image.height - 12, image.height), 10u);
+    trace::Image small;
+    small.resize(40, 30);
+    trace::drawLegend(small, scale);
+    for (const float a : small.alpha) EXPECT_EQ(a, 0.0f);
+    // A level set's surface has no value map: refused.
+    const format::EncodedGrid encoded = denseBlock([](int x, int, int) { return x; });
+    EXPECT_FALSE(trace::legendScale(trace::makeRenderGrid(encoded, trace::Shading::Iso), std::pair{0.0, 1.0}));
+    EXPECT_TRUE(trace::legendScale(trace::makeRenderGrid(encoded, trace::Shading::Mip), std::pair{0.0, 1.0}));
+    EXPECT_TRUE(trace::legendScale(trace::makeRenderGrid(encoded, trace::Shading::Values), std::nullopt));
 }

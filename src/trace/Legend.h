@@ -1,0 +1,32 @@
+// A colour bar in a rendered image (`render --legend`): the colours a value
+// takes from `low` (bottom) to `high` (top), drawn opaque in the image's
+// right margin with both numbers in a small built-in font, so a picture of
+// values says what its colours mean. For value shading (the cool-to-warm
+// map over the grid's range), maximum intensity projections and slices (the
+// grey window) and volume rendering (the transfer function's colours).
+#pragma once
+#include <functional>
+#include <optional>
+
+#include <glm/glm.hpp>
+
+#include "src/trace/Image.h"
+#include "src/trace/RenderGrid.h"
+
+namespace vdbdag::trace {
+
+struct LegendScale {
+    double low = 0, high = 1;
+    std::function<glm::dvec3(double value)> colour;  // linear RGB of a value
+};
+
+// The scale of what `grid` is shown as with `window` (RenderStats::window:
+// mip, slice, volume); nothing for shadings without one value map (fog,
+// surfaces, labels, isosurfaces, colours and vectors).
+std::optional<LegendScale> legendScale(const RenderGrid& grid, const std::optional<std::pair<double, double>>& window);
+
+// Draws the bar and its two numbers; images narrower than 64 or lower than
+// 48 pixels are left as they are.
+void drawLegend(Image& image, const LegendScale& scale);
+
+} // namespace vdbdag::trace
