@@ -184,6 +184,7 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
         std::tie(scene, report) = encodedReport(opt, bridge::importVdb(input).volume, input);
         report["format"] = "vdb";
         report["input_bytes"] = fileBytes;
+        report["vdb_file_version"] = facts.fileVersion;
         if (facts.grids.size() != scene.grids.size()) throw Error(input + ": internal error: grids read twice differ in number");
         for (size_t g = 0; g < facts.grids.size(); ++g) {
             const bridge::VdbGridFacts& f = facts.grids[g];

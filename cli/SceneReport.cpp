@@ -226,9 +226,10 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
 std::string formatSceneReport(const nlohmann::json& r) {
     const std::string format = r.value("format", "ssvdag");
     const bool vdb = format == "vdb" || format == "nvdb";
-    std::string out = vdb ? fmt::format("{}: {} file, {} bytes, {} grid(s); encoded in memory as .ssvdag: {} bytes\n", r["input"].get<std::string>(),
-                                        format == "vdb" ? "OpenVDB" : "NanoVDB", r["input_bytes"].get<uint64_t>(), r["grids"].size(),
-                                        r["ssvdag_bytes"].get<uint64_t>())
+    std::string out = vdb ? fmt::format("{}: {} file{}, {} bytes, {} grid(s); encoded in memory as .ssvdag: {} bytes\n", r["input"].get<std::string>(),
+                                        format == "vdb" ? "OpenVDB" : "NanoVDB",
+                                        r.contains("vdb_file_version") ? fmt::format(" (format {})", r["vdb_file_version"].get<uint32_t>()) : std::string(),
+                                        r["input_bytes"].get<uint64_t>(), r["grids"].size(), r["ssvdag_bytes"].get<uint64_t>())
                           : fmt::format("{}: .ssvdag file (format {}), {} bytes, {} grid(s)\n", r["input"].get<std::string>(),
                                         r.value("format_version", 0u), r["ssvdag_bytes"].get<uint64_t>(), r["grids"].size());
     if (r.contains("file_metadata"))
@@ -238,8 +239,9 @@ std::string formatSceneReport(const nlohmann::json& r) {
                                      ? std::string("empty")
                                      : fmt::format("root 2^{} at ({}, {}, {})", g["root_log2_size"].get<int>(), g["root_origin"][0].get<int64_t>(),
                                                    g["root_origin"][1].get<int64_t>(), g["root_origin"][2].get<int64_t>());
-        out += fmt::format("grid {} '{}' ({}, {}): {} active voxels, {}, {}\n", g["index"].get<size_t>(), g["name"].get<std::string>(),
+        out += fmt::format("grid {} '{}' ({}, {}): {} active voxels{}, {}, {}\n", g["index"].get<size_t>(), g["name"].get<std::string>(),
                            g["value_type"].get<std::string>(), g["class"].get<std::string>(), g["active_voxels"].get<uint64_t>(),
+                           g.contains("active_tiles") ? fmt::format(" ({} active tiles)", g["active_tiles"].get<uint64_t>()) : std::string(),
                            g["encoding"].get<std::string>(), root);
         if (g.contains("tree_type")) out += formatGridHeader(g);
         if (!g["levels"].empty()) {

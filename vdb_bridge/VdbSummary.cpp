@@ -50,6 +50,7 @@ std::vector<MetadataEntry> fileMetadataEntries(const std::vector<uint8_t>& fileM
 VdbFileFacts vdbFileFacts(const std::string& path) {
     detail::VdbFileContents contents = detail::readVdbFile(path);
     VdbFileFacts out;
+    out.fileVersion = contents.fileVersion;
     out.fileMetadata = entriesOf(*contents.metadata);
     for (const openvdb::GridBase::Ptr& base : contents.grids) {
         VdbGridFacts g;

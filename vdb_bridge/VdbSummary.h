@@ -41,6 +41,7 @@ struct VdbGridFacts {
 struct VdbFileFacts {
     std::vector<VdbGridFacts> grids;
     std::vector<MetadataEntry> fileMetadata;
+    uint32_t fileVersion = 0;  // the header's file format version (222, 223, 224, ...), as vdb_print -l shows
 };
 VdbFileFacts vdbFileFacts(const std::string& path);
 

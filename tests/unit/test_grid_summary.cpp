@@ -243,6 +243,16 @@ TEST(GridSummary, InfoOfAVdbAndOfItsSsvdagPrintWhatVdbPrintPrints) {
         EXPECT_EQ(ja["format"], "vdb");
         EXPECT_EQ(jb["format"], "ssvdag");
         EXPECT_EQ(ja["input_bytes"].get<uint64_t>(), fs::file_size(vdb));
+        {  // the file version: the u32 after the 8-byte magic of the header, read here
+            std::ifstream in(vdb, std::ios::binary);
+            uint8_t head[12] = {};
+            in.read(reinterpret_cast<char*>(head), 12);
+            EXPECT_EQ(ja["vdb_file_version"].get<uint32_t>(), uint32_t(head[8]) | uint32_t(head[9]) << 8 | uint32_t(head[10]) << 16 | uint32_t(head[11]) << 24)
+                << vdb;
+            const vdbdag::testing::CommandResult text = vdbdag::testing::runCli("info " + vdb.string());
+            EXPECT_NE(text.out.find("OpenVDB file (format " + std::to_string(ja["vdb_file_version"].get<uint32_t>()) + ")"), std::string::npos) << text.out;
+            EXPECT_NE(text.out.find(" active tiles)"), std::string::npos) << text.out;
+        }
         EXPECT_EQ(jb["input_bytes"].get<uint64_t>(), fs::file_size(ss));
         EXPECT_EQ(ja["file_metadata"], jb["file_metadata"]) << vdb;
         ASSERT_EQ(ja["grids"].size(), jb["grids"].size());

@@ -47,6 +47,7 @@ VdbFileContents readVdbFile(const std::string& path) {
     initializeOpenVdb();
     const VdbFileLayout layout = checkVdbFileLayout(path);
     VdbFileContents contents;
+    contents.fileVersion = layout.fileVersion;
     reportingReadErrors(path, [&] {
         if (layout.hasGridOffsets) {
             // io::File without delayed loading is OpenVDB's strictest reader

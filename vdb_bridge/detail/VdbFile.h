@@ -23,6 +23,7 @@ namespace vdbdag::bridge::detail {
 struct VdbFileContents {
     openvdb::MetaMap::Ptr metadata;  // file-level metadata (never null)
     openvdb::GridPtrVec grids;       // in file order
+    uint32_t fileVersion = 0;        // the header's file format version (222, 223, 224, ...)
 };
 
 // Throws vdbdag::Error naming `path` for a missing, short, corrupt or
