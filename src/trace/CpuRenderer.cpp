@@ -13,29 +13,11 @@
 #include "src/trace/Projection.h"
 #include "src/trace/SliceView.h"
 #include "src/trace/SurfaceHit.h"
+#include "src/trace/ValueGradient.h"
 #include "src/trace/VolumeRender.h"
 
 namespace vdbdag::trace {
 namespace {
-
-// Index-space gradient of a level set at a voxel by central differences of
-// the stored values (one-sided where a neighbour is not active).
-std::optional<glm::dvec3> levelSetGradient(const RenderGrid& grid, const DagTracer& tracer, const RayHit& hit, uint64_t centreAttribute) {
-    const double centre = valueAsDoubles(grid, centreAttribute)[0];
-    glm::dvec3 g(0);
-    for (int a = 0; a < 3; ++a) {
-        std::array<int64_t, 3> plus = hit.voxel, minus = hit.voxel;
-        ++plus[a];
-        --minus[a];
-        const auto p = tracer.find(plus), m = tracer.find(minus);
-        if (p && m) g[a] = (valueAsDoubles(grid, *p)[0] - valueAsDoubles(grid, *m)[0]) * 0.5;
-        else if (p) g[a] = valueAsDoubles(grid, *p)[0] - centre;
-        else if (m) g[a] = centre - valueAsDoubles(grid, *m)[0];
-    }
-    const double len = glm::length(g);
-    if (!(len > 0) || !std::isfinite(len)) return std::nullopt;
-    return g / len;
-}
 
 // The stored ONV normal of the hit's attribute entry, when the grid has
 // normals: world space (vdb_bridge computes the gradient normals through the
@@ -129,7 +111,7 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
                         if (const std::optional<glm::dvec3> stored = storedNormal(grid, hit, oriented)) {
                             normal = *stored;  // world space already
                         } else if (const std::optional<glm::dvec3> gradient =
-                                       grid.levelSet && hit.lodLevel == 0 ? levelSetGradient(grid, tracer, hit, hit.attribute) : std::nullopt) {
+                                       grid.levelSet && hit.lodLevel == 0 ? valueGradient(grid, tracer, hit.voxel, valueAsDoubles(grid, hit.attribute)[0]) : std::nullopt) {
                             normal = frame.normalToWorld(*gradient);
                             surfaceNormal = *gradient;
                             oriented = true;

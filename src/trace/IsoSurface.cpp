@@ -8,6 +8,7 @@
 #include "src/trace/DagTracer.h"
 #include "src/trace/PixelSegments.h"
 #include "src/trace/Projection.h"
+#include "src/trace/ValueGradient.h"
 
 namespace vdbdag::trace {
 
@@ -46,29 +47,6 @@ double automaticIso(const RenderGrid& grid) {
     return automaticWindow(sample).first;
 }
 
-namespace {
-
-// The values' gradient at a voxel in index space by central differences
-// (one-sided where a neighbour is not stored); nullopt where it vanishes.
-std::optional<glm::dvec3> valueGradient(const RenderGrid& grid, const DagTracer& tracer, const RayHit& hit) {
-    const double centre = valueAsDoubles(grid, hit.attribute)[0];
-    glm::dvec3 g(0);
-    for (int a = 0; a < 3; ++a) {
-        std::array<int64_t, 3> plus = hit.voxel, minus = hit.voxel;
-        ++plus[size_t(a)];
-        --minus[size_t(a)];
-        const auto p = tracer.find(plus), m = tracer.find(minus);
-        if (p && m) g[a] = (valueAsDoubles(grid, *p)[0] - valueAsDoubles(grid, *m)[0]) * 0.5;
-        else if (p) g[a] = valueAsDoubles(grid, *p)[0] - centre;
-        else if (m) g[a] = centre - valueAsDoubles(grid, *m)[0];
-    }
-    const double len = glm::length(g);
-    if (!(len > 0) || !std::isfinite(len)) return std::nullopt;
-    return g / len;
-}
-
-} // namespace
-
 Image renderIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, double iso) {
     const GridFrame frame(grid.indexToWorld);
     const DagTracer tracer(*grid.dag);
@@ -84,15 +62,8 @@ Image renderIso(const RenderGrid& grid, const Camera& camera, const RenderOption
                 if (const std::optional<IsoHit>& h = hits[i]) {
                     glm::dvec3 eye, dir;
                     camera.pixelRay(px, py, eye, dir);
-                    glm::dvec3 normal = -dir;
-                    if (const std::optional<glm::dvec3> g = valueGradient(grid, tracer, h->box)) {
-                        normal = frame.normalToWorld(-*g);
-                    } else if (h->box.faceAxis >= 0) {
-                        glm::dvec3 n(0);
-                        n[h->box.faceAxis] = h->box.faceSign;
-                        normal = frame.normalToWorld(n);
-                    }
-                    if (glm::dot(normal, dir) > 0) normal = -normal;
+                    const std::optional<glm::dvec3> g = valueGradient(grid, tracer, h->box.voxel, valueAsDoubles(grid, h->box.attribute)[0]);
+                    const glm::dvec3 normal = facingNormal(frame, h->box, dir, g ? std::optional(-*g) : std::nullopt);
                     const double lambert = std::max(0.0, glm::dot(normal, light));
                     colour = kMaterial * (kAmbient + (1 - kAmbient) * lambert);
                     image.alpha[i] = 1;

@@ -57,13 +57,7 @@ Image renderLabels(const RenderGrid& grid, const Camera& camera, const RenderOpt
             if (const std::optional<LabelHit>& h = hits[i]) {
                 glm::dvec3 eye, dir;
                 camera.pixelRay(px, py, eye, dir);
-                glm::dvec3 normal = -dir;
-                if (h->box.faceAxis >= 0) {
-                    glm::dvec3 n(0);
-                    n[h->box.faceAxis] = h->box.faceSign;
-                    normal = frame.normalToWorld(n);
-                }
-                if (glm::dot(normal, dir) > 0) normal = -normal;
+                const glm::dvec3 normal = facingNormal(frame, h->box, dir);
                 const double lambert = std::max(0.0, glm::dot(normal, light));
                 colour = labelColour(h->label) * (kAmbient + (1 - kAmbient) * lambert);
                 image.alpha[i] = 1;

@@ -17,6 +17,18 @@ glm::dvec3 coolToWarm(double s) {
     return s < 0.5 ? glm::mix(cool, mid, s * 2) : glm::mix(mid, warm, s * 2 - 1);
 }
 
+glm::dvec3 facingNormal(const GridFrame& frame, const RayHit& hit, const glm::dvec3& dir, const std::optional<glm::dvec3>& indexNormal) {
+    glm::dvec3 normal = -dir;
+    if (indexNormal) {
+        normal = frame.normalToWorld(*indexNormal);
+    } else if (hit.faceAxis >= 0) {
+        glm::dvec3 n(0);
+        n[hit.faceAxis] = hit.faceSign;
+        normal = frame.normalToWorld(n);
+    }
+    return glm::dot(normal, dir) > 0 ? -normal : normal;
+}
+
 glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute) {
     switch (grid.colouring) {
     case ValueColouring::None: return kMaterial;

@@ -9,6 +9,8 @@
 
 #include <glm/glm.hpp>
 
+#include "src/trace/Camera.h"
+#include "src/trace/Ray.h"
 #include "src/trace/RenderGrid.h"
 #include "src/trace/shading_constants.h"
 
@@ -51,6 +53,11 @@ glm::dvec3 coolToWarm(double s);
 
 // Linear RGB base colour of a hit's value.
 glm::dvec3 baseColour(const RenderGrid& grid, uint64_t attribute);
+
+// A first hit's world-space normal turned towards the viewer (whose ray
+// goes along `dir`): `indexNormal` (an index-space gradient) when given,
+// else the face the ray entered through, else -dir (a ray starting inside).
+glm::dvec3 facingNormal(const GridFrame& frame, const RayHit& hit, const glm::dvec3& dir, const std::optional<glm::dvec3>& indexNormal = std::nullopt);
 
 // Direction towards the light for a camera: over the viewer's left shoulder.
 glm::dvec3 defaultLight(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& up);

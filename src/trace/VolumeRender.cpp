@@ -9,6 +9,7 @@
 
 #include "src/trace/DagTracer.h"
 #include "src/trace/Projection.h"
+#include "src/trace/ValueGradient.h"
 
 namespace vdbdag::trace {
 
@@ -34,26 +35,6 @@ TransferFunction automaticTransfer(const RenderGrid& grid) {
     const auto [low, high] = automaticWindow(sample);
     return {low, high};
 }
-
-namespace {
-
-// The values' gradient at a voxel in index space by central differences
-// (one-sided where a neighbour is not stored); zero where it vanishes.
-glm::dvec3 valueGradient(const RenderGrid& grid, const DagTracer& tracer, const std::array<int64_t, 3>& voxel, double centre) {
-    glm::dvec3 g(0);
-    for (int a = 0; a < 3; ++a) {
-        std::array<int64_t, 3> plus = voxel, minus = voxel;
-        ++plus[size_t(a)];
-        --minus[size_t(a)];
-        const auto p = tracer.find(plus), m = tracer.find(minus);
-        if (p && m) g[a] = (valueAsDoubles(grid, *p)[0] - valueAsDoubles(grid, *m)[0]) * 0.5;
-        else if (p) g[a] = valueAsDoubles(grid, *p)[0] - centre;
-        else if (m) g[a] = centre - valueAsDoubles(grid, *m)[0];
-    }
-    return g;
-}
-
-} // namespace
 
 Image renderVolume(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const TransferFunction& tf) {
     const GridFrame frame(grid.indexToWorld);
@@ -83,9 +64,8 @@ Image renderVolume(const RenderGrid& grid, const Camera& camera, const RenderOpt
                     if (firstHit < 0) firstHit = box.t;
                     double lit = 1;
                     if (alpha > 0.01) {  // worth a gradient: lit as a surface facing the viewer
-                        glm::dvec3 g = valueGradient(grid, tracer, box.voxel, v);
-                        if (glm::length(g) > 0) {
-                            glm::dvec3 n = frame.normalToWorld(-g);
+                        if (const std::optional<glm::dvec3> g = valueGradient(grid, tracer, box.voxel, v)) {
+                            glm::dvec3 n = frame.normalToWorld(-*g);
                             if (glm::dot(n, dir) > 0) n = -n;
                             lit = kAmbient + (1 - kAmbient) * std::max(0.0, glm::dot(n, light));
                         }

@@ -58,6 +58,29 @@ bool crosses(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& lo, con
     return t1 > t0;
 }
 
+// Every voxel of the 12x10x8 block (voxel 0.5) the world ray crosses, with
+// where it enters and leaves, in order of entry: the brute force.
+struct Crossing {
+    double t0, t1;
+    int x, y, z;
+};
+std::vector<Crossing> crossedVoxels(const glm::dvec3& o, const glm::dvec3& d) {
+    std::vector<Crossing> out;
+    for (int z = 0; z < kNz; ++z)
+        for (int y = 0; y < kNy; ++y)
+            for (int x = 0; x < kNx; ++x) {
+                const glm::dvec3 lo = glm::dvec3(x - 0.5, y - 0.5, z - 0.5) * kVoxel, hi = glm::dvec3(x + 0.5, y + 0.5, z + 0.5) * kVoxel;
+                double t0 = 0;
+                if (!crosses(o, d, lo, hi, &t0)) continue;
+                double t1 = std::numeric_limits<double>::infinity();  // the exit
+                for (int a = 0; a < 3; ++a)
+                    if (d[a] != 0) t1 = std::min(t1, std::max((lo[a] - o[a]) / d[a], (hi[a] - o[a]) / d[a]));
+                out.push_back({t0, t1, x, y, z});
+            }
+    std::stable_sort(out.begin(), out.end(), [](const Crossing& a, const Crossing& b) { return a.t0 < b.t0; });  // ties: z, y, x order
+    return out;
+}
+
 // A 12x10x8 int32 block (voxel 0.5) of the values `value(x, y, z)`,
 // imported through OpenVDB and encoded.
 template <typename Value>
@@ -254,16 +277,13 @@ TEST(LabelRender, FirstLabelsEqualABruteForceOverTheDenseBlock) {
                 camera.pixelRay(px, py, o, d);
                 double bestT = std::numeric_limits<double>::infinity();
                 int32_t want = 0;
-                for (int z = 0; z < kNz; ++z)
-                    for (int y = 0; y < kNy; ++y)
-                        for (int x = 0; x < kNx; ++x) {
-                            const int32_t l = labelAt(x, y, z);
-                            const bool isShown = shown.empty() ? l != 0 : std::find(shown.begin(), shown.end(), int64_t(l)) != shown.end();
-                            double t = 0;
-                            if (isShown && crosses(o, d, glm::dvec3(x - 0.5, y - 0.5, z - 0.5) * kVoxel, glm::dvec3(x + 0.5, y + 0.5, z + 0.5) * kVoxel, &t) &&
-                                t < bestT)
-                                bestT = t, want = l;
-                        }
+                for (const Crossing& c : crossedVoxels(o, d)) {
+                    const int32_t l = labelAt(c.x, c.y, c.z);
+                    if (shown.empty() ? l != 0 : std::find(shown.begin(), shown.end(), int64_t(l)) != shown.end()) {
+                        bestT = c.t0, want = l;
+                        break;
+                    }
+                }
                 const auto& got = hits[size_t(py) * size_t(camera.width) + size_t(px)];
                 if (std::isinf(bestT)) {
                     EXPECT_FALSE(got.has_value()) << px << "," << py;
@@ -284,8 +304,7 @@ TEST(LabelRender, FirstLabelsEqualABruteForceOverTheDenseBlock) {
 // Isosurfaces (src/trace/IsoSurface.h, `--shading iso`) against a brute
 // force over 10^4 rays: each pixel's hit is the voxel reaching the value
 // that its ray enters first (every box tested by the slab method), at two
-// values; the interpolated crossing lies between the centres of that voxel
-// and the one before it; the image is lit where the brute force meets one.
+// values; the image is lit where the brute force meets one.
 TEST(IsoSurface, FirstCrossingsEqualABruteForceOverTheDenseBlock) {
     const auto valueAt = [](int x, int y, int z) -> int32_t {
         const double r = std::sqrt((x - 5.5) * (x - 5.5) + (y - 4.5) * (y - 4.5) + (z - 3.5) * (z - 3.5));
@@ -305,15 +324,11 @@ TEST(IsoSurface, FirstCrossingsEqualABruteForceOverTheDenseBlock) {
                 camera.pixelRay(px, py, o, d);
                 double bestT = std::numeric_limits<double>::infinity();
                 std::array<int64_t, 3> want{};
-                for (int z = 0; z < kNz; ++z)
-                    for (int y = 0; y < kNy; ++y)
-                        for (int x = 0; x < kNx; ++x) {
-                            double t = 0;
-                            if (valueAt(x, y, z) >= iso &&
-                                crosses(o, d, glm::dvec3(x - 0.5, y - 0.5, z - 0.5) * kVoxel, glm::dvec3(x + 0.5, y + 0.5, z + 0.5) * kVoxel, &t) &&
-                                t < bestT)
-                                bestT = t, want = {x, y, z};
-                        }
+                for (const Crossing& c : crossedVoxels(o, d))
+                    if (valueAt(c.x, c.y, c.z) >= iso) {
+                        bestT = c.t0, want = {c.x, c.y, c.z};
+                        break;
+                    }
                 const auto& got = hits[size_t(py) * size_t(camera.width) + size_t(px)];
                 if (std::isinf(bestT)) {
                     EXPECT_FALSE(got.has_value()) << px << "," << py;
@@ -361,23 +376,7 @@ TEST(VolumeRender, CompositingEqualsABruteForceOverTheDenseBlock) {
         for (int px = 0; px < camera.width; ++px) {
             glm::dvec3 o, d;
             camera.pixelRay(px, py, o, d);
-            struct Crossing {
-                double t0, t1;
-                int x, y, z;
-            };
-            std::vector<Crossing> crossings;
-            for (int z = 0; z < kNz; ++z)
-                for (int y = 0; y < kNy; ++y)
-                    for (int x = 0; x < kNx; ++x) {
-                        const glm::dvec3 lo = glm::dvec3(x - 0.5, y - 0.5, z - 0.5) * kVoxel, hi = glm::dvec3(x + 0.5, y + 0.5, z + 0.5) * kVoxel;
-                        double t0 = 0;
-                        if (!crosses(o, d, lo, hi, &t0)) continue;
-                        double t1 = std::numeric_limits<double>::infinity();  // the exit
-                        for (int a = 0; a < 3; ++a)
-                            if (d[a] != 0) t1 = std::min(t1, std::max((lo[a] - o[a]) / d[a], (hi[a] - o[a]) / d[a]));
-                        crossings.push_back({t0, t1, x, y, z});
-                    }
-            std::sort(crossings.begin(), crossings.end(), [](const Crossing& a, const Crossing& b) { return a.t0 < b.t0; });
+            const std::vector<Crossing> crossings = crossedVoxels(o, d);
             double transmittance = 1;
             glm::dvec3 sum(0);
             for (const Crossing& c : crossings) {
