@@ -68,7 +68,8 @@ for r in rows:
     lines.append(f"| {name} | {'x'.join(map(str, r['dims']))} | {r['bits']} | {r['near']} | {r['ours_bytes']:,} | {r['jpegls_bytes']:,} | "
                  f"{r['ratio']:.3f} | {r['ours_encode_mb_s']:.1f} / {r['ours_decode_mb_s']:.1f} | {r['jpegls_encode_mb_s']:.1f} / {r['jpegls_decode_mb_s']:.1f} |")
 lines += ["", "The whole `.ssvdag` file `vdbdag encode` writes for each scan (lossless: geometry, metadata and the values, whose int32 windows "
-          "are coded by `coding/BrickValueCoder` with neighbours across bricks) against the peers of the same samples, lossless: JPEG-LS and "
+          "are coded by `coding/BrickValueCoder` with neighbours across bricks, and a rescaled scan's float windows as their integers, "
+          "`attributes/RescaledFloats`: the PET) against the peers of the same samples, lossless: JPEG-LS and "
           "JPEG 2000 (OpenJPEG, reversible 5/3, one layer) per z-slice at the scan's bit depth, xz -9e and zstd -19 of the whole volume's "
           "min-subtracted samples (1 or 2 bytes each). Every peer's decode is checked.", "",
           "| scan | .ssvdag (bytes) | JPEG-LS | JPEG 2000 | xz -9e | zstd -19 | .ssvdag / JPEG-LS | .ssvdag / JPEG 2000 | .ssvdag / xz |",
