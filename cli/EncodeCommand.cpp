@@ -7,6 +7,7 @@
 #include <chrono>
 #include <filesystem>
 #include <optional>
+#include <set>
 
 #include <tbb/global_control.h>
 
@@ -74,7 +75,10 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb or NanoVDB .nvdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha/.nii scan, or one DICOM series) into an .ssvdag file");
-    cmd->add_option("input", opt->inputs, "input .vdb or .nvdb file or dense scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set)")->required();
+    cmd->add_option("input", opt->inputs,
+                    "input .vdb or .nvdb file or dense scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set); "
+                    "several other inputs (frames of a cache): one .ssvdag each, in the folder -o names or beside each")
+        ->required();
     cmd->add_option("-o,--output", opt->output, "output .ssvdag file (default: the input's name with .ssvdag, beside it: ct.nii.gz -> ct.ssvdag, a DICOM folder dir/ -> dir.ssvdag)");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_option("--grid", opt->grids, "encode only grids with this name (repeatable)");
@@ -107,9 +111,9 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
-    cmd->callback([opt, &exitCode] {
-        opt->input = opt->dense.takeInputs(opt->inputs);
-        if (opt->output.empty()) opt->output = defaultOutputFor(opt->input);
+    // One input (opt->input) to one output (opt->output); the report goes
+    // to `batch` when given, else is printed.
+    const auto encodeOne = [opt, &exitCode](nlohmann::json* batch) {
         setActivity(opt->input, "encoding");
         const auto start = std::chrono::steady_clock::now();
         std::optional<tbb::global_control> threads;
@@ -295,7 +299,12 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             if (g.colour) report["grids_colour"].push_back(colourJson(g));
             if (g.normals) report["grids_normals"].push_back(normalsJson(g));
         }
-        if (opt->json) {
+        if (batch) {
+            batch->push_back(report);
+            if (!opt->json)
+                fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output, scene.grids.size(),
+                           voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);
+        } else if (opt->json) {
             printJson(report);
         } else {
             fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output,
@@ -308,6 +317,43 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             for (const auto& c : report["grids_colour"]) fmt::print("  {}\n", formatColour(c));
             for (const auto& n : report["grids_normals"]) fmt::print("  {}\n", formatNormals(n));
         }
+        exitCode = 0;
+    };
+    cmd->callback([opt, &exitCode, encodeOne] {
+        // Several inputs none of which is DICOM (frames of a cache, scans):
+        // each encoded alone, to the folder -o names (made when missing; a
+        // name ending in .ssvdag is refused) or beside itself, as
+        // IN.ssvdag; the same bytes as one by one.
+        const bool several = opt->inputs.size() > 1 && std::none_of(opt->inputs.begin(), opt->inputs.end(), [](const std::string& in) {
+                                 return bridge::denseFormatOf(in) == bridge::DenseFormat::Dicom;
+                             });
+        if (!several) {
+            opt->input = opt->dense.takeInputs(opt->inputs);
+            if (opt->output.empty()) opt->output = defaultOutputFor(opt->input);
+            encodeOne(nullptr);
+            return;
+        }
+        const std::string folder = opt->output;
+        if (!folder.empty()) {
+            std::error_code ec;
+            const bool fileName = std::filesystem::path(folder).extension() == ".ssvdag";
+            if ((std::filesystem::exists(folder, ec) && !std::filesystem::is_directory(folder, ec)) || (fileName && !std::filesystem::is_directory(folder, ec)))
+                throw Error(folder + ": " + std::to_string(opt->inputs.size()) + " inputs are encoded one file each: -o names a folder, not a file");
+            std::filesystem::create_directories(folder, ec);
+            if (ec) throw Error(folder + ": cannot make the output folder (" + ec.message() + ")");
+        }
+        std::set<std::string> outputs;
+        for (const std::string& in : opt->inputs) {
+            const std::string out = folder.empty() ? defaultOutputFor(in) : (std::filesystem::path(folder) / std::filesystem::path(defaultOutputFor(in)).filename()).string();
+            if (!outputs.insert(out).second) throw Error(in + ": another input is also written to " + out + " (inputs of the same name from different folders)");
+        }
+        nlohmann::json reports = nlohmann::json::array();
+        for (const std::string& in : opt->inputs) {
+            opt->input = in;
+            opt->output = folder.empty() ? defaultOutputFor(in) : (std::filesystem::path(folder) / std::filesystem::path(defaultOutputFor(in)).filename()).string();
+            encodeOne(&reports);
+        }
+        if (opt->json) printJson(reports);
         exitCode = 0;
     });
 }

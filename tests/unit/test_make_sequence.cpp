@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
 #include <openvdb/openvdb.h>
 
 #include "tests/unit/CliRunner.h"
@@ -74,5 +75,33 @@ TEST(MakeSequence, FramesAreAnAdvectedLevelSetAndItsFog) {
         }
         previous = ls;
     }
+    fs::remove_all(dir);
+}
+
+// `encode` of several .vdb frames: each to the folder -o names (made when
+// missing), byte for byte what encoding it alone writes; --json an array
+// of the reports; -o naming a file is refused and writes nothing.
+TEST(MakeSequence, SeveralFramesEncodeOneFileEachAsEachAlone) {
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_batch_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    ASSERT_EQ(vdbdag::testing::runShell(std::string(VDBDAG_SEQUENCE_TOOL) + " " + (dir / "in").string() + " --frames 3 --dim 48 --no-fog >/dev/null").exitCode, 0);
+    std::string inputs;
+    for (int f = 1; f <= 3; ++f) inputs += " " + (dir / "in" / ("levelset.000" + std::to_string(f) + ".vdb")).string();
+    const vdbdag::testing::CommandResult r = vdbdag::testing::runCli("encode" + inputs + " -o " + (dir / "out").string() + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json reports = nlohmann::json::parse(r.out);
+    ASSERT_TRUE(reports.is_array());
+    EXPECT_EQ(reports.size(), 3u);
+    for (int f = 1; f <= 3; ++f) {
+        const std::string stem = "levelset.000" + std::to_string(f);
+        const fs::path alone = dir / (stem + "_alone.ssvdag");
+        ASSERT_EQ(vdbdag::testing::runCli("encode " + (dir / "in" / (stem + ".vdb")).string() + " -o " + alone.string()).exitCode, 0);
+        EXPECT_EQ(vdbdag::testing::runShell("cmp -s " + alone.string() + " " + (dir / "out" / (stem + ".ssvdag")).string()).exitCode, 0) << stem;
+    }
+    const fs::path file = dir / "a_file.ssvdag";
+    const vdbdag::testing::CommandResult refused = vdbdag::testing::runCli("encode" + inputs + " -o " + file.string());
+    EXPECT_NE(refused.exitCode, 0);
+    EXPECT_NE(refused.err.find("-o names a folder"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(file));
     fs::remove_all(dir);
 }
