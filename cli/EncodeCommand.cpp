@@ -7,7 +7,6 @@
 #include <chrono>
 #include <filesystem>
 #include <optional>
-#include <set>
 
 #include <tbb/global_control.h>
 
@@ -342,15 +341,16 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             std::filesystem::create_directories(folder, ec);
             if (ec) throw Error(folder + ": cannot make the output folder (" + ec.message() + ")");
         }
-        std::set<std::string> outputs;
+        std::vector<std::string> outputs;
         for (const std::string& in : opt->inputs) {
-            const std::string out = folder.empty() ? defaultOutputFor(in) : (std::filesystem::path(folder) / std::filesystem::path(defaultOutputFor(in)).filename()).string();
-            if (!outputs.insert(out).second) throw Error(in + ": another input is also written to " + out + " (inputs of the same name from different folders)");
+            outputs.push_back(folder.empty() ? defaultOutputFor(in) : (std::filesystem::path(folder) / std::filesystem::path(defaultOutputFor(in)).filename()).string());
+            if (std::count(outputs.begin(), outputs.end(), outputs.back()) > 1)
+                throw Error(in + ": another input is also written to " + outputs.back() + " (inputs of the same name from different folders)");
         }
         nlohmann::json reports = nlohmann::json::array();
-        for (const std::string& in : opt->inputs) {
-            opt->input = in;
-            opt->output = folder.empty() ? defaultOutputFor(in) : (std::filesystem::path(folder) / std::filesystem::path(defaultOutputFor(in)).filename()).string();
+        for (size_t i = 0; i < opt->inputs.size(); ++i) {
+            opt->input = opt->inputs[i];
+            opt->output = outputs[i];
             encodeOne(&reports);
         }
         if (opt->json) printJson(reports);

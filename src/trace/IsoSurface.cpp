@@ -39,12 +39,7 @@ std::vector<std::optional<IsoHit>> firstCrossings(const RenderGrid& grid, const 
 
 double automaticIso(const RenderGrid& grid) {
     if (!grid.values || grid.values->entryCount == 0) return 0.5;
-    const uint64_t n = grid.values->entryCount, stride = std::max<uint64_t>(1, n >> 20);
-    std::vector<double> sample;
-    sample.reserve(size_t(n / stride + 1));
-    size_t hint = 0;
-    for (uint64_t e = 0; e < n; e += stride) sample.push_back(valueAsDoubles(grid, e, hint)[0]);
-    return automaticWindow(sample).first;
+    return storedValueWindow(grid).first;
 }
 
 Image renderIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, double iso) {

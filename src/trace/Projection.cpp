@@ -50,6 +50,17 @@ std::pair<double, double> automaticWindow(const std::vector<double>& maxima) {
     return {lo + (hi - lo) * double(threshold + 1) / kBins, hi};
 }
 
+std::pair<double, double> storedValueWindow(const RenderGrid& grid) {
+    std::vector<double> sample;
+    if (grid.values) {
+        const uint64_t n = grid.values->entryCount, stride = std::max<uint64_t>(1, n >> 20);
+        sample.reserve(size_t(n / stride + 1));
+        size_t hint = 0;
+        for (uint64_t e = 0; e < n; e += stride) sample.push_back(valueAsDoubles(grid, e, hint)[0]);
+    }
+    return automaticWindow(sample);
+}
+
 Projection renderMip(const RenderGrid& grid, const Camera& camera, std::optional<std::pair<double, double>> window) {
     const std::vector<double> maxima = maximaAlongRays(grid, camera);
     Projection out;

@@ -22,6 +22,9 @@ std::vector<double> maximaAlongRays(const RenderGrid& grid, const Camera& camera
 
 // The window chosen from maxima (Otsu's threshold, the 99.5th percentile).
 std::pair<double, double> automaticWindow(const std::vector<double>& maxima);
+// automaticWindow of the grid's stored scalar values (a sample of at most
+// 2^20 entries): air against tissue, for isosurfaces and volumes.
+std::pair<double, double> storedValueWindow(const RenderGrid& grid);
 
 struct Projection {
     Image image;

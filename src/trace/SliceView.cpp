@@ -15,13 +15,12 @@ namespace vdbdag::trace {
 
 SlicePlane parseSlicePlane(const std::string& text) {
     SlicePlane p;
-    int64_t index = 0;
     const char* end = text.data() + text.size();
-    if (text.size() < 3 || text[1] != '=' || (text[0] != 'x' && text[0] != 'y' && text[0] != 'z') ||
-        std::from_chars(text.data() + 2, end, index).ptr != end || std::from_chars(text.data() + 2, end, index).ec != std::errc())
+    const bool axis = text.size() >= 3 && text[1] == '=' && (text[0] == 'x' || text[0] == 'y' || text[0] == 'z');
+    const std::from_chars_result read = axis ? std::from_chars(text.data() + 2, end, p.index) : std::from_chars_result{};
+    if (!axis || read.ec != std::errc() || read.ptr != end)
         throw Error("--slice: '" + text + "' is not AXIS=INDEX (x, y or z, an integer index: z=40)");
     p.axis = text[0] - 'x';
-    p.index = index;
     return p;
 }
 

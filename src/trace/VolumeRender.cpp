@@ -27,12 +27,7 @@ glm::dvec3 TransferFunction::colour(double v) const {
 
 TransferFunction automaticTransfer(const RenderGrid& grid) {
     if (!grid.values || grid.values->entryCount == 0) return {};
-    const uint64_t n = grid.values->entryCount, stride = std::max<uint64_t>(1, n >> 20);
-    std::vector<double> sample;
-    sample.reserve(size_t(n / stride + 1));
-    size_t hint = 0;
-    for (uint64_t e = 0; e < n; e += stride) sample.push_back(valueAsDoubles(grid, e, hint)[0]);
-    const auto [low, high] = automaticWindow(sample);
+    const auto [low, high] = storedValueWindow(grid);
     return {low, high};
 }
 
@@ -64,11 +59,8 @@ Image renderVolume(const RenderGrid& grid, const Camera& camera, const RenderOpt
                     if (firstHit < 0) firstHit = box.t;
                     double lit = 1;
                     if (alpha > 0.01) {  // worth a gradient: lit as a surface facing the viewer
-                        if (const std::optional<glm::dvec3> g = valueGradient(grid, tracer, box.voxel, v)) {
-                            glm::dvec3 n = frame.normalToWorld(-*g);
-                            if (glm::dot(n, dir) > 0) n = -n;
-                            lit = kAmbient + (1 - kAmbient) * std::max(0.0, glm::dot(n, light));
-                        }
+                        if (const std::optional<glm::dvec3> g = valueGradient(grid, tracer, box.voxel, v))
+                            lit = kAmbient + (1 - kAmbient) * std::max(0.0, glm::dot(facingNormal(frame, box, dir, -*g), light));
                     }
                     sum += transmittance * alpha * lit * tf.colour(v);
                     transmittance *= 1 - alpha;

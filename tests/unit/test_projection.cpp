@@ -81,6 +81,14 @@ std::vector<Crossing> crossedVoxels(const glm::dvec3& o, const glm::dvec3& d) {
     return out;
 }
 
+// The first voxel along the ray that `meets` accepts, if any.
+template <typename Meets>
+std::optional<Crossing> firstCrossed(const glm::dvec3& o, const glm::dvec3& d, Meets&& meets) {
+    for (const Crossing& c : crossedVoxels(o, d))
+        if (meets(c)) return c;
+    return std::nullopt;
+}
+
 // A 12x10x8 int32 block (voxel 0.5) of the values `value(x, y, z)`,
 // imported through OpenVDB and encoded.
 template <typename Value>
@@ -275,22 +283,17 @@ TEST(LabelRender, FirstLabelsEqualABruteForceOverTheDenseBlock) {
             for (int px = 0; px < camera.width; ++px) {
                 glm::dvec3 o, d;
                 camera.pixelRay(px, py, o, d);
-                double bestT = std::numeric_limits<double>::infinity();
-                int32_t want = 0;
-                for (const Crossing& c : crossedVoxels(o, d)) {
+                const std::optional<Crossing> want = firstCrossed(o, d, [&](const Crossing& c) {
                     const int32_t l = labelAt(c.x, c.y, c.z);
-                    if (shown.empty() ? l != 0 : std::find(shown.begin(), shown.end(), int64_t(l)) != shown.end()) {
-                        bestT = c.t0, want = l;
-                        break;
-                    }
-                }
+                    return shown.empty() ? l != 0 : std::find(shown.begin(), shown.end(), int64_t(l)) != shown.end();
+                });
                 const auto& got = hits[size_t(py) * size_t(camera.width) + size_t(px)];
-                if (std::isinf(bestT)) {
+                if (!want) {
                     EXPECT_FALSE(got.has_value()) << px << "," << py;
                     continue;
                 }
                 ++met;
-                differ += !got || got->label != want;
+                differ += !got || got->label != labelAt(want->x, want->y, want->z);
             }
         EXPECT_GT(met, 20u) << shown.size();
         EXPECT_EQ(differ, 0u) << "of " << met << " pixels, " << shown.size() << " labels chosen";
@@ -322,20 +325,14 @@ TEST(IsoSurface, FirstCrossingsEqualABruteForceOverTheDenseBlock) {
             for (int px = 0; px < camera.width; ++px) {
                 glm::dvec3 o, d;
                 camera.pixelRay(px, py, o, d);
-                double bestT = std::numeric_limits<double>::infinity();
-                std::array<int64_t, 3> want{};
-                for (const Crossing& c : crossedVoxels(o, d))
-                    if (valueAt(c.x, c.y, c.z) >= iso) {
-                        bestT = c.t0, want = {c.x, c.y, c.z};
-                        break;
-                    }
+                const std::optional<Crossing> want = firstCrossed(o, d, [&](const Crossing& c) { return valueAt(c.x, c.y, c.z) >= iso; });
                 const auto& got = hits[size_t(py) * size_t(camera.width) + size_t(px)];
-                if (std::isinf(bestT)) {
+                if (!want) {
                     EXPECT_FALSE(got.has_value()) << px << "," << py;
                     continue;
                 }
                 ++met;
-                differ += !got || got->box.voxel != want;
+                differ += !got || got->box.voxel != std::array<int64_t, 3>{want->x, want->y, want->z};
                 if (got) EXPECT_GE(valueAt(int(got->box.voxel[0]), int(got->box.voxel[1]), int(got->box.voxel[2])), iso);
             }
         EXPECT_GT(met, 200u) << iso;
