@@ -14,6 +14,7 @@
 #include "src/attributes/PaletteCompressor.h"
 #include "src/attributes/PredictedChannel.h"
 #include "src/attributes/RescaledFloats.h"
+#include "src/coding/FloatValueCoder.h"
 #include "src/format/ByteIO.h"
 #include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
@@ -54,11 +55,12 @@ bool palettesCannotWin(std::span<const uint8_t> values, uint32_t vs, uint64_t be
 // coded from their neighbours (int32 context-modelled, range coded already,
 // with neighbours across bricks when their places are known, and as labels
 // too when the window looks like labels; int64 brick MED residuals, by
-// zstd's estimate; a rescaled float32 window's integers) and its palettes
+// zstd's estimate; a float32 window's bits predicted in 3-D, and its
+// lattice's integers when it has one) and its palettes
 // (by zstd's fast estimate; they win a tie), unless a sample says they
 // cannot win.
 std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                uint32_t vs, const std::optional<ValueRescale>& rescale) {
+                                uint32_t vs, const std::optional<FloatChannel>& floats) {
     std::vector<uint8_t> best;
     uint64_t bestSize = UINT64_MAX;
     uint8_t coding = detail::kPaletteCoding;
@@ -67,11 +69,17 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         best = std::move(payload), bestSize = size, coding = kind;
     };
     bool labelsLike = false;
-    if (rescale) {  // float32 entries: their palettes or their lattice's integers
-        if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *rescale)) {
-            const uint64_t size = integers->size();
-            consider(std::move(*integers), size, detail::kRescaledFloatCoding);
-        }
+    if (floats) {  // float32 entries: their bits predicted, their lattice's integers, their palettes
+        std::vector<uint32_t> bits(values.size() / 4);
+        std::memcpy(bits.data(), values.data(), bits.size() * 4);
+        std::vector<uint8_t> predicted = coding::encodePlacedFloats(bits, layout, places);
+        const uint64_t size = predicted.size();
+        consider(std::move(predicted), size, detail::kFloatCoding);
+        if (floats->lattice)
+            if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *floats->lattice)) {
+                const uint64_t latticeSize = integers->size();
+                consider(std::move(*integers), latticeSize, detail::kRescaledFloatCoding);
+            }
     } else if (vs == 4) {
         const bool placed = !places.empty();
         std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places);
@@ -103,10 +111,10 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
 } // namespace
 
 PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory,
-                                             std::optional<ValueRescale> rescale)
-    : valueSize_(valueSize), rescale_(rescale), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
+                                             std::optional<FloatChannel> floats)
+    : valueSize_(valueSize), floats_(floats), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
     if (valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
-    if (rescale && valueSize != 4) throw Error("internal error: rescaled predicted windows hold float32 entries");
+    if (floats && valueSize != 4) throw Error("internal error: predicted float windows hold float32 entries");
     const uint8_t zeros[kHeaderBytes] = {};
     if (!spillNear.empty()) {
         spill_ = std::make_shared<ScratchFile>(spillNear, spillInMemory);
@@ -131,7 +139,7 @@ void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const
     if (!layout.empty()) {
         if (!places.empty() && places.size() != layout.size()) throw Error("internal error: a layout and its places differ in length");
         if (placed_ && *placed_ != !places.empty()) throw Error("internal error: brick places given in some calls only");
-        if (rescale_ && places.empty()) throw Error("internal error: rescaled floats are coded with their bricks' places");
+        if (floats_ && places.empty()) throw Error("internal error: floats are coded with their bricks' places");
         placed_ = !places.empty();
     }
     size_t at = 0;  // byte position in `values`
@@ -178,7 +186,7 @@ void PredictedWindowWriter::codePending() {
     std::vector<std::vector<uint8_t>> stored(pending_.size());
     std::vector<uint64_t> rawBytes(pending_.size());
     tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
-        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, pending_[i].places, valueSize_, rescale_);
+        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, pending_[i].places, valueSize_, floats_);
         std::vector<uint8_t>().swap(pending_[i].values);
         std::vector<uint64_t>().swap(pending_[i].layout);
         std::vector<coding::BrickPlace>().swap(pending_[i].places);
@@ -256,8 +264,8 @@ ValueWindowsPayload PredictedWindowWriter::finish() {
 }
 
 std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            std::span<const coding::BrickPlace> places, std::optional<ValueRescale> rescale) {
-    PredictedWindowWriter writer(valueSize, 0, "", 0, rescale);
+                                            std::span<const coding::BrickPlace> places, std::optional<FloatChannel> floats) {
+    PredictedWindowWriter writer(valueSize, 0, "", 0, floats);
     writer.add(values, layout, places);
     return std::move(writer.finish().bytes);
 }

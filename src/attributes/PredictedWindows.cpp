@@ -9,6 +9,7 @@
 #include "src/attributes/ContextChannel.h"
 #include "src/attributes/PredictedChannel.h"
 #include "src/attributes/RescaledFloats.h"
+#include "src/coding/FloatValueCoder.h"
 #include "src/format/ByteIO.h"
 #include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
@@ -93,6 +94,15 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
         if (dir.valueSize != 4) throw Error(where + ": rescaled floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
         return decodeRescaledFloats(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)));
+    }
+    if (raw[0] == detail::kFloatCoding) {
+        if (dir.valueSize != 4) throw Error(where + ": predicted floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
+        if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
+        std::vector<uint32_t> bits(size_t(e.entries));
+        coding::decodePlacedFloats(body, bricks, places.subspan(size_t(e.firstBrick), size_t(e.bricks)), bits, where);
+        std::vector<uint8_t> out(bits.size() * 4);
+        std::memcpy(out.data(), bits.data(), out.size());
+        return out;
     }
     throw Error(where + ": unknown coding " + std::to_string(raw[0]));
 }

@@ -1,10 +1,12 @@
 // An integer value channel (int32 / int64) at rest in windows, each coded
 // on its own as whichever is smaller: its palettes (PaletteChannel.h) or its
-// brick-predicted residuals (PredictedChannel.h). A float32 channel whose
-// values lie on a rescale lattice (GridRecord::rescale) too: its windows
-// are palettes or the lattice's integers (RescaledFloats.h). The windowed form of both,
-// so an encoder of a dense scan holds one window per core, never the whole
-// channel (ValueWindows.h does the same for palettes alone).
+// brick-predicted residuals (PredictedChannel.h). A float32 channel
+// (FloatChannel) too: its windows are palettes, its float bits predicted in
+// 3-D (coding/FloatValueCoder.h) or, when its values lie on a rescale
+// lattice (GridRecord::rescale), the lattice's integers (RescaledFloats.h).
+// The windowed form of all of them, so an encoder of a dense scan holds one
+// window per core, never the whole channel (ValueWindows.h does the same
+// for palettes alone).
 //
 // The predictor reads inside a 4^3 brick, so a window holds whole brick
 // instances: window k holds the instances (and solid nodes) whose first
@@ -29,7 +31,8 @@
 // float32 only, encodeRescaledFloats bytes over its bricks and their
 // places, RescaledFloats.h; 6 and 7: codings 3 and 4 with the bricks
 // visited in spatial order, coding::BrickOrder, which a writer writes
-// today) then that payload;
+// today; 8: float32 only, encodePlacedFloats bytes over its bricks and
+// their places, coding/FloatValueCoder.h) then that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -50,17 +53,24 @@ namespace vdbdag::attributes {
 namespace detail {  // the layout above, shared by the writer and the reader
 inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
 inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3, kPlacedLabelCoding = 4,
-                         kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7;
+                         kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7, kFloatCoding = 8;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail
 
+// A channel of float32 entries (an integer channel has none): their bits
+// are predicted (coding 8), and with a lattice its integers tried too
+// (coding 5).
+struct FloatChannel {
+    std::optional<ValueRescale> lattice;  // the rescale the entries are believed to lie on
+};
+
 class PredictedWindowWriter {
 public:
-    // As ValueWindowWriter's (`valueSize` 4 or 8). With `rescale`, the
-    // entries are float32 believed to lie on that lattice, and need places.
+    // As ValueWindowWriter's (`valueSize` 4 or 8). With `floats`, the
+    // entries are float32 (valueSize 4) and need places.
     explicit PredictedWindowWriter(uint32_t valueSize, unsigned parallel = 0, const std::string& spillNear = "", uint64_t spillInMemory = 0,
-                                   std::optional<ValueRescale> rescale = std::nullopt);
+                                   std::optional<FloatChannel> floats = std::nullopt);
     // `values`: the entries of the brick instances `layout` describes (per
     // instance in attribute order its stored mask, 0 for a solid node),
     // continuing the previous call; `places`: where each lies
@@ -86,7 +96,7 @@ private:
     };
     void codePending();
     uint32_t valueSize_;
-    std::optional<ValueRescale> rescale_;
+    std::optional<FloatChannel> floats_;
     unsigned parallel_;
     uint64_t entries_ = 0, windows_ = 0;
     std::vector<Window> pending_;  // full windows not yet coded, and the one filling (last)
@@ -102,7 +112,7 @@ private:
 
 // All at once.
 std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            std::span<const coding::BrickPlace> places = {}, std::optional<ValueRescale> rescale = std::nullopt);
+                                            std::span<const coding::BrickPlace> places = {}, std::optional<FloatChannel> floats = std::nullopt);
 
 // The entries in attribute order; validates the payload against `layout`
 // (the DAG's attributeLayout) and throws vdbdag::Error starting with `what`.

@@ -6,8 +6,9 @@
 // with its causal neighbours
 //      this slice:  NW N NE        slice below:  PNW PN
 //                   W  *                         PW  P
-// wherever they were visited before in the same walk (in this brick or in
-// any brick before it), and its entry: the rank of its stored bit
+// (and, for a walk that asks for them, WW, NN and PP two voxels back along
+// x, y and z) wherever they were visited before in the same walk (in this
+// brick or in any brick before it), and its entry: the rank of its stored bit
 // (dag_access.h dagStoredBit). A tile (mask 0) is one entry without place.
 #pragma once
 #include <algorithm>
@@ -37,9 +38,9 @@ struct PlacedBrick {
 
 template <typename Rec>
 struct PlacedNeighbours {
-    enum Which { W, N, NW, NE, P, PW, PN, PNW };
-    const PlacedBrick<Rec>* brick[8];
-    int bit[8];
+    enum Which { W, N, NW, NE, P, PW, PN, PNW, WW, NN, PP };
+    const PlacedBrick<Rec>* brick[11];
+    int bit[11];
     bool has(Which k) const { return brick[k] != nullptr; }
     int32_t value(Which k) const { return brick[k]->value[bit[k]]; }
     const Rec& rec(Which k) const { return brick[k]->rec[bit[k]]; }
@@ -101,9 +102,10 @@ inline std::vector<uint32_t> placedVisitOrder(std::span<const uint64_t> layout, 
 }
 
 // tile(entry); voxel(neighbours, entry, value&, rec&) sets the voxel's value
-// (read or decoded) and its record, visiting the instances in `order`.
+// (read or decoded) and its record, visiting the instances in `order`;
+// with `kFar`, the neighbours include WW, NN and PP.
 // Throws vdbdag::Error when the layout, its places and `entries` disagree.
-template <typename Rec, typename Tile, typename Voxel>
+template <typename Rec, bool kFar = false, typename Tile, typename Voxel>
 void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, Tile&& tile,
                       Voxel&& voxel) {
     if (places.size() != layout.size()) throw Error("the layout has " + std::to_string(layout.size()) + " bricks, their places " + std::to_string(places.size()));
@@ -140,7 +142,7 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
         PlacedNeighbours<Rec> n;
         // A neighbour's brick and bit, or null when it is not visited yet.
         const auto at = [&](typename PlacedNeighbours<Rec>::Which k, int x, int y, int z) {
-            const int ox = x < 0 ? -1 : x > 3 ? 1 : 0, oy = y < 0 ? -1 : 0, oz = z < 0 ? -1 : 0;
+            const int ox = x < 0 ? -1 : x > 3 ? 1 : 0, oy = y < 0 ? -1 : 0, oz = z < 0 ? -1 : 0;  // x, y, z >= -2
             const PlacedBrick<Rec>* t = around[ox + 1][oy + 1][oz + 1];
             n.bit[k] = (x & 3) + 4 * (y & 3) + 16 * (z & 3);
             n.brick[k] = t && (t->done >> n.bit[k] & 1) ? t : nullptr;
@@ -150,6 +152,7 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
             const int p = std::countr_zero(bits), x = p & 3, y = (p >> 2) & 3, z = p >> 4;
             at(Nb::W, x - 1, y, z), at(Nb::N, x, y - 1, z), at(Nb::NW, x - 1, y - 1, z), at(Nb::NE, x + 1, y - 1, z);
             at(Nb::P, x, y, z - 1), at(Nb::PW, x - 1, y, z - 1), at(Nb::PN, x, y - 1, z - 1), at(Nb::PNW, x - 1, y - 1, z - 1);
+            if constexpr (kFar) at(Nb::WW, x - 2, y, z), at(Nb::NN, x, y - 2, z), at(Nb::PP, x, y, z - 2);
             const unsigned stored = access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), place.mirror);
             voxel(n, e + uint64_t(std::popcount(mask & ((uint64_t(1) << stored) - 1))), self.value[p], self.rec[p]);
             self.done |= uint64_t(1) << p;

@@ -346,12 +346,12 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     // like colours (clustered over the whole channel), are gathered whole.
     const bool lossy = options.tolerance.mode != attributes::ScalarTolerance::Mode::Exact;
     const bool streamValues = vs > 0 && !isColourGrid(source.header(), options) && (!lossy || team.size() == 1);
-    const bool predicted = usesPredictedWindows(source.header(), options);
     // Gathers the layer into windows (on process 0: all of them).
     auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries,
                            attributes::ScalarQuantizer* quantizer) {
         const unsigned inFlight = valueWindowsInFlight(budget, vs);
         const uint64_t expected = encoding::decodedSize(dag).attributeEntries;
+        const bool inactive = layer == Layer::Inactive;
         ValueStream stream;
         stream.quantizer = quantizer;
         auto run = [&](auto& writer) -> attributes::ValueWindowsPayload {
@@ -387,7 +387,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
             std::optional<std::decay_t<decltype(writer)>> whole;
             if (team.isRoot()) {
                 if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::PredictedWindowWriter>)
-                    whole.emplace(vs, inFlight, budget.spillNear, budget.spillInMemory, valueLattice(source.header(), options));
+                    whole.emplace(vs, inFlight, budget.spillNear, budget.spillInMemory, floatChannelOf(source.header(), options, inactive));
                 else
                     whole.emplace(vs, expected, inFlight, budget.spillNear, budget.spillInMemory);
             }
@@ -401,9 +401,9 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
             if (entries != expected) throw Error("internal error: the processes' values do not add up to the DAG's entries");
             return whole->finish();
         };
-        if (predicted) {
+        if (usesPredictedWindows(source.header(), options, inactive)) {
             attributes::PredictedWindowWriter writer(vs, inFlight, team.size() == 1 ? budget.spillNear : "", budget.spillInMemory,
-                                                     valueLattice(source.header(), options));
+                                                     floatChannelOf(source.header(), options, inactive));
             stream.predicted = &writer;
             return run(writer);
         }

@@ -62,16 +62,16 @@ std::vector<std::array<int64_t, 3>> placementCandidates(const dag::ActiveBounds&
 
 namespace {
 
-// A layer's values at rest: an integer channel (unless --no-predict) in
-// predicted windows, each window predicted or palette-coded, whichever is
-// smaller; anything else in palette windows.
+// A layer's values at rest: an integer or float layer (unless --no-predict;
+// floatChannelOf) in predicted windows, each window predicted or
+// palette-coded, whichever is smaller; anything else in palette windows.
 attributes::ValueWindowsPayload codeValues(const encoding::CompactDag& dag, const std::vector<uint8_t>& attributes, const GridRecord& header,
-                                           const EncodeOptions& options) {
+                                           const EncodeOptions& options, bool inactive) {
     attributes::ValueWindowsPayload out;
     const ValueType type = header.valueType;
-    if (usesPredictedWindows(header, options)) {
+    if (usesPredictedWindows(header, options, inactive)) {
         out.bytes = attributes::encodePredictedWindows(attributes, valueSize(type), encoding::attributeLayout(dag),
-                                                       encoding::attributePlaces(dag, valueSize(type)), valueLattice(header, options));
+                                                       encoding::attributePlaces(dag, valueSize(type)), floatChannelOf(header, options, inactive));
         out.predicted = true;
     } else {
         out.bytes = attributes::encodeValueWindows(attributes, valueSize(type));
@@ -178,11 +178,11 @@ void codeActiveValues(const encoding::CompactDag& dag, CodedValues& coded, const
     coded.lossy = attributes::applyScalarTolerance(coded.attributes, type, options.tolerance);
     if (isColourGrid(header, options))
         coded.colour = attributes::quantiseColours(coded.attributes, type, options.colourBits, "grid '" + header.name + "'");
-    coded.windows = codeValues(dag, coded.attributes, header, options);
+    coded.windows = codeValues(dag, coded.attributes, header, options, false);
 }
 
 void codeInactiveValues(const encoding::CompactDag& dag, CodedValues& coded, const GridRecord& header, const EncodeOptions& options) {
-    coded.windows = codeValues(dag, coded.attributes, header, options);
+    coded.windows = codeValues(dag, coded.attributes, header, options, true);
 }
 
 void storeActiveValues(format::EncodedGrid& out, CodedValues&& coded) {
@@ -198,14 +198,16 @@ void storeInactiveValues(format::EncodedGrid& out, CodedValues&& coded) {
     out.inactiveValueWindows = std::move(coded.windows);
 }
 
-std::optional<ValueRescale> valueLattice(const GridRecord& grid, const EncodeOptions& options) {
+std::optional<attributes::FloatChannel> floatChannelOf(const GridRecord& grid, const EncodeOptions& options, bool inactive) {
     if (!options.predictIntegers || grid.valueType != ValueType::Float || options.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
         return std::nullopt;
-    return grid.rescale;
+    if (inactive && !grid.rescale) return std::nullopt;
+    return attributes::FloatChannel{grid.rescale};
 }
 
-bool usesPredictedWindows(const GridRecord& grid, const EncodeOptions& options) {
-    return (options.predictIntegers && (grid.valueType == ValueType::Int32 || grid.valueType == ValueType::Int64)) || valueLattice(grid, options);
+bool usesPredictedWindows(const GridRecord& grid, const EncodeOptions& options, bool inactive) {
+    return (options.predictIntegers && (grid.valueType == ValueType::Int32 || grid.valueType == ValueType::Int64)) ||
+           floatChannelOf(grid, options, inactive);
 }
 
 bool isColourGrid(const GridRecord& grid, const EncodeOptions& options) {

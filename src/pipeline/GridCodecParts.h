@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "src/attributes/PredictedWindows.h"
 #include "src/dag/DagBuilder.h"
 #include "src/pipeline/GridCodec.h"
 
@@ -55,12 +56,15 @@ encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t
 // An EncodedGrid with `grid`'s header and nothing else.
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options);
 
-// The lattice a float channel of `grid` is tried on (GridRecord::rescale,
-// when its values are kept exactly, unless --no-predict).
-std::optional<ValueRescale> valueLattice(const GridRecord& grid, const EncodeOptions& options);
-// Whether a channel of `grid` is stored in predicted windows (integers, and
-// floats with a lattice; unless --no-predict) rather than palette windows.
-bool usesPredictedWindows(const GridRecord& grid, const EncodeOptions& options);
+// How a float32 layer of `grid` is predicted when its values are kept
+// exactly, unless --no-predict: its bits in 3-D, and its lattice
+// (GridRecord::rescale) when it has one. An inactive layer only with a
+// lattice (a level set's are +-background, which palettes hold in bytes).
+// Nothing for other grids.
+std::optional<attributes::FloatChannel> floatChannelOf(const GridRecord& grid, const EncodeOptions& options, bool inactive);
+// Whether a layer of `grid` is stored in predicted windows (integers,
+// floats as above; unless --no-predict) rather than palette windows.
+bool usesPredictedWindows(const GridRecord& grid, const EncodeOptions& options, bool inactive);
 
 // From coded.attributes (attribute order of `dag`): the lossy settings
 // (tolerance, colours), then the value windows (predicted windows for

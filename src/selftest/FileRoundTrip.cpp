@@ -3,6 +3,8 @@
 
 #include <numeric>
 
+#include "src/format/TraceableValues.h"
+
 namespace vdbdag::selftest {
 
 FileRoundTrip roundTripThroughFile(const GridRecord& grid, const pipeline::EncodeOptions& options) {
@@ -13,6 +15,7 @@ FileRoundTrip roundTripThroughFile(const GridRecord& grid, const pipeline::Encod
     out.fileBytes = bytes.size();
     format::SsvdagScene back = format::readScene(bytes, "selftest grid '" + grid.name + "' (in memory)");
     out.stored = std::move(back.grids.at(0));
+    out.traceable = format::traceableValues(out.stored, false);
     out.decoded = pipeline::decodeGrid(out.stored);
     return out;
 }

@@ -15,9 +15,10 @@ namespace vdbdag::selftest {
 
 struct FileRoundTrip {
     uint64_t fileBytes = 0;       // the whole .ssvdag file
-    format::EncodedGrid stored;   // the grid as read back from the file (DAG, value channel, stats, lossy report)
+    format::EncodedGrid stored;   // the grid as read back from the file (DAG, value windows, stats, lossy report)
+    attributes::PaletteChannel traceable;  // its active values as the reader lays them out for tracing (format::traceableValues)
     GridRecord decoded;
-    uint64_t channelBytes() const { return stored.values.byteSize(); }  // traceable value channel
+    uint64_t channelBytes() const { return traceable.byteSize(); }  // traceable value channel
     uint64_t dagBytes() const { return stored.dag.byteSize(); }
 };
 

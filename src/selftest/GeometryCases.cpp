@@ -77,7 +77,7 @@ void addCases(std::vector<SelftestCase>& cases) {
                          SyntheticGrid grid;
                          Exact e = exactRoundTrip(grid, "empty");
                          e.checks.require(e.rt.decoded.topology.empty() && e.rt.stored.dag.empty(), "the decoded grid is not empty");
-                         e.checks.require(e.rt.stored.values.entryCount == 0, "the empty grid stores values");
+                         e.checks.require(e.rt.traceable.entryCount == 0, "the empty grid stores values");
                          return e.checks.result(fmt::format("{} voxels", e.rt.decoded.topology.activeVoxelCount()), fmt::format("0 voxels, DAG {} bytes, file {} bytes", e.rt.dagBytes(), e.rt.fileBytes));
                      }});
 
@@ -185,13 +185,13 @@ void addCases(std::vector<SelftestCase>& cases) {
                          const GridTopology& t = e.rt.decoded.topology;
                          e.checks.require(t.tiles.size() == 1 && t.tiles[0].log2Size == 12 && t.bricks.size() == 1,
                                           fmt::format("decoded as {} tiles and {} bricks", t.tiles.size(), t.bricks.size()));
-                         e.checks.require(e.rt.stored.values.entryCount == 2, fmt::format("{} attribute entries", e.rt.stored.values.entryCount));
+                         e.checks.require(e.rt.traceable.entryCount == 2, fmt::format("{} attribute entries", e.rt.traceable.entryCount));
                          e.checks.require(e.rt.stored.activeVoxels == (uint64_t(1) << 36) + 1, fmt::format("{} active voxels", e.rt.stored.activeVoxels));
                          e.checks.require(e.rt.fileBytes <= baseline + kTileExtraBytes, fmt::format("file {} bytes, one voxel alone {}", e.rt.fileBytes, baseline));
                          return e.checks.result(fmt::format("+{} B, {} tile", int64_t(e.rt.fileBytes) - int64_t(baseline), t.tiles.size()),
                                                 fmt::format("{} active voxels in {} attribute entries; file {} bytes (one voxel alone: {}), DAG {} bytes "
                                                             "over {} levels, root 2^{}",
-                                                            e.rt.stored.activeVoxels, e.rt.stored.values.entryCount, e.rt.fileBytes, baseline,
+                                                            e.rt.stored.activeVoxels, e.rt.traceable.entryCount, e.rt.fileBytes, baseline,
                                                             e.rt.dagBytes(), e.rt.stored.dag.log2Size - 1, e.rt.stored.dag.log2Size));
                      }});
 }

@@ -282,7 +282,7 @@ void addTypedCases(std::vector<SelftestCase>& cases) {
                                         fmt::format("value channel {} bytes > {}", rt.channelBytes(), kConstantChannelBound));
                          return checks.result(fmt::format("{} B", rt.channelBytes()),
                                               fmt::format("value channel {} bytes ({} materials) for 32768 entries; whole file {} bytes",
-                                                          rt.channelBytes(), rt.stored.values.materialCount(), rt.fileBytes));
+                                                          rt.channelBytes(), rt.traceable.materialCount(), rt.fileBytes));
                      }});
 
     // Two values one ulp apart, alternating.

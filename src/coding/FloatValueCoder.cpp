@@ -1,0 +1,240 @@
+// See FloatValueCoder.h.
+#include "src/coding/FloatValueCoder.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cfloat>
+#include <cmath>
+#include <memory>
+
+#include "src/coding/PlacedWalk.h"
+#include "src/coding/RangeCoder.h"
+#include "src/util/Error.h"
+
+namespace vdbdag::coding {
+namespace {
+
+using detail::PlacedNeighbours;
+using detail::walkPlacedBricks;
+
+constexpr int kPredictors = 8;
+constexpr int kErrorContexts = 62;                 // 0..61: by the expected residual's length
+constexpr int kNoNeighbourContext = 62;            // a voxel with none of W, N, P, NW
+constexpr int kTileContext = 63;                   // a tile, predicted by the tile before
+constexpr int kContexts = 64;
+constexpr int kMaxLength = 32;                     // |residual| < 2^32
+constexpr uint8_t kModelGeneration = 0;
+constexpr size_t kHeaderBytes = 2;
+
+// What a coded voxel leaves for its neighbours: each predictor's error there
+// (0 below FLT_MIN, see toFloat).
+struct FloatRecord {
+    std::array<float, kPredictors> err;
+};
+
+struct FloatModels {
+    std::array<std::array<BitModel, 64>, kContexts> length;  // the bit length's tree, nodes 1..63
+    std::array<BitModel, kContexts> sign;
+    std::array<std::array<std::array<BitModel, 4>, kMaxLength + 1>, kContexts> high;  // two bits below the leading one, as a prefix tree
+};
+
+// Float bits as an unsigned integer in the floats' order, and back.
+constexpr uint32_t ordered(uint32_t u) { return (u & 0x80000000u) ? ~u : (u | 0x80000000u); }
+constexpr uint32_t unordered(uint32_t o) { return (o & 0x80000000u) ? (o & 0x7FFFFFFFu) : ~o; }
+
+// The bits of the value whose ordered form, shifted right by `shift`, is q
+// (the low bits those of a value with `shift` zero low bits).
+uint32_t fromShifted(uint64_t q, unsigned shift) {
+    const uint32_t o = uint32_t(q << shift);
+    const uint32_t fill = (o & 0x80000000u) ? 0u : uint32_t((uint64_t(1) << shift) - 1);
+    return unordered(o | fill);
+}
+
+// A neighbour's value as the predictors read it: false for NaN and
+// infinities, 0 for a subnormal (so denormals-are-zero modes agree).
+bool predictable(uint32_t u, double& v) {
+    const uint32_t exponent = (u >> 23) & 0xFFu;
+    if (exponent == 0xFFu) return false;
+    v = exponent == 0 ? 0.0 : double(std::bit_cast<float>(u));
+    return true;
+}
+
+// The one rounding from double to float: 0 below FLT_MIN in magnitude (and
+// for NaN), +-FLT_MAX above it, else round to nearest. Flush-to-zero modes
+// never see a subnormal result.
+float toFloat(double d) {
+    const double a = std::fabs(d);
+    if (!(a >= double(FLT_MIN))) return 0.0f;
+    if (a > double(FLT_MAX)) return d < 0 ? -FLT_MAX : FLT_MAX;
+    return float(d);
+}
+
+uint32_t shiftedOf(float f, unsigned shift) { return ordered(std::bit_cast<uint32_t>(f)) >> shift; }
+
+// The walk shared by both directions: step(context, predicted, entry)
+// returns the entry's bits, `predicted` its prediction's shifted ordered form.
+template <typename Step>
+void walkFloats(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, unsigned shift, Step&& step) {
+    using Nb = PlacedNeighbours<FloatRecord>;
+    uint32_t lastTile = 0;
+    walkPlacedBricks<FloatRecord, true>(
+        layout, places, entries, BrickOrder::Spatial,
+        [&](uint64_t entry) { lastTile = step(kTileContext, ordered(lastTile) >> shift, entry); },
+        [&](const Nb& nb, uint64_t entry, int32_t& value, FloatRecord& rec) {
+            double v[11];
+            bool has[11];
+            for (int k = 0; k < 11; ++k) has[k] = nb.has(Nb::Which(k)) && predictable(uint32_t(nb.value(Nb::Which(k))), v[k]);
+            const double W = v[Nb::W], N = v[Nb::N], P = v[Nb::P];
+            const bool hW = has[Nb::W], hN = has[Nb::N], hP = has[Nb::P];
+            double pred[kPredictors];
+            bool ok[kPredictors] = {};
+            if (hW && hN && hP && has[Nb::NW] && has[Nb::PW] && has[Nb::PN] && has[Nb::PNW])
+                pred[0] = W + N + P - v[Nb::NW] - v[Nb::PW] - v[Nb::PN] + v[Nb::PNW], ok[0] = true;
+            if (hW && hN && has[Nb::NW]) pred[1] = W + N - v[Nb::NW], ok[1] = true;
+            if (hW && hP && has[Nb::PW]) pred[2] = W + P - v[Nb::PW], ok[2] = true;
+            if (hN && hP && has[Nb::PN]) pred[3] = N + P - v[Nb::PN], ok[3] = true;
+            if (hW && has[Nb::WW]) pred[4] = 2.0 * W - v[Nb::WW], ok[4] = true;
+            if (hN && has[Nb::NN]) pred[5] = 2.0 * N - v[Nb::NN], ok[5] = true;
+            if (hP && has[Nb::PP]) pred[6] = 2.0 * P - v[Nb::PP], ok[6] = true;
+            {
+                double sum = 0;
+                int n = 0;
+                if (hW) sum += W, ++n;
+                if (hN) sum += N, ++n;
+                if (hP) sum += P, ++n;
+                pred[7] = n ? sum / n : 0.0, ok[7] = true;
+            }
+            // Each predictor's errors at W, N, P and NW (visited: their
+            // records exist, whatever their values).
+            const typename Nb::Which around[4] = {Nb::W, Nb::N, Nb::P, Nb::NW};
+            double error[kPredictors] = {};
+            int count = 0;
+            for (const auto k : around) {
+                if (!nb.has(k)) continue;
+                ++count;
+                const FloatRecord& r = nb.rec(k);
+                for (int p = 0; p < kPredictors; ++p) error[p] += double(r.err[p]);
+            }
+            int best = 7;
+            for (int p = 0; p < kPredictors; ++p)
+                if (ok[p] && (error[p] < error[best] || (error[p] == error[best] && p < best))) best = p;
+            const float predicted = toFloat(pred[best]);
+            int context = kNoNeighbourContext;
+            if (count) {
+                const double magnitude = std::fabs(double(predicted));
+                const uint32_t d = shiftedOf(toFloat(magnitude + error[best] / count), shift) - shiftedOf(toFloat(magnitude), shift);
+                const int length = std::bit_width(d);
+                context = std::min(kErrorContexts - 1, 2 * length + (length >= 2 ? int((d >> (length - 2)) & 1u) : 0));
+            }
+            const uint32_t u = step(context, shiftedOf(predicted, shift), entry);
+            value = int32_t(u);
+            double x;
+            if (!predictable(u, x)) {
+                rec.err.fill(FLT_MAX);
+                return;
+            }
+            for (int p = 0; p < kPredictors; ++p) {
+                if (ok[p]) {
+                    rec.err[p] = toFloat(std::fabs(pred[p] - x));
+                    continue;
+                }
+                // A predictor this voxel cannot make: twice its mean error
+                // at W, N and P, or the largest when none has one.
+                double sum = 0;
+                int n = 0;
+                for (const auto k : {Nb::W, Nb::N, Nb::P})
+                    if (nb.has(k)) sum += double(nb.rec(k).err[p]), ++n;
+                rec.err[p] = n ? toFloat(2.0 * sum / n) : FLT_MAX;
+            }
+        });
+}
+
+void putResidual(RangeEncoder& rc, FloatModels& m, int context, int64_t r) {
+    const uint64_t magnitude = uint64_t(r < 0 ? -r : r);
+    const int length = std::bit_width(magnitude);
+    unsigned node = 1;
+    for (int b = 5; b >= 0; --b) {
+        const unsigned bit = unsigned(length >> b) & 1u;
+        rc.encode(m.length[size_t(context)][node], bit);
+        node = 2 * node + bit;
+    }
+    if (length == 0) return;
+    rc.encode(m.sign[size_t(context)], r < 0);
+    const int below = length - 1, modelled = std::min(below, 2);
+    unsigned h = 1;
+    for (int b = 0; b < modelled; ++b) {
+        const unsigned bit = unsigned(magnitude >> (below - 1 - b)) & 1u;
+        rc.encode(m.high[size_t(context)][size_t(length)][h], bit);
+        h = 2 * h + bit;
+    }
+    const int rest = below - modelled;
+    if (rest > 0) rc.encodeDirect(uint32_t(magnitude & ((uint64_t(1) << rest) - 1)), unsigned(rest));
+}
+
+int64_t getResidual(RangeDecoder& rc, FloatModels& m, int context) {
+    unsigned node = 1;
+    for (int b = 0; b < 6; ++b) node = 2 * node + rc.decode(m.length[size_t(context)][node]);
+    const int length = int(node - 64);
+    if (length == 0) return 0;
+    if (length > kMaxLength) throw Error("corrupt (a residual of " + std::to_string(length) + " bits)");
+    const bool negative = rc.decode(m.sign[size_t(context)]);
+    const int below = length - 1, modelled = std::min(below, 2);
+    uint64_t magnitude = 1;
+    unsigned h = 1;
+    for (int b = 0; b < modelled; ++b) {
+        const unsigned bit = rc.decode(m.high[size_t(context)][size_t(length)][h]);
+        h = 2 * h + bit;
+        magnitude = 2 * magnitude + bit;
+    }
+    const int rest = below - modelled;
+    if (rest > 0) magnitude = (magnitude << rest) | rc.decodeDirect(unsigned(rest));
+    return negative ? -int64_t(magnitude) : int64_t(magnitude);
+}
+
+} // namespace
+
+std::vector<uint8_t> encodePlacedFloats(std::span<const uint32_t> bits, std::span<const uint64_t> layout, std::span<const BrickPlace> places) {
+    // The common zero low bits of every entry's magnitude (a half-float
+    // file's values have 13).
+    unsigned shift = 31;
+    for (const uint32_t u : bits)
+        if (const uint32_t m = u & 0x7FFFFFFFu) shift = std::min(shift, unsigned(std::countr_zero(m)));
+    std::vector<uint8_t> out{kModelGeneration, uint8_t(shift)};
+    RangeEncoder rc(out);
+    auto models = std::make_unique<FloatModels>();
+    walkFloats(layout, places, bits.size(), shift, [&](int context, uint32_t predicted, uint64_t entry) {
+        const uint32_t u = bits[entry];
+        putResidual(rc, *models, context, int64_t(ordered(u) >> shift) - int64_t(predicted));
+        return u;
+    });
+    rc.finish();
+    return out;
+}
+
+void decodePlacedFloats(std::span<const uint8_t> payload, std::span<const uint64_t> layout, std::span<const BrickPlace> places, std::span<uint32_t> out,
+                        const std::string& what) {
+    if (payload.size() < kHeaderBytes) throw Error(what + ": corrupt (a float window shorter than its header)");
+    if (payload[0] != kModelGeneration) throw Error(what + ": float model generation " + std::to_string(payload[0]) + " (this version reads 0)");
+    const unsigned shift = payload[1];
+    if (shift > 31) throw Error(what + ": corrupt (a float window shifted by " + std::to_string(shift) + " bits)");
+    const std::span<const uint8_t> stream = payload.subspan(kHeaderBytes);
+    RangeDecoder rc(stream);
+    auto models = std::make_unique<FloatModels>();
+    const int64_t limit = int64_t(1) << (32 - shift);
+    try {
+        walkFloats(layout, places, out.size(), shift, [&](int context, uint32_t predicted, uint64_t entry) {
+            const int64_t q = int64_t(predicted) + getResidual(rc, *models, context);
+            if (q < 0 || q >= limit) throw Error("corrupt (a value outside float32)");
+            return out[entry] = fromShifted(uint64_t(q), shift);
+        });
+    } catch (const Error& e) {
+        throw Error(what + ": " + e.what());
+    }
+    // As CodingLoop.h: the flush leaves at most 4 bytes unread, the decoder
+    // may look up to 4 past its last.
+    if (rc.overrun() > 4 || rc.consumed() + 4 < stream.size())
+        throw Error(what + ": corrupt (the coded values end " + (rc.overrun() > 4 ? "early" : "before the stream does") + ")");
+}
+
+} // namespace vdbdag::coding
