@@ -16,7 +16,7 @@ PACKAGES=(
   mesa-vulkan-drivers libvulkan-dev glslc glslang-tools spirv-tools vulkan-tools vulkan-validationlayers
   libtbb-dev libblosc-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils
-  libzfp-dev fonts-dejavu-core libcharls-dev liblzma-dev libopenjp2-7-dev
+  libzfp-dev fonts-dejavu-core libcharls-dev liblzma-dev libopenjp2-7-dev libfpzip-dev
   libopenmpi-dev openmpi-bin
   libgdcm-dev libgdcm-tools python3-pydicom
   libnifti2-dev python3-nibabel

@@ -112,7 +112,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
 
 PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory,
                                              std::optional<FloatChannel> floats)
-    : valueSize_(valueSize), floats_(floats), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
+    : valueSize_(valueSize), windowEntries_(floats ? kFloatWindowEntries : kValueWindowEntries), floats_(floats), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
     if (valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
     if (floats && valueSize != 4) throw Error("internal error: predicted float windows hold float32 entries");
     const uint8_t zeros[kHeaderBytes] = {};
@@ -129,9 +129,9 @@ void PredictedWindowWriter::beginShare(uint64_t firstEntry, bool endsLayer) {
     share_ = true;
     endsLayer_ = endsLayer;
     entries_ = firstEntry;
-    headEnd_ = (firstEntry + kValueWindowEntries - 1) / kValueWindowEntries * kValueWindowEntries;
-    head_.window = firstEntry / kValueWindowEntries;
-    windows_ = headEnd_ / kValueWindowEntries;
+    headEnd_ = (firstEntry + windowEntries_ - 1) / windowEntries_ * windowEntries_;
+    head_.window = firstEntry / windowEntries_;
+    windows_ = headEnd_ / windowEntries_;
     payload_.clear();  // coded windows only: process 0 writes the header
 }
 
@@ -156,17 +156,17 @@ void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const
     }
     while (i < layout.size()) {
         // A brick instance belongs to the window its first entry falls in.
-        const uint64_t window = entries_ / kValueWindowEntries;
+        const uint64_t window = entries_ / windowEntries_;
         if (pending_.empty() || window != windows_ - 1) {
             if (window != windows_) throw Error("internal error: a predicted window skipped");
             if (pending_.size() == parallel_) codePending();  // every pending window is full
             pending_.emplace_back();
-            pending_.back().values.reserve(size_t((kValueWindowEntries + 64) * valueSize_));  // untouched until filled: never copied
+            pending_.back().values.reserve(size_t((windowEntries_ + 64) * valueSize_));  // untouched until filled: never copied
             ++windows_;
         }
         Window& w = pending_.back();
         // The instances that start in this window.
-        const uint64_t windowEnd = (window + 1) * kValueWindowEntries;
+        const uint64_t windowEnd = (window + 1) * windowEntries_;
         size_t j = i;
         uint64_t n = 0;
         while (j < layout.size() && entries_ + n < windowEnd) n += detail::layoutEntries(layout[j++]);
@@ -206,7 +206,7 @@ ShareWindows PredictedWindowWriter::finishShare() {
     ShareWindows out;
     // The last window is whole here when the next share's first brick
     // starts past it, or this share ends the layer.
-    if (!pending_.empty() && !endsLayer_ && entries_ < windows_ * kValueWindowEntries) {
+    if (!pending_.empty() && !endsLayer_ && entries_ < windows_ * windowEntries_) {
         out.tail.window = windows_ - 1;
         out.tail.values = std::move(pending_.back().values);
         out.tail.layout = std::move(pending_.back().layout);
@@ -214,7 +214,7 @@ ShareWindows PredictedWindowWriter::finishShare() {
         pending_.pop_back();
     }
     codePending();
-    out.firstWindow = headEnd_ / kValueWindowEntries;
+    out.firstWindow = headEnd_ / windowEntries_;
     for (const Directory& d : directory_) out.directory.push_back({d.stored, d.raw, d.entries});
     out.coded = std::move(payload_);
     out.head = std::move(head_);
@@ -235,7 +235,7 @@ void PredictedWindowWriter::addShare(const ShareWindows& share) {
 }
 
 void PredictedWindowWriter::addCoded(uint64_t window, const ShareWindows::Coded& coded, std::span<const uint8_t> bytes) {
-    if (entries_ / kValueWindowEntries != window || windows_ > window || bytes.size() != coded.stored)
+    if (entries_ / windowEntries_ != window || windows_ > window || bytes.size() != coded.stored)
         throw Error("internal error: a coded window out of place");
     codePending();
     appendWindow(payload_, spill_.get(), bytes);
@@ -249,7 +249,7 @@ ValueWindowsPayload PredictedWindowWriter::finish() {
     format::ByteWriter head;
     head.put<uint32_t>(valueSize_);
     head.put<uint64_t>(entries_);
-    head.put<uint64_t>(kValueWindowEntries);
+    head.put<uint64_t>(windowEntries_);
     head.put<uint64_t>(directory_.size());
     format::ByteWriter dir;
     for (const Directory& d : directory_) {

@@ -10,7 +10,9 @@
 //
 // The predictor reads inside a 4^3 brick, so a window holds whole brick
 // instances: window k holds the instances (and solid nodes) whose first
-// entry lies in [k E, (k+1) E), E = kValueWindowEntries, so it starts within
+// entry lies in [k E, (k+1) E), E = kValueWindowEntries (kFloatWindowEntries
+// for a float channel: its coder is slower, so its windows are smaller and
+// more of them run in parallel, for 0.3 % in size), so it starts within
 // 63 entries after kE. The cuts depend on the entries and the DAG's layout
 // only, never on how the entries arrived, the memory limit, the thread
 // count, or the windows before (a process can cut its own share). The bytes
@@ -49,6 +51,8 @@
 #include "src/volume/GridRecord.h"
 
 namespace vdbdag::attributes {
+
+inline constexpr uint64_t kFloatWindowEntries = uint64_t(1) << 20;
 
 namespace detail {  // the layout above, shared by the writer and the reader
 inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
@@ -96,6 +100,7 @@ private:
     };
     void codePending();
     uint32_t valueSize_;
+    uint64_t windowEntries_;  // E, above
     std::optional<FloatChannel> floats_;
     unsigned parallel_;
     uint64_t entries_ = 0, windows_ = 0;

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "src/coding/PlacedWalk.h"
@@ -28,9 +29,9 @@ constexpr uint8_t kModelGeneration = 0;
 constexpr size_t kHeaderBytes = 2;
 
 // What a coded voxel leaves for its neighbours: each predictor's error there
-// (0 below FLT_MIN, see toFloat).
+// as the upper half of its float (errorCode).
 struct FloatRecord {
-    std::array<float, kPredictors> err;
+    std::array<uint16_t, kPredictors> err;
 };
 
 struct FloatModels {
@@ -70,6 +71,12 @@ float toFloat(double d) {
     return float(d);
 }
 
+// An error (>= 0) kept in 16 bits: the upper half of toFloat(e)'s bits
+// (sign, exponent, 7 mantissa bits; truncated), and back: normal or 0.
+uint16_t errorCode(double e) { return uint16_t(std::bit_cast<uint32_t>(toFloat(e)) >> 16); }
+float errorOf(uint16_t code) { return std::bit_cast<float>(uint32_t(code) << 16); }
+constexpr uint16_t kLargestError = 0x7F7F;  // FLT_MAX's upper half
+
 uint32_t shiftedOf(float f, unsigned shift) { return ordered(std::bit_cast<uint32_t>(f)) >> shift; }
 
 // The walk shared by both directions: step(context, predicted, entry)
@@ -87,7 +94,7 @@ void walkFloats(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             for (int k = 0; k < 11; ++k) has[k] = nb.has(Nb::Which(k)) && predictable(uint32_t(nb.value(Nb::Which(k))), v[k]);
             const double W = v[Nb::W], N = v[Nb::N], P = v[Nb::P];
             const bool hW = has[Nb::W], hN = has[Nb::N], hP = has[Nb::P];
-            double pred[kPredictors];
+            double pred[kPredictors] = {};
             bool ok[kPredictors] = {};
             if (hW && hN && hP && has[Nb::NW] && has[Nb::PW] && has[Nb::PN] && has[Nb::PNW])
                 pred[0] = W + N + P - v[Nb::NW] - v[Nb::PW] - v[Nb::PN] + v[Nb::PNW], ok[0] = true;
@@ -106,24 +113,29 @@ void walkFloats(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
                 pred[7] = n ? sum / n : 0.0, ok[7] = true;
             }
             // Each predictor's errors at W, N, P and NW (visited: their
-            // records exist, whatever their values).
+            // records exist, whatever their values), summed in float: the
+            // terms are normal or 0, so no mode flushes anything.
             const typename Nb::Which around[4] = {Nb::W, Nb::N, Nb::P, Nb::NW};
-            double error[kPredictors] = {};
+            float error[kPredictors] = {};
             int count = 0;
             for (const auto k : around) {
                 if (!nb.has(k)) continue;
                 ++count;
                 const FloatRecord& r = nb.rec(k);
-                for (int p = 0; p < kPredictors; ++p) error[p] += double(r.err[p]);
+                for (int p = 0; p < kPredictors; ++p) error[p] += errorOf(r.err[p]);
             }
-            int best = 7;
-            for (int p = 0; p < kPredictors; ++p)
-                if (ok[p] && (error[p] < error[best] || (error[p] == error[best] && p < best))) best = p;
+            // The least error; the lowest predictor of equals (7 is always made).
+            for (int p = 0; p < kPredictors; ++p) error[p] = ok[p] ? error[p] : std::numeric_limits<float>::infinity();
+            float least = error[7];
+            for (int p = 0; p < 7; ++p) least = std::min(least, error[p]);
+            unsigned equal = 0;
+            for (int p = 0; p < kPredictors; ++p) equal |= unsigned(error[p] == least) << p;
+            const int best = std::countr_zero(equal);
             const float predicted = toFloat(pred[best]);
             int context = kNoNeighbourContext;
             if (count) {
                 const double magnitude = std::fabs(double(predicted));
-                const uint32_t d = shiftedOf(toFloat(magnitude + error[best] / count), shift) - shiftedOf(toFloat(magnitude), shift);
+                const uint32_t d = shiftedOf(toFloat(magnitude + double(error[best]) / count), shift) - shiftedOf(toFloat(magnitude), shift);
                 const int length = std::bit_width(d);
                 context = std::min(kErrorContexts - 1, 2 * length + (length >= 2 ? int((d >> (length - 2)) & 1u) : 0));
             }
@@ -131,21 +143,19 @@ void walkFloats(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             value = int32_t(u);
             double x;
             if (!predictable(u, x)) {
-                rec.err.fill(FLT_MAX);
+                rec.err.fill(kLargestError);
                 return;
             }
+            // A predictor this voxel cannot make is charged twice the chosen
+            // one's error.
+            const uint16_t missing = errorCode(2.0 * std::fabs(pred[best] - x));
             for (int p = 0; p < kPredictors; ++p) {
-                if (ok[p]) {
-                    rec.err[p] = toFloat(std::fabs(pred[p] - x));
-                    continue;
-                }
-                // A predictor this voxel cannot make: twice its mean error
-                // at W, N and P, or the largest when none has one.
-                double sum = 0;
-                int n = 0;
-                for (const auto k : {Nb::W, Nb::N, Nb::P})
-                    if (nb.has(k)) sum += double(nb.rec(k).err[p]), ++n;
-                rec.err[p] = n ? toFloat(2.0 * sum / n) : FLT_MAX;
+                // errorCode without branches (|pred - x| is finite)
+                double a = std::fabs(pred[p] - x);
+                a = a < double(FLT_MIN) ? 0.0 : a;
+                a = a > double(FLT_MAX) ? double(FLT_MAX) : a;
+                const uint16_t code = uint16_t(std::bit_cast<uint32_t>(float(a)) >> 16);
+                rec.err[p] = ok[p] ? code : missing;
             }
         });
 }
@@ -169,7 +179,7 @@ void putResidual(RangeEncoder& rc, FloatModels& m, int context, int64_t r) {
         h = 2 * h + bit;
     }
     const int rest = below - modelled;
-    if (rest > 0) rc.encodeDirect(uint32_t(magnitude & ((uint64_t(1) << rest) - 1)), unsigned(rest));
+    if (rest > 0) rc.encodeBits(uint32_t(magnitude & ((uint64_t(1) << rest) - 1)), unsigned(rest));
 }
 
 int64_t getResidual(RangeDecoder& rc, FloatModels& m, int context) {
@@ -188,7 +198,7 @@ int64_t getResidual(RangeDecoder& rc, FloatModels& m, int context) {
         magnitude = 2 * magnitude + bit;
     }
     const int rest = below - modelled;
-    if (rest > 0) magnitude = (magnitude << rest) | rc.decodeDirect(unsigned(rest));
+    if (rest > 0) magnitude = (magnitude << rest) | rc.decodeBits(unsigned(rest));
     return negative ? -int64_t(magnitude) : int64_t(magnitude);
 }
 

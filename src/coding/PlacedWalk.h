@@ -31,6 +31,7 @@ namespace vdbdag::coding::detail {
 // coder's record of each.
 template <typename Rec>
 struct PlacedBrick {
+    PlacedBrick() {}  // values and records are read only where `done` says (no zeroing: a brick is 1-2 KB)
     uint64_t done = 0;
     int32_t value[64];
     Rec rec[64];

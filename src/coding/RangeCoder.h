@@ -60,6 +60,20 @@ public:
             }
         }
     }
+    // Up to 32 bits at probability 1/2, at most 8 per step (one multiply
+    // instead of a step per bit); a stream of its own, not encodeDirect's.
+    void encodeBits(uint32_t value, unsigned bits) {
+        while (bits > 0) {
+            const unsigned k = bits < 8 ? bits : 8;
+            bits -= k;
+            range_ >>= k;
+            low_ += uint64_t((value >> bits) & ((1u << k) - 1)) * range_;
+            while (range_ < (1u << 24)) {
+                range_ <<= 8;
+                shiftLow();
+            }
+        }
+    }
     void finish() {
         for (int i = 0; i < 5; ++i) shiftLow();
     }
@@ -115,6 +129,25 @@ public:
             const unsigned bit = code_ >= range_ ? 1u : 0u;
             if (bit) code_ -= range_;
             value = (value << 1) | bit;
+            while (range_ < (1u << 24)) {
+                range_ <<= 8;
+                code_ = (code_ << 8) | next();
+            }
+        }
+        return value;
+    }
+    // Inverse of RangeEncoder::encodeBits. A corrupt stream decodes to
+    // some value of `bits` bits.
+    uint32_t decodeBits(unsigned bits) {
+        uint32_t value = 0;
+        while (bits > 0) {
+            const unsigned k = bits < 8 ? bits : 8;
+            bits -= k;
+            range_ >>= k;
+            uint32_t v = code_ / range_;
+            if (v >> k) v = (1u << k) - 1;
+            code_ -= v * range_;
+            value = (value << k) | v;
             while (range_ < (1u << 24)) {
                 range_ <<= 8;
                 code_ = (code_ << 8) | next();

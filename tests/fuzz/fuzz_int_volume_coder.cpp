@@ -3,7 +3,9 @@
 // 7 odd, a layout of up to 16 bricks whose masks come from the data, tiles
 // among them; byte 7 & 2, the bricks placed side by side with mirrors; & 4
 // as well, lossless, coded as labels; & 8, the bricks visited in the
-// layout's order rather than spatially), the sample range, near and the
+// layout's order rather than spatially; with places and byte 5 & 0x40, the
+// entries are float32 bits for coding/FloatValueCoder, any bits allowed and
+// every bit kept), the sample range, near and the
 // model generation; the rest is (a) a stream to
 // decode, which must throw vdbdag::Error or give samples inside the range,
 // never crash or read out of bounds, and (b) the samples of a volume to
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "src/coding/BrickValueCoder.h"
+#include "src/coding/FloatValueCoder.h"
 #include "src/coding/IntVolumeCoder.h"
 #include "src/coding/LabelCoder.h"
 #include "src/util/Error.h"
@@ -45,6 +48,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::vector<BrickPlace> places;
     if (bricks && (data[7] & 2))
         for (unsigned b = 0; b < layout.size(); ++b) places.push_back({int32_t(4 * (b % 4)), int32_t(4 * (b / 4)), 0, uint32_t(data[(b % 6) + 1] % 8)});
+    if (!places.empty() && (data[5] & 0x40)) {  // float32 bits: any decode refused or in bounds, every encode exact
+        const uint64_t n = layoutEntryCount(layout);
+        std::vector<uint32_t> out(n), bits(n);
+        try {
+            decodePlacedFloats(rest, layout, places, out, "fuzz");
+        } catch (const vdbdag::Error&) {
+        }
+        for (size_t i = 0; i < n; ++i)
+            if (!rest.empty()) std::memcpy(&bits[i], rest.data() + (i * 4) % rest.size(), std::min<size_t>(4, rest.size() - (i * 4) % rest.size()));
+        decodePlacedFloats(encodePlacedFloats(bits, layout, places), layout, places, out, "fuzz");
+        if (out != bits) std::abort();
+        return 0;
+    }
     const bool labels = !places.empty() && (data[7] & 4) && o.near == 0;  // byte 7 & 4: coded as labels (LabelCoder)
     const BrickOrder order = data[7] & 8 ? BrickOrder::Attribute : BrickOrder::Spatial;  // byte 7 & 8: the layout's brick order
     const auto decode = [&](std::span<const uint8_t> stream, std::vector<int32_t>& out) {
