@@ -16,6 +16,7 @@
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
+#include "src/util/ParallelFor.h"
 #include "vdb_bridge/DenseExport.h"
 #include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/VdbExport.h"
@@ -133,6 +134,7 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
             checkOutputPath((std::filesystem::path(opt->output).parent_path() / (std::filesystem::path(opt->output).stem().string() + ".raw")).string(),
                             {opt->input}, rules);
         format::ReadOptions readOptions;
+        readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
         readOptions.keepValueWindows = dense;  // a scan is written window by window when it can be
         // A .vdb decode builds OpenVDB's grid beside the decoded values: one more copy of each.
         readOptions.limits = opt->limits.limits(dense ? 0 : 1);

@@ -21,6 +21,7 @@
 #include "cli/SceneReport.h"
 #include "cli/JsonReport.h"
 #include "src/pipeline/GridCodec.h"
+#include "src/util/ParallelFor.h"
 #include "vdb_bridge/InputScene.h"
 #include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/DenseImport.h"
@@ -162,6 +163,7 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
         // they are in the file (their range is read window by window)
         // unless --values asks for the channels' statistics.
         format::ReadOptions readOptions;
+        readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
         readOptions.limits = opt.limits.limits(0);
         readOptions.keepValueWindows = !opt.values;
         const format::SsvdagScene scene = format::readScene(bytes, input, readOptions);

@@ -26,6 +26,7 @@
 #include "src/trace/SliceView.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
+#include "src/util/ParallelFor.h"
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/ImageWriter.h"
 #include "vdb_bridge/InputScene.h"
@@ -151,6 +152,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         setActivity(opt->input, "rendering");
         checkOutputPath(opt->output, {opt->input}, {{".png", ".exr"}, "render", opt->force});
         format::ReadOptions readOptions;
+        readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
         readOptions.limits = opt->limits.limits(0);  // traced where it lies, compressed
         // A .vdb, .nvdb or scan is encoded in memory first, as `encode` would.
         const format::SsvdagScene scene = bridge::sceneOfInput(opt->input, readOptions);

@@ -25,6 +25,7 @@
 #include "src/util/Error.h"
 #include "src/util/Progress.h"
 #include "src/util/TemporaryFiles.h"
+#include "src/util/ParallelFor.h"
 #include "vdb_bridge/InputScene.h"
 #include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/VdbCompare.h"
@@ -63,6 +64,7 @@ struct RemovedAfterwards {
 // An .ssvdag file against the input, cube by cube.
 void compareByCubes(const VerifyOptions& opt, const std::string& encoded, Progress& progress, uint64_t from, uint64_t units, Verified& out) {
     format::ReadOptions readOptions;
+    readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
     readOptions.keepValueWindows = true;
     readOptions.limits = opt.limits.limits(0);  // compared cube by cube: no copy of the whole
     const format::SsvdagScene scene = format::readSceneFile(encoded, readOptions);

@@ -20,6 +20,7 @@
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
+#include "src/util/ParallelFor.h"
 #include "vdb_bridge/VdbImport.h"
 #include "vdb_bridge/detail/GridSource.h"
 #include "vdb_bridge/detail/VoxelCells.h"
@@ -100,6 +101,7 @@ StructureExportReport exportStructure(const std::string& input, const std::strin
     format::SsvdagScene scene;
     if (detail::isSsvdagPath(input)) {
         format::ReadOptions readOptions;
+        readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
         readOptions.limits = options.limits;
         scene = format::readSceneFile(input, readOptions);
     } else {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <exception>
 
 #include "src/attributes/ContextChannel.h"
 #include "src/attributes/PredictedChannel.h"
@@ -108,14 +109,26 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
 }
 
 std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            const std::string& what, std::span<const coding::BrickPlace> places) {
+                                            const std::string& what, std::span<const coding::BrickPlace> places, const ParallelFor& parallel) {
     const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
-    std::vector<uint8_t> out;
-    out.reserve(size_t(dir.entries * valueSize));  // entries matched the DAG's layout
-    for (size_t k = 0; k < dir.windows.size(); ++k) {
-        const std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, what, places);
-        out.insert(out.end(), values.begin(), values.end());
-    }
+    std::vector<uint8_t> out(size_t(dir.entries * valueSize));  // entries matched the DAG's layout
+    // The windows through `parallel` (in any order, each into its place: the
+    // directory gave each window's first entry and count); a failure is
+    // reported as the lowest failing window's, whatever the thread count.
+    std::vector<std::exception_ptr> failed(dir.windows.size());
+    const auto one = [&](size_t k) {
+        try {
+            const std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, what, places);
+            if (values.size() != dir.windows[k].entries * valueSize) throw Error(what + " window " + std::to_string(k) + ": decoded to the wrong size");
+            std::memcpy(out.data() + dir.windows[k].firstEntry * valueSize, values.data(), values.size());
+        } catch (...) {
+            failed[k] = std::current_exception();
+        }
+    };
+    if (parallel) parallel(dir.windows.size(), one);
+    else for (size_t k = 0; k < dir.windows.size(); ++k) one(k);
+    for (const std::exception_ptr& e : failed)
+        if (e) std::rethrow_exception(e);
     return out;
 }
 

@@ -121,9 +121,10 @@ std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uin
 
 // The entries in attribute order; validates the payload against `layout`
 // (the DAG's attributeLayout) and throws vdbdag::Error starting with `what`.
-// `places` (encoding::attributePlaces) are needed by coding-3 windows.
+// `places` (encoding::attributePlaces) are needed by codings 3-8. The
+// windows are decoded through `parallel` when given.
 std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            const std::string& what, std::span<const coding::BrickPlace> places);
+                                            const std::string& what, std::span<const coding::BrickPlace> places, const ParallelFor& parallel = {});
 
 // Window by window (WindowCursor.h): the directory, checked against
 // `layout` as decodePredictedWindows checks it, and window k's entries.

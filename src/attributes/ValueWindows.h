@@ -22,6 +22,7 @@
 // own part of the merged material array.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -33,6 +34,12 @@
 #include "src/util/ScratchFile.h"
 
 namespace vdbdag::attributes {
+
+// Runs body(0) .. body(n - 1), in any order and on any threads: how a
+// decoder of windows may spread them (the core library passes TBB's
+// parallel_for, util/ParallelFor.h; the reader library, which links no
+// thread pool, none: one after another).
+using ParallelFor = std::function<void(size_t n, const std::function<void(size_t)>& body)>;
 
 inline constexpr uint64_t kValueWindowEntries = uint64_t(1) << 22;
 

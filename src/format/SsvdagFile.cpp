@@ -346,7 +346,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                     return;
                 } else {
                     attributes = attributes::decodePredictedWindows(predictedWindowSection->data, vs, encoding::attributeLayout(dag),
-                                                                    what + " " + layer + " predicted windows", encoding::attributePlaces(dag, vs));
+                                                                    what + " " + layer + " predicted windows", encoding::attributePlaces(dag, vs),
+                                                                    options.parallel);
                     windows.bytes = std::move(predictedWindowSection->data);  // kept as it is: a rewrite stores it again
                     windows.predicted = true;
                 }

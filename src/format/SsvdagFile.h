@@ -85,6 +85,9 @@ struct ReadOptions {
     bool keepValueWindows = false;
     // Refuse what would expand past these (ReadLimits.h) before expanding it.
     ReadLimits limits;
+    // How predicted windows are decoded (util::tbbParallelFor in the core
+    // library's users; the reader library: one after another).
+    attributes::ParallelFor parallel;
 };
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options);
 

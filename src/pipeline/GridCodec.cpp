@@ -15,6 +15,7 @@
 #include "src/encoding/AttributeLayout.h"
 #include "src/pipeline/AttributeOrder.h"
 #include "src/pipeline/GridCodecParts.h"
+#include "src/util/ParallelFor.h"
 
 namespace vdbdag::pipeline {
 
@@ -199,10 +200,20 @@ void storeInactiveValues(format::EncodedGrid& out, CodedValues&& coded) {
 }
 
 std::optional<attributes::FloatChannel> floatChannelOf(const GridRecord& grid, const EncodeOptions& options, bool inactive) {
-    if (!options.predictIntegers || grid.valueType != ValueType::Float || options.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
-        return std::nullopt;
-    if (inactive && !grid.rescale) return std::nullopt;
-    return attributes::FloatChannel{grid.rescale};
+    if (!options.predictIntegers || grid.valueType != ValueType::Float) return std::nullopt;
+    using Mode = attributes::ScalarTolerance::Mode;
+    switch (options.tolerance.mode) {
+    case Mode::Exact:
+        if (inactive && !grid.rescale) return std::nullopt;
+        return attributes::FloatChannel{grid.rescale};
+    case Mode::Absolute:  // the quantiser rounds to float(k x 2E): a lattice (values it keeps exact are exceptions)
+        if (inactive) return std::nullopt;  // never lossy
+        return attributes::FloatChannel{ValueRescale{2.0 * options.tolerance.bound, 0.0}};
+    case Mode::Relative:  // a logarithmic grid: the float coder or palettes
+        if (inactive) return std::nullopt;
+        return attributes::FloatChannel{};
+    }
+    return std::nullopt;
 }
 
 bool usesPredictedWindows(const GridRecord& grid, const EncodeOptions& options, bool inactive) {
@@ -293,7 +304,7 @@ const std::vector<uint8_t>& attributesOf(const format::EncodedGrid& grid, bool i
         const encoding::CompactDag& dag = inactive ? grid.inactiveDag : grid.dag;
         const uint32_t vs = valueSize(grid.record.valueType);
         store = attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(dag), "grid '" + grid.record.name + "' predicted windows",
-                                                   encoding::attributePlaces(dag, vs));
+                                                   encoding::attributePlaces(dag, vs), util::tbbParallelFor());
     }
     else
         store = format::traceableValues(grid, inactive).decodeAll();

@@ -56,11 +56,13 @@ encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t
 // An EncodedGrid with `grid`'s header and nothing else.
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options);
 
-// How a float32 layer of `grid` is predicted when its values are kept
-// exactly, unless --no-predict: its bits in 3-D, and its lattice
-// (GridRecord::rescale) when it has one. An inactive layer only with a
-// lattice (a level set's are +-background, which palettes hold in bytes).
-// Nothing for other grids.
+// How a float32 layer of `grid` is predicted, unless --no-predict: its bits
+// in 3-D, and a lattice when it has one: GridRecord::rescale when its values
+// are kept exactly, the quantiser's multiples of 2E under --abs-error E
+// (ScalarTolerance.h; both are float(k x slope + intercept)). An exact
+// inactive layer only with a rescale (a level set's are +-background, which
+// palettes hold in bytes); a lossy grid's inactive layer never. Nothing for
+// other grids.
 std::optional<attributes::FloatChannel> floatChannelOf(const GridRecord& grid, const EncodeOptions& options, bool inactive);
 // Whether a layer of `grid` is stored in predicted windows (integers,
 // floats as above; unless --no-predict) rather than palette windows.

@@ -9,6 +9,7 @@
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
+#include "src/util/ParallelFor.h"
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/InputScene.h"
 #include "vdb_bridge/NanoVdb.h"
@@ -68,6 +69,7 @@ std::vector<LoadedGrid> loadGrids(const std::string& path, const std::vector<std
     }
     if (isSsvdagPath(path)) {
         format::ReadOptions readOptions;
+        readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
         readOptions.limits = limits;
         format::SsvdagScene scene = format::readSceneFile(path, readOptions);
         std::vector<std::string> names;
