@@ -56,7 +56,8 @@ bool palettesCannotWin(std::span<const uint8_t> values, uint32_t vs, uint64_t be
 // with neighbours across bricks when their places are known, and as labels
 // too when the window looks like labels; int64 brick MED residuals, by
 // zstd's estimate; a float32 window's bits predicted in 3-D, and its
-// lattice's integers when it has one) and its palettes
+// lattice's integers when it has one; a vec3s window's components' bits)
+// and its palettes
 // (by zstd's fast estimate; they win a tie), unless a sample says they
 // cannot win.
 std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
@@ -69,7 +70,11 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         best = std::move(payload), bestSize = size, coding = kind;
     };
     bool labelsLike = false;
-    if (floats) {  // float32 entries: their bits predicted, their lattice's integers, their palettes
+    if (floats && vs == 12) {  // vec3s entries: each component's bits predicted, or their palettes
+        std::vector<uint8_t> components = encodeFloatVectors(values, layout, places);
+        const uint64_t size = components.size();
+        consider(std::move(components), size, detail::kFloatVectorCoding);
+    } else if (floats) {  // float32 entries: their bits predicted, their lattice's integers, their palettes
         std::vector<uint32_t> bits(values.size() / 4);
         std::memcpy(bits.data(), values.data(), bits.size() * 4);
         std::vector<uint8_t> predicted = coding::encodePlacedFloats(bits, layout, places);
@@ -113,8 +118,8 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
 PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory,
                                              std::optional<FloatChannel> floats)
     : valueSize_(valueSize), windowEntries_(floats ? kFloatWindowEntries : kValueWindowEntries), floats_(floats), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
-    if (valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
-    if (floats && valueSize != 4) throw Error("internal error: predicted float windows hold float32 entries");
+    if (!floats && valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
+    if (floats && valueSize != 4 && valueSize != 12) throw Error("internal error: predicted float windows hold float32 or vec3s entries");
     const uint8_t zeros[kHeaderBytes] = {};
     if (!spillNear.empty()) {
         spill_ = std::make_shared<ScratchFile>(spillNear, spillInMemory);

@@ -17,6 +17,38 @@
 
 namespace vdbdag::attributes {
 
+std::vector<uint8_t> encodeFloatVectors(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
+    if (values.size() % 12) throw Error("internal error: vec3s entries are 12 bytes");
+    const size_t n = values.size() / 12;
+    std::vector<uint8_t> out;
+    std::vector<uint32_t> component(n);
+    for (size_t c = 0; c < 3; ++c) {
+        for (size_t i = 0; i < n; ++i) std::memcpy(&component[i], values.data() + 12 * i + 4 * c, 4);
+        const std::vector<uint8_t> coded = coding::encodePlacedFloats(component, layout, places);
+        const uint64_t bytes = coded.size();
+        const auto* b = reinterpret_cast<const uint8_t*>(&bytes);
+        out.insert(out.end(), b, b + 8);
+        out.insert(out.end(), coded.begin(), coded.end());
+    }
+    return out;
+}
+
+std::vector<uint8_t> decodeFloatVectors(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries,
+                                        std::span<const coding::BrickPlace> places, const std::string& what) {
+    format::ByteReader r(payload, what);
+    std::vector<uint8_t> out(size_t(entries) * 12);
+    std::vector<uint32_t> component(static_cast<size_t>(entries));
+    for (size_t c = 0; c < 3; ++c) {
+        const uint64_t bytes = r.get<uint64_t>();
+        if (bytes > r.remaining()) r.fail("component " + std::to_string(c) + " runs past the end");
+        coding::decodePlacedFloats(payload.subspan(r.position(), size_t(bytes)), layout, places, component, what + " component " + std::to_string(c));
+        r.skip(size_t(bytes));
+        for (size_t i = 0; i < component.size(); ++i) std::memcpy(out.data() + 12 * i + 4 * c, &component[i], 4);
+    }
+    if (r.remaining()) r.fail("bytes after the third component");
+    return out;
+}
+
 WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
                                              const std::string& what) {
     format::ByteReader r(payload, what);
@@ -104,6 +136,11 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
         std::vector<uint8_t> out(bits.size() * 4);
         std::memcpy(out.data(), bits.data(), out.size());
         return out;
+    }
+    if (raw[0] == detail::kFloatVectorCoding) {
+        if (dir.valueSize != 12) throw Error(where + ": predicted vectors of " + std::to_string(dir.valueSize) + "-byte values (vec3s only)");
+        if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
+        return decodeFloatVectors(body, bricks, e.entries, places.subspan(size_t(e.firstBrick), size_t(e.bricks)), where);
     }
     throw Error(where + ": unknown coding " + std::to_string(raw[0]));
 }

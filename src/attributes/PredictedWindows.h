@@ -34,7 +34,8 @@
 // places, RescaledFloats.h; 6 and 7: codings 3 and 4 with the bricks
 // visited in spatial order, coding::BrickOrder, which a writer writes
 // today; 8: float32 only, encodePlacedFloats bytes over its bricks and
-// their places, coding/FloatValueCoder.h) then that payload;
+// their places, coding/FloatValueCoder.h; 9: vec3s only, encodeFloatVectors
+// bytes: each component as coding 8) then that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -57,14 +58,14 @@ inline constexpr uint64_t kFloatWindowEntries = uint64_t(1) << 20;
 namespace detail {  // the layout above, shared by the writer and the reader
 inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
 inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3, kPlacedLabelCoding = 4,
-                         kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7, kFloatCoding = 8;
+                         kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7, kFloatCoding = 8, kFloatVectorCoding = 9;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail
 
-// A channel of float32 entries (an integer channel has none): their bits
-// are predicted (coding 8), and with a lattice its integers tried too
-// (coding 5).
+// A channel of float32 or vec3s entries (an integer channel has none):
+// their bits are predicted (coding 8; vec3s: each component, coding 9), and
+// with a lattice (float32) its integers tried too (coding 5).
 struct FloatChannel {
     std::optional<ValueRescale> lattice;  // the rescale the entries are believed to lie on
 };
@@ -114,6 +115,14 @@ private:
     uint64_t headEnd_ = 0;
     ShareWindows::Loose head_;
 };
+
+// Coding 9's payload: vec3s entries (12 bytes each) over `layout`/`places`
+// as their x, y and z components, each a u64 byte count then the coding-8
+// payload (encodePlacedFloats) of that component; and its inverse, which
+// validates it (throws vdbdag::Error starting with `what`).
+std::vector<uint8_t> encodeFloatVectors(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places);
+std::vector<uint8_t> decodeFloatVectors(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries,
+                                        std::span<const coding::BrickPlace> places, const std::string& what);
 
 // All at once.
 std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uint32_t valueSize, std::span<const uint64_t> layout,

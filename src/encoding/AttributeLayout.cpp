@@ -33,7 +33,7 @@ std::vector<uint64_t> attributeLayout(const CompactDag& dag) {
 
 std::vector<coding::BrickPlace> attributePlaces(const CompactDag& dag, uint32_t valueSize) {
     std::vector<coding::BrickPlace> places;
-    if (dag.empty() || valueSize != 4) return places;
+    if (dag.empty() || (valueSize != 4 && valueSize != 12)) return places;  // int32, float32, vec3s
     const uint64_t emitted = decodedSize(dag).emittedBricks;
     if (emitted > (uint64_t(1) << 31))
         throw Error("the DAG emits " + std::to_string(emitted) + " bricks, more than the 2^31 a predicted-value layout holds");

@@ -71,6 +71,10 @@ public:
         pos_ += count * sizeof(T);
         return values;
     }
+    void skip(size_t n) {
+        need(n);
+        pos_ += n;
+    }
     size_t remaining() const { return data_.size() - pos_; }
     size_t position() const { return pos_; }
     [[noreturn]] void fail(const std::string& why) const { throw Error(what_ + ": " + why); }

@@ -332,9 +332,9 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             if ((predictedSection || windowSection || predictedWindowSection) && (!vs || dag.empty()))
                 throw Error(what + ": unexpected " + layer + " values section for a grid without values");
             if (predictedSection || predictedWindowSection) {
-                // Integers; float32 too in windows (their lattice's integers, coding 5).
+                // Integers; float32 and vec3s too in windows (codings 5, 8, 9).
                 const ValueType type = grid.record.valueType;
-                if (type != ValueType::Int32 && type != ValueType::Int64 && !(predictedWindowSection && type == ValueType::Float))
+                if (type != ValueType::Int32 && type != ValueType::Int64 && !(predictedWindowSection && (type == ValueType::Float || type == ValueType::Vec3S)))
                     throw Error(what + ": predicted values for a " + valueTypeName(type) + " grid");
                 if (predictedSection) {
                     predicted = std::move(predictedSection->data);

@@ -252,7 +252,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
             if (stream) {
                 piece.gathered.resize(entriesOf(piece.index) * vs);
                 gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, piece.gathered.data(), s.firstEntry,
-                              stream->predicted ? &piece.layout : nullptr, stream->predicted && vs == 4 ? &piece.places : nullptr);
+                              stream->predicted ? &piece.layout : nullptr, stream->predicted && (vs == 4 || vs == 12) ? &piece.places : nullptr);
             } else {
                 gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, attributes.data(), firstEntry);
             }

@@ -200,7 +200,11 @@ void storeInactiveValues(format::EncodedGrid& out, CodedValues&& coded) {
 }
 
 std::optional<attributes::FloatChannel> floatChannelOf(const GridRecord& grid, const EncodeOptions& options, bool inactive) {
-    if (!options.predictIntegers || grid.valueType != ValueType::Float) return std::nullopt;
+    if (!options.predictIntegers) return std::nullopt;
+    // A vec3s layer (velocities; colours have their own quantiser) is kept
+    // exactly whatever the tolerance (ScalarTolerance.h): its components' bits.
+    if (grid.valueType == ValueType::Vec3S) return inactive || isColourGrid(grid, options) ? std::nullopt : std::optional(attributes::FloatChannel{});
+    if (grid.valueType != ValueType::Float) return std::nullopt;
     using Mode = attributes::ScalarTolerance::Mode;
     switch (options.tolerance.mode) {
     case Mode::Exact:

@@ -61,7 +61,8 @@ format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& o
 // are kept exactly, the quantiser's multiples of 2E under --abs-error E
 // (ScalarTolerance.h; both are float(k x slope + intercept)). An exact
 // inactive layer only with a rescale (a level set's are +-background, which
-// palettes hold in bytes); a lossy grid's inactive layer never. Nothing for
+// palettes hold in bytes); a lossy grid's inactive layer never. A vec3s
+// active layer that is not a colour grid: its components' bits. Nothing for
 // other grids.
 std::optional<attributes::FloatChannel> floatChannelOf(const GridRecord& grid, const EncodeOptions& options, bool inactive);
 // Whether a layer of `grid` is stored in predicted windows (integers,

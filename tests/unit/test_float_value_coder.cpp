@@ -5,7 +5,8 @@
 // payloads, -0.0, infinities, subnormals, FLT_MAX, tiles) comes back bit for
 // bit; half floats lose their 13 zero bits; the decoder gives the same bits
 // with flush-to-zero and denormals-are-zero set (as a host application may
-// leave them); corrupt payloads are refused without reading out of bounds.
+// leave them); corrupt payloads are refused without reading out of bounds;
+// a vec3s window codes each component (coding 9).
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -184,6 +185,43 @@ TEST(FloatValueCoder, AFloatWindowIsStoredAsCodingEight) {
     ASSERT_EQ(dir.windows.size(), 1u);
     EXPECT_EQ(attributes::windowRawBytes(windows, dir.windows[0], "test").at(0), attributes::detail::kFloatCoding);
     EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, c.layout, "test", c.places), bytes);
+}
+
+// A vec3s window (a velocity field: the gradient of the sphere's distance,
+// a unit vector per voxel, in closed form) is coding 9, each component
+// predicted on its own: bit for bit back, under two thirds of the palettes' bytes;
+// a component cut short is refused.
+TEST(FloatValueCoder, AVectorWindowCodesEachComponent) {
+    std::mt19937 rng(12);
+    std::vector<uint8_t> bytes;
+    FloatChannel where = sparseBox(rng, [](int X, int Y, int Z) { return (X * 7 + Y * 3 + Z) % 11 != 0; }, [](int, int, int) { return 0.0f; });
+    // Re-walk the same bricks to give each entry its vector (stored-bit order within each brick).
+    for (size_t b = 0; b < where.layout.size(); ++b) {
+        const BrickPlace& pl = where.places[b];
+        float brick[64][3];
+        for (int z = 0; z < 4; ++z)
+            for (int y = 0; y < 4; ++y)
+                for (int x = 0; x < 4; ++x) {
+                    const double X = pl.x + x - 40.3, Y = pl.y + y - 11.9, Z = pl.z + z + 25.2, r = std::sqrt(X * X + Y * Y + Z * Z);
+                    float* v = brick[access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), pl.mirror)];
+                    v[0] = float(X / r), v[1] = float(Y / r), v[2] = float(Z / r);
+                }
+        for (uint64_t m = where.layout[b]; m; m &= m - 1) {
+            const auto* p = reinterpret_cast<const uint8_t*>(brick[std::countr_zero(m)]);
+            bytes.insert(bytes.end(), p, p + 12);
+        }
+    }
+    ASSERT_EQ(bytes.size(), where.bits.size() * 12);
+    const std::vector<uint8_t> windows = attributes::encodePredictedWindows(bytes, 12, where.layout, where.places, attributes::FloatChannel{});
+    const attributes::WindowDirectory dir = attributes::readPredictedWindowDirectory(windows, 12, where.layout, "test");
+    ASSERT_EQ(dir.windows.size(), 1u);
+    const std::vector<uint8_t> raw = attributes::windowRawBytes(windows, dir.windows[0], "test");
+    EXPECT_EQ(raw.at(0), attributes::detail::kFloatVectorCoding);
+    EXPECT_EQ(attributes::decodePredictedWindows(windows, 12, where.layout, "test", where.places), bytes);
+    EXPECT_LT(windows.size() * 3 / 2, format::zstdFastSize(attributes::serializePalette(attributes::compressPalette(bytes, 12))));
+    const std::span<const uint8_t> body = std::span<const uint8_t>(raw).subspan(1);
+    EXPECT_THROW(attributes::decodeFloatVectors(body.first(body.size() / 2), where.layout, where.bits.size(), where.places, "cut"), Error);
+    EXPECT_THROW(attributes::decodeFloatVectors(body.first(4), where.layout, where.bits.size(), where.places, "count"), Error);
 }
 
 } // namespace
