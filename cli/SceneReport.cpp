@@ -8,6 +8,8 @@
 #include <fmt/core.h>
 
 #include "src/attributes/PaletteCompressor.h"
+#include "src/attributes/PredictedWindows.h"
+#include "src/encoding/AttributeLayout.h"
 #include "src/format/TraceableValues.h"
 #include "vdb_bridge/DenseImport.h"
 
@@ -169,8 +171,22 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
         uint64_t gridBytes = 0;
         for (const auto& s : sections) {
             if (s.kind == format::SectionKind::FileInfo || s.grid != g) continue;
-            j["sections"].push_back({{"kind", format::sectionKindName(s.kind)}, {"stored_bytes", s.storedBytes},
-                                     {"raw_bytes", s.rawBytes}, {"compressed", s.compressed}});
+            json section{{"kind", format::sectionKindName(s.kind)}, {"stored_bytes", s.storedBytes}, {"raw_bytes", s.rawBytes}, {"compressed", s.compressed}};
+            // Predicted windows: how many windows each coding holds.
+            if (s.kind == format::SectionKind::PredictedWindows || s.kind == format::SectionKind::InactivePredictedWindows) {
+                const bool inactive = s.kind == format::SectionKind::InactivePredictedWindows;
+                const attributes::ValueWindowsPayload& w = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+                if (w.predicted && !w.empty()) {
+                    const std::vector<uint64_t> counts = attributes::predictedWindowCodings(
+                        w.load(), valueSize(grid.record.valueType), encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
+                        "grid '" + grid.record.name + "' predicted windows");
+                    json codings = json::object();
+                    for (size_t c = 0; c < counts.size(); ++c)
+                        if (counts[c]) codings[attributes::predictedCodingName(uint8_t(c))] = codings.value(attributes::predictedCodingName(uint8_t(c)), uint64_t(0)) + counts[c];
+                    section["window_codings"] = codings;
+                }
+            }
+            j["sections"].push_back(section);
             gridBytes += s.storedBytes;
         }
         fileLevelBytes -= std::min(fileLevelBytes, gridBytes);
@@ -253,9 +269,15 @@ std::string formatSceneReport(const nlohmann::json& r) {
                                    l["stored_nodes"].get<uint64_t>());
             }
         }
-        for (const auto& s : g["sections"])
-            out += fmt::format("  section {:<22} {:>12} bytes{}\n", s["kind"].get<std::string>(), s["stored_bytes"].get<uint64_t>(),
-                               s["compressed"].get<bool>() ? fmt::format(" (zstd, {} raw)", s["raw_bytes"].get<uint64_t>()) : std::string());
+        for (const auto& s : g["sections"]) {
+            std::string codings;
+            if (s.contains("window_codings"))
+                for (const auto& [name, count] : s["window_codings"].items())
+                    codings += fmt::format("{}{} {}", codings.empty() ? " (windows: " : ", ", count.get<uint64_t>(), name);
+            if (!codings.empty()) codings += ")";
+            out += fmt::format("  section {:<22} {:>12} bytes{}{}\n", s["kind"].get<std::string>(), s["stored_bytes"].get<uint64_t>(),
+                               s["compressed"].get<bool>() ? fmt::format(" (zstd, {} raw)", s["raw_bytes"].get<uint64_t>()) : std::string(), codings);
+        }
         for (const auto& c : g["channels"])
             out += fmt::format("  {} values: {} entries, {} unique; raw {} B, material+index {} B, palette-compressed {} B ({} palette / {} direct blocks, {} palettes)\n",
                                c["layer"].get<std::string>(), c["entries"].get<uint64_t>(), c["unique"].get<uint64_t>(), c["raw_bytes"].get<uint64_t>(),

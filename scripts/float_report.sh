@@ -32,8 +32,10 @@ trap 'rm -rf "$TMP"' EXIT
 
 # Level sets not in ../shared, made by OpenVDB's tools (skipped without the meshes).
 made=()
-if [ -e "$DATA/meshes/chinese_dragon_10kv.off" ]; then
-  vdb_tool -read "$DATA/meshes/chinese_dragon_10kv.off" -mesh2ls d=512 width=3 -write "$TMP/dragon_d512_ls.vdb" >/dev/null 2>&1 && made+=("$TMP/dragon_d512_ls.vdb|made: vdb_tool -mesh2ls d=512 of meshes/chinese_dragon_10kv.off")
+if [ -e "$DATA/meshes/chinese_dragon_10kv.off" ]; then  # vdb_tool reads no .off: the same mesh as .obj first
+  awk 'NR == 1 { next } NR == 2 { nv = $1; next } NR - 2 <= nv { print "v", $1, $2, $3; next } $1 >= 3 { printf "f"; for (i = 2; i <= $1 + 1; i++) printf " %d", $i + 1; print "" }' \
+    "$DATA/meshes/chinese_dragon_10kv.off" > "$TMP/dragon.obj"
+  vdb_tool -read "$TMP/dragon.obj" -mesh2ls d=512 width=3 -write "$TMP/dragon_d512_ls.vdb" >/dev/null 2>&1 && made+=("$TMP/dragon_d512_ls.vdb|made: vdb_tool -mesh2ls d=512 of meshes/chinese_dragon_10kv.off")
 fi
 if [ -e "$DATA/meshes/stanford_bunny_with_holes.ply" ]; then
   vdb_tool -read "$DATA/meshes/stanford_bunny_with_holes.ply" -mesh2ls d=384 width=3 -write "$TMP/holed_bunny_d384_ls.vdb" >/dev/null 2>&1 && made+=("$TMP/holed_bunny_d384_ls.vdb|made: vdb_tool -mesh2ls d=384 of meshes/stanford_bunny_with_holes.ply")

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstring>
 #include <exception>
+#include <iterator>
 
 #include "src/attributes/ContextChannel.h"
 #include "src/attributes/PredictedChannel.h"
@@ -16,6 +17,27 @@
 #include "src/util/Error.h"
 
 namespace vdbdag::attributes {
+
+std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
+                                             const std::string& what) {
+    const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
+    std::vector<uint64_t> counts(size_t(detail::kFloatVectorCoding) + 1);
+    for (size_t k = 0; k < dir.windows.size(); ++k) {
+        const WindowDirectory::Window& e = dir.windows[k];
+        const std::span<const uint8_t> stored = payload.subspan(size_t(e.offset), size_t(e.stored));
+        const std::vector<uint8_t> first =
+            e.stored == e.raw ? std::vector<uint8_t>(stored.begin(), stored.begin() + 1) : format::zstdFirstBytes(stored, 1, what + " window " + std::to_string(k));
+        if (first.empty() || first[0] >= counts.size()) throw Error(what + " window " + std::to_string(k) + ": unknown coding");
+        ++counts[first[0]];
+    }
+    return counts;
+}
+
+const char* predictedCodingName(uint8_t coding) {
+    static const char* const names[] = {"palettes", "brick residuals", "context-coded", "placed context-coded", "placed labels",
+                                        "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors"};
+    return coding < std::size(names) ? names[coding] : "unknown";
+}
 
 std::vector<uint8_t> encodeFloatVectors(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
     if (values.size() % 12) throw Error("internal error: vec3s entries are 12 bytes");

@@ -116,6 +116,14 @@ private:
     ShareWindows::Loose head_;
 };
 
+// How many windows use each coding (index: the coding byte, 0..9), read
+// from each window's first byte only (a compressed window's start is
+// inflated, nothing more); the directory is checked as for decoding. And
+// what each coding is, in a few words (a report's names).
+std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
+                                             const std::string& what);
+const char* predictedCodingName(uint8_t coding);
+
 // Coding 9's payload: vec3s entries (12 bytes each) over `layout`/`places`
 // as their x, y and z components, each a u64 byte count then the coding-8
 // payload (encodePlacedFloats) of that component; and its inverse, which

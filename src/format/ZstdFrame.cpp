@@ -94,4 +94,19 @@ std::vector<uint8_t> zstdInflateFrame(std::span<const uint8_t> stored, uint64_t 
     return data;
 }
 
+std::vector<uint8_t> zstdFirstBytes(std::span<const uint8_t> frame, size_t n, const std::string& what) {
+    std::unique_ptr<ZSTD_DStream, size_t (*)(ZSTD_DStream*)> stream(ZSTD_createDStream(), ZSTD_freeDStream);
+    if (!stream) throw std::bad_alloc();
+    std::vector<uint8_t> out(n);
+    ZSTD_inBuffer in{frame.data(), frame.size(), 0};
+    ZSTD_outBuffer o{out.data(), out.size(), 0};
+    while (o.pos < o.size && in.pos < in.size) {
+        const size_t r = ZSTD_decompressStream(stream.get(), &o, &in);
+        if (ZSTD_isError(r)) throw Error(what + ": corrupted zstd data (" + ZSTD_getErrorName(r) + ")");
+        if (r == 0) break;  // the frame ended
+    }
+    out.resize(o.pos);
+    return out;
+}
+
 } // namespace vdbdag::format

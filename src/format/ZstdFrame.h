@@ -38,4 +38,10 @@ uint64_t zstdFastSize(std::span<const uint8_t> data);
 // starting with `what` otherwise, std::bad_alloc when out of memory.
 std::vector<uint8_t> zstdInflateFrame(std::span<const uint8_t> frame, uint64_t rawSize, const std::string& what);
 
+// The first `n` bytes a zstd frame inflates to (fewer when it holds fewer),
+// inflating no more than a block or so beyond them: what a report needs to
+// read a header inside a large frame. Throws vdbdag::Error starting with
+// `what` on corrupt data.
+std::vector<uint8_t> zstdFirstBytes(std::span<const uint8_t> frame, size_t n, const std::string& what);
+
 } // namespace vdbdag::format

@@ -185,6 +185,11 @@ TEST(FloatValueCoder, AFloatWindowIsStoredAsCodingEight) {
     ASSERT_EQ(dir.windows.size(), 1u);
     EXPECT_EQ(attributes::windowRawBytes(windows, dir.windows[0], "test").at(0), attributes::detail::kFloatCoding);
     EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, c.layout, "test", c.places), bytes);
+    // What `info` reports: one window of coding 8, read from its first byte.
+    std::vector<uint64_t> expected(10);
+    expected[attributes::detail::kFloatCoding] = 1;
+    EXPECT_EQ(attributes::predictedWindowCodings(windows, 4, c.layout, "test"), expected);
+    EXPECT_STREQ(attributes::predictedCodingName(attributes::detail::kFloatCoding), "predicted floats");
 }
 
 // A vec3s window (a velocity field: the gradient of the sphere's distance,
