@@ -41,33 +41,17 @@ const char* predictedCodingName(uint8_t coding) {
 
 std::vector<uint8_t> encodeFloatVectors(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
     if (values.size() % 12) throw Error("internal error: vec3s entries are 12 bytes");
-    const size_t n = values.size() / 12;
-    std::vector<uint8_t> out;
-    std::vector<uint32_t> component(n);
-    for (size_t c = 0; c < 3; ++c) {
-        for (size_t i = 0; i < n; ++i) std::memcpy(&component[i], values.data() + 12 * i + 4 * c, 4);
-        const std::vector<uint8_t> coded = coding::encodePlacedFloats(component, layout, places);
-        const uint64_t bytes = coded.size();
-        const auto* b = reinterpret_cast<const uint8_t*>(&bytes);
-        out.insert(out.end(), b, b + 8);
-        out.insert(out.end(), coded.begin(), coded.end());
-    }
-    return out;
+    std::vector<uint32_t> bits(values.size() / 4);
+    std::memcpy(bits.data(), values.data(), values.size());
+    return coding::encodePlacedFloatVectors(bits, layout, places);
 }
 
 std::vector<uint8_t> decodeFloatVectors(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries,
                                         std::span<const coding::BrickPlace> places, const std::string& what) {
-    format::ByteReader r(payload, what);
-    std::vector<uint8_t> out(size_t(entries) * 12);
-    std::vector<uint32_t> component(static_cast<size_t>(entries));
-    for (size_t c = 0; c < 3; ++c) {
-        const uint64_t bytes = r.get<uint64_t>();
-        if (bytes > r.remaining()) r.fail("component " + std::to_string(c) + " runs past the end");
-        coding::decodePlacedFloats(payload.subspan(r.position(), size_t(bytes)), layout, places, component, what + " component " + std::to_string(c));
-        r.skip(size_t(bytes));
-        for (size_t i = 0; i < component.size(); ++i) std::memcpy(out.data() + 12 * i + 4 * c, &component[i], 4);
-    }
-    if (r.remaining()) r.fail("bytes after the third component");
+    std::vector<uint32_t> bits(static_cast<size_t>(entries) * 3);
+    coding::decodePlacedFloatVectors(payload, layout, places, bits, what);
+    std::vector<uint8_t> out(bits.size() * 4);
+    std::memcpy(out.data(), bits.data(), out.size());
     return out;
 }
 

@@ -35,7 +35,7 @@
 // visited in spatial order, coding::BrickOrder, which a writer writes
 // today; 8: float32 only, encodePlacedFloats bytes over its bricks and
 // their places, coding/FloatValueCoder.h; 9: vec3s only, encodeFloatVectors
-// bytes: each component as coding 8) then that payload;
+// bytes: the three components in one stream) then that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -124,9 +124,9 @@ std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, u
                                              const std::string& what);
 const char* predictedCodingName(uint8_t coding);
 
-// Coding 9's payload: vec3s entries (12 bytes each) over `layout`/`places`
-// as their x, y and z components, each a u64 byte count then the coding-8
-// payload (encodePlacedFloats) of that component; and its inverse, which
+// Coding 9's payload: vec3s entries (12 bytes each) over `layout`/`places`,
+// coding::encodePlacedFloatVectors' bytes (each component predicted, the
+// later ones under cross-component contexts); and its inverse, which
 // validates it (throws vdbdag::Error starting with `what`).
 std::vector<uint8_t> encodeFloatVectors(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places);
 std::vector<uint8_t> decodeFloatVectors(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries,

@@ -56,4 +56,15 @@ std::vector<uint8_t> encodePlacedFloats(std::span<const uint32_t> bits, std::spa
 void decodePlacedFloats(std::span<const uint8_t> payload, std::span<const uint64_t> layout, std::span<const BrickPlace> places, std::span<uint32_t> out,
                         const std::string& what);
 
+// vec3s entries (window coding 9): `bits` holds each entry's x, y and z
+// bits in turn. Each component is predicted from the same component of the
+// neighbours, as above; component c > 0 is coded under contexts of its own,
+// split by how component c - 1's residual at the same voxel compared with
+// its context's expectation (shorter, about the same, longer): turbulence
+// shows in every component at once. Payload: u8 generation (0), 3 x u8
+// shift (one per component), the range-coded stream.
+std::vector<uint8_t> encodePlacedFloatVectors(std::span<const uint32_t> bits, std::span<const uint64_t> layout, std::span<const BrickPlace> places);
+void decodePlacedFloatVectors(std::span<const uint8_t> payload, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
+                              std::span<uint32_t> out, const std::string& what);
+
 } // namespace vdbdag::coding
