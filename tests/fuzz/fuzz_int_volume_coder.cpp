@@ -4,8 +4,8 @@
 // among them; byte 7 & 2, the bricks placed side by side with mirrors; & 4
 // as well, lossless, coded as labels; & 8, the bricks visited in the
 // layout's order rather than spatially; with places and byte 5 & 0x40, the
-// entries are float32 bits for coding/FloatValueCoder, any bits allowed and
-// every bit kept), the sample range, near and the
+// entries are float32 bits for coding/FloatValueCoder, & 0x20 too vec3s,
+// any bits allowed and every bit kept), the sample range, near and the
 // model generation; the rest is (a) a stream to
 // decode, which must throw vdbdag::Error or give samples inside the range,
 // never crash or read out of bounds, and (b) the samples of a volume to
@@ -48,16 +48,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::vector<BrickPlace> places;
     if (bricks && (data[7] & 2))
         for (unsigned b = 0; b < layout.size(); ++b) places.push_back({int32_t(4 * (b % 4)), int32_t(4 * (b / 4)), 0, uint32_t(data[(b % 6) + 1] % 8)});
-    if (!places.empty() && (data[5] & 0x40)) {  // float32 bits: any decode refused or in bounds, every encode exact
-        const uint64_t n = layoutEntryCount(layout);
+    if (!places.empty() && (data[5] & 0x40)) {  // float32 bits (byte 5 & 0x20: vec3s): any decode refused or in bounds, every encode exact
+        const bool vectors = data[5] & 0x20;
+        const uint64_t n = layoutEntryCount(layout) * (vectors ? 3 : 1);
         std::vector<uint32_t> out(n), bits(n);
         try {
-            decodePlacedFloats(rest, layout, places, out, "fuzz");
+            if (vectors) decodePlacedFloatVectors(rest, layout, places, out, "fuzz");
+            else decodePlacedFloats(rest, layout, places, out, "fuzz");
         } catch (const vdbdag::Error&) {
         }
         for (size_t i = 0; i < n; ++i)
             if (!rest.empty()) std::memcpy(&bits[i], rest.data() + (i * 4) % rest.size(), std::min<size_t>(4, rest.size() - (i * 4) % rest.size()));
-        decodePlacedFloats(encodePlacedFloats(bits, layout, places), layout, places, out, "fuzz");
+        if (vectors) decodePlacedFloatVectors(encodePlacedFloatVectors(bits, layout, places), layout, places, out, "fuzz");
+        else decodePlacedFloats(encodePlacedFloats(bits, layout, places), layout, places, out, "fuzz");
         if (out != bits) std::abort();
         return 0;
     }
