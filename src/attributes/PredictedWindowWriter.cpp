@@ -38,17 +38,21 @@ bool looksLikeLabels(std::span<const uint8_t> values) {
 
 // Whether a window's palettes are not worth building: estimated from its
 // first sixteenth, 16 times the sample's palettes (zstd's fast estimate)
-// exceed 1.5 times the best coding found. A palette's indices grow with its
-// entries and only its material array is shared, so the estimate errs high
-// by at most that array; a scan's noise never lets palettes win, and
-// building them was a tenth of an encode. Small windows and windows that
-// look like labels build theirs.
-bool palettesCannotWin(std::span<const uint8_t> values, uint32_t vs, uint64_t bestSize, bool labelsLike) {
+// exceed 1.5 times the best coding found (1.2 times for float windows). A
+// palette's indices grow with its entries and only its material array is
+// shared, so the estimate errs high by at most that array; a scan's noise
+// never lets palettes win, and building them was a tenth of an encode. On
+// float windows (level sets, fogs, smoke) the estimate came within 0.96 to
+// 1.16 of the palettes' size, so 1.2 leaves them out only where they lose,
+// and a half-float smoke's encode no longer builds them (smoke1: estimate
+// 1.23 times the predicted floats). Small windows and windows that look
+// like labels build theirs.
+bool palettesCannotWin(std::span<const uint8_t> values, uint32_t vs, uint64_t bestSize, bool labelsLike, bool floats) {
     constexpr size_t kSampleEntries = size_t(1) << 14;  // the smallest sample worth estimating from
     const size_t n = values.size() / vs;
     if (labelsLike || bestSize == UINT64_MAX || n / 16 < kSampleEntries) return false;
     const uint64_t sample = format::zstdFastSize(serializePalette(compressPalette(values.first(n / 16 * vs), vs)));
-    return 16 * sample > bestSize + bestSize / 2;
+    return 16 * sample > bestSize + (floats ? bestSize / 5 : bestSize / 2);
 }
 
 // A window's raw bytes: its coding byte, then the smallest of its entries
@@ -101,7 +105,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         const uint64_t size = format::zstdFastSize(predicted);
         consider(std::move(predicted), size, detail::kPredictedCoding);
     }
-    if (!palettesCannotWin(values, vs, bestSize, labelsLike)) {
+    if (!palettesCannotWin(values, vs, bestSize, labelsLike, floats.has_value())) {
         std::vector<uint8_t> palette = serializePalette(compressPalette(values, vs));
         const uint64_t size = format::zstdFastSize(palette);
         consider(std::move(palette), size, detail::kPaletteCoding);
