@@ -26,14 +26,13 @@
 #include <openvdb/openvdb.h>
 #include <zfp.h>
 
+#include "tests/tools/BenchTiming.h"
+
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0 : v[v.size() / 2];
-}
+using vdbdag::benchtools::Clock;
+using vdbdag::benchtools::median;
+using vdbdag::benchtools::seconds;
 
 struct Coded {
     size_t bytes = 0;
