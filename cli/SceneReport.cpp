@@ -181,8 +181,10 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
                         w.load(), valueSize(grid.record.valueType), encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
                         "grid '" + grid.record.name + "' predicted windows");
                     json codings = json::object();
-                    for (size_t c = 0; c < counts.size(); ++c)
-                        if (counts[c]) codings[attributes::predictedCodingName(uint8_t(c))] = codings.value(attributes::predictedCodingName(uint8_t(c)), uint64_t(0)) + counts[c];
+                    for (size_t c = 0; c < counts.size(); ++c) {
+                        const char* name = attributes::predictedCodingName(uint8_t(c));  // two codings share a name
+                        if (counts[c]) codings[name] = codings.value(name, uint64_t(0)) + counts[c];
+                    }
                     section["window_codings"] = codings;
                 }
             }

@@ -229,7 +229,8 @@ void measureZfp(const GridT& grid, double tolerance, const PeerOptions& options,
     using ValueT = typename GridT::ValueType;
     const zfp_type type = std::is_same_v<ValueT, float> ? zfp_type_float : zfp_type_double;
     const bool reversible = tolerance == 0;
-    bench::BenchPoint p = basePoint(grid, "ZFP", reversible ? std::string("reversible") : fmt::format("accuracy {:g}", tolerance), reversible ? "ZFP reversible" : "ZFP");
+    bench::BenchPoint p = basePoint(grid, "ZFP", reversible ? std::string("reversible") : fmt::format("accuracy {:g}", tolerance),
+                                    reversible ? "ZFP reversible" : "ZFP");
     std::vector<const typename GridT::TreeType::LeafNodeType*> leaves;
     for (auto it = grid.tree().cbeginLeaf(); it; ++it) leaves.push_back(&*it);
     uint64_t tiles = 0;

@@ -121,7 +121,10 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
 
 PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory,
                                              std::optional<FloatChannel> floats)
-    : valueSize_(valueSize), windowEntries_(floats ? kFloatWindowEntries : kValueWindowEntries), floats_(floats), parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
+    : valueSize_(valueSize),
+      windowEntries_(floats ? kFloatWindowEntries : kValueWindowEntries),
+      floats_(floats),
+      parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
     if (!floats && valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
     if (floats && valueSize != 4 && valueSize != 12) throw Error("internal error: predicted float windows hold float32 or vec3s entries");
     const uint8_t zeros[kHeaderBytes] = {};

@@ -25,8 +25,8 @@ std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, u
     for (size_t k = 0; k < dir.windows.size(); ++k) {
         const WindowDirectory::Window& e = dir.windows[k];
         const std::span<const uint8_t> stored = payload.subspan(size_t(e.offset), size_t(e.stored));
-        const std::vector<uint8_t> first =
-            e.stored == e.raw ? std::vector<uint8_t>(stored.begin(), stored.begin() + 1) : format::zstdFirstBytes(stored, 1, what + " window " + std::to_string(k));
+        const std::vector<uint8_t> first = e.stored == e.raw ? std::vector<uint8_t>(stored.begin(), stored.begin() + 1)
+                                                             : format::zstdFirstBytes(stored, 1, what + " window " + std::to_string(k));
         if (first.empty() || first[0] >= counts.size()) throw Error(what + " window " + std::to_string(k) + ": unknown coding");
         ++counts[first[0]];
     }

@@ -98,7 +98,10 @@ void walkFloats(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
     walkPlacedBricks<Rec, true>(
         layout, places, entries, BrickOrder::Spatial,
         [&](uint64_t entry) {
-            for (int c = 0; c < C; ++c) lastTile[size_t(c)] = step(c, kTileContext + (c ? kContextsPerGroup : 0), ordered(lastTile[size_t(c)]) >> shifts[size_t(c)], entry);
+            for (int c = 0; c < C; ++c) {
+                uint32_t& last = lastTile[size_t(c)];
+                last = step(c, kTileContext + (c ? kContextsPerGroup : 0), ordered(last) >> shifts[size_t(c)], entry);
+            }
         },
         [&](const Nb& nb, uint64_t entry, int32_t& value, Rec& rec) {
             for (int c = 0; c < C; ++c) {
