@@ -98,7 +98,7 @@ bool looksLikeLabels(const format::EncodedGrid& grid) {
 
 void addRenderCommand(CLI::App& app, int& exitCode) {
     struct Options {
-        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels, iso, slice;
+        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels, iso, slice, tf;
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
         bool shadows = false, json = false, force = false, legend = false;
@@ -130,6 +130,10 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                     "mip: LOW,HIGH, the values shown black to white (LOW and below transparent; default: Otsu's threshold of the pixels' "
                     "maxima to their 99.5th percentile); volume: LOW,HIGH, the transfer function's ramp (default: Otsu's threshold of the "
                     "values to their 99.5th percentile)");
+    cmd->add_option("--tf", opt->tf,
+                    "volume: a transfer function file, a ParaView colour-map preset (JSON with \"RGBPoints\" and optional opacity \"Points\"), "
+                    "instead of --window's ramp")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--labels", opt->labels, "labels: the labels shown, e.g. 3,17 (default: every one but 0 and the background)");
     cmd->add_flag("--legend", opt->legend,
                   "draw a colour bar with its range in the image's right margin (value shading, mip, slice and volume)");
@@ -179,6 +183,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                         trace::shadingOf(grid) + " (use --shading fog)");
         if (!opt->window.empty() && !grid.mip && !grid.volume && !grid.slice) throw Error(opt->input + ": --window applies to --shading mip, volume and slice");
         if (!opt->slice.empty() && !grid.slice) throw Error(opt->input + ": --slice applies to --shading slice");
+        if (!opt->tf.empty() && !grid.volume) throw Error(opt->input + ": --tf applies to --shading volume");
+        if (!opt->tf.empty() && !opt->window.empty()) throw Error(opt->input + ": --tf and --window both set the transfer function: give one");
         if (opt->legend && !trace::legendScale(grid, std::pair{0.0, 1.0}))
             throw Error(opt->input + ": --legend applies to value shading, mip, slice and volume, and grid '" + chosen->record.name + "' is shown as " +
                         trace::shadingOf(grid));
@@ -224,6 +230,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             if (!(w[1] > w[0])) throw Error("--window: HIGH must be greater than LOW");
             options.window = std::pair{w[0], w[1]};
         }
+        if (grid.volume && !opt->tf.empty()) options.transfer = trace::readTransferFunction(opt->tf);
         if (grid.iso && !opt->iso.empty()) options.iso = parseNumbers(opt->iso, 1, "--iso")[0];
         if (grid.labels && !opt->labels.empty())
             for (const double l : parseNumbers(opt->labels, size_t(std::count(opt->labels.begin(), opt->labels.end(), ',') + 1), "--labels")) {
@@ -240,7 +247,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         }
         std::sort(times.begin(), times.end());
         const double ms = times[times.size() / 2];
-        if (opt->legend) trace::drawLegend(image, *trace::legendScale(grid, stats.window));
+        if (opt->legend) trace::drawLegend(image, *trace::legendScale(grid, stats.window, options.transfer ? &*options.transfer : nullptr));
         bridge::writeImage(opt->output, image);
         const double raysPerSecond = double(stats.primaryRays + stats.secondaryRays) / (ms / 1000.0);
         if (opt->json) {

@@ -48,8 +48,8 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
             image = std::move(p.image);
             window = std::pair{p.low, p.high};
         } else if (grid.volume) {
-            TransferFunction tf = automaticTransfer(grid);
-            if (options.window) tf.low = options.window->first, tf.high = options.window->second;
+            TransferFunction tf = options.transfer ? *options.transfer : automaticTransfer(grid);
+            if (options.window && !options.transfer) tf.low = options.window->first, tf.high = options.window->second;
             image = renderVolume(grid, camera, options, tf);
             window = std::pair{tf.low, tf.high};
         } else if (grid.iso) {

@@ -12,6 +12,7 @@
 
 #include "src/trace/Image.h"
 #include "src/trace/RenderGrid.h"
+#include "src/trace/TransferFunction.h"
 
 namespace vdbdag::trace {
 
@@ -22,8 +23,10 @@ struct LegendScale {
 
 // The scale of what `grid` is shown as with `window` (RenderStats::window:
 // mip, slice, volume); nothing for shadings without one value map (fog,
-// surfaces, labels, isosurfaces, colours and vectors).
-std::optional<LegendScale> legendScale(const RenderGrid& grid, const std::optional<std::pair<double, double>>& window);
+// surfaces, labels, isosurfaces, colours and vectors). A volume's colours
+// are `transfer`'s when given (a --tf file), else the ramp's over `window`.
+std::optional<LegendScale> legendScale(const RenderGrid& grid, const std::optional<std::pair<double, double>>& window,
+                                       const TransferFunction* transfer = nullptr);
 
 // Draws the bar and its two numbers; images narrower than 64 or lower than
 // 48 pixels are left as they are.

@@ -12,6 +12,7 @@
 #include "src/trace/Camera.h"
 #include "src/trace/Ray.h"
 #include "src/trace/RenderGrid.h"
+#include "src/trace/TransferFunction.h"
 #include "src/trace/shading_constants.h"
 
 namespace vdbdag::trace {
@@ -32,6 +33,9 @@ struct RenderOptions {
     // function's window (VolumeRender.h; chosen from the values);
     // --shading slice: the grey window (SliceView.h).
     std::optional<std::pair<double, double>> window;
+    // --shading volume: a transfer function read from a file (--tf), used
+    // instead of the window's ramp.
+    std::optional<TransferFunction> transfer;
     // --shading labels: the labels shown (`--labels`; empty: every one but 0 and the background).
     std::vector<int64_t> labels;
     // --shading iso: the surface's value (`--iso`; IsoSurface.h's automaticIso when absent).

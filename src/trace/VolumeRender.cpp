@@ -13,18 +13,6 @@
 
 namespace vdbdag::trace {
 
-double TransferFunction::opacity(double v) const {
-    if (!(v > low)) return 0;
-    const double t = std::min(1.0, (v - low) / (high > low ? high - low : 1));
-    return kMaxOpacity * t * t;
-}
-
-glm::dvec3 TransferFunction::colour(double v) const {
-    const double t = std::clamp((v - low) / (high > low ? high - low : 1), 0.0, 1.0);
-    const glm::dvec3 dark(0.45, 0.12, 0.06), ivory(0.95, 0.90, 0.78);  // linear light
-    return dark + (ivory - dark) * std::sqrt(t);
-}
-
 TransferFunction automaticTransfer(const RenderGrid& grid) {
     if (!grid.values || grid.values->entryCount == 0) return {};
     const auto [low, high] = storedValueWindow(grid);

@@ -362,54 +362,100 @@ TEST(VolumeRender, CompositingEqualsABruteForceOverTheDenseBlock) {
     const trace::RenderGrid grid = trace::makeRenderGrid(encoded, trace::Shading::Volume);
     ASSERT_TRUE(grid.volume);
     const trace::Camera camera = obliqueCamera();
-    const trace::TransferFunction tf{200, 900};
-    trace::RenderOptions options;
-    const trace::Image image = trace::renderVolume(grid, camera, options, tf);
-    const glm::dvec3 light = trace::defaultLight(camera.eye, camera.target, camera.up);
-    const auto stored = [&](int x, int y, int z) { return x >= 0 && y >= 0 && z >= 0 && x < kNx && y < kNy && z < kNz; };
-    size_t met = 0;
-    double worst = 0;
-    for (int py = 0; py < camera.height; ++py)
-        for (int px = 0; px < camera.width; ++px) {
-            glm::dvec3 o, d;
-            camera.pixelRay(px, py, o, d);
-            const std::vector<Crossing> crossings = crossedVoxels(o, d);
-            double transmittance = 1;
-            glm::dvec3 sum(0);
-            for (const Crossing& c : crossings) {
-                const double v = valueAt(c.x, c.y, c.z), a = tf.opacity(v);
-                if (a <= 0) continue;
-                const double alpha = 1 - std::pow(1 - a, (c.t1 - c.t0) * glm::length(d) / kVoxel);
-                if (!(alpha > 0)) continue;
-                double lit = 1;
-                if (alpha > 0.01) {
-                    glm::dvec3 g(0);
-                    for (int k = 0; k < 3; ++k) {
-                        int p[3] = {c.x, c.y, c.z}, m[3] = {c.x, c.y, c.z};
-                        ++p[k], --m[k];
-                        const bool hp = stored(p[0], p[1], p[2]), hm = stored(m[0], m[1], m[2]);
-                        if (hp && hm) g[k] = (valueAt(p[0], p[1], p[2]) - valueAt(m[0], m[1], m[2])) * 0.5;
-                        else if (hp) g[k] = valueAt(p[0], p[1], p[2]) - v;
-                        else if (hm) g[k] = v - valueAt(m[0], m[1], m[2]);
+    // The default ramp over a window, and points read from a ParaView preset
+    // (a --tf file: colour points in sRGB, an opacity ramp with a plateau).
+    const fs::path presetPath = fs::temp_directory_path() / ("vdbdag_tf_" + std::to_string(::getpid()) + ".json");
+    std::ofstream(presetPath) << R"([{"Name": "test", "RGBPoints": [150, 0.1, 0.2, 0.9, 500, 1, 0.5, 0, 950, 1, 1, 1],
+                                       "Points": [250, 0, 0.5, 0, 600, 0.8, 0.5, 0, 800, 0.8, 0.5, 0, 1000, 1, 0.5, 0]}])";
+    const trace::TransferFunction fromFile = trace::readTransferFunction(presetPath.string());
+    fs::remove(presetPath);
+    for (const trace::TransferFunction& tf : {trace::TransferFunction{200, 900}, fromFile}) {
+        trace::RenderOptions options;
+        const trace::Image image = trace::renderVolume(grid, camera, options, tf);
+        const glm::dvec3 light = trace::defaultLight(camera.eye, camera.target, camera.up);
+        const auto stored = [&](int x, int y, int z) { return x >= 0 && y >= 0 && z >= 0 && x < kNx && y < kNy && z < kNz; };
+        size_t met = 0;
+        double worst = 0;
+        for (int py = 0; py < camera.height; ++py)
+            for (int px = 0; px < camera.width; ++px) {
+                glm::dvec3 o, d;
+                camera.pixelRay(px, py, o, d);
+                const std::vector<Crossing> crossings = crossedVoxels(o, d);
+                double transmittance = 1;
+                glm::dvec3 sum(0);
+                for (const Crossing& c : crossings) {
+                    const double v = valueAt(c.x, c.y, c.z), a = tf.opacity(v);
+                    if (a <= 0) continue;
+                    const double alpha = 1 - std::pow(1 - a, (c.t1 - c.t0) * glm::length(d) / kVoxel);
+                    if (!(alpha > 0)) continue;
+                    double lit = 1;
+                    if (alpha > 0.01) {
+                        glm::dvec3 g(0);
+                        for (int k = 0; k < 3; ++k) {
+                            int p[3] = {c.x, c.y, c.z}, m[3] = {c.x, c.y, c.z};
+                            ++p[k], --m[k];
+                            const bool hp = stored(p[0], p[1], p[2]), hm = stored(m[0], m[1], m[2]);
+                            if (hp && hm) g[k] = (valueAt(p[0], p[1], p[2]) - valueAt(m[0], m[1], m[2])) * 0.5;
+                            else if (hp) g[k] = valueAt(p[0], p[1], p[2]) - v;
+                            else if (hm) g[k] = v - valueAt(m[0], m[1], m[2]);
+                        }
+                        if (glm::length(g) > 0) {
+                            glm::dvec3 n = glm::normalize(-g);
+                            if (glm::dot(n, d) > 0) n = -n;
+                            lit = trace::kAmbient + (1 - trace::kAmbient) * std::max(0.0, glm::dot(n, light));
+                        }
                     }
-                    if (glm::length(g) > 0) {
-                        glm::dvec3 n = glm::normalize(-g);
-                        if (glm::dot(n, d) > 0) n = -n;
-                        lit = trace::kAmbient + (1 - trace::kAmbient) * std::max(0.0, glm::dot(n, light));
-                    }
+                    sum += transmittance * alpha * lit * tf.colour(v);
+                    transmittance *= 1 - alpha;
+                    if (transmittance < 0.02) break;
                 }
-                sum += transmittance * alpha * lit * tf.colour(v);
-                transmittance *= 1 - alpha;
-                if (transmittance < 0.02) break;
+                const size_t i = size_t(py) * size_t(camera.width) + size_t(px);
+                EXPECT_NEAR(image.alpha[i], 1 - transmittance, 1e-5) << px << "," << py;
+                const glm::dvec3 want = sum + transmittance * options.background;
+                for (int a = 0; a < 3; ++a) worst = std::max(worst, std::abs(double(image.rgb[3 * i + size_t(a)]) - want[a]));
+                met += transmittance < 1;
             }
-            const size_t i = size_t(py) * size_t(camera.width) + size_t(px);
-            EXPECT_NEAR(image.alpha[i], 1 - transmittance, 1e-5) << px << "," << py;
-            const glm::dvec3 want = sum + transmittance * options.background;
-            for (int a = 0; a < 3; ++a) worst = std::max(worst, std::abs(double(image.rgb[3 * i + size_t(a)]) - want[a]));
-            met += transmittance < 1;
+        EXPECT_GT(met, 100u);
+        EXPECT_LT(worst, 1e-5) << "largest colour difference over " << met << " covered pixels";
+    }
+}
+
+// A --tf file (a ParaView colour-map preset) against its closed form: colours
+// from sRGB to linear, linear between points and clamped beyond; opacity
+// points scaled by kMaxOpacity; without "Points" the ramp over the colour
+// points' range; bad files refused naming the file.
+TEST(VolumeRender, ATransferFunctionFileIsReadAsParaViewWritesIt) {
+    const fs::path path = fs::temp_directory_path() / ("vdbdag_tf_read_" + std::to_string(::getpid()) + ".json");
+    const auto write = [&](const std::string& text) { std::ofstream(path) << text; };
+    const auto linear = [](double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };
+    write(R"({"RGBPoints": [0, 0, 0.5, 1, 10, 1, 0.5, 0], "Points": [2, 0, 0.5, 0, 6, 1, 0.5, 0]})");
+    trace::TransferFunction tf = trace::readTransferFunction(path.string());
+    EXPECT_EQ(tf.low, 0);
+    EXPECT_EQ(tf.high, 10);
+    const glm::dvec3 mid = tf.colour(5);
+    EXPECT_NEAR(mid.r, 0.5 * linear(1.0), 1e-12);
+    EXPECT_NEAR(mid.g, linear(0.5), 1e-12);
+    EXPECT_NEAR(mid.b, 0.5 * linear(1.0), 1e-12);
+    EXPECT_NEAR(tf.colour(-3).b, 1.0, 1e-12) << "clamped below";
+    EXPECT_NEAR(tf.opacity(4), 0.5 * trace::kMaxOpacity, 1e-12);
+    EXPECT_EQ(tf.opacity(1), 0);
+    EXPECT_NEAR(tf.opacity(100), trace::kMaxOpacity, 1e-12);
+    write(R"({"RGBPoints": [100, 0, 0, 0, 300, 1, 1, 1]})");
+    tf = trace::readTransferFunction(path.string());
+    EXPECT_EQ(tf.opacity(100), 0);
+    EXPECT_NEAR(tf.opacity(200), trace::kMaxOpacity * 0.25, 1e-12) << "the ramp over the points' range";
+    for (const char* bad : {"{}", "[1, 2", R"({"RGBPoints": [0, 0, 0, 0]})", R"({"RGBPoints": [5, 0, 0, 0, 1, 1, 1, 1]})",
+                            R"({"RGBPoints": [0, 0, 0, 0, 1, 1, 1]})", R"({"RGBPoints": [0, 0, 0, 0, 1, 1, 1, "x"]})"}) {
+        write(bad);
+        try {
+            trace::readTransferFunction(path.string());
+            ADD_FAILURE() << "accepted " << bad;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
         }
-    EXPECT_GT(met, 100u);
-    EXPECT_LT(worst, 1e-5) << "largest colour difference over " << met << " covered pixels";
+    }
+    fs::remove(path);
+    EXPECT_THROW(trace::readTransferFunction(path.string()), Error);
 }
 
 // The default shading of a dense scan in bytes: an 8-bit scan (a ball of
