@@ -30,6 +30,7 @@
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/ImageWriter.h"
 #include "vdb_bridge/InputScene.h"
+#include "vdb_bridge/VdbSummary.h"
 
 namespace vdbdag::cli {
 namespace {
@@ -247,7 +248,13 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         }
         std::sort(times.begin(), times.end());
         const double ms = times[times.size() / 2];
-        if (opt->legend) trace::drawLegend(image, *trace::legendScale(grid, stats.window, options.transfer ? &*options.transfer : nullptr));
+        if (opt->legend) {
+            trace::LegendScale scale = *trace::legendScale(grid, stats.window, options.transfer ? &*options.transfer : nullptr);
+            std::vector<std::pair<std::string, std::string>> metadata;
+            for (const bridge::MetadataEntry& m : bridge::gridHeaderFacts(chosen->record, std::nullopt, opt->input).metadata) metadata.emplace_back(m.name, m.value);
+            scale.units = trace::valueUnits(metadata);
+            trace::drawLegend(image, scale);
+        }
         bridge::writeImage(opt->output, image);
         const double raysPerSecond = double(stats.primaryRays + stats.secondaryRays) / (ms / 1000.0);
         if (opt->json) {

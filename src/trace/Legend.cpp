@@ -31,6 +31,21 @@ std::array<uint8_t, 5> glyph(char c) {
         case '+': return {0, 2, 7, 2, 0};
         case '.': return {0, 0, 0, 0, 2};
         case 'e': return {0, 7, 7, 4, 7};
+        // The letters of the units valueUnits names.
+        case 'B': return {6, 5, 6, 5, 6};
+        case 'H': return {5, 5, 7, 5, 5};
+        case 'U': return {5, 5, 5, 5, 7};
+        case 'q': return {0, 7, 5, 7, 1};
+        case 'g': return {0, 7, 5, 7, 3};
+        case 'm': return {0, 7, 7, 5, 5};
+        case 'l': return {2, 2, 2, 2, 2};
+        case 'c': return {0, 7, 4, 4, 7};
+        case 'o': return {0, 7, 5, 5, 7};
+        case 'u': return {0, 5, 5, 5, 7};
+        case 'n': return {0, 6, 5, 5, 5};
+        case 't': return {2, 7, 2, 2, 3};
+        case 's': return {0, 3, 6, 1, 6};
+        case '/': return {1, 1, 2, 4, 4};
         default: return {0, 0, 0, 0, 0};
     }
 }
@@ -81,6 +96,25 @@ std::optional<LegendScale> legendScale(const RenderGrid& grid, const std::option
     return std::nullopt;
 }
 
+std::string valueUnits(const std::vector<std::pair<std::string, std::string>>& metadata) {
+    const auto find = [&](const char* name) -> std::string {
+        for (const auto& [key, value] : metadata)
+            if (key == name) return value;
+        return {};
+    };
+    // DICOM's Units (0054,1001) for PET, then Rescale Type (0028,1054), then
+    // a CT's Hounsfield units.
+    const std::string units = find("dicom_Units");
+    if (units == "BQML") return "Bq/ml";
+    if (units == "CNTS") return "counts";
+    if (units == "GML") return "g/ml";
+    if (units == "HU") return "HU";
+    const std::string rescale = find("dicom_RescaleType");
+    if (rescale == "HU") return "HU";
+    if (find("dicom_Modality") == "CT" && (rescale.empty() || rescale == "US")) return "HU";
+    return {};
+}
+
 void drawLegend(Image& image, const LegendScale& scale) {
     if (image.width < 64 || image.height < 48) return;
     const int s = std::max(1, image.height / 240);          // glyph scale
@@ -95,7 +129,7 @@ void drawLegend(Image& image, const LegendScale& scale) {
         const glm::dvec3 c = scale.colour(scale.low + t * (scale.high - scale.low));
         for (int x = left; x < right; ++x) setPixel(image, x, y, c);
     }
-    drawText(image, fmt::format("{:.4g}", scale.high), right, margin, s);
+    drawText(image, fmt::format("{:.4g}", scale.high) + (scale.units.empty() ? "" : " " + scale.units), right, margin, s);
     drawText(image, fmt::format("{:.4g}", scale.low), right, bottom + 2 * s, s);
 }
 

@@ -7,6 +7,9 @@
 #pragma once
 #include <functional>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -19,7 +22,13 @@ namespace vdbdag::trace {
 struct LegendScale {
     double low = 0, high = 1;
     std::function<glm::dvec3(double value)> colour;  // linear RGB of a value
+    std::string units;  // drawn after the high value ("HU", "Bq/ml"); empty: none
 };
+
+// The units of a grid's values from its metadata (name, value as text):
+// DICOM's Units for a PET (BQML -> Bq/ml, CNTS -> counts, GML -> g/ml),
+// Rescale Type HU, or HU for a CT; empty when nothing says.
+std::string valueUnits(const std::vector<std::pair<std::string, std::string>>& metadata);
 
 // The scale of what `grid` is shown as with `window` (RenderStats::window:
 // mip, slice, volume); nothing for shadings without one value map (fog,

@@ -580,3 +580,30 @@ TEST(Legend, TheBarShowsTheScaleFromHighToLowWithItsNumbers) {
     EXPECT_TRUE(trace::legendScale(trace::makeRenderGrid(encoded, trace::Shading::Mip), std::pair{0.0, 1.0}));
     EXPECT_TRUE(trace::legendScale(trace::makeRenderGrid(encoded, trace::Shading::Values), std::nullopt));
 }
+
+// Units after the high value, from the grid's DICOM metadata: a PET's Units,
+// a Rescale Type, a CT's HU; nothing when nothing says. Drawn, the label
+// reaches further left than the number alone.
+TEST(Legend, UnitsComeFromTheMetadataAndFollowTheHighValue) {
+    using M = std::vector<std::pair<std::string, std::string>>;
+    EXPECT_EQ(trace::valueUnits(M{{"dicom_Modality", "PT"}, {"dicom_Units", "BQML"}}), "Bq/ml");
+    EXPECT_EQ(trace::valueUnits(M{{"dicom_Units", "CNTS"}}), "counts");
+    EXPECT_EQ(trace::valueUnits(M{{"dicom_Modality", "CT"}, {"dicom_RescaleType", "HU"}}), "HU");
+    EXPECT_EQ(trace::valueUnits(M{{"dicom_Modality", "CT"}}), "HU");
+    EXPECT_EQ(trace::valueUnits(M{{"dicom_Modality", "MR"}}), "");
+    EXPECT_EQ(trace::valueUnits(M{}), "");
+    const auto leftmostWhite = [](const trace::Image& image) {
+        int left = image.width;
+        for (int y = 0; y < 12; ++y)
+            for (int x = 0; x < image.width; ++x)
+                if (image.rgb[3 * (size_t(y) * size_t(image.width) + size_t(x))] == 1.0f) left = std::min(left, x);
+        return left;
+    };
+    trace::LegendScale scale{0, 1500, [](double v) { return glm::dvec3(v / 1500); }};
+    trace::Image plain, withUnits;
+    plain.resize(320, 240), withUnits.resize(320, 240);
+    trace::drawLegend(plain, scale);
+    scale.units = "Bq/ml";
+    trace::drawLegend(withUnits, scale);
+    EXPECT_LT(leftmostWhite(withUnits), leftmostWhite(plain) - 5 * 4) << "six more glyphs of 4 pixels";
+}
