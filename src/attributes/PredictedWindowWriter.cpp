@@ -122,7 +122,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
 PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory,
                                              std::optional<FloatChannel> floats)
     : valueSize_(valueSize),
-      windowEntries_(floats ? kFloatWindowEntries : kValueWindowEntries),
+      windowEntries_(floats && !floats->lattice ? kFloatWindowEntries : kValueWindowEntries),
       floats_(floats),
       parallel_(parallel ? parallel : unsigned(std::max(1, tbb::info::default_concurrency()))) {
     if (!floats && valueSize != 4 && valueSize != 8) throw Error("internal error: predicted windows hold 4- or 8-byte integers");
