@@ -64,10 +64,7 @@ void decodeSamples(std::span<const uint8_t> bytes, const IntCoderOptions& option
     } catch (const Error& e) {
         throw Error(what + ": " + e.what());
     }
-    // The encoder's flush leaves at most 4 bytes the decoder never needs
-    // and the decoder may look up to 4 bytes past its last one.
-    if (rc.overrun() > 4 || rc.consumed() + 4 < bytes.size())
-        throw Error(what + ": corrupt (the coded values end " + (rc.overrun() > 4 ? "early" : "before the stream does") + ")");
+    if (const char* fault = rc.endFault()) throw Error(what + ": corrupt (the coded values end " + fault + ")");
 }
 
 } // namespace vdbdag::coding::detail

@@ -67,7 +67,12 @@ float toFloat(double d) {
 
 // An error (>= 0) kept in 16 bits: the upper half of toFloat(e)'s bits
 // (sign, exponent, 7 mantissa bits; truncated), and back: normal or 0.
-uint16_t errorCode(double e) { return uint16_t(std::bit_cast<uint32_t>(toFloat(e)) >> 16); }
+// Written without branches (it runs eight times a voxel).
+uint16_t errorCode(double e) {
+    e = !(e >= double(FLT_MIN)) ? 0.0 : e;
+    e = e > double(FLT_MAX) ? double(FLT_MAX) : e;
+    return uint16_t(std::bit_cast<uint32_t>(float(e)) >> 16);
+}
 float errorOf(uint16_t code) { return std::bit_cast<float>(uint32_t(code) << 16); }
 constexpr uint16_t kLargestError = 0x7F7F;  // FLT_MAX's upper half
 
@@ -174,14 +179,7 @@ void walkFloats(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
                 // A predictor this voxel cannot make is charged twice the chosen
                 // one's error.
                 const uint16_t missing = errorCode(2.0 * std::fabs(pred[best] - x));
-                for (int p = 0; p < kPredictors; ++p) {
-                    // errorCode without branches (|pred - x| is finite)
-                    double a = std::fabs(pred[p] - x);
-                    a = a < double(FLT_MIN) ? 0.0 : a;
-                    a = a > double(FLT_MAX) ? double(FLT_MAX) : a;
-                    const uint16_t code = uint16_t(std::bit_cast<uint32_t>(float(a)) >> 16);
-                    errors[size_t(p)] = ok[p] ? code : missing;
-                }
+                for (int p = 0; p < kPredictors; ++p) errors[size_t(p)] = ok[p] ? errorCode(std::fabs(pred[p] - x)) : missing;
             }
         });
 }
@@ -227,10 +225,6 @@ int64_t getResidual(RangeDecoder& rc, FloatModels& m, int context) {
     if (rest > 0) magnitude = (magnitude << rest) | rc.decodeBits(unsigned(rest));
     return negative ? -int64_t(magnitude) : int64_t(magnitude);
 }
-
-} // namespace
-
-namespace {
 
 // C components per entry, interleaved in `bits`. Header: the generation,
 // then each component's shift (the common zero low bits of its magnitudes:
@@ -279,10 +273,7 @@ void decodeComponents(std::span<const uint8_t> payload, std::span<const uint64_t
     } catch (const Error& e) {
         throw Error(what + ": " + e.what());
     }
-    // As CodingLoop.h: the flush leaves at most 4 bytes unread, the decoder
-    // may look up to 4 past its last.
-    if (rc.overrun() > 4 || rc.consumed() + 4 < stream.size())
-        throw Error(what + ": corrupt (the coded values end " + (rc.overrun() > 4 ? "early" : "before the stream does") + ")");
+    if (const char* fault = rc.endFault()) throw Error(what + ": corrupt (the coded values end " + fault + ")");
 }
 
 } // namespace

@@ -137,8 +137,7 @@ void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t
     } catch (const Error& e) {
         throw Error(what + ": " + e.what());
     }
-    if (rc.overrun() > 4 || rc.consumed() + 4 < bytes.size())
-        throw Error(what + ": corrupt (the coded labels end " + (rc.overrun() > 4 ? "early" : "before the stream does") + ")");
+    if (const char* fault = rc.endFault()) throw Error(what + ": corrupt (the coded labels end " + fault + ")");
 }
 
 } // namespace vdbdag::coding

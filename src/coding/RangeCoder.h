@@ -159,6 +159,10 @@ public:
     // them legitimate).
     uint64_t overrun() const { return past_; }
     size_t consumed() const { return at_; }
+    // How a finished stream ends wrongly, or null when it ends as the
+    // encoder's flush leaves it (at most 4 bytes never needed, at most 4
+    // read past the end): "early" or "before the stream does".
+    const char* endFault() const { return past_ > 4 ? "early" : at_ + 4 < in_.size() ? "before the stream does" : nullptr; }
 
 private:
     uint32_t next() {
