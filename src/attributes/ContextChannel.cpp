@@ -14,14 +14,16 @@ namespace vdbdag::attributes {
 namespace {
 constexpr size_t kHeaderBytes = 1 + 4 + 4 + 4 + 4 + 8;
 // The model generation of a window's coding (coding/IntVolumeCoder.h):
-// 1 for bricks in spatial order (codings 5, 6), 0 for the codings before.
-int modelOf(std::span<const coding::BrickPlace> places, coding::BrickOrder order) {
-    return !places.empty() && order == coding::BrickOrder::Spatial ? 1 : 0;
+// `spatial` (1 or 2, the window's coding says which) for bricks in spatial
+// order, 0 for the codings before (2, 3).
+int modelOf(std::span<const coding::BrickPlace> places, coding::BrickOrder order, int spatial) {
+    if (spatial < 1 || spatial > coding::kLatestIntModel) throw Error("internal error: model generation " + std::to_string(spatial));
+    return !places.empty() && order != coding::BrickOrder::Attribute ? spatial : 0;
 }
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                          bool labels, coding::BrickOrder order) {
+                                          bool labels, coding::BrickOrder order, int model) {
     if (labels && places.empty()) throw Error("internal error: labels are coded with their bricks' places");
     if (values.size() % 4) throw Error("internal error: a context-coded channel holds int32 entries");
     std::vector<int32_t> entries(values.size() / 4);
@@ -41,7 +43,7 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
     coding::IntCoderOptions options;
     options.minValue = step > 1 ? 0 : lo;
     options.maxValue = step > 1 ? (int64_t(hi) - lo) / int64_t(step) : hi;
-    options.model = modelOf(places, order);
+    options.model = modelOf(places, order, model);
     const std::vector<uint8_t> stream =
         labels           ? coding::encodePlacedLabels(entries, layout, places, order, int32_t(options.minValue), int32_t(options.maxValue))
         : places.empty() ? coding::encodeBrickValues(entries, layout, options)
@@ -59,12 +61,12 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
 }
 
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places, bool labels, coding::BrickOrder order) {
+                                          std::span<const coding::BrickPlace> places, bool labels, coding::BrickOrder order, int model) {
     format::ByteReader r(payload, what);
     const uint8_t valueSize = r.get<uint8_t>();
     if (valueSize != 4) r.fail("a context-coded channel of " + std::to_string(valueSize) + "-byte values (4 expected)");
     coding::IntCoderOptions options;
-    options.model = modelOf(places, order);
+    options.model = modelOf(places, order, model);
     const uint32_t near = r.get<uint32_t>();
     if (near > (1u << 20)) r.fail("a near-lossless bound of " + std::to_string(near) + " (at most 2^20)");
     options.near = int32_t(near);

@@ -13,8 +13,9 @@
 // values quantised by --abs-error), i32 minValue, i32 maxValue (the
 // entries' range, which bounds every prediction and the residuals' modulo;
 // step divides maxValue - minValue), u64 n (entries), then the coder's
-// stream to the end. The stream's model generation follows from the walk:
-// 1 with places in spatial order (codings 5, 6), else 0 (codings 2, 3).
+// stream to the end. The stream's model generation (coding/SamplePredictor.h)
+// is 0 without places or in attribute order (codings 2, 3); in spatial order
+// the window's coding says it: 1 (codings 5, 6) or 2 (codings 10, 11).
 #pragma once
 #include <cstdint>
 #include <span>
@@ -31,15 +32,16 @@ namespace vdbdag::attributes {
 // in `order`); without, from each brick alone (coding 2).
 // With `labels` (and places), the entries are coded as categories by
 // coding/LabelCoder.h (codings 7 and 4).
+// `model`: the generation in spatial order (ignored otherwise).
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
-                                          coding::BrickOrder order = coding::BrickOrder::Spatial);
+                                          coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel);
 
 // Inverse (`places` given exactly when the payload was coded with them);
 // validates the payload against `layout` and `entries` (throws
 // vdbdag::Error starting with `what`).
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
-                                          coding::BrickOrder order = coding::BrickOrder::Spatial);
+                                          coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel);
 
 } // namespace vdbdag::attributes

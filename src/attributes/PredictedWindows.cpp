@@ -21,7 +21,7 @@ namespace vdbdag::attributes {
 std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
                                              const std::string& what) {
     const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
-    std::vector<uint64_t> counts(size_t(detail::kFloatVectorCoding) + 1);
+    std::vector<uint64_t> counts(size_t(detail::kCodingCount));
     for (size_t k = 0; k < dir.windows.size(); ++k) {
         const WindowDirectory::Window& e = dir.windows[k];
         const std::span<const uint8_t> stored = payload.subspan(size_t(e.offset), size_t(e.stored));
@@ -35,7 +35,8 @@ std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, u
 
 const char* predictedCodingName(uint8_t coding) {
     static const char* const names[] = {"palettes", "brick residuals", "context-coded", "placed context-coded", "placed labels",
-                                        "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors"};
+                                        "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors",
+                                        "fitted context-coded", "fitted rescaled floats"};
     return coding < std::size(names) ? names[coding] : "unknown";
 }
 
@@ -120,19 +121,20 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
     if (raw[0] == detail::kPredictedCoding) return decodePredicted(body, dir.valueSize, bricks, where);
     const uint8_t c = raw[0];
     if (c == detail::kContextCoding || c == detail::kPlacedContextCoding || c == detail::kPlacedLabelCoding || c == detail::kSpatialContextCoding ||
-        c == detail::kSpatialLabelCoding) {
+        c == detail::kSpatialLabelCoding || c == detail::kFittedContextCoding) {
         if (dir.valueSize != 4) throw Error(where + ": a context-coded window of " + std::to_string(dir.valueSize) + "-byte values (int32 only)");
         if (c == detail::kContextCoding) return decodeContextChannel(body, bricks, e.entries, where);
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
-        const bool spatial = c == detail::kSpatialContextCoding || c == detail::kSpatialLabelCoding;
+        const bool fitted = c == detail::kFittedContextCoding, spatial = c == detail::kSpatialContextCoding || c == detail::kSpatialLabelCoding;
         return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
                                     c == detail::kPlacedLabelCoding || c == detail::kSpatialLabelCoding,
-                                    spatial ? coding::BrickOrder::Spatial : coding::BrickOrder::Attribute);
+                                    fitted ? coding::BrickOrder::Raster : spatial ? coding::BrickOrder::Spatial : coding::BrickOrder::Attribute, fitted ? 2 : 1);
     }
-    if (raw[0] == detail::kRescaledFloatCoding) {
+    if (raw[0] == detail::kRescaledFloatCoding || raw[0] == detail::kFittedRescaledFloatCoding) {
         if (dir.valueSize != 4) throw Error(where + ": rescaled floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
-        return decodeRescaledFloats(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)));
+        return decodeRescaledFloats(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
+                                    raw[0] == detail::kFittedRescaledFloatCoding ? 2 : 1);
     }
     if (raw[0] == detail::kFloatCoding) {
         if (dir.valueSize != 4) throw Error(where + ": predicted floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");

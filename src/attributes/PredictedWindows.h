@@ -33,10 +33,12 @@
 // same payload with the entries coded as labels, coding/LabelCoder.h; 5:
 // float32 only, encodeRescaledFloats bytes over its bricks and their
 // places, RescaledFloats.h; 6 and 7: codings 3 and 4 with the bricks
-// visited in spatial order, coding::BrickOrder, which a writer writes
-// today; 8: float32 only, encodePlacedFloats bytes over its bricks and
-// their places, coding/FloatValueCoder.h; 9: vec3s only, encodeFloatVectors
-// bytes: the three components in one stream) then that payload;
+// visited in spatial order, coding::BrickOrder; 8: float32 only,
+// encodePlacedFloats bytes over its bricks and their places, coding/FloatValueCoder.h; 9: vec3s only, encodeFloatVectors
+// bytes: the three components in one stream; 10 and 11: codings 6 and 5
+// with the integers' model generation 2, the least-squares fit,
+// coding/LeastSquaresPredictor.h, which a writer writes today) then that
+// payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -59,7 +61,8 @@ inline constexpr uint64_t kFloatWindowEntries = uint64_t(1) << 20;
 namespace detail {  // the layout above, shared by the writer and the reader
 inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
 inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3, kPlacedLabelCoding = 4,
-                         kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7, kFloatCoding = 8, kFloatVectorCoding = 9;
+                         kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7, kFloatCoding = 8, kFloatVectorCoding = 9,
+                         kFittedContextCoding = 10, kFittedRescaledFloatCoding = 11, kCodingCount = 12;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail

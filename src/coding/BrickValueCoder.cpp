@@ -16,7 +16,8 @@ namespace {
 
 using namespace detail;
 
-// `step(context, signs, prediction, entry)` returns the reconstructed entry.
+// `step(prediction, entry)` returns the reconstructed entry. Each brick sees
+// only itself (coding 2, generation 0): the far neighbours are W's value.
 template <typename Step>
 void walk(std::span<const uint64_t> layout, uint64_t entries, const IntCoderOptions& options, Models& models, Step&& step) {
     int64_t value[64];
@@ -26,7 +27,7 @@ void walk(std::span<const uint64_t> layout, uint64_t entries, const IntCoderOpti
     uint64_t e = 0;
     const auto code = [&](Neighbourhood& n) {
         const Prediction pr = predict(n, options.minValue, options.maxValue, models);
-        const int64_t v = step(*pr.ctx, pr.signs, pr.value, e++);
+        const int64_t v = step(pr, e++);
         SampleRecord r;
         learn(pr, v, r);
         last = v;
@@ -38,6 +39,7 @@ void walk(std::span<const uint64_t> layout, uint64_t entries, const IntCoderOpti
             if (e >= entries) throw Error("the layout holds more entries than the channel");
             Neighbourhood n;
             n.W = n.N = n.NW = n.NE = n.P = n.PW = n.PN = n.PNW = last;
+            n.far.fill(last);
             n.rW = &lastRec;
             code(n);
             continue;
@@ -62,6 +64,7 @@ void walk(std::span<const uint64_t> layout, uint64_t entries, const IntCoderOpti
             } else {
                 n.P = med(n.W, n.N, n.NW), n.PW = n.W, n.PN = n.N, n.PNW = n.NW;
             }
+            n.far.fill(n.W);
             n.rW = hx ? &rec[i - 1] : (!hy && !hz) ? &lastRec : nullptr;
             n.rN = hy ? &rec[i - 4] : nullptr;
             n.rP = hz ? &rec[i - 16] : nullptr;
@@ -99,20 +102,24 @@ struct CompactRecord {
     }
 };
 
-template <typename Step>
+// Generation 2 (kReach Wide) also finds the far neighbours, with the raster
+// walk's substitutes (IntVolumeCoder.cpp) where a neighbour's brick is not
+// visited yet.
+template <Reach kReach, typename Step>
 void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
                 Models& models, Step&& step) {
     int64_t last = 0;  // the previous entry visited, and its record
     SampleRecord lastRec{};
     using Nb = PlacedNeighbours<CompactRecord>;
-    walkPlacedBricks<CompactRecord>(
+    walkPlacedBricks<CompactRecord, kReach>(
         layout, places, entries, order,
         [&](uint64_t entry) {  // a tile: one entry, no neighbours
             Neighbourhood n;
             n.W = n.N = n.NW = n.NE = n.P = n.PW = n.PN = n.PNW = last;
+            n.far.fill(last);
             n.rW = &lastRec;
             const Prediction pr = predict(n, options.minValue, options.maxValue, models);
-            last = step(*pr.ctx, pr.signs, pr.value, entry);
+            last = step(pr, entry);
             learn(pr, last, lastRec);
         },
         [&](const Nb& nb, uint64_t entry, int32_t& value, CompactRecord& rec) {
@@ -131,6 +138,15 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             } else {
                 n.P = med(n.W, n.N, n.NW), n.PW = n.W, n.PN = n.N, n.PNW = n.NW;
             }
+            if constexpr (kReach == Reach::Wide) {
+                const auto o = [&](Nb::Which k, int64_t substitute) { return nb.has(k) ? v(k) : substitute; };
+                n.far[kWW] = o(Nb::WW, n.W), n.far[kNN] = o(Nb::NN, n.N), n.far[kPP] = o(Nb::PP, n.P);
+                n.far[kPE] = o(Nb::PE, n.P), n.far[kPS] = o(Nb::PS, n.P), n.far[kPNE] = o(Nb::PNE, n.PN), n.far[kPSW] = o(Nb::PSW, n.PW);
+                n.far[kPSE] = o(Nb::PSE, n.far[kPS]), n.far[kNWW] = o(Nb::NWW, n.NW), n.far[kNNE] = o(Nb::NNE, n.far[kNN]);
+                n.far[kNNW] = o(Nb::NNW, n.far[kNN]), n.far[kNEE] = o(Nb::NEE, n.NE);
+            } else {
+                n.far.fill(n.W);
+            }
             SampleRecord rW, rN, rP;
             if (hW) rW = nb.rec(Nb::W).expand();
             if (hN) rN = nb.rec(Nb::N).expand();
@@ -146,7 +162,7 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             };
             add(Nb::N, 2), add(Nb::P, 2), add(Nb::NE, 1), add(Nb::NW, 1), add(Nb::PW, 1), add(Nb::PN, 1);
             const Prediction pr = predict(n, options.minValue, options.maxValue, models);
-            const int64_t decoded = step(*pr.ctx, pr.signs, pr.value, entry);
+            const int64_t decoded = step(pr, entry);
             SampleRecord r;
             learn(pr, decoded, r);
             value = int32_t(decoded);
@@ -154,6 +170,13 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             last = decoded;
             lastRec = r;
         });
+}
+
+template <typename Step>
+void walkPlacedAny(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
+                   Models& models, Step&& step) {
+    if (options.model >= 2) walkPlaced<Reach::Wide>(layout, places, entries, order, options, models, step);
+    else walkPlaced<Reach::Near>(layout, places, entries, order, options, models, step);
 }
 
 } // namespace
@@ -178,12 +201,12 @@ void decodeBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t>
 std::vector<uint8_t> encodePlacedBrickValues(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
                                              BrickOrder order, const IntCoderOptions& options, std::vector<int32_t>* reconstructed) {
     return encodeSamples(entries, options, reconstructed,
-                         [&](Models& models, auto&& step) { walkPlaced(layout, places, entries.size(), order, options, models, step); });
+                         [&](Models& models, auto&& step) { walkPlacedAny(layout, places, entries.size(), order, options, models, step); });
 }
 
 void decodePlacedBrickValues(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order,
                              const IntCoderOptions& options, std::span<int32_t> out, const std::string& what) {
-    decodeSamples(bytes, options, out, what, [&](Models& models, auto&& step) { walkPlaced(layout, places, out.size(), order, options, models, step); });
+    decodeSamples(bytes, options, out, what, [&](Models& models, auto&& step) { walkPlacedAny(layout, places, out.size(), order, options, models, step); });
 }
 
 } // namespace vdbdag::coding

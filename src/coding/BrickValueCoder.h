@@ -50,12 +50,17 @@ struct BrickPlace {
 
 // The order a placed walk visits a layout's instances in. Attribute: the
 // layout's own (window codings 3 and 4). Spatial: its tiles, then its
-// bricks by the (z, y, x) of their corners (codings 5-7), where every causal
+// bricks in the Morton order of their corners (codings 5-9), where every causal
 // neighbour's brick comes before the brick, whatever the mirrors on the
 // DAG's paths (under a mirror a symmetric DAG visits its children from the
 // far side, so in attribute order a PET's bricks lose a fifth of their
 // neighbours and the window costs 24 % more).
-enum class BrickOrder : uint8_t { Attribute, Spatial };
+// Raster (codings 10, 11): 32^3-voxel blocks in Morton order, the bricks of
+// a block in (z, y, x) order of their corners, so that inside a block the
+// slice of bricks below is wholly coded before a brick (Morton order leaves
+// some of it for later): the far neighbours of generation 2
+// (LeastSquaresPredictor.h) are there more often (PlacedWalk.h).
+enum class BrickOrder : uint8_t { Attribute, Spatial, Raster };
 
 // The same coding with neighbours across brick boundaries: with `places`
 // (one per layout entry), each brick's voxels are visited in spatial raster

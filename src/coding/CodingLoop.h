@@ -20,10 +20,11 @@ inline void checkRange(const IntCoderOptions& options) {
     if (options.minValue > options.maxValue || options.minValue < INT32_MIN || options.maxValue > INT32_MAX)
         throw Error("value coder: the sample range must be a non-empty part of int32");
     if (options.near < 0 || options.near > 1 << 20) throw Error("value coder: near must lie in 0..2^20");
-    if (options.model < 0 || options.model > 1) throw Error("value coder: model generation " + std::to_string(options.model) + " (0 or 1)");
+    if (options.model < 0 || options.model > kLatestModel)
+        throw Error("value coder: model generation " + std::to_string(options.model) + " (0 to " + std::to_string(kLatestModel) + ")");
 }
 
-// `walk(models, step)` runs the walk; step(context, signs, prediction, index).
+// `walk(models, step)` runs the walk; step(prediction, index) returns the sample's reconstruction.
 template <typename Walk>
 std::vector<uint8_t> encodeSamples(std::span<const int32_t> samples, const IntCoderOptions& options, std::vector<int32_t>* reconstructed, Walk&& walk) {
     checkRange(options);
@@ -32,13 +33,21 @@ std::vector<uint8_t> encodeSamples(std::span<const int32_t> samples, const IntCo
     auto models = std::make_unique<Models>(options.model);
     const int64_t step = 2 * int64_t(options.near) + 1;
     if (reconstructed) reconstructed->resize(samples.size());
-    walk(*models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
+    walk(*models, [&](const Prediction& pr, uint64_t at) {
         const int64_t s = samples[at];
         if (s < options.minValue || s > options.maxValue)
             throw Error("value coder: sample " + std::to_string(s) + " lies outside " + std::to_string(options.minValue) + ".." + std::to_string(options.maxValue));
+        if (pr.floor >= 0) {  // generation 2: is it the minimum?
+            rc.encode(models->floor[size_t(pr.floor)], s == options.minValue);
+            if (s == options.minValue) {
+                if (reconstructed) (*reconstructed)[at] = int32_t(s);
+                return s;
+            }
+        }
+        const int64_t prediction = pr.value;
         const int64_t e = s - prediction;
         const int64_t q = options.near == 0 ? wrap(e, options.minValue, options.maxValue) : (e >= 0 ? (e + options.near) / step : -((options.near - e) / step));
-        putResidual(rc, *models, c, signs, q);
+        putResidual(rc, *models, *pr.ctx, pr.signs, q);
         const int64_t v = reconstruct(prediction, q, step, options.minValue, options.maxValue);
         if (reconstructed) (*reconstructed)[at] = int32_t(v);
         return v;
@@ -56,8 +65,12 @@ void decodeSamples(std::span<const uint8_t> bytes, const IntCoderOptions& option
     auto models = std::make_unique<Models>(options.model);
     const int64_t step = 2 * int64_t(options.near) + 1;
     try {
-        walk(*models, [&](ContextModels& c, unsigned signs, int64_t prediction, uint64_t at) {
-            const int64_t v = reconstruct(prediction, getResidual(rc, *models, c, signs), step, options.minValue, options.maxValue);
+        walk(*models, [&](const Prediction& pr, uint64_t at) {
+            if (pr.floor >= 0 && rc.decode(models->floor[size_t(pr.floor)])) {
+                out[at] = int32_t(options.minValue);
+                return options.minValue;
+            }
+            const int64_t v = reconstruct(pr.value, getResidual(rc, *models, *pr.ctx, pr.signs), step, options.minValue, options.maxValue);
             out[at] = int32_t(v);
             return v;
         });

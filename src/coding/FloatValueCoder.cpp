@@ -100,7 +100,7 @@ void walkFloats(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
     using Rec = VoxelRecord<C>;
     using Nb = PlacedNeighbours<Rec>;
     std::array<uint32_t, C> lastTile{};
-    walkPlacedBricks<Rec, true>(
+    walkPlacedBricks<Rec, detail::Reach::Far>(
         layout, places, entries, BrickOrder::Spatial,
         [&](uint64_t entry) {
             for (int c = 0; c < C; ++c) {

@@ -20,13 +20,33 @@ namespace {
 
 using namespace detail;
 
-// The raster walk shared by both directions. `step(context, prediction,
-// sample index)` returns the reconstructed sample.
+// Generation 2's far neighbours (LeastSquaresPredictor.h) of sample i at
+// (x, y, z), each with the nearest near neighbour where the volume ends.
+inline void farNeighbours(Neighbourhood& n, int64_t x, int64_t y, int64_t z, int64_t nx, int64_t ny, size_t i, const std::vector<int64_t>& cur,
+                          const std::vector<int64_t>& prev, const std::vector<int64_t>& prev2) {
+    const size_t row = size_t(nx);
+    const bool hx = x > 0, hy = y > 0, hz = z > 0, hE = x + 1 < nx, hS = y + 1 < ny;
+    n.far[kWW] = x > 1 ? cur[i - 2] : n.W;
+    n.far[kNN] = y > 1 ? cur[i - 2 * row] : n.N;
+    n.far[kPP] = z > 1 ? prev2[i] : n.P;
+    n.far[kPE] = hz && hE ? prev[i + 1] : n.P;
+    n.far[kPS] = hz && hS ? prev[i + row] : n.P;
+    n.far[kPNE] = hz && hE && hy ? prev[i - row + 1] : hz ? n.PN : n.P;
+    n.far[kPSW] = hz && hS && hx ? prev[i + row - 1] : hz ? n.PW : n.P;
+    n.far[kPSE] = hz && hS && hE ? prev[i + row + 1] : n.far[kPS];
+    n.far[kNWW] = x > 1 && hy ? cur[i - row - 2] : n.NW;
+    n.far[kNNE] = y > 1 && hE ? cur[i - 2 * row + 1] : n.far[kNN];
+    n.far[kNNW] = y > 1 && hx ? cur[i - 2 * row - 1] : n.far[kNN];
+    n.far[kNEE] = x + 2 < nx && hy ? cur[i - row + 2] : n.NE;
+}
+
+// The raster walk shared by both directions. `step(prediction, sample
+// index)` returns the reconstructed sample.
 template <typename Step>
 void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, Step&& step) {
     const int64_t nx = shape.nx, ny = shape.ny, nz = shape.nz;
     const size_t plane = size_t(nx) * size_t(ny);
-    std::vector<int64_t> cur(plane), prev(plane);
+    std::vector<int64_t> cur(plane), prev(plane), prev2(plane);  // this slice, the two below
     std::vector<SampleRecord> curRec(plane), prevRec(plane);
     const SampleRecord none{};
     // Per row, what the neighbours above and behind contribute to each
@@ -67,17 +87,19 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
                 } else {
                     n.P = med(n.W, n.N, n.NW), n.PW = n.W, n.PN = n.N, n.PNW = n.NW;
                 }
+                farNeighbours(n, x, y, z, nx, ny, i, cur, prev, prev2);
                 n.rW = hx ? &curRec[i - 1] : nullptr;
                 n.rN = hy ? &curRec[i - size_t(nx)] : nullptr;
                 n.rP = hz ? &prevRec[i] : nullptr;
                 std::copy_n(&rowErrors[size_t(x) * kPredictors], kPredictors, n.errorsAbove.begin());
                 n.residualsAbove = rowResiduals[size_t(x)];
                 const Prediction pr = predict(n, options.minValue, options.maxValue, models);
-                const int64_t value = step(*pr.ctx, pr.signs, pr.value, size_t(z) * plane + i);
+                const int64_t value = step(pr, size_t(z) * plane + i);
                 learn(pr, value, curRec[i]);
                 cur[i] = value;
             }
         }
+        std::swap(prev2, prev);
         std::swap(cur, prev);
         std::swap(curRec, prevRec);
     }

@@ -44,6 +44,9 @@ struct IntVolumeShape {
     uint64_t count() const { return uint64_t(nx) * uint64_t(ny) * uint64_t(nz); }
 };
 
+// The newest model generation (SamplePredictor.h), what a writer writes.
+inline constexpr int kLatestIntModel = 2;
+
 struct IntCoderOptions {
     // Every sample and every reconstruction lies in [minValue, maxValue]
     // (the sample type's range: 0..4095 for 12-bit CT).
@@ -52,8 +55,9 @@ struct IntCoderOptions {
     int32_t near = 0;
     // The model's generation (SamplePredictor.h): 0, bias correction per
     // activity context (window codings 2-4 of files written before 2026-12-05);
-    // 1, per activity context and texture (codings 5 and 6, and this coder).
-    int model = 1;
+    // 1, per activity context and texture (codings 5 and 6); 2, the least-
+    // squares fit and the floor flag (codings 10 and 11, and this coder).
+    int model = kLatestIntModel;
 };
 
 // Codes `samples` (shape.count() of them, raster order). With near > 0,

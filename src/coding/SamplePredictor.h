@@ -1,8 +1,11 @@
 // The per-sample model of the integer value coders (docs/CODING.md): six
-// predictions from a causal 3-D neighbourhood blended by their local errors,
-// an activity context, bias correction (per activity context, generation 0,
-// or per activity context and texture, generation 1), and the residual's
-// binary coding.
+// predictions from a causal 3-D neighbourhood blended by their local errors
+// (generations 0 and 1) or a least-squares fit over 19 neighbours
+// (generation 2, LeastSquaresPredictor.h), an activity context, bias
+// correction (per activity context, generation 0, or per activity context
+// and texture, generations 1 and 2), and the residual's binary coding.
+// Generation 2 also codes "the sample is the range's minimum" first where a
+// neighbour holds it (a scan's background at a tissue's edge).
 // IntVolumeCoder walks a raster box with it, BrickValueCoder the 4^3 bricks
 // of a DAG's attribute order; both hand it the same neighbourhood
 //      this slice:  NW N NE        previous slice:  PNW PN
@@ -17,6 +20,8 @@
 #include <cstdlib>
 #include <vector>
 
+#include "src/coding/IntVolumeCoder.h"
+#include "src/coding/LeastSquaresPredictor.h"
 #include "src/coding/RangeCoder.h"
 
 namespace vdbdag::coding::detail {
@@ -50,9 +55,12 @@ struct ContextModels {
     BiasCell bias;                                              // generation 0's bias correction
 };
 
+inline constexpr int kLatestModel = kLatestIntModel;
+
 struct Models {
-    explicit Models(int generation) : textureBias(generation >= 1) {}
-    bool textureBias;  // generation 1: the bias corrections below, not the contexts' own
+    explicit Models(int generation) : textureBias(generation >= 1), leastSquares(generation >= 2) {}
+    bool textureBias;   // generations 1, 2: the bias corrections below, not the contexts' own
+    bool leastSquares;  // generation 2: the fits below predict, and the floor flags
     std::array<ContextModels, kContexts> ctx;
     std::array<std::array<BitModel, kMaxLength + 1>, kMaxLength + 1> low;  // [length][bit]: the remaining bits
     // Generation 1's bias corrections, per activity context and texture:
@@ -62,6 +70,12 @@ struct Models {
     // per context cannot see which side. On the shared scans 1-2.4 % smaller
     // (tooth the most: 637,721 -> 622,454 bytes in raster order).
     std::array<BiasCell, size_t(kContexts) * kTextures> bias;
+    std::array<LeastSquaresFit, kContexts> fit;  // generation 2, per activity context
+    // Generation 2's "the sample is the minimum" flag, coded before the
+    // residual where 1-7 of W, N, NW, NE, P, PW, PN hold the minimum and the
+    // prediction does not: by how many (the edge of a skull-stripped MR's
+    // zero background: FLAIR 2.2 % smaller) and the activity (8 buckets).
+    std::array<BitModel, 64> floor;
 };
 
 inline uint32_t saturate(int64_t v) { return v > int64_t(UINT32_MAX) ? UINT32_MAX : uint32_t(v); }
@@ -92,6 +106,7 @@ inline int64_t weightOf(uint64_t errors) { return kWeights[errors < kWeightCap ?
 // the placed walk's time).
 struct Neighbourhood {
     int64_t W, N, NW, NE, P, PW, PN, PNW;
+    std::array<int64_t, kFarNeighbours> far;  // generation 2 (LeastSquaresPredictor.h): set by every walk
     const SampleRecord* rW = nullptr;
     const SampleRecord* rN = nullptr;
     const SampleRecord* rP = nullptr;
@@ -108,30 +123,46 @@ struct Prediction {
     ContextModels* ctx = nullptr;
     BiasCell* bias = nullptr;
     unsigned signs = 0;
+    int floor = -1;  // generation 2: the floor flag's model, or -1 when no flag is coded
+    LeastSquaresFit* fit = nullptr;
+    std::array<double, kLsTaps> x{};  // the fit's neighbours, relative to W
+    int64_t W = 0;
 };
 
 inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxValue, Models& models) {
     Prediction out;
-    const int64_t inPlane = med(n.W, n.N, n.NW);
-    out.p = {inPlane, n.W + n.N + n.P - n.NW - n.PW - n.PN + n.PNW, n.P + inPlane - med(n.PW, n.PN, n.PNW), n.W + n.NE - n.N, n.N + n.P - n.PN,
-             n.W + n.P - n.PW};
-    for (int64_t& q : out.p) q = std::clamp(q, minValue, maxValue);  // a prediction outside the range helps no one
     static constexpr SampleRecord none{};
     const SampleRecord& rW = n.rW ? *n.rW : none;
     const SampleRecord& rN = n.rN ? *n.rN : none;
     const SampleRecord& rP = n.rP ? *n.rP : none;
-    int64_t weightSum = 0, weighted = 0;  // |weighted| < 6 x (2^26 + 1) x 2^31 < 2^60
-    for (size_t k = 0; k < size_t(kPredictors); ++k) {
-        const int64_t w = weightOf((n.errorsAbove[k] + 2 * uint64_t(rW.err[k])) / 2);  // 2 (W + N + P) + NE + NW + PW + PN, halved
-        weightSum += w;
-        weighted += w * out.p[k];
+    if (!models.leastSquares) {  // generations 0 and 1: the blend of six
+        const int64_t inPlane = med(n.W, n.N, n.NW);
+        out.p = {inPlane, n.W + n.N + n.P - n.NW - n.PW - n.PN + n.PNW, n.P + inPlane - med(n.PW, n.PN, n.PNW), n.W + n.NE - n.N, n.N + n.P - n.PN,
+                 n.W + n.P - n.PW};
+        for (int64_t& q : out.p) q = std::clamp(q, minValue, maxValue);  // a prediction outside the range helps no one
+        int64_t weightSum = 0, weighted = 0;  // |weighted| < 6 x (2^26 + 1) x 2^31 < 2^60
+        for (size_t k = 0; k < size_t(kPredictors); ++k) {
+            const int64_t w = weightOf((n.errorsAbove[k] + 2 * uint64_t(rW.err[k])) / 2);  // 2 (W + N + P) + NE + NW + PW + PN, halved
+            weightSum += w;
+            weighted += w * out.p[k];
+        }
+        out.blend = std::clamp(divRound(weighted, weightSum), std::min({n.W, n.N, n.NE, n.P}), std::max({n.W, n.N, n.NE, n.P}));
     }
-    out.blend = std::clamp(divRound(weighted, weightSum), std::min({n.W, n.N, n.NE, n.P}), std::max({n.W, n.N, n.NE, n.P}));
+    // The activity: the residuals around (W, N, P twice) and the gradients;
+    // generation 2 weighs the gradients twice as much (0.3-0.5 % smaller).
     const uint64_t gradient = uint64_t(std::abs(n.W - n.NW) + std::abs(n.N - n.NW) + std::abs(n.NE - n.N) + std::abs(n.P - med(n.PW, n.PN, n.PNW)));
-    const uint64_t activity = (n.residualsAbove + 2 * uint64_t(rW.residual)) / 2 + gradient / 2;
+    const uint64_t activity = (n.residualsAbove + 2 * uint64_t(rW.residual)) / 2 + (models.leastSquares ? gradient : gradient / 2);
     const int length = 64 - std::countl_zero(activity);
     const int context = std::min(kContexts - 1, 2 * length + (length >= 2 ? int(activity >> (length - 2)) & 1 : 0));
     out.ctx = &models.ctx[size_t(context)];
+    if (models.leastSquares) {
+        out.fit = &models.fit[size_t(context)];
+        out.W = n.W;
+        const int64_t nearSeven[] = {n.N, n.NW, n.NE, n.P, n.PW, n.PN, n.PNW};
+        for (size_t k = 0; k < 7; ++k) out.x[k] = double(nearSeven[k] - n.W);
+        for (size_t k = 0; k < size_t(kFarNeighbours); ++k) out.x[7 + k] = double(n.far[k] - n.W);
+        out.blend = std::clamp(int64_t(std::nearbyint(out.fit->predict(out.x, double(n.W)))), minValue, maxValue);
+    }
     if (models.textureBias) {
         const int64_t b = out.blend;
         const unsigned texture = unsigned(n.W > b) | unsigned(n.N > b) << 1 | unsigned(n.P > b) << 2 | unsigned(n.NW > b) << 3 | unsigned(n.NE > b) << 4 |
@@ -143,13 +174,20 @@ inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxV
     const int64_t bias = out.bias->count ? divRound(out.bias->sum, out.bias->count) : 0;
     out.value = std::clamp(out.blend + bias, minValue, maxValue);
     out.signs = unsigned(9 * (rP.sign + 1) + 3 * (rW.sign + 1) + (rN.sign + 1));
+    if (models.leastSquares && out.value != minValue) {
+        const int k = (n.W == minValue) + (n.N == minValue) + (n.NW == minValue) + (n.NE == minValue) + (n.P == minValue) + (n.PW == minValue) +
+                      (n.PN == minValue);
+        if (k > 0) out.floor = k + 8 * std::min(7, context / 4);
+    }
     return out;
 }
 
 // What the neighbours learn from the reconstructed `value`: its record and
 // the context's bias.
 inline void learn(const Prediction& pr, int64_t value, SampleRecord& r) {
-    for (size_t k = 0; k < size_t(kPredictors); ++k) r.err[k] = saturate(std::abs(pr.p[k] - value));
+    if (pr.fit) pr.fit->learn(pr.x, double(value - pr.W)), r.err = {};
+    else
+        for (size_t k = 0; k < size_t(kPredictors); ++k) r.err[k] = saturate(std::abs(pr.p[k] - value));
     r.residual = saturate(std::abs(value - pr.value));
     r.sign = int8_t((value > pr.value) - (value < pr.value));
     BiasCell& c = *pr.bias;

@@ -3,7 +3,7 @@
 // 7 odd, a layout of up to 16 bricks whose masks come from the data, tiles
 // among them; byte 7 & 2, the bricks placed side by side with mirrors; & 4
 // as well, lossless, coded as labels; & 8, the bricks visited in the
-// layout's order rather than spatially; with places and byte 5 & 0x40, the
+// layout's order rather than spatially, & 16 in raster blocks; with places and byte 5 & 0x40, the
 // entries are float32 bits for coding/FloatValueCoder, & 0x20 too vec3s,
 // any bits allowed and every bit kept), the sample range, near and the
 // model generation; the rest is (a) a stream to
@@ -32,7 +32,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     o.minValue = data[4] & 1 ? -(int64_t(1) << (bits - 1)) : 0;
     o.maxValue = std::min<int64_t>(INT32_MAX, o.minValue + (int64_t(1) << bits) - 1);
     o.near = data[5] % 4 == 0 ? data[6] % 5 : 0;
-    o.model = (data[5] >> 7) & 1;  // byte 5's top bit: the model generation
+    o.model = ((data[5] >> 7) & 1) + ((data[6] >> 7) & 1);  // bytes 5's and 6's top bits: the model generation, 0-2
     const std::span<const uint8_t> rest(data + 8, size - 8);
     const bool bricks = data[7] & 1;
     std::vector<uint64_t> layout;
@@ -65,7 +65,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         return 0;
     }
     const bool labels = !places.empty() && (data[7] & 4) && o.near == 0;  // byte 7 & 4: coded as labels (LabelCoder)
-    const BrickOrder order = data[7] & 8 ? BrickOrder::Attribute : BrickOrder::Spatial;  // byte 7 & 8: the layout's brick order
+    // byte 7 & 8: the layout's brick order; & 16, raster blocks
+    const BrickOrder order = data[7] & 8 ? BrickOrder::Attribute : data[7] & 16 ? BrickOrder::Raster : BrickOrder::Spatial;
     const auto decode = [&](std::span<const uint8_t> stream, std::vector<int32_t>& out) {
         if (labels) decodePlacedLabels(stream, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue), out, "fuzz");
         else if (!places.empty()) decodePlacedBrickValues(stream, layout, places, order, o, out, "fuzz");

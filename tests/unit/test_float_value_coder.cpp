@@ -186,7 +186,7 @@ TEST(FloatValueCoder, AFloatWindowIsStoredAsCodingEight) {
     EXPECT_EQ(attributes::windowRawBytes(windows, dir.windows[0], "test").at(0), attributes::detail::kFloatCoding);
     EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, c.layout, "test", c.places), bytes);
     // What `info` reports: one window of coding 8, read from its first byte.
-    std::vector<uint64_t> expected(10);
+    std::vector<uint64_t> expected(attributes::detail::kCodingCount);
     expected[attributes::detail::kFloatCoding] = 1;
     EXPECT_EQ(attributes::predictedWindowCodings(windows, 4, c.layout, "test"), expected);
     EXPECT_STREQ(attributes::predictedCodingName(attributes::detail::kFloatCoding), "predicted floats");

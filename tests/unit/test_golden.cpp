@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <tuple>
 
 #include "tests/unit/CliRunner.h"
 #include "tests/unit/VdbTreeCompare.h"
@@ -83,11 +84,19 @@ TEST(Golden, VdbSourcedFilesDecodeToTheirSources) {
 }
 
 TEST(Golden, ScanSourcedFileDecodesToTheSameSamples) {
-    const fs::path dir = testFolder("golden_scan");
-    const fs::path back = dir / "labels_24x20x10_int16le.raw";
-    const CommandResult r = runCli("decode " + (kGolden / "labels.ssvdag").string() + " -o " + back.string() + " -q");
-    ASSERT_EQ(r.exitCode, 0) << r.err;
-    const std::string want = bytesOf(kGolden / "labels_24x20x10_int16le.raw");
-    ASSERT_EQ(want.size(), 24u * 20 * 10 * 2);
-    EXPECT_TRUE(bytesOf(back) == want);
+    // labels (coding 7) and scan_coding10 (a 24x24x16 crop of
+    // ../shared/data/dense/headsq, its int16 CT samples in coding 10, the
+    // least-squares fit, as written on 2026-12-05).
+    for (const auto& [name, raw, bytes] : {std::tuple{"labels", "labels_24x20x10_int16le.raw", 24u * 20 * 10 * 2},
+                                           {"scan_coding10", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2}}) {
+        const fs::path dir = testFolder(std::string("golden_scan_") + name);
+        const fs::path back = dir / raw;
+        const CommandResult r = runCli("decode " + (kGolden / (std::string(name) + ".ssvdag")).string() + " -o " + back.string() + " -q");
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        const std::string want = bytesOf(kGolden / raw);
+        ASSERT_EQ(want.size(), bytes);
+        EXPECT_TRUE(bytesOf(back) == want) << name;
+    }
+    const CommandResult info = runCli("info " + (kGolden / "scan_coding10.ssvdag").string());
+    EXPECT_NE(info.out.find("windows: 1 fitted context-coded"), std::string::npos) << info.out;
 }
