@@ -157,7 +157,8 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             const auto add = [&](Nb::Which k, unsigned times) {
                 if (!nb.has(k)) return;
                 const CompactRecord& r = nb.rec(k);
-                for (size_t j = 0; j < size_t(kPredictors); ++j) n.errorsAbove[j] += times * uint64_t(r.err[j]);
+                if constexpr (kReach != Reach::Wide)  // generation 2 has no blend to weigh
+                    for (size_t j = 0; j < size_t(kPredictors); ++j) n.errorsAbove[j] += times * uint64_t(r.err[j]);
                 n.residualsAbove += times * uint64_t(r.residual);
             };
             add(Nb::N, 2), add(Nb::P, 2), add(Nb::NE, 1), add(Nb::NW, 1), add(Nb::PW, 1), add(Nb::PN, 1);

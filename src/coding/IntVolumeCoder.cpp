@@ -66,8 +66,9 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
                 const SampleRecord& rP = hz ? prevRec[i] : none;
                 const SampleRecord& rPW = hz && hx ? prevRec[i - 1] : none;
                 const SampleRecord& rPN = hz && hy ? prevRec[i - size_t(nx)] : none;
-                for (size_t k = 0; k < kPredictors; ++k)
-                    rowErrors[size_t(x) * kPredictors + k] = 2 * (uint64_t(rN.err[k]) + rP.err[k]) + rNE.err[k] + rNW.err[k] + rPW.err[k] + rPN.err[k];
+                if (!models.leastSquares)  // generation 2 has no blend to weigh
+                    for (size_t k = 0; k < kPredictors; ++k)
+                        rowErrors[size_t(x) * kPredictors + k] = 2 * (uint64_t(rN.err[k]) + rP.err[k]) + rNE.err[k] + rNW.err[k] + rPW.err[k] + rPN.err[k];
                 rowResiduals[size_t(x)] = 2 * (uint64_t(rN.residual) + rP.residual) + rNE.residual + rNW.residual + rPW.residual + rPN.residual;
             }
             for (int64_t x = 0; x < nx; ++x) {

@@ -18,7 +18,9 @@
 // and substitutes the nearest coded one (PlacedWalk.h).
 //
 // The fit: each context sums x x^T and x y of its samples (x the 19
-// neighbours less W, y the sample less W); every 32 samples it solves
+// neighbours less W, y the sample less W; each period's sums in float32,
+// x and y rounded to float, each product added in turn, then added to the
+// double sums before the solve); every 32 samples it solves
 // (A + r I) c = b by Cholesky (r a thousandth of A's mean diagonal: a flat
 // region's singular A still solves) and scales A and b by 0.95, so the fit
 // follows the last ~640 samples of the context (against 64 and 0.9: 0.1-
@@ -52,10 +54,15 @@ inline constexpr double kLsRidge = 1e-3;   // of the mean diagonal
 enum FarNeighbour { kWW, kNN, kPP, kPE, kPS, kPNE, kPSW, kPSE, kNWW, kNNE, kNNW, kNEE, kFarNeighbours };
 
 struct LeastSquaresFit {
-    std::array<double, kLsTaps * kLsTaps> a{};  // lower triangle of sum x x^T
+    std::array<double, kLsTaps * kLsTaps> a{};  // sum x x^T (the solve reads the lower triangle)
     std::array<double, kLsTaps> b{};            // sum x y
     std::array<double, kLsTaps> c{};            // the weights
     int count = 0;                              // samples since the last solve
+    // This period's sums, in float: 4 products a step (SSE2), 1.3x faster
+    // overall; exact for samples of up to 9 bits (|x| < 724: 32 x^2 < 2^24),
+    // and rounded alike everywhere beyond.
+    alignas(16) std::array<float, kLsTaps * kLsTaps> pa{};
+    alignas(16) std::array<float, kLsTaps> pb{};
 
     // The prediction for the neighbours `x` (relative to `ref`), unrounded.
     double predict(const std::array<double, kLsTaps>& x, double ref) const {
@@ -65,47 +72,58 @@ struct LeastSquaresFit {
     }
 
     void learn(const std::array<double, kLsTaps>& x, double y) {
+        float xf[kLsTaps];
+        for (int i = 0; i < kLsTaps; ++i) xf[i] = float(x[size_t(i)]);
+        const float yf = float(y);
         for (int i = 0; i < kLsTaps; ++i) {
-            for (int j = 0; j <= i; ++j) a[size_t(i * kLsTaps + j)] += x[size_t(i)] * x[size_t(j)];
-            b[size_t(i)] += x[size_t(i)] * y;
+            const float xi = xf[i];
+            for (int j = 0; j < kLsTaps; ++j) pa[size_t(i * kLsTaps + j)] += xi * xf[j];
+            pb[size_t(i)] += xi * yf;
         }
         if (++count < kLsPeriod) return;
         count = 0;
+        for (size_t i = 0; i < a.size(); ++i) a[i] += double(pa[i]), pa[i] = 0;
+        for (size_t i = 0; i < b.size(); ++i) b[i] += double(pb[i]), pb[i] = 0;
         solve();
         for (double& v : a) v = std::abs(v) < kLsTiny ? 0.0 : v * kLsDecay;
         for (double& v : b) v = std::abs(v) < kLsTiny ? 0.0 : v * kLsDecay;
     }
 
 private:
+    // A + r I = L L^T by Cholesky, then L z = b and L^T w = z. Each
+    // element of L and z is a_ij (b_i) less its products in increasing k,
+    // then scaled: written column by column ("right-looking", L's columns
+    // contiguous: col[k][i] = L(i, k)), so the compiler vectorises the
+    // updates without reordering any element's sums.
     void solve() {
+        constexpr size_t T = kLsTaps;
         double trace = 0;
-        for (int i = 0; i < kLsTaps; ++i) trace += a[size_t(i * kLsTaps + i)];
+        for (size_t i = 0; i < T; ++i) trace += a[i * T + i];
         const double ridge = kLsRidge * trace / kLsTaps + 1e-6;
-        std::array<double, kLsTaps * kLsTaps> l{};  // A + r I = L L^T
-        std::array<double, kLsTaps> inv{};          // 1 / L's diagonal
-        for (int i = 0; i < kLsTaps; ++i)
-            for (int j = 0; j <= i; ++j) {
-                double s = a[size_t(i * kLsTaps + j)] + (i == j ? ridge : 0.0);
-                for (int k = 0; k < j; ++k) s -= l[size_t(i * kLsTaps + k)] * l[size_t(j * kLsTaps + k)];
-                if (i == j) {
-                    if (!(s > 0)) return;  // keep the previous weights
-                    l[size_t(i * kLsTaps + i)] = std::sqrt(s);
-                    inv[size_t(i)] = 1.0 / l[size_t(i * kLsTaps + i)];
-                } else {
-                    l[size_t(i * kLsTaps + j)] = s * inv[size_t(j)];
-                }
+        std::array<double, T * T> col{};
+        std::array<double, T> inv{};  // 1 / L's diagonal
+        for (size_t k = 0; k < T; ++k)
+            for (size_t i = k; i < T; ++i) col[k * T + i] = a[i * T + k] + (i == k ? ridge : 0.0);
+        std::array<double, T> z = b;
+        for (size_t j = 0; j < T; ++j) {
+            double* cj = &col[j * T];
+            if (!(cj[j] > 0)) return;  // keep the previous weights
+            cj[j] = std::sqrt(cj[j]);
+            inv[j] = 1.0 / cj[j];
+            for (size_t i = j + 1; i < T; ++i) cj[i] *= inv[j];
+            for (size_t k = j + 1; k < T; ++k) {
+                double* ck = &col[k * T];
+                const double f = cj[k];
+                for (size_t i = k; i < T; ++i) ck[i] -= cj[i] * f;
             }
-        std::array<double, kLsTaps> z{};
-        for (int i = 0; i < kLsTaps; ++i) {
-            double s = b[size_t(i)];
-            for (int k = 0; k < i; ++k) s -= l[size_t(i * kLsTaps + k)] * z[size_t(k)];
-            z[size_t(i)] = s * inv[size_t(i)];
+            z[j] *= inv[j];
+            for (size_t i = j + 1; i < T; ++i) z[i] -= cj[i] * z[j];
         }
-        std::array<double, kLsTaps> w{};
-        for (int i = kLsTaps - 1; i >= 0; --i) {
-            double s = z[size_t(i)];
-            for (int k = i + 1; k < kLsTaps; ++k) s -= l[size_t(k * kLsTaps + i)] * w[size_t(k)];
-            w[size_t(i)] = s * inv[size_t(i)];
+        std::array<double, T> w{};
+        for (size_t i = T; i-- > 0;) {
+            double s = z[i];
+            for (size_t k = i + 1; k < T; ++k) s -= col[i * T + k] * w[k];
+            w[i] = s * inv[i];
         }
         for (double& v : w) {
             if (!std::isfinite(v)) return;

@@ -118,14 +118,14 @@ struct Neighbourhood {
 
 // One sample's prediction, and what it needs to learn from the sample.
 struct Prediction {
-    std::array<int64_t, kPredictors> p{};
+    std::array<int64_t, kPredictors> p;  // generations 0 and 1 (not cleared: a Prediction is made per sample)
     int64_t blend = 0, value = 0;  // value: the final prediction
     ContextModels* ctx = nullptr;
     BiasCell* bias = nullptr;
     unsigned signs = 0;
     int floor = -1;  // generation 2: the floor flag's model, or -1 when no flag is coded
     LeastSquaresFit* fit = nullptr;
-    std::array<double, kLsTaps> x{};  // the fit's neighbours, relative to W
+    std::array<double, kLsTaps> x;  // generation 2: the fit's neighbours, relative to W (not cleared either)
     int64_t W = 0;
 };
 
