@@ -21,7 +21,7 @@ namespace vdbdag::attributes {
 std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
                                              const std::string& what) {
     const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
-    std::vector<uint64_t> counts(size_t(detail::kCodingCount));
+    std::vector<uint64_t> counts(static_cast<size_t>(detail::kCodingCount));
     for (size_t k = 0; k < dir.windows.size(); ++k) {
         const WindowDirectory::Window& e = dir.windows[k];
         const std::span<const uint8_t> stored = payload.subspan(size_t(e.offset), size_t(e.stored));
