@@ -6,6 +6,10 @@
 //
 //   vdbdag_int_coder_bench SCAN [--near N] [--repeats R] [--series N] [--volume N]
 //
+// `ours_model1_bytes`: the same volume coded with the previous model
+// generation (the blend of six, SamplePredictor.h), once, for the table's
+// "before" column.
+//
 // Both see the same samples: JPEG-LS each z-slice, min-subtracted, at the
 // scan's own bit depth (the bits its value range needs, at least 2: 12 for
 // most CT, 8 for 8-bit MR), as the issue measures it; ours the whole volume
@@ -176,6 +180,9 @@ int main(int argc, char** argv) {
         vdbdag::coding::IntCoderOptions o;
         o.minValue = minValue, o.maxValue = maxValue, o.near = near;
         const vdbdag::coding::IntVolumeShape shape{nx, ny, nz};
+        vdbdag::coding::IntCoderOptions model1 = o;
+        model1.model = 1;
+        const size_t model1Bytes = vdbdag::coding::encodeIntVolume(samples, {nx, ny, nz}, model1).size();
         std::vector<double> oursEncode, oursDecode, jlsEncode, jlsDecode;
         size_t oursBytes = 0, jlsBytes = 0, oursWrong = 0, jlsWrong = 0;
         for (int r = 0; r < repeats; ++r) {
@@ -272,6 +279,7 @@ int main(int argc, char** argv) {
                                     {"bits", bits},
                                     {"near", near},
                                     {"ours_bytes", oursBytes},
+                                    {"ours_model1_bytes", model1Bytes},
                                     {"jpegls_bytes", jlsBytes},
                                     {"ratio", double(oursBytes) / double(jlsBytes)},
                                     {"ours_samples_wrong", oursWrong},

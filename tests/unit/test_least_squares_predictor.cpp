@@ -41,6 +41,12 @@ std::vector<int32_t> autoregressive(IntVolumeShape s, uint32_t seed) {
     return v;
 }
 
+IntCoderOptions eightBits() {
+    IntCoderOptions o;
+    o.minValue = 0, o.maxValue = 255;
+    return o;
+}
+
 std::vector<int32_t> decode(const std::vector<uint8_t>& bytes, IntVolumeShape s, const IntCoderOptions& o) {
     std::vector<int32_t> back(s.count());
     decodeIntVolume(bytes, s, o, back);
@@ -66,8 +72,7 @@ TEST(LeastSquaresPredictor, FindsTheWeightsOfALinearRecurrence) {
 TEST(LeastSquaresPredictor, AnAutoregressiveFieldCodesNearTheNoisesEntropy) {
     const IntVolumeShape s{48, 48, 48};
     const std::vector<int32_t> v = autoregressive(s, 1);
-    IntCoderOptions o;
-    o.minValue = 0, o.maxValue = 255;
+    const IntCoderOptions o = eightBits();
     const std::vector<uint8_t> fitted = encodeIntVolume(v, s, o);
     EXPECT_EQ(decode(fitted, s, o), v);
     const double bits = 8.0 * double(fitted.size()) / double(v.size());
@@ -93,8 +98,7 @@ TEST(LeastSquaresPredictor, TheBackgroundAtAnEdgeCostsAFlag) {
                 const double r = std::hypot(x - 20.0, y - 20.0, z - 20.0);
                 v[size_t((z * s.ny + y) * s.nx + x)] = r < 15 ? u(rng) : 0;
             }
-    IntCoderOptions o;
-    o.minValue = 0, o.maxValue = 255;
+    const IntCoderOptions o = eightBits();
     const std::vector<uint8_t> bytes = encodeIntVolume(v, s, o);
     EXPECT_EQ(decode(bytes, s, o), v);
     size_t tissue = 0;
@@ -112,8 +116,8 @@ TEST(LeastSquaresPredictor, NearLosslessStaysWithinN) {
     const IntVolumeShape s{33, 21, 17};
     const std::vector<int32_t> v = autoregressive(s, 2);
     for (const int near : {1, 2, 5}) {
-        IntCoderOptions o;
-        o.minValue = 0, o.maxValue = 255, o.near = near;
+        IntCoderOptions o = eightBits();
+        o.near = near;
         std::vector<int32_t> reconstructed;
         const std::vector<uint8_t> bytes = encodeIntVolume(v, s, o, &reconstructed);
         const std::vector<int32_t> back = decode(bytes, s, o);
@@ -126,8 +130,7 @@ TEST(LeastSquaresPredictor, NearLosslessStaysWithinN) {
 TEST(LeastSquaresPredictor, TheSameBitsWithFlushToZeroAndDenormalsAreZero) {
     const IntVolumeShape s{30, 30, 30};
     const std::vector<int32_t> v = autoregressive(s, 4);
-    IntCoderOptions o;
-    o.minValue = 0, o.maxValue = 255;
+    const IntCoderOptions o = eightBits();
     const std::vector<uint8_t> plain = encodeIntVolume(v, s, o);
     const unsigned csr = _mm_getcsr();
     _mm_setcsr(csr | 0x8040u);  // FTZ | DAZ
