@@ -1,6 +1,7 @@
 // Generation 2 of the integer value coders' prediction (SamplePredictor.h):
 // a linear prediction from 19 causal neighbours whose weights are the least-
-// squares fit of the samples already coded, one fit per activity context.
+// squares fit of the samples already coded, one fit per four activity
+// contexts (SamplePredictor.h).
 //
 // Why: the blend of six fixed predictors (generations 0 and 1) cannot learn
 // a scan's own correlations: an MR's smooth tissue wants most of its weight
@@ -17,21 +18,21 @@
 // placed walk of a DAG's bricks has all but those in bricks not yet visited,
 // and substitutes the nearest coded one (PlacedWalk.h).
 //
-// The fit: each context sums x x^T and x y of its samples (x the 19
+// The fit: each fit sums x x^T and x y of its samples (x the 19
 // neighbours less W, y the sample less W; each period's sums in float32,
 // x and y rounded to float, each product added in turn, then added to the
-// double sums before the solve); every 32 samples it solves
+// double sums before the solve); every 32 of its samples it solves
 // (A + r I) c = b by Cholesky (r a thousandth of A's mean diagonal: a flat
 // region's singular A still solves) and scales A and b by 0.95, so the fit
-// follows the last ~640 samples of the context (against 64 and 0.9: 0.1-
-// 0.3 % smaller, 20 % slower). Until its first solve a context predicts W.
+// follows its last ~640 samples (against 64 and 0.9: 0.1-0.3 % smaller, 20 %
+// slower). Until its first solve a fit predicts W.
 //
 // Every decoder must compute the same bits: the sums, the solve and the
 // prediction are IEEE doubles in a fixed order, without fused multiply-add
 // (-ffp-contract=off on the files that include this, CMakeLists.txt),
 // rounded to the nearest integer (ties to even) under the default rounding
 // mode. Nothing here enters the FTZ/DAZ flags' domain: the sums are of
-// integer products, and what the decay brings below 2^-600 (a context that
+// integer products, and what the decay brings below 2^-600 (a fit that
 // sees only flat background for millions of samples) is set to 0 before it
 // could become subnormal; a fit that fails (a pivot <= 0, NaN) keeps its
 // previous weights, weights below 2^-600 are 0.
@@ -43,7 +44,7 @@
 namespace vdbdag::coding::detail {
 
 inline constexpr int kLsTaps = 19;  // the near seven besides W, and the far twelve
-inline constexpr int kLsPeriod = 32;       // samples of a context between solves
+inline constexpr int kLsPeriod = 32;       // samples of a fit between solves
 inline constexpr double kLsDecay = 0.95;   // what the sums keep at each solve
 inline constexpr double kLsTiny = 0x1p-600;  // below this a sum or weight is 0
 inline constexpr double kLsRidge = 1e-3;   // of the mean diagonal
