@@ -91,7 +91,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
             }
     } else if (vs == 4) {
         const bool placed = !places.empty();
-        std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places, false, coding::BrickOrder::Raster);
+        std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel));
         const uint64_t size = numeric.size();
         consider(std::move(numeric), size, placed ? detail::kFittedContextCoding : detail::kContextCoding);
         labelsLike = placed && looksLikeLabels(values);

@@ -125,10 +125,11 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
         if (dir.valueSize != 4) throw Error(where + ": a context-coded window of " + std::to_string(dir.valueSize) + "-byte values (int32 only)");
         if (c == detail::kContextCoding) return decodeContextChannel(body, bricks, e.entries, where);
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
-        const bool fitted = c == detail::kFittedContextCoding, spatial = c == detail::kSpatialContextCoding || c == detail::kSpatialLabelCoding;
+        const int model = c == detail::kFittedContextCoding ? 2 : 1;
+        const bool spatial = c == detail::kSpatialContextCoding || c == detail::kSpatialLabelCoding || c == detail::kFittedContextCoding;
         return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
                                     c == detail::kPlacedLabelCoding || c == detail::kSpatialLabelCoding,
-                                    fitted ? coding::BrickOrder::Raster : spatial ? coding::BrickOrder::Spatial : coding::BrickOrder::Attribute, fitted ? 2 : 1);
+                                    spatial ? coding::spatialOrderOf(model) : coding::BrickOrder::Attribute, model);
     }
     if (raw[0] == detail::kRescaledFloatCoding || raw[0] == detail::kFittedRescaledFloatCoding) {
         if (dir.valueSize != 4) throw Error(where + ": rescaled floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");

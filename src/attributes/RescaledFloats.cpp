@@ -49,8 +49,7 @@ std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t
     }
     const std::vector<uint8_t> coded = encodeContextChannel(
         std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(integers.data()), integers.size() * 4), layout, places, false,
-        model >= 2 ? coding::BrickOrder::Raster : coding::BrickOrder::Spatial,
-        model);
+        coding::spatialOrderOf(model), model);
     format::ByteWriter w;
     w.bytes().reserve(kHeaderBytes + 8 * exceptions.size() + coded.size());
     w.put(rescale.slope);
@@ -80,8 +79,8 @@ std::vector<uint8_t> decodeRescaledFloats(std::span<const uint8_t> payload, std:
         if (exceptions[j].first >= entries || (j && exceptions[j].first <= exceptions[j - 1].first))
             r.fail("its exceptions are not in increasing entry order inside the window");
     }
-    std::vector<uint8_t> out = decodeContextChannel(payload.subspan(r.position()), layout, entries, what, places, false,
-                                                    model >= 2 ? coding::BrickOrder::Raster : coding::BrickOrder::Spatial, model);
+    std::vector<uint8_t> out =
+        decodeContextChannel(payload.subspan(r.position()), layout, entries, what, places, false, coding::spatialOrderOf(model), model);
     for (size_t i = 0; i + 4 <= out.size(); i += 4) {
         int32_t k;
         std::memcpy(&k, out.data() + i, 4);

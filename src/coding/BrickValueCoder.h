@@ -62,6 +62,10 @@ struct BrickPlace {
 // (LeastSquaresPredictor.h) are there more often (PlacedWalk.h).
 enum class BrickOrder : uint8_t { Attribute, Spatial, Raster };
 
+// The order the spatially ordered codings of a model generation walk in
+// (IntCoderOptions::model): Raster for generation 2, Spatial before.
+inline BrickOrder spatialOrderOf(int model) { return model >= 2 ? BrickOrder::Raster : BrickOrder::Spatial; }
+
 // The same coding with neighbours across brick boundaries: with `places`
 // (one per layout entry), each brick's voxels are visited in spatial raster
 // order (x fastest; the entry of spatial voxel p is the rank of its stored

@@ -123,14 +123,14 @@ struct Neighbourhood {
 
 // One sample's prediction, and what it needs to learn from the sample.
 struct Prediction {
-    std::array<int64_t, kPredictors> p;  // generations 0 and 1 (not cleared: a Prediction is made per sample)
+    std::array<int64_t, kPredictors> p{};  // generations 0 and 1
     int64_t blend = 0, value = 0;  // value: the final prediction
     ContextModels* ctx = nullptr;
     BiasCell* bias = nullptr;
     unsigned signs = 0;
     int floor = -1;  // generation 2: the floor flag's model, or -1 when no flag is coded
     LeastSquaresFit* fit = nullptr;
-    std::array<double, kLsTaps> x;  // generation 2: the fit's neighbours, relative to W (not cleared either)
+    std::array<double, kLsTaps> x{};  // generation 2: the fit's neighbours, relative to W
     int64_t W = 0;
 };
 
@@ -190,9 +190,12 @@ inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxV
 // What the neighbours learn from the reconstructed `value`: its record and
 // the context's bias.
 inline void learn(const Prediction& pr, int64_t value, SampleRecord& r) {
-    if (pr.fit) pr.fit->learn(pr.x, double(value - pr.W)), r.err = {};
-    else
+    if (pr.fit) {
+        pr.fit->learn(pr.x, double(value - pr.W));
+        r.err = {};
+    } else {
         for (size_t k = 0; k < size_t(kPredictors); ++k) r.err[k] = saturate(std::abs(pr.p[k] - value));
+    }
     r.residual = saturate(std::abs(value - pr.value));
     r.sign = int8_t((value > pr.value) - (value < pr.value));
     BiasCell& c = *pr.bias;
