@@ -49,3 +49,8 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/vdbdagConfig.cmake ${CMAKE_CURRENT_BIN
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdbdag)
 configure_file(${CMAKE_CURRENT_SOURCE_DIR}/cmake/vdbdag.pc.in ${CMAKE_CURRENT_BINARY_DIR}/vdbdag.pc @ONLY)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/vdbdag.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+# The same package for projects built against this build tree (the
+# ParaView plugin, cmake/ParaViewPlugin.cmake): -Dvdbdag_DIR=BUILD/reader-config.
+export(EXPORT vdbdagTargets NAMESPACE vdbdag:: FILE ${CMAKE_CURRENT_BINARY_DIR}/reader-config/vdbdagTargets.cmake)
+file(COPY ${CMAKE_CURRENT_BINARY_DIR}/vdbdagConfig.cmake ${CMAKE_CURRENT_BINARY_DIR}/vdbdagConfigVersion.cmake
+     DESTINATION ${CMAKE_CURRENT_BINARY_DIR}/reader-config)

@@ -25,6 +25,8 @@ PACKAGES=(
   clang libclang-rt-14-dev
   help2man
   pybind11-dev python3-dev python3-numpy python3-pytest python3-openvdb
+  # the ParaView plugin (paraview/); pvpython is unpacked, not installed, by scripts/paraview_sdk.sh
+  paraview-dev paraview
 )
 
 missing=()

@@ -160,12 +160,27 @@ public:
         return out;
     }
     Accessor accessor() const { return Accessor(data_); }
+    // The values of `box`'s voxels every `stride` voxels along each axis,
+    // from box.min (stride 1: every voxel, as OpenVDB's copyToDense; stride
+    // 2^L: the point samples of a level of detail L), written with i
+    // fastest, then j, then k: a VTK image's point order, numpy's [k][j][i].
+    // A value is what Accessor::valueBytes answers; a mask grid writes one
+    // byte per voxel, 1 where it is active. `out` holds
+    // sampleCount(box, stride) * max(valueSize(), 1) bytes. The accessor is
+    // made here, so disjoint boxes may be read from several threads.
+    void sampleBox(const IndexBBox& box, uint64_t stride, void* out) const;
 
 private:
     friend struct detail::FileData;
     explicit Grid(const detail::GridData* data) : data_(data) {}
     const detail::GridData* data_;
 };
+
+// Samples per axis of `box` read every `stride` voxels ((max - min) / stride
+// + 1; 0 on each axis of an empty box), and their product. Throws
+// vdbdag::Error for a stride of 0 or a count past 2^62.
+VDBDAG_API std::array<uint64_t, 3> sampleDims(const IndexBBox& box, uint64_t stride);
+VDBDAG_API uint64_t sampleCount(const IndexBBox& box, uint64_t stride);
 
 // What a file may make the reader hold before open() refuses it: a forged
 // file of a few kilobytes can claim sections of gigabytes or a DAG standing

@@ -117,6 +117,44 @@ void Accessor::valueBytes(int64_t i, int64_t j, int64_t k, void* out) {
     }
 }
 
+std::array<uint64_t, 3> sampleDims(const IndexBBox& box, uint64_t stride) {
+    if (stride == 0) throw Error("a box read every 0 voxels");
+    if (box.empty()) return {0, 0, 0};
+    std::array<uint64_t, 3> dims{};
+    for (int a = 0; a < 3; ++a) dims[a] = (uint64_t(box.max[a]) - uint64_t(box.min[a])) / stride + 1;  // max >= min: no wrap
+    return dims;
+}
+
+uint64_t sampleCount(const IndexBBox& box, uint64_t stride) {
+    const std::array<uint64_t, 3> dims = sampleDims(box, stride);
+    uint64_t count = 1;
+    for (const uint64_t n : dims) {
+        if (n != 0 && count > (uint64_t(1) << 62) / n)
+            throw Error("a box of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " + std::to_string(dims[2]) + " samples");
+        count *= n;
+    }
+    return count;
+}
+
+void Grid::sampleBox(const IndexBBox& box, uint64_t stride, void* out) const {
+    const std::array<uint64_t, 3> dims = sampleDims(box, stride);
+    sampleCount(box, stride);  // refuses a count past 2^62
+    auto* bytes = static_cast<uint8_t*>(out);
+    Accessor a = accessor();
+    const unsigned vs = data_->valueSize;
+    for (uint64_t z = 0; z < dims[2]; ++z)
+        for (uint64_t y = 0; y < dims[1]; ++y)
+            for (uint64_t x = 0; x < dims[0]; ++x) {
+                const int64_t i = box.min[0] + int64_t(x * stride), j = box.min[1] + int64_t(y * stride), k = box.min[2] + int64_t(z * stride);
+                if (vs == 0) {
+                    *bytes++ = a.isActive(i, j, k) ? 1 : 0;
+                } else {
+                    a.valueBytes(i, j, k, bytes);
+                    bytes += vs;
+                }
+            }
+}
+
 unsigned Accessor::valueSize() const { return grid_->valueSize; }
 bool Accessor::maskGrid() const { return grid_->grid.record.valueType == ValueType::Mask; }
 

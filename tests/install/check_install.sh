@@ -32,6 +32,16 @@ for d in $deps; do
 done
 echo "libvdbdag.so needs: $(echo $deps)"
 
+# The ParaView plugin, when this build made one: under ParaView's plugin
+# layout, finding the prefix's libvdbdag.so (not the build tree's).
+if [ -n "$(find "$BUILD/paraview/lib" -name VdbdagReader.so 2>/dev/null | head -1)" ]; then
+    plugin=$(find "$WORK/prefix" -path '*/paraview-*/plugins/VdbdagReader/VdbdagReader.so' | head -1)
+    [ -n "$plugin" ] || fail "the ParaView plugin is not installed under LIBDIR/paraview-X.Y/plugins/VdbdagReader/"
+    found=$(ldd "$plugin" | sed -n 's/.*libvdbdag\.so[^ ]* => \([^ ]*\).*/\1/p')
+    [ "$(realpath "$found")" = "$(realpath "$LIBDIR/libvdbdag.so")" ] || fail "the installed plugin finds libvdbdag at '$found', not in the prefix"
+    echo "ParaView plugin installed: ${plugin#$WORK/prefix/}"
+fi
+
 # 1. CMake: find_package(vdbdag CONFIG) with CMAKE_PREFIX_PATH.
 cmake -S "$ROOT/examples" -B "$WORK/cmake-build" -G Ninja -DCMAKE_PREFIX_PATH="$WORK/prefix" -DCMAKE_BUILD_TYPE=Release > "$WORK/configure.log" 2>&1 ||
     { cat "$WORK/configure.log"; fail "configuring examples/ against the installed package"; }

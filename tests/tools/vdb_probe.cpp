@@ -3,6 +3,7 @@
 // reports comes from OpenVDB's own reader.
 //
 //   vdbdag_vdb_probe meta FILE    JSON: file metadata, grids in file order, grid metadata
+//                                 and index_to_world (4x4 row-major, a linear map)
 //   vdbdag_vdb_probe same A B     exit 0 iff A and B hold the same file metadata,
 //                                 grid order, grid metadata (file_* rule below)
 //                                 and the same trees (type, transform,
@@ -147,13 +148,27 @@ FileContents openFile(const std::string& path, bool withTrees) {
     return c;
 }
 
+std::string fmt17(double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+
 int cmdMeta(const std::string& path) {
     const FileContents c = openFile(path, false);
     std::cout << "{\n  \"file\": " << jsonString(path) << ",\n  \"file_metadata\": " << metaJson(*c.fileMeta) << ",\n  \"grids\": [";
     for (size_t i = 0; i < c.grids->size(); ++i) {
         const GridBase& g = *(*c.grids)[i];
         std::cout << (i ? ",\n" : "\n") << "    {\"index\": " << i << ", \"name\": " << jsonString(g.getName()) << ", \"type\": " << jsonString(g.type())
-                  << ", \"metadata\": " << metaJson(g) << "}";
+                  << ", \"index_to_world\": [";
+        // The transform as a 4x4 row-major matrix (world = [i j k 1] * M), for a linear map.
+        const openvdb::math::MapBase::ConstPtr map = g.transform().baseMap();
+        if (map->isLinear()) {
+            const openvdb::Mat4d m = map->getAffineMap()->getMat4();
+            for (int r = 0; r < 4; ++r)
+                for (int col = 0; col < 4; ++col) std::cout << (r || col ? ", " : "") << fmt17(m(r, col));
+        }
+        std::cout << "], \"metadata\": " << metaJson(g) << "}";
     }
     std::cout << "\n  ]\n}\n";
     return 0;

@@ -308,3 +308,60 @@ TEST(Reader, OpenNamesTheFileInItsError) {
     EXPECT_THROW((void)File::open(junk.string()), Error);
     std::filesystem::remove(junk);
 }
+
+// Grid::sampleBox (the ParaView reader's level of detail): every stride's
+// samples, i fastest, equal the brute-force answer at box.min + n * stride;
+// a mask grid writes its active states.
+TEST(Reader, SampleBoxIsTheBruteForceAnswerAtEveryStride) {
+    std::mt19937 rng(5);
+    std::vector<Case> cases;
+    cases.push_back(shell(ValueType::Float, "float", rng, [](double d, std::mt19937&, uint8_t* out) {
+        const float v = float(d);
+        std::memcpy(out, &v, 4);
+    }));
+    cases.push_back(shell(ValueType::Vec3S, "vec3s", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const float v[3] = {float(d), float(r() % 5), -0.0f};
+        std::memcpy(out, v, 12);
+    }));
+    cases.push_back(shell(ValueType::Mask, "mask", rng, [](double, std::mt19937&, uint8_t*) {}));
+    std::vector<std::pair<Case*, bool>> grids;
+    for (Case& c : cases) grids.push_back({&c, true});
+    const auto path = writeFile(grids, {}, "reader_sample_box");
+    const File file = File::open(path.string());
+    IndexBBox box;
+    box.min = {-33, -31, -30};
+    box.max = {70, 35, 33};  // through the shell and the 8^3 tiles
+    for (size_t g = 0; g < cases.size(); ++g) {
+        Reference ref;
+        ref.vs = valueSize(cases[g].active.type);
+        Reference::add(cases[g].active, ref.vs, ref.active, ref.activeTiles);
+        if (ref.vs) Reference::add(cases[g].inactive, ref.vs, ref.inactive, ref.inactiveTiles);
+        ref.background.assign(ref.vs, '\0');
+        const unsigned row = std::max(1u, ref.vs);
+        for (const uint64_t stride : {1u, 2u, 3u, 8u, 200u}) {
+            const auto dims = sampleDims(box, stride);
+            const uint64_t n = sampleCount(box, stride);
+            ASSERT_EQ(n, dims[0] * dims[1] * dims[2]);
+            for (int a = 0; a < 3; ++a) EXPECT_EQ(dims[a], uint64_t(box.max[a] - box.min[a]) / stride + 1);
+            std::vector<uint8_t> got(n * row);
+            file.grid(g).sampleBox(box, stride, got.data());
+            uint64_t at = 0, failures = 0;
+            for (uint64_t z = 0; z < dims[2]; ++z)
+                for (uint64_t y = 0; y < dims[1]; ++y)
+                    for (uint64_t x = 0; x < dims[0]; ++x, ++at) {
+                        const int64_t i = box.min[0] + int64_t(x * stride), j = box.min[1] + int64_t(y * stride), k = box.min[2] + int64_t(z * stride);
+                        const std::string want = ref.vs ? ref.value(i, j, k) : std::string(1, ref.isActive(i, j, k) ? 1 : 0);
+                        if (std::memcmp(got.data() + at * row, want.data(), row) != 0 && ++failures <= 3)
+                            ADD_FAILURE() << cases[g].name << " stride " << stride << ": sample (" << i << "," << j << "," << k << ") differs";
+                    }
+            EXPECT_EQ(failures, 0u) << cases[g].name << " stride " << stride;
+        }
+    }
+    EXPECT_EQ(sampleCount(IndexBBox{}, 4), 0u);
+    EXPECT_THROW(sampleDims(box, 0), Error);
+    IndexBBox huge;
+    huge.min = {INT64_MIN / 2, INT64_MIN / 2, INT64_MIN / 2};
+    huge.max = {INT64_MAX / 2, INT64_MAX / 2, INT64_MAX / 2};
+    EXPECT_THROW(sampleCount(huge, 1), Error);
+    std::filesystem::remove(path);
+}

@@ -1,0 +1,87 @@
+// vtkSsvdagReader: reads a .ssvdag file (vdbdag's public reader library,
+// <vdbdag/vdbdag.h>) as a vtkImageData, for ParaView (the VdbdagReader
+// plugin) and for any VTK pipeline.
+//
+// The image covers a box of index coordinates (by default the union of the
+// selected grids' active boxes) at a level of detail L: its points are the
+// voxels box.min + n * 2^L, point-sampled, so reading costs what the image
+// holds, not what the file holds (a 2048^3 grid at L = 3 reads 256^3
+// voxels). The automatic level (LevelOfDetail -1) is the finest whose image
+// stays within MaximumCells million points. Each selected grid becomes one
+// point array named as the grid (3 components for vectors; a mask grid's
+// active state as 0/1); inactive voxels hold what the file stores for them,
+// so a level set keeps its inside sign and contours at 0. Origin, spacing and
+// direction come from the grid's index-to-world transform (points at voxel
+// centres, as OpenVDB's index space). Grids whose transform differs from the
+// first selected grid's are left out with a warning.
+#ifndef vtkSsvdagReader_h
+#define vtkSsvdagReader_h
+
+#include "vtkImageAlgorithm.h"
+#include "vtkSsvdagReaderModule.h"
+
+#include <memory>
+
+class vtkCallbackCommand;
+class vtkDataArraySelection;
+
+class VTKSSVDAGREADER_EXPORT vtkSsvdagReader : public vtkImageAlgorithm
+{
+public:
+  static vtkSsvdagReader* New();
+  vtkTypeMacro(vtkSsvdagReader, vtkImageAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  vtkSetStringMacro(FileName);
+  vtkGetStringMacro(FileName);
+  // 1 when the file starts with the .ssvdag magic.
+  int CanReadFile(const char* name);
+
+  // The grids to read (all by default), by name.
+  vtkDataArraySelection* GetGridSelection();
+  int GetNumberOfGridArrays();
+  const char* GetGridArrayName(int index);
+  int GetGridArrayStatus(const char* name);
+  void SetGridArrayStatus(const char* name, int status);
+
+  // Level of detail: the image's spacing is 2^L voxels; -1 (the default)
+  // chooses the finest level within MaximumCells.
+  vtkSetClampMacro(LevelOfDetail, int, -1, 30);
+  vtkGetMacro(LevelOfDetail, int);
+  // The automatic level's budget, in millions of points (default 64).
+  vtkSetClampMacro(MaximumCells, double, 1e-6, 1e6);
+  vtkGetMacro(MaximumCells, double);
+  // A box of index coordinates (x0, x1, y0, y1, z0, z1, inclusive) instead
+  // of the grids' active box, when UseBox is on.
+  vtkSetMacro(UseBox, vtkTypeBool);
+  vtkGetMacro(UseBox, vtkTypeBool);
+  vtkBooleanMacro(UseBox, vtkTypeBool);
+  vtkSetVector6Macro(Box, int);
+  vtkGetVector6Macro(Box, int);
+  // The level the last update read (after RequestInformation).
+  vtkGetMacro(ChosenLevel, int);
+
+protected:
+  vtkSsvdagReader();
+  ~vtkSsvdagReader() override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+private:
+  vtkSsvdagReader(const vtkSsvdagReader&) = delete;
+  void operator=(const vtkSsvdagReader&) = delete;
+  static void SelectionModified(vtkObject*, unsigned long, void* clientdata, void*);
+
+  char* FileName = nullptr;
+  int LevelOfDetail = -1;
+  double MaximumCells = 64;
+  vtkTypeBool UseBox = 0;
+  int Box[6] = { 0, 0, 0, 0, 0, 0 };
+  int ChosenLevel = 0;
+  vtkDataArraySelection* GridSelection;
+  vtkCallbackCommand* SelectionObserver;
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif

@@ -1,0 +1,210 @@
+"""The ParaView reader plugin as a user meets it, against independent readers.
+
+ParaView (pvpython, dump_image.py) loads the plugin from the build tree,
+opens .ssvdag files through its reader factory and hands back images; this
+script (Debian's python3) compares them with what OpenVDB (pyopenvdb's
+copyToArray, i.e. copyToDense, and its transform) and nibabel read from the
+files the .ssvdag files were made from:
+  - a level set at level of detail 0 (every voxel of the active box, the
+    inactive inside keeping its sign) and 2 (every 4th voxel);
+  - a fog with active tiles under a 1-million-point budget: the level is the
+    finest whose image fits, and the samples are OpenVDB's at that stride;
+  - a file of several grids (vectors, integers, a level set): one array per
+    grid of the first grid's transform;
+  - a box given in index coordinates, partly outside the grid (background);
+  - a NIfTI scan with an oblique affine: every sample equal to nibabel's, and
+    each point's position equal to the affine's (in LPS, as vdbdag stores
+    patient space) at levels 0 and 1;
+  - a truncated file: ParaView reports it, naming the file, and does not crash.
+usage: check_plugin.py BUILD_DIR PLUGIN.so PVPYTHON PV_SITE_PACKAGES
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import nibabel as nib
+import numpy as np
+import pyopenvdb as vdb
+
+BUILD, PLUGIN, PVPYTHON, PV_SITE = sys.argv[1:5]
+HERE = os.path.dirname(os.path.abspath(__file__))
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok:
+        failures.append(what)
+
+
+def run(*args):
+    subprocess.run(list(args), check=True, stdout=subprocess.DEVNULL)
+
+
+def dump(work, cases):
+    spec = os.path.join(work, "cases.json")
+    with open(spec, "w") as f:
+        json.dump(cases, f)
+    done = subprocess.run([PVPYTHON, os.path.join(HERE, "dump_image.py"), PV_SITE, PLUGIN, spec],
+                          capture_output=True, text=True, timeout=600)
+    print(done.stdout, end="")
+    return done
+
+
+def pv_values(image, index):
+    """ParaView's array `index` as [i, j, k(, c)], from VTK's x-fastest order."""
+    nx, ny, nz = image["dims"]
+    a = image["array_%d" % index]
+    comps = a.shape[1] if a.ndim == 2 else 1
+    a = a.reshape(nz, ny, nx, comps).transpose(2, 1, 0, 3)
+    return a[..., 0] if comps == 1 else a
+
+
+def vdb_dense(grid, lo, hi):
+    """OpenVDB's values of the inclusive index box [lo, hi] (copyToDense)."""
+    shape = tuple(int(h - l + 1) for l, h in zip(lo, hi))
+    if grid.valueTypeName.startswith("vec3"):
+        shape = shape + (3,)
+    dtype = {"float": np.float32, "double": np.float64, "int32": np.int32, "int64": np.int64, "bool": np.bool_,
+             "vec3s": np.float32, "vec3d": np.float64, "vec3i": np.int32}[grid.valueTypeName]
+    out = np.zeros(shape, dtype=dtype)
+    grid.copyToArray(out, ijk=tuple(int(v) for v in lo))
+    return out
+
+
+def check_geometry(name, image, grid, lo, stride):
+    origin = np.array(grid.transform.indexToWorld(tuple(float(v) for v in lo)))
+    check(np.allclose(image["origin"], origin, rtol=0, atol=1e-9), "%s: origin %s is OpenVDB's %s" % (name, image["origin"], origin))
+    spacing = np.array(grid.transform.voxelSize()) * stride
+    check(np.allclose(image["spacing"], spacing, rtol=1e-12), "%s: spacing %s is OpenVDB's voxel size x %d" % (name, image["spacing"], stride))
+
+
+def check_values(name, got, want):
+    same = got.shape == want.shape and np.array_equal(got.view(np.uint8) if got.dtype == np.bool_ else got,
+                                                       want.astype(got.dtype))
+    if not same and got.shape == want.shape:
+        bad = np.argwhere(got != want.astype(got.dtype))
+        print("     first differing samples:", bad[:3].tolist())
+    check(same, "%s: %s samples equal OpenVDB's bit for bit" % (name, "x".join(map(str, got.shape))))
+
+
+with tempfile.TemporaryDirectory() as work:
+    run(os.path.join(BUILD, "vdbdag_make_samples"), work)
+    for stem in ("sphere_ls", "fog_tiles", "multi_grid"):
+        run(os.path.join(BUILD, "vdbdag"), "encode", os.path.join(work, stem + ".vdb"), "-o", os.path.join(work, stem + ".ssvdag"), "-q")
+
+    # A NIfTI scan: int16, an oblique affine (rotated, anisotropic), smooth with noise.
+    rng = np.random.default_rng(7)
+    i, j, k = np.meshgrid(np.arange(37), np.arange(30), np.arange(11), indexing="ij")
+    scan = (600 * np.sin(i / 5.0) * np.cos(j / 7.0) + 40 * k + rng.integers(-30, 30, i.shape)).astype(np.int16)
+    c, s = np.cos(0.3), np.sin(0.3)
+    affine = np.array([[0.7 * c, -0.8 * s, 0, -12.5], [0.7 * s, 0.8 * c, 0, 30.25], [0, 0, 2.5, -40], [0, 0, 0, 1]])
+    img = nib.Nifti1Image(scan, affine)
+    img.set_qform(affine, code=1)
+    img.set_sform(affine, code=1)
+    nib.save(img, os.path.join(work, "scan.nii.gz"))
+    run(os.path.join(BUILD, "vdbdag"), "encode", os.path.join(work, "scan.nii.gz"), "-o", os.path.join(work, "scan.ssvdag"), "-q")
+    with open(os.path.join(work, "scan.ssvdag"), "rb") as f:
+        head = f.read(4096)
+    with open(os.path.join(work, "truncated.ssvdag"), "wb") as f:
+        f.write(head)
+
+    w = lambda name: os.path.join(work, name)  # noqa: E731
+    cases = [
+        {"file": w("sphere_ls.ssvdag"), "out": w("sphere0.npz")},
+        {"file": w("sphere_ls.ssvdag"), "out": w("sphere2.npz"), "properties": {"LevelOfDetail": 2}},
+        {"file": w("fog_tiles.ssvdag"), "out": w("fog.npz"), "properties": {"MaximumCells": 1.0}},
+        {"file": w("multi_grid.ssvdag"), "out": w("multi.npz")},
+        {"file": w("sphere_ls.ssvdag"), "out": w("box.npz"), "properties": {"UseBox": 1, "Box": [-50, 10, -5, 5, 30, 60]}},
+        {"file": w("scan.ssvdag"), "out": w("scan0.npz")},
+        {"file": w("scan.ssvdag"), "out": w("scan1.npz"), "properties": {"LevelOfDetail": 1}},
+    ]
+    done = dump(work, cases)
+    check(done.returncode == 0, "pvpython loaded the plugin and read %d images (exit %d)" % (len(cases), done.returncode))
+    if done.returncode != 0:
+        print(done.stderr[-3000:])
+        sys.exit(1)
+    load = lambda name: np.load(w(name))  # noqa: E731
+
+    # The level set: levels 0 and 2 against copyToDense of its active box.
+    sphere = vdb.read(w("sphere_ls.vdb"), "sphere")
+    lo, hi = sphere.evalActiveVoxelBoundingBox()
+    dense = vdb_dense(sphere, lo, hi)
+    for name, stride in (("sphere0.npz", 1), ("sphere2.npz", 4)):
+        image = load(name)
+        check(int(image["level"]) == int(np.log2(stride)), "%s: level %d" % (name, int(image["level"])))
+        check(list(image["arrays"]) == ["sphere"], "%s: one array named as the grid" % name)
+        check_geometry(name, image, sphere, lo, stride)
+        check_values(name, pv_values(image, 0), dense[::stride, ::stride, ::stride])
+    check(float(pv_values(load("sphere0.npz"), 0)[42, 42, 42]) < 0, "sphere0.npz: the inactive inside keeps the level set's sign")
+
+    # The fog under a budget of 10^6 points: the finest level that fits.
+    fog = vdb.read(w("fog_tiles.vdb"), "density")
+    lo, hi = fog.evalActiveVoxelBoundingBox()
+    counts = [np.prod([(h - l) // (1 << L) + 1 for l, h in zip(lo, hi)]) for L in range(8)]
+    want_level = next(L for L in range(8) if counts[L] <= 1e6)
+    image = load("fog.npz")
+    check(int(image["level"]) == want_level and want_level > 0,
+          "fog.npz: level %d is the finest within 10^6 points (%s points per level)" % (int(image["level"]), counts[:want_level + 1]))
+    stride = 1 << want_level
+    check_geometry("fog.npz", image, fog, lo, stride)
+    check_values("fog.npz", pv_values(image, 0), vdb_dense(fog, lo, hi)[::stride, ::stride, ::stride])
+
+    # Several grids (vectors, int32, bool: pyopenvdb reads only some types, so
+    # OpenVDB's accessor through vdbdag_vdb_probe): one array each, of the
+    # grids sharing the first grid's transform.
+    meta = json.loads(subprocess.run([os.path.join(BUILD, "vdbdag_vdb_probe"), "meta", w("multi_grid.vdb")],
+                                     check=True, capture_output=True, text=True).stdout)["grids"]
+    same = [g for g in meta if g["index_to_world"] == meta[0]["index_to_world"]]
+    field = lambda g, key: [int(v) for v in next(m["value"] for m in g["metadata"] if m["name"] == key).strip("[]").split(",")]  # noqa: E731
+    lo = [min(field(g, "file_bbox_min")[a] for g in same) for a in range(3)]
+    hi = [max(field(g, "file_bbox_max")[a] for g in same) for a in range(3)]
+    image = load("multi.npz")
+    names = [g["name"] or "grid" for g in same]  # an unnamed grid is "grid"
+    check(list(image["arrays"]) == names, "multi.npz: arrays %s are the grids of the first grid's transform %s" % (list(image["arrays"]), names))
+    check(np.allclose(image["origin"], np.array(lo + [1.0]) @ np.array(meta[0]["index_to_world"]).reshape(4, 4)[:, :3]),
+          "multi.npz: origin %s is OpenVDB's transform of %s" % (image["origin"], lo))
+    axes = np.ogrid[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1, lo[2]:hi[2] + 1]
+    coords = np.stack(np.broadcast_arrays(*axes), axis=-1).reshape(-1, 3)
+    text = "\n".join("%d %d %d" % tuple(c) for c in coords) + "\n"
+    for n, g in enumerate(same):
+        lines = subprocess.run([os.path.join(BUILD, "vdbdag_vdb_probe"), "values", w("multi_grid.vdb"), g["name"]], input=text,
+                               check=True, capture_output=True, text=True).stdout.split()
+        want = np.frombuffer(bytes.fromhex("".join(lines[1::2])), dtype=np.uint8)
+        got = pv_values(image, n)
+        got = np.ascontiguousarray(got.astype(np.uint8) if got.dtype == np.bool_ else got).reshape(len(coords), -1).view(np.uint8).reshape(-1)
+        check(np.array_equal(got, want), "multi.npz '%s' (%s): %d samples equal OpenVDB's accessor bit for bit" % (names[n], g["type"], len(coords)))
+
+    # A box partly outside the grid.
+    image = load("box.npz")
+    check(list(image["dims"]) == [61, 11, 31], "box.npz: dims %s for the box x -50..10, y -5..5, z 30..60" % list(image["dims"]))
+    check_geometry("box.npz", image, sphere, (-50, -5, 30), 1)
+    check_values("box.npz", pv_values(image, 0), vdb_dense(sphere, (-50, -5, 30), (10, 5, 60)))
+
+    # The scan: nibabel's samples, and each point where the affine puts it (LPS).
+    lps = np.diag([-1.0, -1.0, 1.0, 1.0]) @ nib.load(w("scan.nii.gz")).affine
+    stored = np.asarray(nib.load(w("scan.nii.gz")).dataobj)
+    for name, stride in (("scan0.npz", 1), ("scan1.npz", 2)):
+        image = load(name)
+        want = stored[::stride, ::stride, ::stride]
+        check(list(image["dims"]) == list(want.shape), "%s: dims %s are nibabel's %s every %d" % (name, list(image["dims"]), want.shape, stride))
+        check(np.array_equal(pv_values(image, 0), want), "%s: every sample equals nibabel's" % name)
+        direction = image["direction"].reshape(3, 3)
+        worst = 0.0
+        for n in ((0, 0, 0), tuple(d - 1 for d in image["dims"]), (3, 1, 2)):
+            paraview_point = image["origin"] + direction @ (image["spacing"] * np.array(n))
+            nifti_point = (lps @ np.array([n[0] * stride, n[1] * stride, n[2] * stride, 1.0]))[:3]
+            worst = max(worst, float(np.abs(paraview_point - nifti_point).max()))
+        check(worst < 1e-4, "%s: points lie where the NIfTI affine puts them (LPS), worst %.2g mm" % (name, worst))
+
+    # A truncated file: an error naming it, no crash, no image.
+    done = dump(work, [{"file": w("truncated.ssvdag"), "out": w("truncated.npz")}])
+    check(done.returncode == 0 and "truncated.ssvdag: truncated" in done.stderr and "vtkSsvdagReader" in done.stderr,
+          "truncated.ssvdag: ParaView reports an error naming the file (exit %d)" % done.returncode)
+    if os.path.exists(w("truncated.npz")):
+        check(np.prod(np.load(w("truncated.npz"))["dims"]) == 0, "truncated.ssvdag: no image")
+
+print("%d failure(s)" % len(failures))
+sys.exit(1 if failures else 0)

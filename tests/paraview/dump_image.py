@@ -1,0 +1,40 @@
+# Run by pvpython (ParaView's own Python): loads the VdbdagReader plugin,
+# opens each case's file with ParaView's reader factory (as File > Open
+# does), applies the case's reader properties, fetches the image and saves
+# what ParaView holds (geometry, chosen level, every point array) as .npz
+# for check_plugin.py to compare with independent readers.
+#   pvpython dump_image.py PV_SITE_PACKAGES PLUGIN.so CASES.json
+import json
+import sys
+
+sys.path.insert(0, sys.argv[1])  # ParaView's modules before python3-vtk9's
+from paraview.simple import LoadPlugin, OpenDataFile  # noqa: E402
+from paraview import servermanager  # noqa: E402
+import numpy as np  # noqa: E402
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+
+LoadPlugin(sys.argv[2], remote=False, ns=globals())
+for case in json.load(open(sys.argv[3])):
+    reader = OpenDataFile(case["file"])
+    if reader is None or reader.GetXMLName() != "VdbdagReader":
+        sys.exit("dump_image: ParaView opened %s with %s, not the plugin's reader"
+                 % (case["file"], None if reader is None else reader.GetXMLName()))
+    for name, value in case.get("properties", {}).items():
+        setattr(reader, name, value)
+    reader.UpdatePipeline()
+    reader.UpdatePropertyInformation()  # ChosenLevel of this update
+    image = servermanager.Fetch(reader)
+    out = {
+        "class": np.array(image.GetClassName()),
+        "dims": np.array(image.GetDimensions()),
+        "origin": np.array(image.GetOrigin()),
+        "spacing": np.array(image.GetSpacing()),
+        "direction": np.array([image.GetDirectionMatrix().GetElement(r, c) for r in range(3) for c in range(3)]),
+        "level": np.array(reader.GetProperty("ChosenLevel").GetData()),
+        "grids": np.array(list(reader.GetProperty("GridInfo").GetData() or [])[0::2]),
+        "arrays": np.array([image.GetPointData().GetArrayName(i) for i in range(image.GetPointData().GetNumberOfArrays())]),
+    }
+    for i in range(image.GetPointData().GetNumberOfArrays()):
+        out["array_%d" % i] = vtk_to_numpy(image.GetPointData().GetArray(i))
+    np.savez(case["out"], **out)
+    print("dump_image: %s -> %s %s" % (case["file"], out["dims"], list(out["arrays"])))
