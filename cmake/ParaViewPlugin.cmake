@@ -20,6 +20,15 @@ if(VDBDAG_PARAVIEW)
     endif()
   endif()
   if(VDBDAG_PARAVIEW_DIR AND EXISTS "${VDBDAG_PARAVIEW_DIR}/paraview-config.cmake")
+    # The checked .vdb reading of vdb_bridge (the file's layout verified
+    # before OpenVDB walks it, grids in file order), position-independent
+    # for the plugin, which links it through reader-config/.
+    add_library(vdbdag_vdb_files STATIC vdb_bridge/detail/VdbFile.cpp vdb_bridge/detail/VdbFileLayout.cpp
+                src/util/AtomicFile.cpp src/util/InputPath.cpp src/util/TemporaryFiles.cpp)
+    set_target_properties(vdbdag_vdb_files PROPERTIES POSITION_INDEPENDENT_CODE ON)
+    target_include_directories(vdbdag_vdb_files PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}>)
+    target_link_libraries(vdbdag_vdb_files PUBLIC OpenVDB::openvdb)
+    export(TARGETS vdbdag_vdb_files NAMESPACE vdbdag:: FILE ${CMAKE_CURRENT_BINARY_DIR}/reader-config/vdbdagVdbFilesTargets.cmake)
     string(REGEX MATCH "paraview-[0-9]+\\.[0-9]+$" _vdbdag_pv_subdir "${VDBDAG_PARAVIEW_DIR}")
     include(ExternalProject)
     ExternalProject_Add(vdbdag_paraview
@@ -29,7 +38,7 @@ if(VDBDAG_PARAVIEW)
                  -DParaView_DIR=${VDBDAG_PARAVIEW_DIR} -Dvdbdag_DIR=${CMAKE_CURRENT_BINARY_DIR}/reader-config
       BUILD_ALWAYS ON
       INSTALL_COMMAND ""
-      DEPENDS vdbdag_lib)
+      DEPENDS vdbdag_lib vdbdag_vdb_files)
     set(VDBDAG_PARAVIEW_PLUGIN ${CMAKE_CURRENT_BINARY_DIR}/paraview/lib/${_vdbdag_pv_subdir}/plugins/VdbdagReader/VdbdagReader.so)
     # pvpython and ParaView's Python modules, for the plugin's test.
     get_filename_component(VDBDAG_PARAVIEW_PREFIX "${VDBDAG_PARAVIEW_DIR}/../../../.." ABSOLUTE)

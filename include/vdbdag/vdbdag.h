@@ -169,6 +169,8 @@ public:
     // sampleCount(box, stride) * max(valueSize(), 1) bytes. The accessor is
     // made here, so disjoint boxes may be read from several threads.
     void sampleBox(const IndexBBox& box, uint64_t stride, void* out) const;
+    // The same samples' active states, one byte each (1: active).
+    void sampleActive(const IndexBBox& box, uint64_t stride, uint8_t* out) const;
 
 private:
     friend struct detail::FileData;

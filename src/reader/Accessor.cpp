@@ -136,23 +136,33 @@ uint64_t sampleCount(const IndexBBox& box, uint64_t stride) {
     return count;
 }
 
-void Grid::sampleBox(const IndexBBox& box, uint64_t stride, void* out) const {
+namespace {
+// Calls visit(i, j, k) at box.min + n * stride, i fastest.
+template <typename Visit>
+void forEachSample(const IndexBBox& box, uint64_t stride, Visit&& visit) {
     const std::array<uint64_t, 3> dims = sampleDims(box, stride);
     sampleCount(box, stride);  // refuses a count past 2^62
+    for (uint64_t z = 0; z < dims[2]; ++z)
+        for (uint64_t y = 0; y < dims[1]; ++y)
+            for (uint64_t x = 0; x < dims[0]; ++x)
+                visit(box.min[0] + int64_t(x * stride), box.min[1] + int64_t(y * stride), box.min[2] + int64_t(z * stride));
+}
+} // namespace
+
+void Grid::sampleBox(const IndexBBox& box, uint64_t stride, void* out) const {
     auto* bytes = static_cast<uint8_t*>(out);
     Accessor a = accessor();
     const unsigned vs = data_->valueSize;
-    for (uint64_t z = 0; z < dims[2]; ++z)
-        for (uint64_t y = 0; y < dims[1]; ++y)
-            for (uint64_t x = 0; x < dims[0]; ++x) {
-                const int64_t i = box.min[0] + int64_t(x * stride), j = box.min[1] + int64_t(y * stride), k = box.min[2] + int64_t(z * stride);
-                if (vs == 0) {
-                    *bytes++ = a.isActive(i, j, k) ? 1 : 0;
-                } else {
-                    a.valueBytes(i, j, k, bytes);
-                    bytes += vs;
-                }
-            }
+    if (vs == 0) return sampleActive(box, stride, bytes);
+    forEachSample(box, stride, [&](int64_t i, int64_t j, int64_t k) {
+        a.valueBytes(i, j, k, bytes);
+        bytes += vs;
+    });
+}
+
+void Grid::sampleActive(const IndexBBox& box, uint64_t stride, uint8_t* out) const {
+    Accessor a = accessor();
+    forEachSample(box, stride, [&](int64_t i, int64_t j, int64_t k) { *out++ = a.isActive(i, j, k) ? 1 : 0; });
 }
 
 unsigned Accessor::valueSize() const { return grid_->valueSize; }

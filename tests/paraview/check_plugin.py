@@ -15,7 +15,14 @@ files the .ssvdag files were made from:
   - a NIfTI scan with an oblique affine: every sample equal to nibabel's, and
     each point's position equal to the affine's (in LPS, as vdbdag stores
     patient space) at levels 0 and 1;
-  - a truncated file: ParaView reports it, naming the file, and does not crash.
+  - the .vdb files themselves (OpenVDB's reader inside the plugin): the same
+    images as their .ssvdag files;
+  - a comparison (CompareWith) of the level set with a copy changed by
+    pyopenvdb (values changed, voxels switched off and on), as .ssvdag and
+    as .vdb: a, b, abs_error and status at every point equal those computed
+    here from OpenVDB's accessor on both files;
+  - truncated .ssvdag and .vdb files: ParaView reports each, naming the
+    file, and does not crash.
 usage: check_plugin.py BUILD_DIR PLUGIN.so PVPYTHON PV_SITE_PACKAGES
 """
 import json
@@ -74,6 +81,19 @@ def vdb_dense(grid, lo, hi):
     return out
 
 
+def probe(vdb_file, grid, lo, hi):
+    """OpenVDB's accessor (vdbdag_vdb_probe) on every voxel of [lo, hi], i fastest:
+    (active flags, value bytes as an (N, bytes) uint8 array)."""
+    axes = np.ogrid[lo[2]:hi[2] + 1, lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
+    kji = np.stack(np.broadcast_arrays(*axes), axis=-1).reshape(-1, 3)
+    text = "\n".join("%d %d %d" % (c[2], c[1], c[0]) for c in kji) + "\n"
+    lines = subprocess.run([os.path.join(BUILD, "vdbdag_vdb_probe"), "values", vdb_file, grid], input=text,
+                           check=True, capture_output=True, text=True).stdout.split()
+    active = np.array([v == "1" for v in lines[0::2]])
+    values = np.frombuffer(bytes.fromhex("".join(lines[1::2])), dtype=np.uint8).reshape(len(kji), -1)
+    return active, values
+
+
 def check_geometry(name, image, grid, lo, stride):
     origin = np.array(grid.transform.indexToWorld(tuple(float(v) for v in lo)))
     check(np.allclose(image["origin"], origin, rtol=0, atol=1e-9), "%s: origin %s is OpenVDB's %s" % (name, image["origin"], origin))
@@ -112,6 +132,20 @@ with tempfile.TemporaryDirectory() as work:
         f.write(head)
 
     w = lambda name: os.path.join(work, name)  # noqa: E731
+    # A copy of the level set changed by OpenVDB itself: 50 values changed,
+    # 30 voxels switched off, 20 inactive voxels switched on.
+    changed = vdb.read(w("sphere_ls.vdb"), "sphere")
+    acc = changed.getAccessor()
+    on = [tuple(int(c) for c in ijk) for ijk in rng.integers(-30, 31, (4000, 3)) if acc.isValueOn(tuple(int(c) for c in ijk))]
+    off = [tuple(int(c) for c in ijk) for ijk in rng.integers(-42, 43, (4000, 3)) if not acc.isValueOn(tuple(int(c) for c in ijk))]
+    for ijk in on[:50]:
+        acc.setValueOn(ijk, acc.getValue(ijk) + 0.5)
+    for ijk in on[50:80]:
+        acc.setActiveState(ijk, False)
+    for ijk in off[:20]:
+        acc.setValueOn(ijk, 1.25)
+    vdb.write(w("sphere_mod.vdb"), grids=[changed])
+    run(os.path.join(BUILD, "vdbdag"), "encode", w("sphere_mod.vdb"), "-o", w("sphere_mod.ssvdag"), "-q")
     cases = [
         {"file": w("sphere_ls.ssvdag"), "out": w("sphere0.npz")},
         {"file": w("sphere_ls.ssvdag"), "out": w("sphere2.npz"), "properties": {"LevelOfDetail": 2}},
@@ -120,6 +154,11 @@ with tempfile.TemporaryDirectory() as work:
         {"file": w("sphere_ls.ssvdag"), "out": w("box.npz"), "properties": {"UseBox": 1, "Box": [-50, 10, -5, 5, 30, 60]}},
         {"file": w("scan.ssvdag"), "out": w("scan0.npz")},
         {"file": w("scan.ssvdag"), "out": w("scan1.npz"), "properties": {"LevelOfDetail": 1}},
+        {"file": w("sphere_ls.vdb"), "out": w("sphere0_vdb.npz")},
+        {"file": w("fog_tiles.vdb"), "out": w("fog_vdb.npz"), "properties": {"MaximumCells": 1.0}},
+        {"file": w("multi_grid.vdb"), "out": w("multi_vdb.npz")},
+        {"file": w("sphere_ls.ssvdag"), "out": w("diff.npz"), "properties": {"CompareWith": w("sphere_mod.ssvdag")}},
+        {"file": w("sphere_ls.ssvdag"), "out": w("diff_vdb.npz"), "properties": {"CompareWith": w("sphere_mod.vdb")}},
     ]
     done = dump(work, cases)
     check(done.returncode == 0, "pvpython loaded the plugin and read %d images (exit %d)" % (len(cases), done.returncode))
@@ -199,12 +238,44 @@ with tempfile.TemporaryDirectory() as work:
             worst = max(worst, float(np.abs(paraview_point - nifti_point).max()))
         check(worst < 1e-4, "%s: points lie where the NIfTI affine puts them (LPS), worst %.2g mm" % (name, worst))
 
-    # A truncated file: an error naming it, no crash, no image.
-    done = dump(work, [{"file": w("truncated.ssvdag"), "out": w("truncated.npz")}])
-    check(done.returncode == 0 and "truncated.ssvdag: truncated" in done.stderr and "vtkSsvdagReader" in done.stderr,
-          "truncated.ssvdag: ParaView reports an error naming the file (exit %d)" % done.returncode)
-    if os.path.exists(w("truncated.npz")):
-        check(np.prod(np.load(w("truncated.npz"))["dims"]) == 0, "truncated.ssvdag: no image")
+    # The .vdb files read by the plugin through OpenVDB: the same images.
+    for ssvdag, vdbfile in (("sphere0.npz", "sphere0_vdb.npz"), ("fog.npz", "fog_vdb.npz"), ("multi.npz", "multi_vdb.npz")):
+        x, y = load(ssvdag), load(vdbfile)
+        same = all(np.array_equal(x[key], y[key]) for key in ("dims", "origin", "spacing", "direction", "level", "arrays"))
+        same = same and all(np.array_equal(x["array_%d" % n], y["array_%d" % n]) for n in range(len(x["arrays"])))
+        check(same, "%s: the .vdb read through OpenVDB gives the image of its .ssvdag" % vdbfile)
+
+    # Comparisons: every point of the union of both active boxes.
+    lo, hi = [-42, -42, -42], [42, 42, 42]
+    a_on, a_val = probe(w("sphere_ls.vdb"), "sphere", lo, hi)
+    b_on, b_val = probe(w("sphere_mod.vdb"), "sphere", lo, hi)
+    a_f, b_f = a_val.copy().view(np.float32)[:, 0], b_val.copy().view(np.float32)[:, 0]
+    want_status = np.where(a_on & b_on, np.where(np.all(a_val == b_val, axis=1), 0, 1), np.where(a_on, 2, np.where(b_on, 3, 4)))
+    want_error = np.where(np.all(a_val == b_val, axis=1), 0.0, np.abs(a_f.astype(np.float64) - b_f.astype(np.float64)))
+    counts = np.bincount(want_status, minlength=5)
+    for name in ("diff.npz", "diff_vdb.npz"):
+        image = load(name)
+        check(list(image["arrays"]) == ["a", "b", "abs_error", "status"] and list(image["dims"]) == [85, 85, 85],
+              "%s: arrays %s over the 85^3 union box" % (name, list(image["arrays"])))
+        got = {str(n): image["array_%d" % i] for i, n in enumerate(image["arrays"])}
+        check(np.array_equal(got["a"], a_f) and np.array_equal(got["b"], b_f), "%s: a and b are OpenVDB's values of both files" % name)
+        check(np.array_equal(got["status"], want_status),
+              "%s: status at every point as OpenVDB's active states and bits say (%s same, %s changed, %s only in A, %s only in B, %s neither)"
+              % ((name,) + tuple(counts)))
+        check(np.allclose(got["abs_error"], want_error, rtol=0, atol=0), "%s: abs_error = |a - b| at every point" % name)
+    check(counts[1] == 50 and counts[2] == 30 and counts[3] == 20, "the changed copy holds 50 changed, 30 switched-off and 20 switched-on voxels")
+
+    # Truncated files: an error naming the file, no crash, no image.
+    with open(w("sphere_ls.vdb"), "rb") as f:
+        head = f.read(3000)
+    with open(w("truncated.vdb"), "wb") as f:
+        f.write(head)
+    for name in ("truncated.ssvdag", "truncated.vdb"):
+        done = dump(work, [{"file": w(name), "out": w(name + ".npz")}])
+        line = next((l for l in done.stderr.splitlines() if "vtkVdbdagReader" in l and name in l), "")
+        check(done.returncode == 0 and line != "", "%s: ParaView reports an error naming the file: %s" % (name, line.split("): ", 1)[-1][:120]))
+        if os.path.exists(w(name + ".npz")):
+            check(np.prod(np.load(w(name + ".npz"))["dims"]) == 0, "%s: no image" % name)
 
 print("%d failure(s)" % len(failures))
 sys.exit(1 if failures else 0)

@@ -311,7 +311,8 @@ TEST(Reader, OpenNamesTheFileInItsError) {
 
 // Grid::sampleBox (the ParaView reader's level of detail): every stride's
 // samples, i fastest, equal the brute-force answer at box.min + n * stride;
-// a mask grid writes its active states.
+// a mask grid writes its active states; sampleActive the active states of
+// every grid.
 TEST(Reader, SampleBoxIsTheBruteForceAnswerAtEveryStride) {
     std::mt19937 rng(5);
     std::vector<Case> cases;
@@ -355,6 +356,15 @@ TEST(Reader, SampleBoxIsTheBruteForceAnswerAtEveryStride) {
                             ADD_FAILURE() << cases[g].name << " stride " << stride << ": sample (" << i << "," << j << "," << k << ") differs";
                     }
             EXPECT_EQ(failures, 0u) << cases[g].name << " stride " << stride;
+            std::vector<uint8_t> active(n);
+            file.grid(g).sampleActive(box, stride, active.data());
+            at = failures = 0;
+            for (uint64_t z = 0; z < dims[2]; ++z)
+                for (uint64_t y = 0; y < dims[1]; ++y)
+                    for (uint64_t x = 0; x < dims[0]; ++x, ++at)
+                        if (active[at] != (ref.isActive(box.min[0] + int64_t(x * stride), box.min[1] + int64_t(y * stride), box.min[2] + int64_t(z * stride)) ? 1 : 0))
+                            ++failures;
+            EXPECT_EQ(failures, 0u) << cases[g].name << " stride " << stride << ": active states";
         }
     }
     EXPECT_EQ(sampleCount(IndexBBox{}, 4), 0u);

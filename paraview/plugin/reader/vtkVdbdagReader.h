@@ -1,6 +1,6 @@
-// vtkSsvdagReader: reads a .ssvdag file (vdbdag's public reader library,
-// <vdbdag/vdbdag.h>) as a vtkImageData, for ParaView (the VdbdagReader
-// plugin) and for any VTK pipeline.
+// vtkVdbdagReader: reads an .ssvdag file (vdbdag's reader library) or a .vdb
+// file (OpenVDB) as a vtkImageData, for ParaView (the VdbdagReader plugin)
+// and for any VTK pipeline.
 //
 // The image covers a box of index coordinates (by default the union of the
 // selected grids' active boxes) at a level of detail L: its points are the
@@ -14,27 +14,35 @@
 // direction come from the grid's index-to-world transform (points at voxel
 // centres, as OpenVDB's index space). Grids whose transform differs from the
 // first selected grid's are left out with a warning.
-#ifndef vtkSsvdagReader_h
-#define vtkSsvdagReader_h
+//
+// With CompareWith set to a second file, each selected grid is compared with
+// the grid of the same name there, as `vdbdag diff` does, over the union of
+// both active boxes: arrays "a", "b", "abs_error" (|a - b|, the Euclidean
+// norm of the difference for vectors) and "status" (0 the same bits and both
+// active, 1 the value differs and both active, 2 active only in the first
+// file, 3 only in the second, 4 inactive in both), prefixed "GRID " when
+// several grids are compared.
+#ifndef vtkVdbdagReader_h
+#define vtkVdbdagReader_h
 
 #include "vtkImageAlgorithm.h"
-#include "vtkSsvdagReaderModule.h"
+#include "vtkVdbdagVolumeReaderModule.h"
 
 #include <memory>
 
 class vtkCallbackCommand;
 class vtkDataArraySelection;
 
-class VTKSSVDAGREADER_EXPORT vtkSsvdagReader : public vtkImageAlgorithm
+class VTKVDBDAGVOLUMEREADER_EXPORT vtkVdbdagReader : public vtkImageAlgorithm
 {
 public:
-  static vtkSsvdagReader* New();
-  vtkTypeMacro(vtkSsvdagReader, vtkImageAlgorithm);
+  static vtkVdbdagReader* New();
+  vtkTypeMacro(vtkVdbdagReader, vtkImageAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   vtkSetStringMacro(FileName);
   vtkGetStringMacro(FileName);
-  // 1 when the file starts with the .ssvdag magic.
+  // 1 for an .ssvdag file (its magic) or a .vdb file (OpenVDB's magic).
   int CanReadFile(const char* name);
 
   // The grids to read (all by default), by name.
@@ -58,21 +66,25 @@ public:
   vtkBooleanMacro(UseBox, vtkTypeBool);
   vtkSetVector6Macro(Box, int);
   vtkGetVector6Macro(Box, int);
+  // A second file to compare with (empty: none).
+  vtkSetStringMacro(CompareWith);
+  vtkGetStringMacro(CompareWith);
   // The level the last update read (after RequestInformation).
   vtkGetMacro(ChosenLevel, int);
 
 protected:
-  vtkSsvdagReader();
-  ~vtkSsvdagReader() override;
+  vtkVdbdagReader();
+  ~vtkVdbdagReader() override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
 private:
-  vtkSsvdagReader(const vtkSsvdagReader&) = delete;
-  void operator=(const vtkSsvdagReader&) = delete;
+  vtkVdbdagReader(const vtkVdbdagReader&) = delete;
+  void operator=(const vtkVdbdagReader&) = delete;
   static void SelectionModified(vtkObject*, unsigned long, void* clientdata, void*);
 
   char* FileName = nullptr;
+  char* CompareWith = nullptr;
   int LevelOfDetail = -1;
   double MaximumCells = 64;
   vtkTypeBool UseBox = 0;

@@ -1,0 +1,49 @@
+// A volume file as the reader plugin sees it: its grids' facts, and point
+// samples of a box of index coordinates every `stride` voxels, laid out as
+// vdbdag::Grid::sampleBox writes them (i fastest; a mask grid's samples are
+// its active states, one byte each; bool one byte). Two kinds:
+// .ssvdag through vdbdag's reader library (SsvdagSource.cxx) and .vdb through
+// OpenVDB's own reader with delayed loading (VdbSource.cxx), so a coarse
+// level of detail reads only the leaves its samples fall in.
+#ifndef VolumeSource_h
+#define VolumeSource_h
+
+#include <vdbdag/vdbdag.h>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+struct VolumeGrid
+{
+  std::string name;  // as the file names it
+  std::string type;  // "float", "double", "int32", "int64", "bool", "mask", "vec3s", "vec3d", "vec3i"
+  unsigned valueSize = 0; // bytes per value (mask 0: its samples are one byte)
+  std::array<double, 16> indexToWorld{}; // row-major, world = [i j k 1] * M
+  vdbdag::IndexBBox box; // of the active voxels
+};
+
+class VolumeSource
+{
+public:
+  virtual ~VolumeSource() = default;
+  const std::vector<VolumeGrid>& grids() const { return this->Grids; }
+  // Grid g's values at box.min + n * stride; callable from several threads
+  // at once for disjoint outputs.
+  virtual void sample(size_t g, const vdbdag::IndexBBox& box, uint64_t stride, void* out) const = 0;
+  // Their active states, one byte each (1: active).
+  virtual void sampleActive(size_t g, const vdbdag::IndexBBox& box, uint64_t stride, uint8_t* out) const = 0;
+  // Opens an .ssvdag file (by its magic) or else a .vdb file; throws
+  // std::runtime_error with one line naming the file.
+  static std::unique_ptr<VolumeSource> open(const std::string& path);
+
+protected:
+  std::vector<VolumeGrid> Grids;
+};
+
+std::unique_ptr<VolumeSource> openSsvdagSource(const std::string& path);
+std::unique_ptr<VolumeSource> openVdbSource(const std::string& path);
+
+#endif
