@@ -21,6 +21,8 @@ files the .ssvdag files were made from:
     pyopenvdb (values changed, voxels switched off and on), as .ssvdag and
     as .vdb: a, b, abs_error and status at every point equal those computed
     here from OpenVDB's accessor on both files;
+  - a numbered series of .ssvdag files (OpenVDB's level-set advection) as
+    one source with a time step per file, each step the image of its frame;
   - truncated .ssvdag and .vdb files: ParaView reports each, naming the
     file, and does not crash.
 usage: check_plugin.py BUILD_DIR PLUGIN.so PVPYTHON PV_SITE_PACKAGES
@@ -146,6 +148,11 @@ with tempfile.TemporaryDirectory() as work:
         acc.setValueOn(ijk, 1.25)
     vdb.write(w("sphere_mod.vdb"), grids=[changed])
     run(os.path.join(BUILD, "vdbdag"), "encode", w("sphere_mod.vdb"), "-o", w("sphere_mod.ssvdag"), "-q")
+    # A frame sequence made with OpenVDB's level-set advection, one .ssvdag per frame.
+    run(os.path.join(BUILD, "vdbdag_make_sequence"), w("seq"), "--frames", "3", "--dim", "64", "--no-fog")
+    frames = [w("seq/levelset.%04d" % n) for n in (1, 2, 3)]
+    for f in frames:
+        run(os.path.join(BUILD, "vdbdag"), "encode", f + ".vdb", "-o", f + ".ssvdag", "-q")
     cases = [
         {"file": w("sphere_ls.ssvdag"), "out": w("sphere0.npz")},
         {"file": w("sphere_ls.ssvdag"), "out": w("sphere2.npz"), "properties": {"LevelOfDetail": 2}},
@@ -159,7 +166,7 @@ with tempfile.TemporaryDirectory() as work:
         {"file": w("multi_grid.vdb"), "out": w("multi_vdb.npz")},
         {"file": w("sphere_ls.ssvdag"), "out": w("diff.npz"), "properties": {"CompareWith": w("sphere_mod.ssvdag")}},
         {"file": w("sphere_ls.ssvdag"), "out": w("diff_vdb.npz"), "properties": {"CompareWith": w("sphere_mod.vdb")}},
-    ]
+    ] + [{"file": [f + ".ssvdag" for f in frames], "time": float(t), "out": w("frame%d.npz" % t)} for t in (2, 0, 1)]
     done = dump(work, cases)
     check(done.returncode == 0, "pvpython loaded the plugin and read %d images (exit %d)" % (len(cases), done.returncode))
     if done.returncode != 0:
@@ -244,6 +251,15 @@ with tempfile.TemporaryDirectory() as work:
         same = all(np.array_equal(x[key], y[key]) for key in ("dims", "origin", "spacing", "direction", "level", "arrays"))
         same = same and all(np.array_equal(x["array_%d" % n], y["array_%d" % n]) for n in range(len(x["arrays"])))
         check(same, "%s: the .vdb read through OpenVDB gives the image of its .ssvdag" % vdbfile)
+
+    # The sequence: three time steps, each the image of its own frame.
+    for t in (0, 1, 2):
+        image = load("frame%d.npz" % t)
+        grid = vdb.read(frames[t] + ".vdb", "surface")
+        lo, hi = grid.evalActiveVoxelBoundingBox()
+        check(list(image["times"]) == [0.0, 1.0, 2.0], "frame%d.npz: the series has time steps %s" % (t, list(image["times"])))
+        check_geometry("frame%d.npz" % t, image, grid, lo, 1)
+        check_values("frame%d.npz (levelset.%04d)" % (t, t + 1), pv_values(image, 0), vdb_dense(grid, lo, hi))
 
     # Comparisons: every point of the union of both active boxes.
     lo, hi = [-42, -42, -42], [42, 42, 42]

@@ -1,6 +1,7 @@
 # Run by pvpython (ParaView's own Python): loads the VdbdagReader plugin,
-# opens each case's file with ParaView's reader factory (as File > Open
-# does), applies the case's reader properties, fetches the image and saves
+# opens each case's file (or list of files: a series) with ParaView's reader
+# factory (as File > Open does), applies the case's reader properties,
+# updates it (at the case's time, if any) and saves
 # what ParaView holds (geometry, chosen level, every point array) as .npz
 # for check_plugin.py to compare with independent readers.
 #   pvpython dump_image.py PV_SITE_PACKAGES PLUGIN.so CASES.json
@@ -9,7 +10,6 @@ import sys
 
 sys.path.insert(0, sys.argv[1])  # ParaView's modules before python3-vtk9's
 from paraview.simple import LoadPlugin, OpenDataFile  # noqa: E402
-from paraview import servermanager  # noqa: E402
 import numpy as np  # noqa: E402
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 
@@ -21,9 +21,12 @@ for case in json.load(open(sys.argv[3])):
                  % (case["file"], None if reader is None else reader.GetXMLName()))
     for name, value in case.get("properties", {}).items():
         setattr(reader, name, value)
-    reader.UpdatePipeline()
+    if "time" in case:
+        reader.UpdatePipeline(case["time"])
+    else:
+        reader.UpdatePipeline()
     reader.UpdatePropertyInformation()  # ChosenLevel of this update
-    image = servermanager.Fetch(reader)
+    image = reader.GetClientSideObject().GetOutputDataObject(0)  # the builtin session's data of this update
     out = {
         "class": np.array(image.GetClassName()),
         "dims": np.array(image.GetDimensions()),
@@ -31,6 +34,7 @@ for case in json.load(open(sys.argv[3])):
         "spacing": np.array(image.GetSpacing()),
         "direction": np.array([image.GetDirectionMatrix().GetElement(r, c) for r in range(3) for c in range(3)]),
         "level": np.array(reader.GetProperty("ChosenLevel").GetData()),
+        "times": np.array(list(reader.TimestepValues) if reader.TimestepValues else []),
         "grids": np.array(list(reader.GetProperty("GridInfo").GetData() or [])[0::2]),
         "arrays": np.array([image.GetPointData().GetArrayName(i) for i in range(image.GetPointData().GetNumberOfArrays())]),
     }

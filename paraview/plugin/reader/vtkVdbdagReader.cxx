@@ -138,6 +138,11 @@ struct vtkVdbdagReader::Internals
   vdbdag::IndexBBox Box;
   uint64_t Stride = 1;
   std::array<double, 16> IndexToWorld{};
+  // The image this plan makes. RequestData sets them on the output itself:
+  // a file series (vtkFileSeriesReader) plans each file in a temporary
+  // information object, so the pipeline's keys keep the first file's.
+  int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  double Origin[3] = { 0, 0, 0 }, Spacing[3] = { 1, 1, 1 }, Direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
 };
 
 vtkVdbdagReader::vtkVdbdagReader()
@@ -334,13 +339,14 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
         extent[2 * a + 1] = int(dims[a]) - 1;
       }
     }
-    double spacing[3], direction[9];
-    AxesOf(in.IndexToWorld, in.Stride, spacing, direction);
+    AxesOf(in.IndexToWorld, in.Stride, in.Spacing, in.Direction);
     const std::array<double, 3> origin = WorldOf(in.IndexToWorld, in.Box.empty() ? std::array<int64_t, 3>{ 0, 0, 0 } : in.Box.min);
+    std::copy(origin.begin(), origin.end(), in.Origin);
+    std::copy(extent, extent + 6, in.WholeExtent);
     outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
-    outInfo->Set(vtkDataObject::ORIGIN(), origin.data(), 3);
-    outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
-    outInfo->Set(vtkDataObject::DIRECTION(), direction, 9);
+    outInfo->Set(vtkDataObject::ORIGIN(), in.Origin, 3);
+    outInfo->Set(vtkDataObject::SPACING(), in.Spacing, 3);
+    outInfo->Set(vtkDataObject::DIRECTION(), in.Direction, 9);
     outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
     return 1;
   }
@@ -360,16 +366,22 @@ int vtkVdbdagReader::RequestData(vtkInformation*, vtkInformationVector**, vtkInf
   vtkImageData* out = vtkImageData::GetData(outInfo);
   if (!in.A.Source || !out)
     return 0;
-  int ext[6];
+  // The update extent; a request for the pipeline's whole extent is one for
+  // this plan's (they differ between the files of a series).
+  int ext[6], whole[6];
   outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext);
+  outInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  if (std::equal(ext, ext + 6, whole))
+    std::copy(in.WholeExtent, in.WholeExtent + 6, ext);
+  for (int a = 0; a < 3; ++a)
+  {
+    ext[2 * a] = std::max(ext[2 * a], in.WholeExtent[2 * a]);
+    ext[2 * a + 1] = std::min(ext[2 * a + 1], in.WholeExtent[2 * a + 1]);
+  }
   out->SetExtent(ext);
-  double spacing[3], direction[9], origin[3];
-  outInfo->Get(vtkDataObject::SPACING(), spacing);
-  outInfo->Get(vtkDataObject::ORIGIN(), origin);
-  outInfo->Get(vtkDataObject::DIRECTION(), direction);
-  out->SetSpacing(spacing);
-  out->SetOrigin(origin);
-  out->SetDirectionMatrix(direction);
+  out->SetSpacing(in.Spacing);
+  out->SetOrigin(in.Origin);
+  out->SetDirectionMatrix(in.Direction);
   if (ext[1] < ext[0] || ext[3] < ext[2] || ext[5] < ext[4])
     return 1;
 
