@@ -26,8 +26,15 @@ void Layer::load() const {
         const attributes::PaletteChannel& channel = inactive ? grid->inactiveValues : grid->values;
         const std::vector<uint8_t>& attributes = inactive ? grid->inactiveAttributes : grid->attributes;
         if (!windows.empty() && windows.predicted) {
-            flat_ = attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(*dag), what + " predicted windows",
-                                                       encoding::attributePlaces(*dag, vs));
+            auto w = std::make_unique<Windows>();
+            if (windows.file) w->spilled = windows.load();
+            w->payload = windows.file ? std::span<const uint8_t>(w->spilled) : std::span<const uint8_t>(windows.bytes);
+            w->layout = encoding::attributeLayout(*dag);
+            w->places = encoding::attributePlaces(*dag, vs);
+            w->directory = attributes::readPredictedWindowDirectory(w->payload, vs, w->layout, what + " predicted windows");
+            w->decoded = std::make_unique<std::once_flag[]>(w->directory.windows.size());
+            w->values = std::make_unique<std::vector<uint8_t>[]>(w->directory.windows.size());
+            windows_ = std::move(w);
         } else if (!windows.empty()) {
             channel_ = attributes::decodeValueWindows(windows.load(), what + " value windows");
             palette_ = true;
@@ -45,6 +52,25 @@ void Layer::value(uint64_t entry, uint8_t* out, size_t& hint) const {
     const unsigned vs = valueSize(grid->record.valueType);
     if (palette_) {
         channel_.lookup(entry, out, hint);
+        return;
+    }
+    if (windows_) {
+        Windows& w = *windows_;
+        const auto& list = w.directory.windows;
+        size_t k = hint;
+        if (k >= list.size() || entry < list[k].firstEntry || entry - list[k].firstEntry >= list[k].entries) {
+            const auto after = std::upper_bound(list.begin(), list.end(), entry, [](uint64_t e, const auto& window) { return e < window.firstEntry; });
+            k = size_t(after - list.begin()) - 1;  // the directory's first window starts at entry 0
+            if (after == list.begin() || entry - list[k].firstEntry >= list[k].entries)
+                throw Error(what + ": value entry " + std::to_string(entry) + " is past the channel's end");
+            hint = k;
+        }
+        std::call_once(w.decoded[k], [&] {
+            std::vector<uint8_t> values = attributes::decodePredictedWindow(w.payload, w.directory, k, w.layout, what + " predicted windows", w.places);
+            if (values.size() != list[k].entries * vs) throw Error(what + " predicted windows window " + std::to_string(k) + ": decoded to the wrong size");
+            w.values[k] = std::move(values);
+        });
+        std::memcpy(out, w.values[k].data() + (entry - list[k].firstEntry) * vs, vs);
         return;
     }
     if ((entry + 1) * vs > flat_.size()) throw Error(what + ": value entry " + std::to_string(entry) + " is past the channel's end");

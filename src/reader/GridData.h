@@ -4,12 +4,14 @@
 #pragma once
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <vector>
 
 #include <vdbdag/vdbdag.h>
 
 #include "src/attributes/PaletteChannel.h"
+#include "src/attributes/PredictedWindows.h"
 #include "src/format/SsvdagFile.h"
 
 namespace vdbdag::detail {
@@ -21,8 +23,9 @@ struct Layer {
     // 2), walking from where `path` left off; false when the layer has no
     // such voxel.
     bool find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t& entry) const;
-    // Entry `entry`'s value (valueSize bytes); the channel is decoded the
-    // first time.
+    // Entry `entry`'s value (valueSize bytes); its window (or an older
+    // file's channel) is decoded the first time. `hint` remembers the last
+    // window or palette block.
     void value(uint64_t entry, uint8_t* out, size_t& hint) const;
 
     // Set by the file reader; the channel is built from them once.
@@ -35,7 +38,21 @@ private:
     mutable std::once_flag loaded_;
     mutable bool palette_ = false;
     mutable attributes::PaletteChannel channel_;  // palette windows, or a palette of an older file
-    mutable std::vector<uint8_t> flat_;           // predicted (integer) windows, decoded in attribute order
+    mutable std::vector<uint8_t> flat_;           // an older file's predicted values, in attribute order
+    // Predicted windows (integers, floats, vectors), each decoded the first
+    // time one of its entries is asked for: a lookup, a coarse level of
+    // detail or a box decodes the windows it touches, not the channel, and
+    // threads that touch different windows decode them at once.
+    struct Windows {
+        std::vector<uint8_t> spilled;  // the payload, when it was spilled to a scratch file
+        std::span<const uint8_t> payload;
+        std::vector<uint64_t> layout;              // encoding::attributeLayout
+        std::vector<coding::BrickPlace> places;    // encoding::attributePlaces
+        attributes::WindowDirectory directory;
+        std::unique_ptr<std::once_flag[]> decoded;
+        std::unique_ptr<std::vector<uint8_t>[]> values;  // per window, once decoded
+    };
+    mutable std::unique_ptr<Windows> windows_;
 };
 
 struct GridData {
