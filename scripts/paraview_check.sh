@@ -1,21 +1,38 @@
 #!/usr/bin/env bash
-# Opens a VTK export in ParaView 5.11 (pvpython under xvfb), colours it by a
-# cell field and saves a screenshot, to check by eye that the object shows.
+# Opens a file in ParaView 5.11 (pvpython under xvfb) and saves a
+# screenshot, to check by eye that the object shows.
 #
 #   scripts/paraview_check.sh FILE.vtu|vti|vtm FIELD OUT.png [THRESHOLD_FIELD MIN MAX]
+#   scripts/paraview_check.sh FILE.ssvdag|vdb OUT.png [contour VALUE | volume] [LEVEL]
 #
-# The optional threshold keeps cells with MIN <= THRESHOLD_FIELD <= MAX (e.g.
-# `level 5 5` for one level of a --structure export, `status 1 3` for the
-# differing cells of a diff). Installs `paraview xvfb` if missing, and unpacks
-# pvpython without installing it (python3-paraview would remove libvtk9-dev,
+# A VTK export is coloured by a cell field; the optional threshold keeps
+# cells with MIN <= THRESHOLD_FIELD <= MAX (e.g. `level 5 5` for one level of
+# a --structure export, `status 1 3` for the differing cells of a diff). An
+# .ssvdag or .vdb file is opened directly through the VdbdagReader plugin of
+# ./build (scripts/paraview_view.py): its zero surface (contour, the default
+# VALUE 0) or a volume rendering, at the reader's automatic level of detail
+# or LEVEL. Installs `paraview xvfb` if missing, and unpacks pvpython without
+# installing it (python3-paraview would remove libvtk9-dev,
 # ../shared/TOOLCHAIN.md) into ${VDBDAG_PV_DIR:-$HOME/.cache/vdbdag/pvpython}.
 # Not part of the test suite.
 set -euo pipefail
-if [ $# -ne 3 ] && [ $# -ne 6 ]; then
+case "${1:-}" in
+  *.ssvdag|*.vdb) PLUGIN_MODE=1 ;;
+  *) PLUGIN_MODE=0 ;;
+esac
+if [ "$PLUGIN_MODE" = 1 ]; then
+  if [ $# -lt 2 ] || [ $# -gt 5 ]; then
+    echo "usage: $0 FILE.ssvdag|vdb OUT.png [contour VALUE | volume] [LEVEL]" >&2
+    exit 2
+  fi
+  INPUT=$(realpath "$1"); OUTPUT=$(realpath -m "$2")
+elif [ $# -ne 3 ] && [ $# -ne 6 ]; then
   echo "usage: $0 FILE.vtu|vti|vtm FIELD OUT.png [THRESHOLD_FIELD MIN MAX]" >&2
+  echo "       $0 FILE.ssvdag|vdb OUT.png [contour VALUE | volume] [LEVEL]" >&2
   exit 2
+else
+  INPUT=$(realpath "$1"); FIELD=$2; OUTPUT=$(realpath -m "$3")
 fi
-INPUT=$(realpath "$1"); FIELD=$2; OUTPUT=$(realpath -m "$3")
 [ -f "$INPUT" ] || { echo "$0: $1: no such file" >&2; exit 1; }
 
 SUDO=""
@@ -32,6 +49,30 @@ if [ ! -x "$PV_DIR/usr/bin/pvpython" ]; then
   chmod 755 "$tmp"  # apt downloads as _apt
   (cd "$tmp" && apt-get download -qq python3-paraview >/dev/null && dpkg-deb -x python3-paraview_*.deb "$PV_DIR")
   rm -rf "$tmp"
+fi
+
+# pvpython under xvfb now and then aborts at start-up ("bad X server
+# connection": xvfb-run -a races other users of display :99). Start from a
+# random display number and retry a crash (exit >= 128), never an ordinary failure.
+run_pvpython() {
+  local attempt status=0
+  for attempt in 1 2 3; do
+    status=0
+    xvfb-run -a -n $((100 + RANDOM % 800)) -s "-screen 0 1024x768x24" "$@" || status=$?
+    [ "$status" -lt 128 ] && return "$status"
+    echo "paraview_check: pvpython crashed (exit $status), attempt $attempt of 3" >&2
+  done
+  return "$status"
+}
+
+if [ "$PLUGIN_MODE" = 1 ]; then
+  ROOT=$(cd "$(dirname "$0")/.." && pwd)
+  plugin=$(find "$ROOT/build/paraview/lib" -name VdbdagReader.so 2>/dev/null | head -1)
+  [ -n "$plugin" ] || { echo "$0: no plugin in build/paraview (paraview-dev missing? scripts/setup.sh installs it)" >&2; exit 1; }
+  shift 2
+  run_pvpython "$PV_DIR/usr/bin/pvpython" --force-offscreen-rendering "$ROOT/scripts/paraview_view.py" \
+    "$PV_DIR/usr/lib/python3/dist-packages" "$plugin" "$INPUT" "$OUTPUT" "$@"
+  exit $?
 fi
 
 script=$(mktemp --suffix=.py)
@@ -82,13 +123,4 @@ SaveScreenshot("$OUTPUT", view, ImageResolution=[1024, 768])
 print("paraview_check: wrote $OUTPUT")
 PY
 shift 3
-# pvpython under xvfb now and then aborts at start-up ("bad X server
-# connection": xvfb-run -a races other users of display :99). Start from a
-# random display number and retry a crash (exit >= 128), never an ordinary failure.
-for attempt in 1 2 3; do
-  status=0
-  xvfb-run -a -n $((100 + RANDOM % 800)) -s "-screen 0 1024x768x24" "$PV_DIR/usr/bin/pvpython" --force-offscreen-rendering "$script" "$@" || status=$?
-  [ "$status" -lt 128 ] && exit "$status"
-  echo "paraview_check: pvpython crashed (exit $status), attempt $attempt of 3" >&2
-done
-exit "$status"
+run_pvpython "$PV_DIR/usr/bin/pvpython" --force-offscreen-rendering "$script" "$@"

@@ -2,7 +2,7 @@
 to look at: a contour (level sets: the zero surface) or a volume rendering
 (fogs and scans), at the reader's automatic level of detail.
   pvpython scripts/paraview_view.py PV_SITE_PACKAGES PLUGIN.so FILE OUT.png [contour VALUE | volume] [LEVEL]
-scripts/paraview_view.sh finds the arguments; it is not part of the test suite."""
+scripts/paraview_check.sh FILE.ssvdag|vdb OUT.png ... runs it; it is not part of the test suite."""
 import sys
 import time
 
@@ -47,8 +47,11 @@ else:
     # Transparent below a fifth of the range (air, empty space), rising to 0.6.
     opacity.Points = [lo, 0, 0.5, 0, lo + 0.2 * (hi - lo), 0, 0.5, 0, hi, 0.6, 0.5, 0]
     colours.RescaleTransferFunction(lo, hi)
-view.CameraPosition = [1, -1, 0.6]
-view.CameraViewUp = [0, 0, 1]
+# Y up (OpenVDB's and the scanned models' convention), from the front, a
+# little from above and the side.
+view.CameraPosition = [0.8, 0.6, 1.6]
+view.CameraFocalPoint = [0, 0, 0]
+view.CameraViewUp = [0, 1, 0]
 ResetCamera(view)
 SaveScreenshot(out, view, ImageResolution=[800, 800])
 print("paraview_view: wrote " + out)

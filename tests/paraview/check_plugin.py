@@ -23,6 +23,9 @@ files the .ssvdag files were made from:
     here from OpenVDB's accessor on both files;
   - a numbered series of .ssvdag files (OpenVDB's level-set advection) as
     one source with a time step per file, each step the image of its frame;
+  - ../shared's bunny level set, when present: a box through its surface at
+    level 0 from its .ssvdag and from the .vdb, and a contour at 0 of the
+    default image, which has points;
   - truncated .ssvdag and .vdb files: ParaView reports each, naming the
     file, and does not crash.
 usage: check_plugin.py BUILD_DIR PLUGIN.so PVPYTHON PV_SITE_PACKAGES
@@ -134,6 +137,13 @@ with tempfile.TemporaryDirectory() as work:
         f.write(head)
 
     w = lambda name: os.path.join(work, name)  # noqa: E731
+    # ../shared's bunny level set, when present: a box through its surface at
+    # level 0, from its .ssvdag and from the .vdb itself, and its contour.
+    bunny = os.path.join(HERE, "..", "..", "..", "shared", "data", "levelsets", "bunny_d512_ls.vdb")
+    if os.path.exists(bunny):
+        run(os.path.join(BUILD, "vdbdag"), "encode", bunny, "-o", w("bunny.ssvdag"), "-q")
+    else:
+        print("skip: ../shared/data absent, the bunny checks do not run")
     # A copy of the level set changed by OpenVDB itself: 50 values changed,
     # 30 voxels switched off, 20 inactive voxels switched on.
     changed = vdb.read(w("sphere_ls.vdb"), "sphere")
@@ -167,6 +177,12 @@ with tempfile.TemporaryDirectory() as work:
         {"file": w("sphere_ls.ssvdag"), "out": w("diff.npz"), "properties": {"CompareWith": w("sphere_mod.ssvdag")}},
         {"file": w("sphere_ls.ssvdag"), "out": w("diff_vdb.npz"), "properties": {"CompareWith": w("sphere_mod.vdb")}},
     ] + [{"file": [f + ".ssvdag" for f in frames], "time": float(t), "out": w("frame%d.npz" % t)} for t in (2, 0, 1)]
+    bunny_box = [-40, 55, -10, 85, -60, 35]  # x0 x1 y0 y1 z0 z1, through the ear's base and the back
+    if os.path.exists(bunny):
+        for name in ("bunny.ssvdag", "bunny.vdb"):
+            cases.append({"file": w("bunny.ssvdag") if name.endswith("ssvdag") else bunny, "out": w(name + ".npz"),
+                          "properties": {"UseBox": 1, "Box": bunny_box, "LevelOfDetail": 0}})
+            cases.append({"file": w("bunny.ssvdag") if name.endswith("ssvdag") else bunny, "out": w(name + ".contour.npz"), "contour": 0.0})
     done = dump(work, cases)
     check(done.returncode == 0, "pvpython loaded the plugin and read %d images (exit %d)" % (len(cases), done.returncode))
     if done.returncode != 0:
@@ -260,6 +276,19 @@ with tempfile.TemporaryDirectory() as work:
         check(list(image["times"]) == [0.0, 1.0, 2.0], "frame%d.npz: the series has time steps %s" % (t, list(image["times"])))
         check_geometry("frame%d.npz" % t, image, grid, lo, 1)
         check_values("frame%d.npz (levelset.%04d)" % (t, t + 1), pv_values(image, 0), vdb_dense(grid, lo, hi))
+
+    if os.path.exists(bunny):
+        grid = vdb.read(bunny, vdb.readAllGridMetadata(bunny)[0].name)
+        lo, hi = bunny_box[0::2], bunny_box[1::2]
+        want = vdb_dense(grid, lo, hi)
+        for name in ("bunny.ssvdag", "bunny.vdb"):
+            image = load(name + ".npz")
+            check_geometry(name + " box", image, grid, lo, 1)
+            check_values(name + " box at level 0 (%d active voxels in it)" % int(np.count_nonzero(np.abs(want) < grid.background)),
+                         pv_values(image, 0), want)
+            surface = load(name + ".contour.npz")
+            check(int(surface["contour_points"]) > 10000, "%s: the contour at 0 of the default image (level %d) has %d points"
+                  % (name, int(surface["level"]), int(surface["contour_points"])))
 
     # Comparisons: every point of the union of both active boxes.
     lo, hi = [-42, -42, -42], [42, 42, 42]

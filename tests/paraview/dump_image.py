@@ -9,7 +9,7 @@ import json
 import sys
 
 sys.path.insert(0, sys.argv[1])  # ParaView's modules before python3-vtk9's
-from paraview.simple import LoadPlugin, OpenDataFile  # noqa: E402
+from paraview.simple import Contour, LoadPlugin, OpenDataFile  # noqa: E402
 import numpy as np  # noqa: E402
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 
@@ -38,6 +38,10 @@ for case in json.load(open(sys.argv[3])):
         "grids": np.array(list(reader.GetProperty("GridInfo").GetData() or [])[0::2]),
         "arrays": np.array([image.GetPointData().GetArrayName(i) for i in range(image.GetPointData().GetNumberOfArrays())]),
     }
+    if "contour" in case:  # the surface at that value of the first array
+        surface = Contour(Input=reader, ContourBy=["POINTS", out["arrays"][0]], Isosurfaces=[case["contour"]])
+        surface.UpdatePipeline()
+        out["contour_points"] = np.array(surface.GetDataInformation().GetNumberOfPoints())
     for i in range(image.GetPointData().GetNumberOfArrays()):
         out["array_%d" % i] = vtk_to_numpy(image.GetPointData().GetArray(i))
     np.savez(case["out"], **out)
