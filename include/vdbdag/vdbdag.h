@@ -27,6 +27,7 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -171,6 +172,14 @@ public:
     void sampleBox(const IndexBBox& box, uint64_t stride, void* out) const;
     // The same samples' active states, one byte each (1: active).
     void sampleActive(const IndexBBox& box, uint64_t stride, uint8_t* out) const;
+    // Every active voxel and tile of the grid that overlaps `box`:
+    // visit(corner, log2, value) with the cube's minimum corner, log2 of its
+    // edge (0: a voxel; more: a tile, or a cube of voxels that the DAG stores
+    // as one value) and the value's bytes (valueSize() of them; nullptr for a
+    // mask grid). A cube is given whole where it sticks out of the box. The
+    // walk stops when visit returns false.
+    using ActiveVisitor = std::function<bool(const std::array<int64_t, 3>& corner, unsigned log2, const void* value)>;
+    void forEachActive(const IndexBBox& box, const ActiveVisitor& visit) const;
 
 private:
     friend struct detail::FileData;

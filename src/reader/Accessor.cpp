@@ -165,6 +165,51 @@ void Grid::sampleActive(const IndexBBox& box, uint64_t stride, uint8_t* out) con
     forEachSample(box, stride, [&](int64_t i, int64_t j, int64_t k) { *out++ = a.isActive(i, j, k) ? 1 : 0; });
 }
 
+// The DAG's instances in attribute order (encoding::visitInAttributeOrder),
+// cut into subtrees of at most 2^7 voxels so that those outside the box are
+// skipped whole.
+void Grid::forEachActive(const IndexBBox& box, const ActiveVisitor& visit) const {
+    const encoding::CompactDag& d = data_->grid.dag;
+    if (d.empty() || d.innerLevelCount() == 0 || d.log2Size > 62 || box.empty()) return;
+    const detail::Layer& layer = data_->active;
+    const bool mask = data_->valueSize == 0;
+    uint8_t value[sizeof(Accessor::Path::value)] = {};
+    size_t hint = 0;
+    bool stopped = false;
+    const auto overlaps = [&](int64_t x, int64_t y, int64_t z, unsigned log2) {
+        const int64_t c[3] = {x, y, z};
+        for (int a = 0; a < 3; ++a)
+            if (c[a] > box.max[a] || c[a] + ((int64_t(1) << log2) - 1) < box.min[a]) return false;
+        return true;
+    };
+    const auto emit = [&](const std::array<int64_t, 3>& corner, unsigned log2, uint64_t entry) {
+        if (!mask) layer.value(entry, value, hint);
+        stopped = !visit(corner, log2, mask ? nullptr : value);
+    };
+    const encoding::BrickInstanceVisitor brick = [&](const encoding::BrickInstance& b) {
+        if (stopped || !overlaps(b.x, b.y, b.z, 2)) return;
+        for (unsigned z = 0; z < 4 && !stopped; ++z)
+            for (unsigned y = 0; y < 4 && !stopped; ++y)
+                for (unsigned x = 0; x < 4 && !stopped; ++x) {
+                    const unsigned bit = access::dagStoredBit(x, y, z, b.mirror);
+                    if (((b.storedMask >> bit) & 1u) == 0) continue;
+                    const std::array<int64_t, 3> at{b.x + int64_t(x), b.y + int64_t(y), b.z + int64_t(z)};
+                    if (at[0] < box.min[0] || at[0] > box.max[0] || at[1] < box.min[1] || at[1] > box.max[1] || at[2] < box.min[2] || at[2] > box.max[2])
+                        continue;
+                    emit(at, 0, b.firstEntry + access::dagLeafRank(b.storedMask, bit));
+                }
+    };
+    const encoding::SolidVisitor solid = [&](int64_t x, int64_t y, int64_t z, unsigned log2, uint64_t entry) {
+        if (!stopped && overlaps(x, y, z, log2)) emit({x, y, z}, log2, entry);
+    };
+    for (const encoding::SubtreeInstance& s : encoding::subtreesInAttributeOrder(d, std::min<unsigned>(7, d.log2Size))) {
+        if (stopped) return;
+        if (!overlaps(s.x, s.y, s.z, s.log2Size)) continue;
+        if (s.solid) solid(s.x, s.y, s.z, s.log2Size, s.firstEntry);
+        else encoding::visitSubtreeInAttributeOrder(d, s, brick, solid);
+    }
+}
+
 unsigned Accessor::valueSize() const { return grid_->valueSize; }
 bool Accessor::maskGrid() const { return grid_->grid.record.valueType == ValueType::Mask; }
 

@@ -26,8 +26,11 @@ files the .ssvdag files were made from:
   - ../shared's bunny level set, when present: a box through its surface at
     level 0 from its .ssvdag and from the .vdb, and a contour at 0 of the
     default image, which has points;
-  - truncated .ssvdag and .vdb files: ParaView reports each, naming the
-    file, and does not crash.
+  - Output Type "Active Voxels" (cells) of a fog with tiles and of the
+    several grids, in a box: expanded to voxels, exactly OpenVDB's active
+    voxels of the box with their values, from the .ssvdag and the .vdb;
+  - truncated .ssvdag and .vdb files, and more active cells than Maximum
+    Cells: ParaView reports each, naming the file, and does not crash.
 usage: check_plugin.py BUILD_DIR PLUGIN.so PVPYTHON PV_SITE_PACKAGES
 """
 import json
@@ -177,6 +180,9 @@ with tempfile.TemporaryDirectory() as work:
         {"file": w("sphere_ls.ssvdag"), "out": w("diff.npz"), "properties": {"CompareWith": w("sphere_mod.ssvdag")}},
         {"file": w("sphere_ls.ssvdag"), "out": w("diff_vdb.npz"), "properties": {"CompareWith": w("sphere_mod.vdb")}},
     ] + [{"file": [f + ".ssvdag" for f in frames], "time": float(t), "out": w("frame%d.npz" % t)} for t in (2, 0, 1)]
+    cases += [{"file": w(name), "out": w(name + ".cells.npz"), "properties": {"OutputType": 1, "UseBox": 1, "Box": box}}
+              for name, box in (("fog_tiles.ssvdag", [-60, 20, -30, 40, -50, 10]), ("fog_tiles.vdb", [-60, 20, -30, 40, -50, 10]),
+                                ("multi_grid.ssvdag", [-50, 50, -50, 50, -50, 50]), ("multi_grid.vdb", [-50, 50, -50, 50, -50, 50]))]
     bunny_box = [-40, 55, -10, 85, -60, 35]  # x0 x1 y0 y1 z0 z1, through the ear's base and the back
     if os.path.exists(bunny):
         for name in ("bunny.ssvdag", "bunny.vdb"):
@@ -290,6 +296,41 @@ with tempfile.TemporaryDirectory() as work:
             check(int(surface["contour_points"]) > 10000, "%s: the contour at 0 of the default image (level %d) has %d points"
                   % (name, int(surface["level"]), int(surface["contour_points"])))
 
+    # Active voxels and tiles as cells, in a box: expanded to voxels, exactly
+    # OpenVDB's active voxels in the box (tiles whole) with their values.
+    for stem, box in (("fog_tiles", [-60, 20, -30, 40, -50, 10]), ("multi_grid", [-50, 50, -50, 50, -50, 50])):
+        meta = json.loads(subprocess.run([os.path.join(BUILD, "vdbdag_vdb_probe"), "meta", w(stem + ".vdb")],
+                                         check=True, capture_output=True, text=True).stdout)["grids"]
+        lo, hi = box[0::2], box[1::2]
+        for kind in ("ssvdag", "vdb"):
+            cells = load("%s.%s.cells.npz" % (stem, kind))
+            check(list(cells["blocks"]) == [g["name"] or "grid" for g in meta], "%s.%s cells: one block per grid %s" % (stem, kind, list(cells["blocks"])))
+            for n, g in enumerate(meta):
+                m = np.array(g["index_to_world"]).reshape(4, 4)
+                # Each cell's index box: corner 0 and 6 back through the transform (voxel centres at integers).
+                inv = np.linalg.inv(m)
+                c0 = np.rint((np.c_[cells["lo_%d" % n], np.ones(len(cells["lo_%d" % n]))] @ inv)[:, :3] + 0.5).astype(np.int64)
+                c6 = np.rint((np.c_[cells["hi_%d" % n], np.ones(len(cells["hi_%d" % n]))] @ inv)[:, :3] + 0.5).astype(np.int64)
+                got = {}
+                values = cells["values_%d" % n].reshape(len(c0), -1)
+                for a, b, v in zip(c0, c6, values):
+                    for z in range(a[2], b[2]):
+                        for y in range(a[1], b[1]):
+                            for x in range(a[0], b[0]):
+                                if lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1] and lo[2] <= z <= hi[2]:
+                                    got[(x, y, z)] = v.tobytes()
+                on, val = probe(w(stem + ".vdb"), g["name"], lo, hi)
+                axes = np.ogrid[lo[2]:hi[2] + 1, lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
+                kji = np.stack(np.broadcast_arrays(*axes), axis=-1).reshape(-1, 3)
+                want = {(int(c[2]), int(c[1]), int(c[0])): val[i].tobytes() for i, c in enumerate(kji) if on[i]}
+                if g["type"].endswith("bool_5_4_3"):  # bool cells hold one byte, as the probe prints it
+                    want = {k: v[:1] for k, v in want.items()}
+                if "MaskTree" in g["type"] or "mask" in g["type"]:
+                    got = {k: b"" for k in got}
+                    want = {k: b"" for k in want}
+                check(got == want, "%s.%s cells '%s': %d cells cover the box's %d active voxels with OpenVDB's values (%d wrong or missing)"
+                      % (stem, kind, g["name"] or "grid", len(c0), len(want), len(set(want.items()) ^ set(got.items()))))
+
     # Comparisons: every point of the union of both active boxes.
     lo, hi = [-42, -42, -42], [42, 42, 42]
     a_on, a_val = probe(w("sphere_ls.vdb"), "sphere", lo, hi)
@@ -315,12 +356,14 @@ with tempfile.TemporaryDirectory() as work:
         head = f.read(3000)
     with open(w("truncated.vdb"), "wb") as f:
         f.write(head)
-    for name in ("truncated.ssvdag", "truncated.vdb"):
-        done = dump(work, [{"file": w(name), "out": w(name + ".npz")}])
+    for name in ("truncated.ssvdag", "truncated.vdb", "multi_grid.ssvdag"):
+        properties = {"OutputType": 1, "MaximumCells": 0.001} if name == "multi_grid.ssvdag" else {}  # 1000 cells: too few
+        done = dump(work, [{"file": w(name), "out": w(name + ".npz"), "properties": properties}])
         line = next((l for l in done.stderr.splitlines() if "vtkVdbdagReader" in l and name in l), "")
         check(done.returncode == 0 and line != "", "%s: ParaView reports an error naming the file: %s" % (name, line.split("): ", 1)[-1][:120]))
         if os.path.exists(w(name + ".npz")):
-            check(np.prod(np.load(w(name + ".npz"))["dims"]) == 0, "%s: no image" % name)
+            saved = np.load(w(name + ".npz"))
+            check(np.prod(saved["dims"]) == 0 if "dims" in saved.files else len(saved["blocks"]) == 0, "%s: no image, no cells" % name)
 
 print("%d failure(s)" % len(failures))
 sys.exit(1 if failures else 0)

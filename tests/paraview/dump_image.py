@@ -27,6 +27,17 @@ for case in json.load(open(sys.argv[3])):
         reader.UpdatePipeline()
     reader.UpdatePropertyInformation()  # ChosenLevel of this update
     image = reader.GetClientSideObject().GetOutputDataObject(0)  # the builtin session's data of this update
+    if image.IsA("vtkMultiBlockDataSet"):  # Output Type "Active Voxels": per block, each cell's corners 0 and 6, and values
+        out = {"class": np.array(image.GetClassName()), "blocks": np.array(
+            [image.GetMetaData(b).Get(image.NAME()) for b in range(image.GetNumberOfBlocks())])}
+        for b in range(image.GetNumberOfBlocks()):
+            cells = image.GetBlock(b)
+            corners = vtk_to_numpy(cells.GetPoints().GetData()).reshape(-1, 8, 3)
+            out["lo_%d" % b], out["hi_%d" % b] = corners[:, 0, :], corners[:, 6, :]
+            out["values_%d" % b] = vtk_to_numpy(cells.GetCellData().GetArray(0))
+        np.savez(case["out"], **out)
+        print("dump_image: %s -> cells of %s" % (case["file"], list(out["blocks"])))
+        continue
     out = {
         "class": np.array(image.GetClassName()),
         "dims": np.array(image.GetDimensions()),

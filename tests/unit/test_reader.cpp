@@ -375,3 +375,76 @@ TEST(Reader, SampleBoxIsTheBruteForceAnswerAtEveryStride) {
     EXPECT_THROW(sampleCount(huge, 1), Error);
     std::filesystem::remove(path);
 }
+
+// Grid::forEachActive (the ParaView reader's active voxels): the cubes it
+// gives, expanded to voxels, are exactly the brute-force active voxels and
+// tiles with their values, in the whole grid and in a box (whose
+// overlapping cubes come whole); a visitor returning false stops the walk.
+TEST(Reader, ForEachActiveGivesTheActiveVoxelsAndTiles) {
+    std::mt19937 rng(9);
+    std::vector<Case> cases;
+    cases.push_back(shell(ValueType::Float, "float", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const float v = (r() % 4 == 0) ? float(r() % 7) : float(d);
+        std::memcpy(out, &v, 4);
+    }));
+    cases.push_back(shell(ValueType::Mask, "mask", rng, [](double, std::mt19937&, uint8_t*) {}));
+    std::vector<std::pair<Case*, bool>> grids;
+    for (Case& c : cases) grids.push_back({&c, true});
+    for (const bool symmetry : {true, false}) {
+        pipeline::EncodeOptions options;
+        options.symmetry = symmetry;
+        const auto path = writeFile(grids, options, symmetry ? "reader_active_ssvdag" : "reader_active_svdag");
+        const File file = File::open(path.string());
+        for (size_t g = 0; g < cases.size(); ++g) {
+            Reference ref;
+            ref.vs = valueSize(cases[g].active.type);
+            Reference::add(cases[g].active, ref.vs, ref.active, ref.activeTiles);
+            IndexBBox everything;
+            everything.min = {-1000, -1000, -1000};
+            everything.max = {1000, 1000, 1000};
+            IndexBBox box;
+            box.min = {-5, 3, -40};
+            box.max = {80, 30, 2};
+            for (const IndexBBox& b : {everything, box}) {
+                std::map<std::array<int64_t, 3>, std::string> got;
+                uint64_t repeated = 0, cubes = 0;
+                file.grid(g).forEachActive(b, [&](const std::array<int64_t, 3>& c, unsigned log2, const void* value) {
+                    ++cubes;
+                    const int64_t n = int64_t(1) << log2;
+                    for (int64_t z = 0; z < n; ++z)
+                        for (int64_t y = 0; y < n; ++y)
+                            for (int64_t x = 0; x < n; ++x)
+                                if (!got.emplace(std::array<int64_t, 3>{c[0] + x, c[1] + y, c[2] + z},
+                                                 value ? std::string(static_cast<const char*>(value), ref.vs) : std::string())
+                                         .second)
+                                    ++repeated;
+                    return true;
+                });
+                EXPECT_EQ(repeated, 0u) << cases[g].name << ": a voxel given twice";
+                // Every voxel given is active with its value; every active voxel in the box is given.
+                uint64_t wrong = 0, missing = 0;
+                for (const auto& [p, v] : got)
+                    if (!ref.isActive(p[0], p[1], p[2]) || (ref.vs && v != ref.value(p[0], p[1], p[2]))) ++wrong;
+                auto inBox = [&](int64_t x, int64_t y, int64_t z) {
+                    return x >= b.min[0] && x <= b.max[0] && y >= b.min[1] && y <= b.max[1] && z >= b.min[2] && z <= b.max[2];
+                };
+                for (const auto& [p, v] : ref.active)
+                    if (inBox(p[0], p[1], p[2]) && !got.count(p)) ++missing;
+                for (const auto& [t, v] : ref.activeTiles) {
+                    const int64_t n = int64_t(1) << t.log2Size;
+                    for (int64_t z = 0; z < n; ++z)
+                        for (int64_t y = 0; y < n; ++y)
+                            for (int64_t x = 0; x < n; ++x)
+                                if (inBox(t.x + x, t.y + y, t.z + z) && !got.count({t.x + x, t.y + y, t.z + z})) ++missing;
+                }
+                EXPECT_EQ(wrong, 0u) << cases[g].name << ": voxels given that are not active or hold another value";
+                EXPECT_EQ(missing, 0u) << cases[g].name << ": active voxels in the box not given";
+                EXPECT_GT(cubes, 100u) << cases[g].name;
+            }
+            uint64_t visits = 0;
+            file.grid(g).forEachActive(everything, [&](const std::array<int64_t, 3>&, unsigned, const void*) { return ++visits < 10; });
+            EXPECT_EQ(visits, 10u) << cases[g].name << ": the walk did not stop";
+        }
+        std::filesystem::remove(path);
+    }
+}

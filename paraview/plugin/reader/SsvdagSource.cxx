@@ -24,6 +24,11 @@ public:
     this->File.grid(g).sampleActive(box, stride, out);
   }
 
+  void forEachActive(size_t g, const vdbdag::IndexBBox& box, const vdbdag::Grid::ActiveVisitor& visit) const override
+  {
+    this->File.grid(g).forEachActive(box, visit);
+  }
+
 private:
   vdbdag::File File;
 };

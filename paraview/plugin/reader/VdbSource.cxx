@@ -10,6 +10,7 @@
 
 #include "vdb_bridge/detail/VdbFile.h"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
@@ -124,6 +125,58 @@ public:
     withTypedGrid(*this->VdbGrids.at(g), [&](const auto& grid, const char*) {
       auto accessor = grid.getConstAccessor();
       forEachSample(box, stride, [&](const openvdb::Coord& c, bool inside) { *out++ = inside && accessor.isValueOn(c) ? 1 : 0; });
+    });
+  }
+
+  void forEachActive(size_t g, const vdbdag::IndexBBox& box, const vdbdag::Grid::ActiveVisitor& visit) const override
+  {
+    if (box.empty())
+      return;
+    auto clamp = [](int64_t v) { return int32_t(std::max<int64_t>(INT32_MIN, std::min<int64_t>(INT32_MAX, v))); };
+    const openvdb::CoordBBox region(openvdb::Coord(clamp(box.min[0]), clamp(box.min[1]), clamp(box.min[2])),
+      openvdb::Coord(clamp(box.max[0]), clamp(box.max[1]), clamp(box.max[2])));
+    withTypedGrid(*this->VdbGrids.at(g), [&](const auto& grid, const char*) {
+      using Value = typename std::decay_t<decltype(grid)>::ValueType;
+      // The value's bytes as VolumeSource gives them (bool: one byte; mask: none).
+      auto bytesOf = [](const Value& v, uint8_t* out) -> const void* {
+        if constexpr (std::is_same_v<Value, openvdb::ValueMask>)
+          return nullptr;
+        else if constexpr (std::is_same_v<Value, bool>)
+        {
+          out[0] = v ? 1 : 0;
+          return out;
+        }
+        else
+        {
+          std::memcpy(out, &v, sizeof(Value));
+          return out;
+        }
+      };
+      uint8_t value[24] = {};
+      for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
+      {
+        if (!leaf->getNodeBoundingBox().hasOverlap(region))
+          continue;
+        for (auto v = leaf->cbeginValueOn(); v; ++v)
+        {
+          const openvdb::Coord c = v.getCoord();
+          if (region.isInside(c) && !visit({ c.x(), c.y(), c.z() }, 0, bytesOf(*v, value)))
+            return;
+        }
+      }
+      auto tiles = grid.tree().cbeginValueOn();
+      tiles.setMaxDepth(std::decay_t<decltype(tiles)>::LEAF_DEPTH - 1);
+      for (; tiles; ++tiles)
+      {
+        if (tiles.isVoxelValue())
+          continue;
+        const openvdb::CoordBBox b = tiles.getBoundingBox();
+        if (!b.hasOverlap(region))
+          continue;
+        const unsigned log2 = unsigned(openvdb::util::FindHighestOn(uint32_t(b.dim().x())));
+        if (!visit({ b.min().x(), b.min().y(), b.min().z() }, log2, bytesOf(*tiles, value)))
+          return;
+      }
     });
   }
 

@@ -35,6 +35,10 @@ public:
   virtual void sample(size_t g, const vdbdag::IndexBBox& box, uint64_t stride, void* out) const = 0;
   // Their active states, one byte each (1: active).
   virtual void sampleActive(size_t g, const vdbdag::IndexBBox& box, uint64_t stride, uint8_t* out) const = 0;
+  // Grid g's active voxels and tiles that overlap the box, as
+  // vdbdag::Grid::forEachActive gives them (a mask grid's value: nullptr;
+  // a bool's: one byte).
+  virtual void forEachActive(size_t g, const vdbdag::IndexBBox& box, const vdbdag::Grid::ActiveVisitor& visit) const = 0;
   // Opens an .ssvdag file (by its magic) or else a .vdb file; throws
   // std::runtime_error with one line naming the file.
   static std::unique_ptr<VolumeSource> open(const std::string& path);

@@ -4,15 +4,18 @@
 // VolumeSource (VolumeSource.h), blocks of slices on every core.
 #include "vtkVdbdagReader.h"
 
+#include "ActiveCells.h"
 #include "VolumeSource.h"
 
 #include "vtkCallbackCommand.h"
+#include "vtkCompositeDataSet.h"
 #include "vtkDataArraySelection.h"
 #include "vtkDoubleArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMultiBlockDataSet.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkSmartPointer.h"
@@ -214,7 +217,8 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
   Internals& in = *this->Internal;
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   int extent[6] = { 0, -1, 0, -1, 0, -1 }; // empty until the files are read
-  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  if (this->OutputType == 0)
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   if (!this->FileName || !*this->FileName)
   {
     vtkErrorMacro(<< "no file name");
@@ -345,6 +349,12 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
     const std::array<double, 3> origin = WorldOf(in.IndexToWorld, in.Box.empty() ? std::array<int64_t, 3>{ 0, 0, 0 } : in.Box.min);
     std::copy(origin.begin(), origin.end(), in.Origin);
     std::copy(extent, extent + 6, in.WholeExtent);
+    if (this->OutputType == 1) // cells: no extent
+    {
+      outInfo->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
+      outInfo->Remove(CAN_PRODUCE_SUB_EXTENT());
+      return 1;
+    }
     outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
     outInfo->Set(vtkDataObject::ORIGIN(), in.Origin, 3);
     outInfo->Set(vtkDataObject::SPACING(), in.Spacing, 3);
@@ -361,10 +371,73 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
   }
 }
 
+int vtkVdbdagReader::FillOutputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkDataObject"); // RequestDataObject makes the one OutputType asks for
+  return 1;
+}
+
+int vtkVdbdagReader::RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkDataObject* out = vtkDataObject::GetData(outInfo);
+  if (this->OutputType == 1 ? !vtkMultiBlockDataSet::SafeDownCast(out) : !vtkImageData::SafeDownCast(out))
+  {
+    vtkSmartPointer<vtkDataObject> made;
+    if (this->OutputType == 1)
+      made = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+    else
+      made = vtkSmartPointer<vtkImageData>::New();
+    outInfo->Set(vtkDataObject::DATA_OBJECT(), made);
+  }
+  return 1;
+}
+
 int vtkVdbdagReader::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  Internals& in = *this->Internal;
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  return this->OutputType == 1 ? this->RequestActiveCells(outInfo) : this->RequestImage(outInfo);
+}
+
+int vtkVdbdagReader::RequestActiveCells(vtkInformation* outInfo)
+{
+  Internals& in = *this->Internal;
+  vtkMultiBlockDataSet* out = vtkMultiBlockDataSet::GetData(outInfo);
+  if (!in.A.Source || !out)
+    return 0;
+  try
+  {
+    const uint64_t maxCells = uint64_t(this->MaximumCells * 1e6);
+    std::vector<vtkSmartPointer<vtkUnstructuredGrid>> blocks; // all or none: a failure leaves the output empty
+    for (size_t n = 0; n < in.Grids.size(); ++n)
+    {
+      const size_t g = in.Grids[n];
+      blocks.push_back(BuildActiveCells(*in.A.Source, g, in.Box, in.Names[g], maxCells, in.A.Path));
+      this->UpdateProgress(double(n + 1) / double(in.Grids.size()));
+    }
+    out->SetNumberOfBlocks(unsigned(blocks.size()));
+    for (size_t n = 0; n < blocks.size(); ++n)
+    {
+      out->SetBlock(unsigned(n), blocks[n]);
+      out->GetMetaData(unsigned(n))->Set(vtkCompositeDataSet::NAME(), in.Names[in.Grids[n]].c_str());
+    }
+  }
+  catch (const std::bad_alloc&)
+  {
+    vtkErrorMacro(<< in.A.Path << ": out of memory for the active cells (choose a Box)");
+    return 0;
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro(<< e.what());
+    return 0;
+  }
+  return 1;
+}
+
+int vtkVdbdagReader::RequestImage(vtkInformation* outInfo)
+{
+  Internals& in = *this->Internal;
   vtkImageData* out = vtkImageData::GetData(outInfo);
   if (!in.A.Source || !out)
     return 0;
@@ -536,6 +609,7 @@ void vtkVdbdagReader::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
   os << indent << "CompareWith: " << (this->CompareWith ? this->CompareWith : "(none)") << "\n";
+  os << indent << "OutputType: " << (this->OutputType == 1 ? "active voxels and tiles" : "image") << "\n";
   os << indent << "LevelOfDetail: " << this->LevelOfDetail << " (chosen " << this->ChosenLevel << ")\n";
   os << indent << "MaximumCells: " << this->MaximumCells << " million\n";
   os << indent << "UseBox: " << this->UseBox << " Box: " << this->Box[0] << " " << this->Box[1] << " " << this->Box[2] << " "

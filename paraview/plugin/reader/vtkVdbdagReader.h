@@ -15,6 +15,11 @@
 // centres, as OpenVDB's index space). Grids whose transform differs from the
 // first selected grid's are left out with a warning.
 //
+// With OutputType 1 the output is instead the selected grids' active voxels
+// and tiles in the same box as cells (a vtkMultiBlockDataSet of one
+// vtkUnstructuredGrid per grid, ActiveCells.h), at full resolution, up to
+// MaximumCells million cells per grid: what `vdbdag export` writes.
+//
 // With CompareWith set to a second file, each selected grid is compared with
 // the grid of the same name there, as `vdbdag diff` does, over the union of
 // both active boxes: arrays "a", "b", "abs_error" (|a - b|, the Euclidean
@@ -25,7 +30,7 @@
 #ifndef vtkVdbdagReader_h
 #define vtkVdbdagReader_h
 
-#include "vtkImageAlgorithm.h"
+#include "vtkDataObjectAlgorithm.h"
 #include "vtkVdbdagVolumeReaderModule.h"
 
 #include <memory>
@@ -33,11 +38,11 @@
 class vtkCallbackCommand;
 class vtkDataArraySelection;
 
-class VTKVDBDAGVOLUMEREADER_EXPORT vtkVdbdagReader : public vtkImageAlgorithm
+class VTKVDBDAGVOLUMEREADER_EXPORT vtkVdbdagReader : public vtkDataObjectAlgorithm
 {
 public:
   static vtkVdbdagReader* New();
-  vtkTypeMacro(vtkVdbdagReader, vtkImageAlgorithm);
+  vtkTypeMacro(vtkVdbdagReader, vtkDataObjectAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   vtkSetStringMacro(FileName);
@@ -66,6 +71,9 @@ public:
   vtkBooleanMacro(UseBox, vtkTypeBool);
   vtkSetVector6Macro(Box, int);
   vtkGetVector6Macro(Box, int);
+  // 0 (the default): the image; 1: the active voxels and tiles as cells.
+  vtkSetClampMacro(OutputType, int, 0, 1);
+  vtkGetMacro(OutputType, int);
   // A second file to compare with (empty: none).
   vtkSetStringMacro(CompareWith);
   vtkGetStringMacro(CompareWith);
@@ -77,15 +85,20 @@ protected:
   ~vtkVdbdagReader() override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
 private:
   vtkVdbdagReader(const vtkVdbdagReader&) = delete;
   void operator=(const vtkVdbdagReader&) = delete;
   static void SelectionModified(vtkObject*, unsigned long, void* clientdata, void*);
+  int RequestImage(vtkInformation* outInfo);
+  int RequestActiveCells(vtkInformation* outInfo);
 
   char* FileName = nullptr;
   char* CompareWith = nullptr;
   int LevelOfDetail = -1;
+  int OutputType = 0;
   double MaximumCells = 64;
   vtkTypeBool UseBox = 0;
   int Box[6] = { 0, 0, 0, 0, 0, 0 };
