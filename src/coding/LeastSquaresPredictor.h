@@ -44,6 +44,7 @@
 namespace vdbdag::coding::detail {
 
 inline constexpr int kLsTaps = 19;  // the near seven besides W, and the far twelve
+inline constexpr int kLsStride = 24;  // a row of the float sums: kLsTaps, padded to whole AVX2 vectors
 inline constexpr int kLsPeriod = 32;       // samples of a fit between solves
 inline constexpr double kLsDecay = 0.95;   // what the sums keep at each solve
 inline constexpr double kLsTiny = 0x1p-600;  // below this a sum or weight is 0
@@ -54,16 +55,27 @@ inline constexpr double kLsRidge = 1e-3;   // of the mean diagonal
 // neighbour: its nearest coded substitute).
 enum FarNeighbour { kWW, kNN, kPP, kPE, kPS, kPNE, kPSW, kPSE, kNWW, kNNE, kNNW, kNEE, kFarNeighbours };
 
+// pa[i kLsStride + j] += x[i] x[j] (j < kLsStride, x zero past kLsTaps) and
+// pb[i] += x[i] y, for i < kLsTaps, each a float product added in turn
+// (LeastSquaresKernels.cpp).
+void addProducts(float* pa, float* pb, const float* x, float y);
+// Solves (A + r I) w = b (A kLsTaps^2, row-major; r kLsRidge times A's mean
+// diagonal, plus 1e-6) by Cholesky and stores w in c, unless a pivot is not
+// positive or a weight is not finite (c then keeps its weights); weights
+// below kLsTiny are 0 (LeastSquaresKernels.cpp).
+void solveFit(const double* a, const double* b, double* c);
+
 struct LeastSquaresFit {
     std::array<double, kLsTaps * kLsTaps> a{};  // sum x x^T (the solve reads the lower triangle)
     std::array<double, kLsTaps> b{};            // sum x y
     std::array<double, kLsTaps> c{};            // the weights
     int count = 0;                              // samples since the last solve
-    // This period's sums, in float: 4 products a step (SSE2), 1.3x faster
-    // overall; exact for samples of up to 9 bits (|x| < 724: 32 x^2 < 2^24),
-    // and rounded alike everywhere beyond.
-    alignas(16) std::array<float, kLsTaps * kLsTaps> pa{};
-    alignas(16) std::array<float, kLsTaps> pb{};
+    // This period's sums, in float: 4 or 8 products a step (SSE2, AVX2:
+    // LeastSquaresKernels.cpp), 1.3x faster overall than doubles; exact for
+    // samples of up to 9 bits (|x| < 724: 32 x^2 < 2^24), and rounded alike
+    // everywhere beyond. Rows of kLsStride, the padding's sums 0 and unused.
+    alignas(32) std::array<float, kLsTaps * kLsStride> pa{};
+    alignas(32) std::array<float, kLsTaps> pb{};
 
     // The prediction for the neighbours `x` (relative to `ref`), unrounded.
     double predict(const std::array<double, kLsTaps>& x, double ref) const {
@@ -73,17 +85,14 @@ struct LeastSquaresFit {
     }
 
     void learn(const std::array<double, kLsTaps>& x, double y) {
-        float xf[kLsTaps];
+        alignas(32) float xf[kLsStride] = {};
         for (int i = 0; i < kLsTaps; ++i) xf[i] = float(x[size_t(i)]);
-        const float yf = float(y);
-        for (int i = 0; i < kLsTaps; ++i) {
-            const float xi = xf[i];
-            for (int j = 0; j < kLsTaps; ++j) pa[size_t(i * kLsTaps + j)] += xi * xf[j];
-            pb[size_t(i)] += xi * yf;
-        }
+        addProducts(pa.data(), pb.data(), xf, float(y));
         if (++count < kLsPeriod) return;
         count = 0;
-        for (size_t i = 0; i < a.size(); ++i) a[i] += double(pa[i]), pa[i] = 0;
+        for (size_t i = 0; i < size_t(kLsTaps); ++i)
+            for (size_t j = 0; j < size_t(kLsTaps); ++j) a[i * kLsTaps + j] += double(pa[i * kLsStride + j]);
+        pa.fill(0.0f);
         for (size_t i = 0; i < b.size(); ++i) b[i] += double(pb[i]), pb[i] = 0;
         solve();
         for (double& v : a) v = std::abs(v) < kLsTiny ? 0.0 : v * kLsDecay;
@@ -91,47 +100,8 @@ struct LeastSquaresFit {
     }
 
 private:
-    // A + r I = L L^T by Cholesky, then L z = b and L^T w = z. Each
-    // element of L and z is a_ij (b_i) less its products in increasing k,
-    // then scaled: written column by column ("right-looking", L's columns
-    // contiguous: col[k][i] = L(i, k)), so the compiler vectorises the
-    // updates without reordering any element's sums.
-    void solve() {
-        constexpr size_t T = kLsTaps;
-        double trace = 0;
-        for (size_t i = 0; i < T; ++i) trace += a[i * T + i];
-        const double ridge = kLsRidge * trace / kLsTaps + 1e-6;
-        std::array<double, T * T> col{};
-        std::array<double, T> inv{};  // 1 / L's diagonal
-        for (size_t k = 0; k < T; ++k)
-            for (size_t i = k; i < T; ++i) col[k * T + i] = a[i * T + k] + (i == k ? ridge : 0.0);
-        std::array<double, T> z = b;
-        for (size_t j = 0; j < T; ++j) {
-            double* cj = &col[j * T];
-            if (!(cj[j] > 0)) return;  // keep the previous weights
-            cj[j] = std::sqrt(cj[j]);
-            inv[j] = 1.0 / cj[j];
-            for (size_t i = j + 1; i < T; ++i) cj[i] *= inv[j];
-            for (size_t k = j + 1; k < T; ++k) {
-                double* ck = &col[k * T];
-                const double f = cj[k];
-                for (size_t i = k; i < T; ++i) ck[i] -= cj[i] * f;
-            }
-            z[j] *= inv[j];
-            for (size_t i = j + 1; i < T; ++i) z[i] -= cj[i] * z[j];
-        }
-        std::array<double, T> w{};
-        for (size_t i = T; i-- > 0;) {
-            double s = z[i];
-            for (size_t k = i + 1; k < T; ++k) s -= col[i * T + k] * w[k];
-            w[i] = s * inv[i];
-        }
-        for (double& v : w) {
-            if (!std::isfinite(v)) return;
-            if (std::abs(v) < kLsTiny) v = 0;
-        }
-        c = w;
-    }
+    // (A + r I) c = b, c kept where the solve fails (solveFit).
+    void solve() { solveFit(a.data(), b.data(), c.data()); }
 };
 
 } // namespace vdbdag::coding::detail
