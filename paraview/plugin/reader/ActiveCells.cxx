@@ -17,6 +17,26 @@
 #include <stdexcept>
 #include <vector>
 
+vtkSmartPointer<vtkDataArray> ValueArray(const VolumeGrid& grid, const std::string& name, vtkIdType tuples)
+{
+  vtkSmartPointer<vtkDataArray> array;
+  const std::string& type = grid.type;
+  if (type == "float" || type == "vec3s")
+    array = vtkSmartPointer<vtkFloatArray>::New();
+  else if (type == "double" || type == "vec3d")
+    array = vtkSmartPointer<vtkDoubleArray>::New();
+  else if (type == "int32" || type == "vec3i")
+    array = vtkSmartPointer<vtkTypeInt32Array>::New();
+  else if (type == "int64")
+    array = vtkSmartPointer<vtkTypeInt64Array>::New();
+  else // "bool" (one byte), "mask" (the active state)
+    array = vtkSmartPointer<vtkUnsignedCharArray>::New();
+  array->SetNumberOfComponents(type.rfind("vec3", 0) == 0 ? 3 : 1);
+  array->SetName(name.c_str());
+  array->SetNumberOfTuples(tuples);
+  return array;
+}
+
 vtkSmartPointer<vtkUnstructuredGrid> BuildActiveCells(const VolumeSource& source, size_t g, const vdbdag::IndexBBox& box,
   const std::string& name, uint64_t maxCells, const std::string& path)
 {
@@ -71,21 +91,7 @@ vtkSmartPointer<vtkUnstructuredGrid> BuildActiveCells(const VolumeSource& source
   hexahedra->SetData(offsets, connectivity);
   out->SetCells(VTK_HEXAHEDRON, hexahedra);
 
-  vtkSmartPointer<vtkDataArray> array;
-  const std::string& type = grid.type;
-  if (type == "float" || type == "vec3s")
-    array = vtkSmartPointer<vtkFloatArray>::New();
-  else if (type == "double" || type == "vec3d")
-    array = vtkSmartPointer<vtkDoubleArray>::New();
-  else if (type == "int32" || type == "vec3i")
-    array = vtkSmartPointer<vtkTypeInt32Array>::New();
-  else if (type == "int64")
-    array = vtkSmartPointer<vtkTypeInt64Array>::New();
-  else
-    array = vtkSmartPointer<vtkUnsignedCharArray>::New();
-  array->SetNumberOfComponents(type.rfind("vec3", 0) == 0 ? 3 : 1);
-  array->SetName(name.c_str());
-  array->SetNumberOfTuples(vtkIdType(cells));
+  vtkSmartPointer<vtkDataArray> array = ValueArray(grid, name, vtkIdType(cells));
   if (row && cells)
     std::memcpy(array->GetVoidPointer(0), values.data(), values.size());
   else if (cells) // a mask grid: every cell is active

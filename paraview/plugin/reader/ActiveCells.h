@@ -8,10 +8,16 @@
 
 #include "VolumeSource.h"
 
+#include "vtkDataArray.h"
 #include "vtkSmartPointer.h"
 #include "vtkUnstructuredGrid.h"
 
 #include <string>
+
+// A VTK array for `tuples` values of the grid's type, named `name`: float,
+// double, int32 and int64 as themselves, vectors as 3 components, bool and
+// mask as unsigned char (0/1). The reader's image and its cells both use it.
+vtkSmartPointer<vtkDataArray> ValueArray(const VolumeGrid& grid, const std::string& name, vtkIdType tuples);
 
 // Throws std::runtime_error when the box holds more than maxCells cells.
 vtkSmartPointer<vtkUnstructuredGrid> BuildActiveCells(const VolumeSource& source, size_t grid, const vdbdag::IndexBBox& box,

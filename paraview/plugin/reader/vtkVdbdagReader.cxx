@@ -11,7 +11,6 @@
 #include "vtkCompositeDataSet.h"
 #include "vtkDataArraySelection.h"
 #include "vtkDoubleArray.h"
-#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -20,8 +19,6 @@
 #include "vtkPointData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
-#include "vtkTypeInt32Array.h"
-#include "vtkTypeInt64Array.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
@@ -89,26 +86,6 @@ void AxesOf(const std::array<double, 16>& m, uint64_t stride, double spacing[3],
     for (int r = 0; r < 3; ++r)
       direction[3 * r + a] = len > 0 ? m[4 * a + r] / len : (r == a ? 1.0 : 0.0);
   }
-}
-
-vtkSmartPointer<vtkDataArray> ArrayFor(const VolumeGrid& grid, const std::string& name, vtkIdType points)
-{
-  vtkSmartPointer<vtkDataArray> array;
-  const std::string& type = grid.type;
-  if (type == "float" || type == "vec3s")
-    array = vtkSmartPointer<vtkFloatArray>::New();
-  else if (type == "double" || type == "vec3d")
-    array = vtkSmartPointer<vtkDoubleArray>::New();
-  else if (type == "int32" || type == "vec3i")
-    array = vtkSmartPointer<vtkTypeInt32Array>::New();
-  else if (type == "int64")
-    array = vtkSmartPointer<vtkTypeInt64Array>::New();
-  else // "bool" (one byte), "mask" (the active state)
-    array = vtkSmartPointer<vtkUnsignedCharArray>::New();
-  array->SetNumberOfComponents(type.rfind("vec3", 0) == 0 ? 3 : 1);
-  array->SetName(name.c_str());
-  array->SetNumberOfTuples(points);
-  return array;
 }
 
 // Component c of a value of `type` as a double.
@@ -534,7 +511,7 @@ int vtkVdbdagReader::RequestImage(vtkInformation* outInfo)
       const size_t row = std::max(1u, grid.valueSize);
       if (!compare)
       {
-        vtkSmartPointer<vtkDataArray> values = ArrayFor(grid, in.Names[g], points);
+        vtkSmartPointer<vtkDataArray> values = ValueArray(grid, in.Names[g], points);
         auto* bytes = static_cast<uint8_t*>(values->GetVoidPointer(0));
         if (!forSlabs([&](uint64_t zb, uint64_t, const vdbdag::IndexBBox& slab) {
               in.A.Source->sample(g, slab, in.Stride, bytes + zb * slice * row);
@@ -549,7 +526,7 @@ int vtkVdbdagReader::RequestImage(vtkInformation* outInfo)
       }
       // Compared with B's grid of the same name, as `vdbdag diff` does.
       const std::string prefix = in.Grids.size() > 1 ? in.Names[g] + " " : "";
-      vtkSmartPointer<vtkDataArray> a = ArrayFor(grid, prefix + "a", points), b = ArrayFor(grid, prefix + "b", points);
+      vtkSmartPointer<vtkDataArray> a = ValueArray(grid, prefix + "a", points), b = ValueArray(grid, prefix + "b", points);
       vtkNew<vtkDoubleArray> error;
       error->SetName((prefix + "abs_error").c_str());
       error->SetNumberOfTuples(points);
