@@ -10,7 +10,9 @@
 #include <array>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace py = pybind11;
 
@@ -81,37 +83,73 @@ py::array_t<bool> isActive(const PyGrid& g, const Coords& ijk) {
     return out;
 }
 
-// The values of an inclusive index box ((x0, y0, z0), (x1, y1, z1)) as an
-// array of shape (x1-x0+1, y1-y0+1, z1-z0+1[, 3]): out[i-x0, j-y0, k-z0].
-py::array dense(const PyGrid& g, const std::array<std::array<int64_t, 3>, 2>& box) {
-    const auto& [lo, hi] = box;
-    std::vector<py::ssize_t> shape;
-    uint64_t cells = 1;
-    for (int a = 0; a < 3; ++a) {
-        if (hi[a] < lo[a]) throw py::value_error("dense: the box's maximum is below its minimum on axis " + std::to_string(a));
-        const uint64_t n = uint64_t(hi[a] - lo[a]) + 1;
-        if (n > (uint64_t(1) << 31) || cells > (uint64_t(1) << 40) / n) throw py::value_error("dense: the box is too large");
-        cells *= n;
-        shape.push_back(py::ssize_t(n));
-    }
+vdbdag::IndexBBox toBox(const std::array<std::array<int64_t, 3>, 2>& box, const char* what) {
+    vdbdag::IndexBBox b;
+    b.min = box[0];
+    b.max = box[1];
+    for (int a = 0; a < 3; ++a)
+        if (b.max[a] < b.min[a]) throw py::value_error(std::string(what) + ": the box's maximum is below its minimum on axis " + std::to_string(a));
+    return b;
+}
+
+// The values of an inclusive index box ((x0, y0, z0), (x1, y1, z1)) every
+// `stride` voxels (vdbdag::Grid::sampleBox) as an array of shape (nx, ny,
+// nz[, 3]): out[a, b, c] is the voxel (x0 + a stride, y0 + b stride, z0 + c
+// stride). Its memory is i fastest (Fortran order), as sampleBox writes it.
+py::array dense(const PyGrid& g, const std::array<std::array<int64_t, 3>, 2>& box, uint64_t stride) {
+    if (stride == 0) throw py::value_error("dense: stride must be at least 1");
+    const vdbdag::IndexBBox b = toBox(box, "dense");
+    const std::array<uint64_t, 3> dims = vdbdag::sampleDims(b, stride);
+    if (vdbdag::sampleCount(b, stride) > (uint64_t(1) << 40)) throw py::value_error("dense: the box is too large");
     const Layout layout = layoutOf(g.grid->valueType());
-    if (layout.components == 3) shape.push_back(3);
-    const unsigned vs = g.grid->valueSize();
-    py::array out(layout.dtype, shape);
-    auto* bytes = static_cast<uint8_t*>(out.mutable_data());
+    const py::ssize_t row = py::ssize_t(std::max(1u, g.grid->valueSize())), item = py::ssize_t(layout.dtype.itemsize());
+    std::vector<py::ssize_t> shape{py::ssize_t(dims[0]), py::ssize_t(dims[1]), py::ssize_t(dims[2])};
+    std::vector<py::ssize_t> strides{row, row * shape[0], row * shape[0] * shape[1]};
+    if (layout.components == 3) {
+        shape.push_back(3);
+        strides.push_back(item);
+    }
+    py::array out(layout.dtype, shape, strides);
+    void* bytes = out.mutable_data();
     py::gil_scoped_release release;
-    vdbdag::Accessor a = g.grid->accessor();
-    size_t at = 0;
-    for (int64_t i = lo[0]; i <= hi[0]; ++i)
-        for (int64_t j = lo[1]; j <= hi[1]; ++j)
-            for (int64_t k = lo[2]; k <= hi[2]; ++k) {  // k fastest: C order of (i, j, k)
-                if (vs == 0) bytes[at++] = a.isActive(i, j, k) ? 1 : 0;
-                else {
-                    a.valueBytes(i, j, k, bytes + at);
-                    at += vs;
-                }
-            }
+    g.grid->sampleBox(b, stride, bytes);
     return out;
+}
+
+// The active voxels and tiles overlapping a box (vdbdag::Grid::forEachActive):
+// (corners (N, 3) int64, log2 of each cube's edge (N,) uint8, values (N,) or
+// (N, 3), None for a mask grid).
+py::tuple activeVoxels(const PyGrid& g, const std::optional<std::array<std::array<int64_t, 3>, 2>>& box) {
+    vdbdag::IndexBBox b;
+    if (box) b = toBox(*box, "active_voxels");
+    else {
+        b.min = {INT64_MIN / 4, INT64_MIN / 4, INT64_MIN / 4};
+        b.max = {INT64_MAX / 4, INT64_MAX / 4, INT64_MAX / 4};
+    }
+    const unsigned vs = g.grid->valueSize();
+    std::vector<int64_t> corners;
+    std::vector<uint8_t> sizes, values;
+    {
+        py::gil_scoped_release release;
+        g.grid->forEachActive(b, [&](const std::array<int64_t, 3>& c, unsigned log2, const void* value) {
+            corners.insert(corners.end(), c.begin(), c.end());
+            sizes.push_back(uint8_t(log2));
+            if (vs) values.insert(values.end(), static_cast<const uint8_t*>(value), static_cast<const uint8_t*>(value) + vs);
+            return true;
+        });
+    }
+    const py::ssize_t n = py::ssize_t(sizes.size());
+    py::array_t<int64_t> c({n, py::ssize_t(3)});
+    if (n) std::memcpy(c.mutable_data(), corners.data(), corners.size() * sizeof(int64_t));
+    py::array_t<uint8_t> l(n);
+    if (n) std::memcpy(l.mutable_data(), sizes.data(), sizes.size());
+    if (vs == 0) return py::make_tuple(c, l, py::none());
+    const Layout layout = layoutOf(g.grid->valueType());
+    std::vector<py::ssize_t> shape{n};
+    if (layout.components == 3) shape.push_back(3);
+    py::array v(layout.dtype, shape);
+    if (n) std::memcpy(v.mutable_data(), values.data(), values.size());
+    return py::make_tuple(c, l, v);
 }
 
 } // namespace
@@ -140,7 +178,11 @@ PYBIND11_MODULE(_vdbdag, m) {
                                })
         .def("values", &values, py::arg("ijk"), "values at an (N, 3) array of index coordinates: (N,) or (N, 3) for vectors, exact")
         .def("is_active", &isActive, py::arg("ijk"), "whether the voxels at an (N, 3) array of index coordinates are active")
-        .def("dense", &dense, py::arg("bbox"), "values of the inclusive box ((x0, y0, z0), (x1, y1, z1)), indexed [i-x0, j-y0, k-z0]")
+        .def("dense", &dense, py::arg("bbox"), py::arg("stride") = 1,
+             "values of the inclusive box ((x0, y0, z0), (x1, y1, z1)) every `stride` voxels (a level of detail), indexed "
+             "[(i-x0)/stride, (j-y0)/stride, (k-z0)/stride]")
+        .def("active_voxels", &activeVoxels, py::arg("bbox") = py::none(),
+             "the active voxels and tiles (overlapping the box, if given): (corners (N, 3), log2 edge (N,), values or None for a mask)")
         .def("__repr__", [](const PyGrid& g) { return "<vdbdag.Grid '" + g.grid->name() + "' " + g.grid->valueType() + ">"; });
 
     py::class_<vdbdag::File, std::shared_ptr<vdbdag::File>>(m, "File")

@@ -116,6 +116,57 @@ def test_dense_block_equals_pyopenvdb_copy_to_array(work):
     assert block.tobytes() == want.tobytes()
 
 
+def test_dense_with_a_stride_equals_every_nth_voxel(work):
+    vdb = sphere_file(work)
+    path = encoded(work, vdb)
+    for name, lo, hi in (("sphere", (-70, -70, -60), (70, 66, 70)), ("velocity", (-41, -40, -40), (40, 39, 41))):
+        g = vdbdag.open(path).grid(name)
+        ref = openvdb.read(vdb, name)
+        shape = tuple(h - l + 1 for l, h in zip(lo, hi))
+        want = np.zeros(shape + ((3,) if name == "velocity" else ()), dtype=np.float32)
+        ref.copyToArray(want, ijk=lo)
+        for stride in (1, 3, 8):
+            block = g.dense((lo, hi), stride=stride)
+            assert block.shape == want[::stride, ::stride, ::stride].shape
+            assert block.tobytes() == np.ascontiguousarray(want[::stride, ::stride, ::stride]).tobytes(), (name, stride)
+
+
+def test_active_voxels_and_tiles_equal_pyopenvdb(work):
+    vdb = os.path.join(work, "tiles.vdb")
+    grid = openvdb.FloatGrid()
+    grid.name = "density"
+    grid.fill((0, 0, 0), (31, 15, 7), 2.5)  # tiles where whole 8^3 nodes are filled
+    acc = grid.getAccessor()
+    rng = np.random.default_rng(3)
+    for _ in range(500):
+        acc.setValueOn(tuple(int(v) for v in rng.integers(-20, 50, 3)), float(rng.normal()))
+    grid.prune()
+    openvdb.write(vdb, grids=[grid])
+    g = vdbdag.open(encoded(work, vdb)).grid("density")
+    # OpenVDB's active values, voxels and tiles, expanded to voxels.
+    want = {}
+    for item in grid.citerOnValues():
+        lo, hi = item["min"], item["max"]
+        for z in range(lo[2], hi[2] + 1):
+            for y in range(lo[1], hi[1] + 1):
+                for x in range(lo[0], hi[0] + 1):
+                    want[(x, y, z)] = np.float32(item["value"]).tobytes()
+    for box in (None, ((-5, 0, 0), (20, 40, 60))):
+        corners, log2, values = g.active_voxels(box)
+        got = {}
+        for c, l, v in zip(corners, log2, values):
+            n = 1 << int(l)
+            for z in range(n):
+                for y in range(n):
+                    for x in range(n):
+                        p = (int(c[0]) + x, int(c[1]) + y, int(c[2]) + z)
+                        if box is None or all(box[0][a] <= p[a] <= box[1][a] for a in range(3)):
+                            got[p] = v.tobytes()
+        expected = want if box is None else {p: v for p, v in want.items() if all(box[0][a] <= p[a] <= box[1][a] for a in range(3))}
+        assert got == expected
+        assert (log2 > 0).any() or box is not None
+
+
 def test_encode_decode_round_trip_is_exact(work):
     vdb = sphere_file(work)
     path = encoded(work, vdb)
