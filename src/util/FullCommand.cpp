@@ -18,27 +18,25 @@ std::vector<std::string>& savedArguments() {
     return arguments;
 }
 
-constexpr const char* kFullProgram = "vdbdag-full";
-
 } // namespace
 
 void rememberCommandLine(int argc, char** argv) {
     savedArguments().assign(argv, argv + argc);
 }
 
-std::string fullCommandPath() {
+std::string helperCommandPath(const std::string& name) {
     namespace fs = std::filesystem;
     std::error_code ec;
     const fs::path program = fs::read_symlink("/proc/self/exe", ec);
     if (ec) return "";
-    for (const fs::path& candidate : {program.parent_path() / kFullProgram, program.parent_path().parent_path() / "lib" / "vdbdag" / kFullProgram})
+    for (const fs::path& candidate : {program.parent_path() / name, program.parent_path().parent_path() / "lib" / "vdbdag" / name})
         if (fs::exists(candidate, ec) && access(candidate.c_str(), X_OK) == 0) return candidate.string();
     return "";
 }
 
-void runFullCommand(const std::string& feature) {
-    const std::string path = fullCommandPath();
-    if (path.empty()) throw Error(feature + " needs " + kFullProgram + ", which is not installed beside this vdbdag");
+void runHelperCommand(const std::string& name, const std::string& feature) {
+    const std::string path = helperCommandPath(name);
+    if (path.empty()) throw Error(feature + " needs " + name + ", which is not installed beside this vdbdag");
     if (savedArguments().empty()) throw Error("internal error: " + feature + " needs the command line, which was not saved");
     std::vector<std::string> arguments = savedArguments();
     arguments[0] = path;

@@ -223,3 +223,21 @@ TEST(SelftestCli, RunsAFilteredSetPrintsJsonAndRejectsAnUnknownFilter) {
     EXPECT_NE(r.err.find("no case matches 'no-such-case'"), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
 }
+
+// Issue 41 item 6: the self-test cases and the test oracles are a library
+// of their own that no product links. By nm (binutils): vdbdag, vdbdag-full
+// and vdbdag-mpi hold none of their symbols; `vdbdag selftest` still runs,
+// through the vdbdag-selftest helper, and lists every case.
+TEST(SelftestRegistry, TheProductsLinkNoSelftestCode) {
+    const std::filesystem::path dir = std::filesystem::path(VDBDAG_BINARY).parent_path();
+    std::vector<std::string> products{"vdbdag", "vdbdag-full"};
+    if (std::filesystem::exists(dir / "vdbdag-mpi")) products.push_back("vdbdag-mpi");
+    for (const std::string& p : products) {
+        const auto r = vdbdag::testing::runShell("nm -C " + (dir / p).string() +
+                                                 " | grep -c 'selftest::runCase\\|SyntheticGrid\\|ExactRayReference\\|exactFirstHit' || true");
+        EXPECT_EQ(r.out, "0\n") << p << " links self-test code";
+    }
+    const auto list = vdbdag::testing::runCli("selftest --list --json");
+    ASSERT_EQ(list.exitCode, 0) << list.err;
+    EXPECT_EQ(nlohmann::json::parse(list.out).size(), vdbdag::selftest::selftestCases().size());
+}
