@@ -124,10 +124,10 @@ std::string formatGridHeader(const nlohmann::json& g) {
         size_t count = 0;
         std::string summary;
     };
-    HeaderGroup groups[] = {{"nifti_", "NIfTI header fields", {"nifti_version", "nifti_qform_code", "nifti_sform_code", "nifti_intent_code", "nifti_descrip"}},
-                            {"dicom_", "DICOM tags", {"dicom_Modality", "dicom_SeriesDescription", "dicom_SeriesInstanceUID"}},
-                            {"nrrd_", "NRRD fields and key/value pairs", {}},
-                            {"mha_tag_", "MetaImage tags", {}}};
+    HeaderGroup groups[] = {{"nifti_", "NIfTI header fields", {"nifti_version", "nifti_qform_code", "nifti_sform_code", "nifti_intent_code", "nifti_descrip"}, 0, {}},
+                            {"dicom_", "DICOM tags", {"dicom_Modality", "dicom_SeriesDescription", "dicom_SeriesInstanceUID"}, 0, {}},
+                            {"nrrd_", "NRRD fields and key/value pairs", {}, 0, {}},
+                            {"mha_tag_", "MetaImage tags", {}, 0, {}}};
     for (const auto& [name, e] : g["metadata"].items()) {
         HeaderGroup* group = nullptr;
         for (HeaderGroup& h : groups)

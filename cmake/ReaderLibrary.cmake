@@ -22,7 +22,6 @@ target_include_directories(vdbdag_lib
   PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
 target_link_libraries(vdbdag_lib PRIVATE zstd::libzstd_shared PkgConfig::XXHASH)
 target_link_options(vdbdag_lib PRIVATE -Wl,--no-undefined -Wl,--as-needed)
-target_compile_options(vdbdag_lib PRIVATE -Wall -Wextra)
 if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
   target_compile_options(vdbdag_lib PRIVATE -mpopcnt)
 endif()

@@ -43,7 +43,8 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 BUILD_TYPE=${BUILD_TYPE:-Release}
-if ! cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE" > build.configure.log 2>&1; then
+# VDBDAG_WERROR=ON (scripts/test.sh, so CI): our code's warnings are errors (kept in the cache).
+if ! cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE" ${VDBDAG_WERROR:+-DVDBDAG_WERROR=$VDBDAG_WERROR} > build.configure.log 2>&1; then
   cat build.configure.log; exit 1
 fi
 TARGETS=${VDBDAG_BUILD_TARGETS:-}

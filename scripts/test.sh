@@ -5,7 +5,7 @@
 # Tests that need ../shared/data skip cleanly when it is absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
+VDBDAG_WERROR=ON scripts/setup.sh  # warnings of our own code are errors here
 (cd build && ctest --output-on-failure --timeout 900 -j"$(nproc)")
 # The core library and its unit tests again under ASan + UBSan (build-asan).
 scripts/sanitize.sh

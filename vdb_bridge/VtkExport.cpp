@@ -87,10 +87,12 @@ struct BoxSize {
     std::array<int64_t, 3> dim{0, 0, 0};
     uint64_t voxels = 0;
 };
+__extension__ typedef unsigned __int128 UInt128;  // GCC's and clang's 128-bit integer (not ISO C++: -Wpedantic)
+
 BoxSize sizeOf(const openvdb::CoordBBox& box) {
     BoxSize s;
     if (box.empty()) return s;
-    unsigned __int128 n = 1;
+    UInt128 n = 1;
     for (int a = 0; a < 3; ++a) {
         s.dim[size_t(a)] = int64_t(box.max()[a]) - int64_t(box.min()[a]) + 1;
         n *= uint64_t(s.dim[size_t(a)]);
@@ -119,7 +121,7 @@ Plan planGrid(const GridT& grid, const LoadedGrid& loaded, const std::string& in
         if (plan.region.empty()) throw Error(what + " has no active voxels: there is no region to write as an image (give --bbox)");
         const BoxSize size = sizeOf(plan.region);
         const uint64_t cells = size.voxels;
-        const unsigned __int128 wideBytes = (unsigned __int128)cells * (valueBytes<GridT>() + 1);
+        const UInt128 wideBytes = (UInt128)cells * (valueBytes<GridT>() + 1);
         const uint64_t bytes = wideBytes > std::numeric_limits<uint64_t>::max() ? std::numeric_limits<uint64_t>::max() : uint64_t(wideBytes);
         bool tooWide = false;  // a vtkImageData counts points per axis in int
         for (int64_t d : size.dim) tooWide = tooWide || d >= int64_t(std::numeric_limits<int32_t>::max());

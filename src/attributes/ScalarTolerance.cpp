@@ -54,25 +54,27 @@ void ScalarQuantizer::quantise(std::span<uint8_t> bytes) {
 // s = 2 floor(E) + 1, so the error is at most floor(E) and the values share
 // the step s, which the value coder divides out (ContextChannel.h). A value
 // whose multiple would leave the type's range stays exact.
+__extension__ typedef __int128 Int128;  // GCC's and clang's 128-bit integer (not ISO C++: -Wpedantic)
+
 template <typename T>
 void ScalarQuantizer::quantiseIntegers(std::span<uint8_t> bytes) {
     const ScalarTolerance& tol = report_.tolerance;
     if (tol.mode != ScalarTolerance::Mode::Absolute || !(tol.bound >= 1)) return;
-    const __int128 half = __int128(std::min(tol.bound, 1e15)), s = 2 * half + 1;
+    const Int128 half = Int128(std::min(tol.bound, 1e15)), s = 2 * half + 1;
     const size_t n = bytes.size() / sizeof(T);
     for (size_t i = 0; i < n; ++i) {
         T v;
         std::memcpy(&v, &bytes[i * sizeof(T)], sizeof(T));
-        __int128 r = __int128(v) % s;
+        Int128 r = Int128(v) % s;
         if (r < 0) r += s;
-        __int128 q = __int128(v) - r;
+        Int128 q = Int128(v) - r;
         if (r > half) q += s;
-        if (q < __int128(std::numeric_limits<T>::min()) || q > __int128(std::numeric_limits<T>::max())) {
+        if (q < Int128(std::numeric_limits<T>::min()) || q > Int128(std::numeric_limits<T>::max())) {
             ++report_.keptExact;
             continue;
         }
         const T stored = T(q);
-        const double err = double(q > __int128(v) ? q - __int128(v) : __int128(v) - q);
+        const double err = double(q > Int128(v) ? q - Int128(v) : Int128(v) - q);
         if (stored != v) {
             ++report_.changed;
             std::memcpy(&bytes[i * sizeof(T)], &stored, sizeof(T));

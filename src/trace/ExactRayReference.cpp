@@ -13,7 +13,7 @@
 namespace vdbdag::trace {
 namespace {
 
-using i128 = __int128;
+__extension__ typedef __int128 i128;  // GCC's and clang's 128-bit integer (not ISO C++: -Wpedantic)
 constexpr int kScaleBits = 16;
 constexpr i128 kScale = i128(1) << kScaleBits;
 

@@ -82,16 +82,16 @@ glm::dvec3 grey(double g) {
 std::optional<LegendScale> legendScale(const RenderGrid& grid, const std::optional<std::pair<double, double>>& window, const TransferFunction* transfer) {
     if ((grid.mip || grid.slice) && window) {
         const double lo = window->first, hi = window->second;
-        return LegendScale{lo, hi, [lo, hi](double v) { return grey((v - lo) / (hi > lo ? hi - lo : 1)); }};
+        return LegendScale{lo, hi, [lo, hi](double v) { return grey((v - lo) / (hi > lo ? hi - lo : 1)); }, {}};
     }
     if (grid.volume && window) {
-        const TransferFunction tf = transfer ? *transfer : TransferFunction{window->first, window->second};
-        return LegendScale{tf.low, tf.high, [tf](double v) { return tf.colour(v); }};
+        const TransferFunction tf = transfer ? *transfer : TransferFunction{window->first, window->second, {}, {}};
+        return LegendScale{tf.low, tf.high, [tf](double v) { return tf.colour(v); }, {}};
     }
     if (!grid.mip && !grid.slice && !grid.volume && !grid.iso && !grid.labels && !grid.fog && !grid.levelSet &&
         grid.colouring == ValueColouring::Scalar) {
         const double lo = grid.valueMin, hi = grid.valueMax;
-        return LegendScale{lo, hi, [lo, hi](double v) { return coolToWarm((v - lo) / (hi - lo)); }};
+        return LegendScale{lo, hi, [lo, hi](double v) { return coolToWarm((v - lo) / (hi - lo)); }, {}};
     }
     return std::nullopt;
 }

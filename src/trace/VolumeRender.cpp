@@ -16,7 +16,10 @@ namespace vdbdag::trace {
 TransferFunction automaticTransfer(const RenderGrid& grid) {
     if (!grid.values || grid.values->entryCount == 0) return {};
     const auto [low, high] = storedValueWindow(grid);
-    return {low, high};
+    TransferFunction tf;
+    tf.low = low;
+    tf.high = high;
+    return tf;
 }
 
 Image renderVolume(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const TransferFunction& tf) {
