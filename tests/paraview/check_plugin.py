@@ -90,16 +90,17 @@ def vdb_dense(grid, lo, hi):
 
 
 def probe(vdb_file, grid, lo, hi):
-    """OpenVDB's accessor (vdbdag_vdb_probe) on every voxel of [lo, hi], i fastest:
-    (active flags, value bytes as an (N, bytes) uint8 array)."""
+    """OpenVDB's accessor (vdbdag_vdb_probe) on every voxel of [lo, hi], i fastest
+    (a VTK image's point order): (coordinates (N, 3) as i, j, k; active flags;
+    value bytes as an (N, bytes) uint8 array)."""
     axes = np.ogrid[lo[2]:hi[2] + 1, lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
-    kji = np.stack(np.broadcast_arrays(*axes), axis=-1).reshape(-1, 3)
-    text = "\n".join("%d %d %d" % (c[2], c[1], c[0]) for c in kji) + "\n"
+    ijk = np.stack(np.broadcast_arrays(*axes), axis=-1).reshape(-1, 3)[:, ::-1]
+    text = "\n".join("%d %d %d" % tuple(c) for c in ijk) + "\n"
     lines = subprocess.run([os.path.join(BUILD, "vdbdag_vdb_probe"), "values", vdb_file, grid], input=text,
                            check=True, capture_output=True, text=True).stdout.split()
     active = np.array([v == "1" for v in lines[0::2]])
-    values = np.frombuffer(bytes.fromhex("".join(lines[1::2])), dtype=np.uint8).reshape(len(kji), -1)
-    return active, values
+    values = np.frombuffer(bytes.fromhex("".join(lines[1::2])), dtype=np.uint8).reshape(len(ijk), -1)
+    return ijk, active, values
 
 
 def check_geometry(name, image, grid, lo, stride):
@@ -234,16 +235,10 @@ with tempfile.TemporaryDirectory() as work:
     check(list(image["arrays"]) == names, "multi.npz: arrays %s are the grids of the first grid's transform %s" % (list(image["arrays"]), names))
     check(np.allclose(image["origin"], np.array(lo + [1.0]) @ np.array(meta[0]["index_to_world"]).reshape(4, 4)[:, :3]),
           "multi.npz: origin %s is OpenVDB's transform of %s" % (image["origin"], lo))
-    axes = np.ogrid[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1, lo[2]:hi[2] + 1]
-    coords = np.stack(np.broadcast_arrays(*axes), axis=-1).reshape(-1, 3)
-    text = "\n".join("%d %d %d" % tuple(c) for c in coords) + "\n"
     for n, g in enumerate(same):
-        lines = subprocess.run([os.path.join(BUILD, "vdbdag_vdb_probe"), "values", w("multi_grid.vdb"), g["name"]], input=text,
-                               check=True, capture_output=True, text=True).stdout.split()
-        want = np.frombuffer(bytes.fromhex("".join(lines[1::2])), dtype=np.uint8)
-        got = pv_values(image, n)
-        got = np.ascontiguousarray(got.astype(np.uint8) if got.dtype == np.bool_ else got).reshape(len(coords), -1).view(np.uint8).reshape(-1)
-        check(np.array_equal(got, want), "multi.npz '%s' (%s): %d samples equal OpenVDB's accessor bit for bit" % (names[n], g["type"], len(coords)))
+        _, _, want = probe(w("multi_grid.vdb"), g["name"], lo, hi)
+        got = np.ascontiguousarray(image["array_%d" % n]).view(np.uint8).reshape(len(want), -1)  # i fastest, as the probe's
+        check(np.array_equal(got, want), "multi.npz '%s' (%s): %d samples equal OpenVDB's accessor bit for bit" % (names[n], g["type"], len(want)))
 
     # A box partly outside the grid.
     image = load("box.npz")
@@ -319,10 +314,8 @@ with tempfile.TemporaryDirectory() as work:
                             for x in range(a[0], b[0]):
                                 if lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1] and lo[2] <= z <= hi[2]:
                                     got[(x, y, z)] = v.tobytes()
-                on, val = probe(w(stem + ".vdb"), g["name"], lo, hi)
-                axes = np.ogrid[lo[2]:hi[2] + 1, lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
-                kji = np.stack(np.broadcast_arrays(*axes), axis=-1).reshape(-1, 3)
-                want = {(int(c[2]), int(c[1]), int(c[0])): val[i].tobytes() for i, c in enumerate(kji) if on[i]}
+                ijk, on, val = probe(w(stem + ".vdb"), g["name"], lo, hi)
+                want = {tuple(int(v) for v in c): val[i].tobytes() for i, c in enumerate(ijk) if on[i]}
                 if g["type"].endswith("bool_5_4_3"):  # bool cells hold one byte, as the probe prints it
                     want = {k: v[:1] for k, v in want.items()}
                 if "MaskTree" in g["type"] or "mask" in g["type"]:
@@ -333,8 +326,8 @@ with tempfile.TemporaryDirectory() as work:
 
     # Comparisons: every point of the union of both active boxes.
     lo, hi = [-42, -42, -42], [42, 42, 42]
-    a_on, a_val = probe(w("sphere_ls.vdb"), "sphere", lo, hi)
-    b_on, b_val = probe(w("sphere_mod.vdb"), "sphere", lo, hi)
+    _, a_on, a_val = probe(w("sphere_ls.vdb"), "sphere", lo, hi)
+    _, b_on, b_val = probe(w("sphere_mod.vdb"), "sphere", lo, hi)
     a_f, b_f = a_val.copy().view(np.float32)[:, 0], b_val.copy().view(np.float32)[:, 0]
     want_status = np.where(a_on & b_on, np.where(np.all(a_val == b_val, axis=1), 0, 1), np.where(a_on, 2, np.where(b_on, 3, 4)))
     want_error = np.where(np.all(a_val == b_val, axis=1), 0.0, np.abs(a_f.astype(np.float64) - b_f.astype(np.float64)))

@@ -39,6 +39,9 @@ public:
   // vdbdag::Grid::forEachActive gives them (a mask grid's value: nullptr;
   // a bool's: one byte).
   virtual void forEachActive(size_t g, const vdbdag::IndexBBox& box, const vdbdag::Grid::ActiveVisitor& visit) const = 0;
+  // What a file is, by its first bytes: .ssvdag's magic, or OpenVDB's.
+  enum class Kind { None, Ssvdag, Vdb };
+  static Kind kindOf(const std::string& path);
   // Opens an .ssvdag file (by its magic) or else a .vdb file; throws
   // std::runtime_error with one line naming the file.
   static std::unique_ptr<VolumeSource> open(const std::string& path);

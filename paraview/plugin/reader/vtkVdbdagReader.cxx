@@ -28,7 +28,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <mutex>
 #include <new>
@@ -88,23 +87,27 @@ void AxesOf(const std::array<double, 16>& m, uint64_t stride, double spacing[3],
   }
 }
 
-// Component c of a value of `type` as a double.
-double Component(const std::string& type, const uint8_t* value, int c)
+// Reads component c of a value as a double; chosen once per grid by its type
+// (a comparison reads two per component of every point).
+using ComponentReader = double (*)(const uint8_t* value, int c);
+template <typename T>
+double ReadComponent(const uint8_t* value, int c)
 {
-  auto read = [&](auto t) {
-    decltype(t) v;
-    std::memcpy(&v, value + size_t(c) * sizeof v, sizeof v);
-    return double(v);
-  };
+  T v;
+  std::memcpy(&v, value + size_t(c) * sizeof v, sizeof v);
+  return double(v);
+}
+ComponentReader ComponentReaderFor(const std::string& type)
+{
   if (type == "float" || type == "vec3s")
-    return read(float());
+    return &ReadComponent<float>;
   if (type == "double" || type == "vec3d")
-    return read(double());
+    return &ReadComponent<double>;
   if (type == "int32" || type == "vec3i")
-    return read(int32_t());
+    return &ReadComponent<int32_t>;
   if (type == "int64")
-    return read(int64_t());
-  return double(value[0]); // bool, mask
+    return &ReadComponent<int64_t>;
+  return &ReadComponent<uint8_t>; // bool, mask
 }
 } // namespace
 
@@ -156,13 +159,7 @@ void vtkVdbdagReader::SelectionModified(vtkObject*, unsigned long, void* clientd
 
 int vtkVdbdagReader::CanReadFile(const char* name)
 {
-  static const char ssvdag[8] = { '\x89', 'S', 'S', 'V', 'D', 'A', 'G', '\n' };
-  static const char vdb[4] = { ' ', 'B', 'D', 'V' }; // OpenVDB's magic 0x56444220, little-endian
-  char head[8] = {};
-  std::ifstream in(name ? name : "", std::ios::binary);
-  if (!in.read(head, 8))
-    return 0;
-  return std::memcmp(head, ssvdag, 8) == 0 || std::memcmp(head, vdb, 4) == 0 ? 1 : 0;
+  return VolumeSource::kindOf(name ? name : "") != VolumeSource::Kind::None ? 1 : 0;
 }
 
 vtkDataArraySelection* vtkVdbdagReader::GetGridSelection()
@@ -536,6 +533,7 @@ int vtkVdbdagReader::RequestImage(vtkInformation* outInfo)
       auto* aBytes = static_cast<uint8_t*>(a->GetVoidPointer(0));
       auto* bBytes = static_cast<uint8_t*>(b->GetVoidPointer(0));
       const int components = a->GetNumberOfComponents();
+      const ComponentReader component = ComponentReaderFor(grid.type);
       if (!forSlabs([&](uint64_t zb, uint64_t ze, const vdbdag::IndexBBox& slab) {
             const uint64_t first = zb * slice, count = (ze - zb) * slice;
             in.A.Source->sample(g, slab, in.Stride, aBytes + first * row);
@@ -550,7 +548,7 @@ int vtkVdbdagReader::RequestImage(vtkInformation* outInfo)
               double sq = 0;
               for (int c = 0; c < components; ++c)
               {
-                const double d = Component(grid.type, va, c) - Component(grid.type, vb, c);
+                const double d = component(va, c) - component(vb, c);
                 sq += d * d;
               }
               const bool same = std::memcmp(va, vb, row) == 0;
