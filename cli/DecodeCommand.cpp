@@ -14,6 +14,8 @@
 #include "src/pipeline/GridCodec.h"
 #include "src/pipeline/LayerScatter.h"
 #include "src/util/Error.h"
+#include "src/util/FramePattern.h"
+#include "src/format/FrameSequence.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "src/util/ParallelFor.h"
@@ -78,15 +80,103 @@ bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& inp
     return true;
 }
 
+struct DecodeOptions {
+    std::string input, output, grid, frames;
+    bool force = false, storedValues = false, json = false;
+    ReadLimitOptions limits;
+};
+
+// One volume of the input (the whole file, or frame `frame` of a sequence)
+// to `output`; its report goes to `batch` when given, else is printed.
+void decodeOne(const DecodeOptions& opt, const std::string& output, std::optional<uint32_t> frame, nlohmann::json* batch) {
+    setActivity(opt.input, "decoding");
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::string> notes;
+    size_t gridCount = 0;
+    uint64_t activeVoxels = 0;
+    // The summary line (or JSON) once the output is in place, as encode prints one.
+    auto summary = [&] {
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::error_code ec;
+        const uint64_t bytes = std::filesystem::file_size(output, ec);
+        const nlohmann::json report{{"input", opt.input}, {"output", output}, {"grids", gridCount}, {"active_voxels", activeVoxels},
+                                    {"output_bytes", ec ? 0 : bytes}, {"seconds", seconds}, {"notes", notes}};
+        if (batch) batch->push_back(report);
+        else if (opt.json) printJson(report);
+        if (!opt.json) fmt::print("{} -> {}: {} grid(s), {} active voxels, {} bytes in {:.2f} s\n", opt.input, output, gridCount, activeVoxels,
+                        ec ? 0 : bytes, seconds);
+    };
+    const bool dense = bridge::isDenseOutput(output);
+    const bool nano = lowerExtension(output) == ".nvdb";
+    if (!dense && !nano && lowerExtension(output) != ".vdb")
+        throw Error(output + ": decode writes .vdb or .nvdb, or a dense scan as .nrrd, .nhdr, .mha, .mhd, .nii, .nii.gz or .raw");
+    if (!dense && !opt.grid.empty()) throw Error(output + ": --grid applies to scan outputs (a .vdb or .nvdb file takes every grid)");
+    if (!dense && opt.storedValues) throw Error(output + ": --stored-values applies to scan outputs (a .vdb or .nvdb file holds the grid's values)");
+    bridge::DenseExportOptions denseOptions;
+    denseOptions.storedValues = opt.storedValues;
+    // What changed on the way out, one line each (not silenced by -q: a value written otherwise than stored).
+    auto printNotes = [&] {
+        for (const std::string& n : notes) fmt::print(stderr, "{}: note: {}\n", output, n);
+    };
+    const OutputRules rules{{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt.force};
+    checkOutputPath(output, {opt.input}, rules);
+    const std::string ext = lowerExtension(output);
+    if (ext == ".nhdr" || ext == ".mhd")  // their samples go beside them, as NAME.raw
+        checkOutputPath((std::filesystem::path(output).parent_path() / (std::filesystem::path(output).stem().string() + ".raw")).string(),
+                        {opt.input}, rules);
+    format::ReadOptions readOptions;
+    readOptions.frame = frame;
+    readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
+    readOptions.keepValueWindows = dense;  // a scan is written window by window when it can be
+    // A .vdb decode builds OpenVDB's grid beside the decoded values: one more copy of each.
+    readOptions.limits = opt.limits.limits(dense ? 0 : 1);
+    Volume volume;
+    // Steps of a .vdb decode, in thousandths: reading (50), decoding the
+    // grids (450, by active voxels), building OpenVDB's grids and
+    // writing the file (500, by grid and a last step for the write), so
+    // the ETA moves with the work, not from 0% to 100%.
+    Progress progress("decode: reading " + std::filesystem::path(opt.input).filename().string(), 1000);
+    {
+        const format::SsvdagScene scene = format::readSceneFile(opt.input, readOptions);
+        gridCount = scene.grids.size();
+        for (const auto& g : scene.grids) activeVoxels += g.activeVoxels;
+        if (dense && decodeDenseByCubes(scene, opt.input, output, opt.grid, denseOptions, notes)) {
+            printNotes();
+            summary();
+            return;
+        }
+        progress.set(50);
+        uint64_t voxels = 0, done = 0;
+        for (const auto& g : scene.grids) voxels += g.activeVoxels + g.inactiveVoxels;
+        volume = pipeline::decodeScene(scene, [&](size_t i, size_t) {
+            if (i > 0) done += scene.grids[i - 1].activeVoxels + scene.grids[i - 1].inactiveVoxels;
+            progress.setLabel("decode: grid '" + scene.grids[i].record.name + "'");
+            progress.set(50 + 450 * done / std::max<uint64_t>(voxels, 1));
+        });
+        progress.set(500);
+    }  // the scene is released before the output is built
+    progress.setLabel("decode: writing " + std::filesystem::path(output).filename().string());
+    if (dense) {
+        // The volumes of a 4-D scan go back as one file; else one grid.
+        if (const auto series = opt.grid.empty() ? bridge::volumeSeriesOf(volume.grids) : std::nullopt) {
+            std::vector<const GridRecord*> volumes;
+            for (size_t i : *series) volumes.push_back(&volume.grids[i]);
+            notes = bridge::exportDenseVolumes(volumes, output, denseOptions).notes;
+        } else {
+            notes = bridge::exportDense(denseGridOf(volume.grids, opt.input, opt.grid, [](const GridRecord& g) { return g.name; }), output, denseOptions).notes;
+        }
+    }
+    else if (nano) bridge::exportNanoVdb(volume, output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
+    else bridge::exportVdb(volume, output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
+    progress.finish();
+    printNotes();
+    summary();
+}
+
 } // namespace
 
 void addDecodeCommand(CLI::App& app, int& exitCode) {
-    struct Options {
-        std::string input, output, grid;
-        bool force = false, storedValues = false, json = false;
-        ReadLimitOptions limits;
-    };
-    auto opt = std::make_shared<Options>();
+    auto opt = std::make_shared<DecodeOptions>();
     CLI::App* cmd = app.add_subcommand("decode", "Decode an .ssvdag file back into a .vdb (or NanoVDB .nvdb) file, or a dense grid into a scan file");
     cmd->add_option("input", opt->input, "input .ssvdag file")->required();
     cmd->add_option("-o,--output", opt->output, "output .vdb or .nvdb, or .nrrd/.nhdr/.mha/.mhd/.nii/.nii.gz/.raw for a dense scan")->required();
@@ -96,90 +186,45 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
                   "key/value pairs, instead of the grid's values (NIfTI always holds the stored integers and the rescale)");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
+    cmd->add_option("--frames", opt->frames, "a sequence file: the frames to write (12, 10-20, 1,5,9-12; default: all), each to the file -o names with its number (out.####.vdb)");
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
-        setActivity(opt->input, "decoding");
         if (opt->json) setQuiet(true);
-        const auto start = std::chrono::steady_clock::now();
-        std::vector<std::string> notes;
-        size_t gridCount = 0;
-        uint64_t activeVoxels = 0;
-        // The summary line (or JSON) once the output is in place, as encode prints one.
-        auto summary = [&] {
-            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            std::error_code ec;
-            const uint64_t bytes = std::filesystem::file_size(opt->output, ec);
-            const nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"grids", gridCount}, {"active_voxels", activeVoxels},
-                                        {"output_bytes", ec ? 0 : bytes}, {"seconds", seconds}, {"notes", notes}};
-            if (opt->json) printJson(report);
-            else fmt::print("{} -> {}: {} grid(s), {} active voxels, {} bytes in {:.2f} s\n", opt->input, opt->output, gridCount, activeVoxels,
-                            ec ? 0 : bytes, seconds);
-        };
-        const bool dense = bridge::isDenseOutput(opt->output);
-        const bool nano = lowerExtension(opt->output) == ".nvdb";
-        if (!dense && !nano && lowerExtension(opt->output) != ".vdb")
-            throw Error(opt->output + ": decode writes .vdb or .nvdb, or a dense scan as .nrrd, .nhdr, .mha, .mhd, .nii, .nii.gz or .raw");
-        if (!dense && !opt->grid.empty()) throw Error(opt->output + ": --grid applies to scan outputs (a .vdb or .nvdb file takes every grid)");
-        if (!dense && opt->storedValues) throw Error(opt->output + ": --stored-values applies to scan outputs (a .vdb or .nvdb file holds the grid's values)");
-        bridge::DenseExportOptions denseOptions;
-        denseOptions.storedValues = opt->storedValues;
-        // What changed on the way out, one line each (not silenced by -q: a value written otherwise than stored).
-        auto printNotes = [&] {
-            for (const std::string& n : notes) fmt::print(stderr, "{}: note: {}\n", opt->output, n);
-        };
-        const OutputRules rules{{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt->force};
-        checkOutputPath(opt->output, {opt->input}, rules);
-        const std::string ext = lowerExtension(opt->output);
-        if (ext == ".nhdr" || ext == ".mhd")  // their samples go beside them, as NAME.raw
-            checkOutputPath((std::filesystem::path(opt->output).parent_path() / (std::filesystem::path(opt->output).stem().string() + ".raw")).string(),
-                            {opt->input}, rules);
-        format::ReadOptions readOptions;
-        readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
-        readOptions.keepValueWindows = dense;  // a scan is written window by window when it can be
-        // A .vdb decode builds OpenVDB's grid beside the decoded values: one more copy of each.
-        readOptions.limits = opt->limits.limits(dense ? 0 : 1);
-        Volume volume;
-        // Steps of a .vdb decode, in thousandths: reading (50), decoding the
-        // grids (450, by active voxels), building OpenVDB's grids and
-        // writing the file (500, by grid and a last step for the write), so
-        // the ETA moves with the work, not from 0% to 100%.
-        Progress progress("decode: reading " + std::filesystem::path(opt->input).filename().string(), 1000);
-        {
-            const format::SsvdagScene scene = format::readSceneFile(opt->input, readOptions);
-            gridCount = scene.grids.size();
-            for (const auto& g : scene.grids) activeVoxels += g.activeVoxels;
-            if (dense && decodeDenseByCubes(scene, opt->input, opt->output, opt->grid, denseOptions, notes)) {
-                printNotes();
-                summary();
-                exitCode = 0;
-                return;
-            }
-            progress.set(50);
-            uint64_t voxels = 0, done = 0;
-            for (const auto& g : scene.grids) voxels += g.activeVoxels + g.inactiveVoxels;
-            volume = pipeline::decodeScene(scene, [&](size_t i, size_t) {
-                if (i > 0) done += scene.grids[i - 1].activeVoxels + scene.grids[i - 1].inactiveVoxels;
-                progress.setLabel("decode: grid '" + scene.grids[i].record.name + "'");
-                progress.set(50 + 450 * done / std::max<uint64_t>(voxels, 1));
-            });
-            progress.set(500);
-        }  // the scene is released before the output is built
-        progress.setLabel("decode: writing " + std::filesystem::path(opt->output).filename().string());
-        if (dense) {
-            // The volumes of a 4-D scan go back as one file; else one grid.
-            if (const auto series = opt->grid.empty() ? bridge::volumeSeriesOf(volume.grids) : std::nullopt) {
-                std::vector<const GridRecord*> volumes;
-                for (size_t i : *series) volumes.push_back(&volume.grids[i]);
-                notes = bridge::exportDenseVolumes(volumes, opt->output, denseOptions).notes;
-            } else {
-                notes = bridge::exportDense(denseGridOf(volume.grids, opt->input, opt->grid, [](const GridRecord& g) { return g.name; }), opt->output, denseOptions).notes;
-            }
+        const format::FrameList list = format::readFrameList(opt->input);
+        const bool pattern = isFramePattern(opt->output) && !std::filesystem::exists(opt->output);
+        if (!list.sequence) {
+            if (!opt->frames.empty()) throw Error(opt->input + ": --frames applies to sequence files; this file holds one volume");
+            if (pattern) throw Error(opt->output + ": " + opt->input + " holds one volume, not a sequence: -o names one file");
+            decodeOne(*opt, opt->output, std::nullopt, nullptr);
+            exitCode = 0;
+            return;
         }
-        else if (nano) bridge::exportNanoVdb(volume, opt->output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
-        else bridge::exportVdb(volume, opt->output, [&](size_t step, size_t steps) { progress.set(500 + 500 * step / steps); });
-        progress.finish();
-        printNotes();
-        summary();
+        // A sequence: the frames chosen, each to its own file.
+        std::vector<uint32_t> chosen;
+        const std::optional<FrameSelection> selection = opt->frames.empty() ? std::nullopt : std::optional(parseFrameSelection(opt->frames));
+        for (uint32_t i = 0; i < list.frames.size(); ++i)
+            if (!selection || selection->contains(list.frames[i].number)) chosen.push_back(i);
+        const std::string range = fmt::format("{} frames, {} to {}", list.frames.size(), list.frames.front().number, list.frames.back().number);
+        if (chosen.empty()) throw Error(opt->input + ": --frames " + opt->frames + " selects none of its " + range);
+        if (!pattern) {
+            if (chosen.size() != 1)
+                throw Error(opt->input + ": holds " + range + "; write them with a frame token in -o (out.####.vdb, out.%04d.vdb) or pick one with --frames N");
+            decodeOne(*opt, opt->output, chosen.front(), nullptr);
+            exitCode = 0;
+            return;
+        }
+        // Every output checked before any is written.
+        std::vector<std::string> outputs;
+        for (uint32_t i : chosen) {
+            outputs.push_back(framePath(opt->output, list.frames[i].number));
+            checkOutputPath(outputs.back(), {opt->input}, {{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt->force});
+        }
+        nlohmann::json reports = nlohmann::json::array();
+        for (size_t k = 0; k < chosen.size(); ++k) {
+            decodeOne(*opt, outputs[k], chosen[k], &reports);
+            reports.back()["frame"] = list.frames[chosen[k]].number;
+        }
+        if (opt->json) printJson(reports);
         exitCode = 0;
     });
 }

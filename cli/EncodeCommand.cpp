@@ -26,6 +26,9 @@
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
 #include "src/util/AtomicFile.h"
+#include "src/util/FramePattern.h"
+#include "src/util/TemporaryFiles.h"
+#include "src/format/FrameSequence.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/DenseImport.h"
@@ -71,12 +74,17 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         std::vector<std::string> colourGrids;
         std::string normalGrid;
         DenseInputOptions dense;
+        // While a sequence is encoded: its progress (each frame 1000 units)
+        // and the frame being encoded; the frames print no line of their own.
+        Progress* sequenceProgress = nullptr;
+        size_t frameIndex = 0;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb or NanoVDB .nvdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha/.nii scan, or one DICOM series) into an .ssvdag file");
     cmd->add_option("input", opt->inputs,
                     "input .vdb or .nvdb file or dense scan, or DICOM input (folders, .dcm files, DICOMDIRs: several are read as one set); "
-                    "several other inputs (frames of a cache): one .ssvdag each, in the folder -o names or beside each")
+                    "a frame pattern (smoke.####.vdb, smoke.%04d.vdb, smoke.$F4.vdb) or several other inputs with -o NAME.ssvdag: one sequence file "
+                    "holding every frame; several other inputs otherwise: one .ssvdag each, in the folder -o names or beside each")
         ->required();
     cmd->add_option("-o,--output", opt->output, "output .ssvdag file (default: the input's name with .ssvdag, beside it: ct.nii.gz -> ct.ssvdag, a DICOM folder dir/ -> dir.ssvdag)");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
@@ -200,7 +208,14 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         encodeOptions.normalBits = opt->normalBits;
         // Each step is 1000 units, filled cube by cube where the encoder reports it.
         constexpr uint64_t kUnits = 1000;
-        Progress progress("encode", (imported.volume.grids.size() * pipeline::kEncodeSteps + 1) * kUnits);
+        const uint64_t totalUnits = (imported.volume.grids.size() * pipeline::kEncodeSteps + 1) * kUnits;
+        Progress progress("encode", totalUnits);
+        // In a sequence the frame's share of the whole moves instead (this
+        // frame's own line stays silent: setQuiet while it runs).
+        const auto setProgress = [&](uint64_t units) {
+            progress.set(units);
+            if (opt->sequenceProgress) opt->sequenceProgress->set(opt->frameIndex * kUnits + std::min(units, totalUnits) * kUnits / totalUnits);
+        };
         std::string gridName;
         uint64_t stepsStarted = 0;
         // Seconds spent in each step, reported with --json ("phases").
@@ -208,10 +223,10 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         encodeOptions.onStep = [&](const char* step) {
             phases.push_back({fmt::format("{}: {}", gridName, step), std::chrono::steady_clock::now()});
             progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
-            progress.set(stepsStarted++ * kUnits);
+            setProgress(stepsStarted++ * kUnits);
         };
         encodeOptions.onStepProgress = [&](uint64_t done, uint64_t total) {
-            if (stepsStarted && total) progress.set((stepsStarted - 1) * kUnits + std::min<uint64_t>(kUnits, done * kUnits / total));
+            if (stepsStarted && total) setProgress((stepsStarted - 1) * kUnits + std::min<uint64_t>(kUnits, done * kUnits / total));
         };
         std::vector<std::string> gridNames;
         for (const auto& g : imported.volume.grids) gridNames.push_back(g.name);
@@ -264,7 +279,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         progress.finish();
         // Where the geometry weighs, other root placements may shrink it
         // (a tilted torus: 30%): say that the option exists.
-        if (opt->placementTrials == 1 && fileBytes && geometryBytes * 4 > fileBytes)
+        if (opt->placementTrials == 1 && !opt->sequenceProgress && fileBytes && geometryBytes * 4 > fileBytes)
             note("the geometry is a large part of this file: --placement-trials 4 tries other root placements and keeps the smallest file");
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -300,7 +315,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         }
         if (batch) {
             batch->push_back(report);
-            if (!opt->json)
+            if (!opt->json && !opt->sequenceProgress)
                 fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output, scene.grids.size(),
                            voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);
         } else if (opt->json) {
@@ -318,7 +333,92 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         }
         exitCode = 0;
     };
-    cmd->callback([opt, &exitCode, encodeOne] {
+    // Frames of a cache into one sequence file: each frame encoded alone
+    // (every option applies, the same bytes as its own file) into a
+    // temporary folder beside the output (or in --scratch), then the frame
+    // files gathered into the output section by section
+    // (format/FrameSequence.h), and the folder removed.
+    const auto encodeSequence = [opt, &exitCode, encodeOne](const std::vector<FrameFile>& frames, const std::string& described) {
+        const auto start = std::chrono::steady_clock::now();
+        const std::string output = opt->output;
+        std::vector<std::string> inputs;
+        for (const FrameFile& f : frames) inputs.push_back(f.path);
+        checkOutputPath(output, inputs, {{".ssvdag"}, "encode", opt->force});
+        const std::filesystem::path near = opt->scratch.empty() ? std::filesystem::path(output) : std::filesystem::path(opt->scratch) / std::filesystem::path(output).filename();
+        const std::string folder = temporaryNameFor(near.string());
+        const TemporaryGuard guard(folder, /*folder=*/true);
+        struct Removed {
+            std::string path;
+            ~Removed() {
+                std::error_code ignored;
+                std::filesystem::remove_all(path, ignored);
+            }
+        } removed{folder};
+        std::error_code ec;
+        if (!std::filesystem::create_directory(folder, ec) || ec)
+            throw Error(folder + ": cannot make the folder for the frames being encoded (" + (ec ? ec.message() : "it exists") + ")");
+        Progress progress("encode " + std::filesystem::path(output).filename().string(), frames.size() * 1000);
+        const bool wasQuiet = isQuiet();
+        setQuiet(true);  // the frames' own progress lines
+        struct Restore {
+            bool quiet;
+            Options& o;
+            ~Restore() {
+                setQuiet(quiet);
+                o.sequenceProgress = nullptr;
+            }
+        } restore{wasQuiet, *opt};
+        opt->sequenceProgress = &progress;
+        std::vector<format::FramePart> parts;
+        nlohmann::json reports = nlohmann::json::array();
+        for (size_t i = 0; i < frames.size(); ++i) {
+            progress.setLabel(fmt::format("encode frame {} ({} of {})", frames[i].number, i + 1, frames.size()));
+            opt->frameIndex = i;
+            opt->input = frames[i].path;
+            opt->output = (std::filesystem::path(folder) / fmt::format("frame{:06}.ssvdag", i)).string();
+            encodeOne(&reports);
+            parts.push_back({frames[i].number, opt->output});
+        }
+        opt->output = output;
+        if (!cubeTeam().isRoot()) {
+            exitCode = 0;
+            return;
+        }
+        progress.setLabel("encode: writing " + output);
+        uint64_t bytes = 0;
+        writeStreamAtomically(output, [&](std::ostream& out) { bytes = format::writeSequence(parts, out); });
+        progress.finish();
+        uint64_t frameBytes = 0, voxels = 0;
+        for (const auto& r : reports) {
+            frameBytes += r["bytes"].get<uint64_t>();
+            voxels += r["active_voxels"].get<uint64_t>();
+        }
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        nlohmann::json report{{"input", described}, {"output", output}, {"bytes", bytes}, {"ssvdag_bytes", bytes}, {"frames", frames.size()},
+                              {"first_frame", frames.front().number}, {"last_frame", frames.back().number}, {"frame_files_bytes", frameBytes},
+                              {"active_voxels", voxels}, {"seconds", seconds}, {"bits_per_active_voxel", voxels ? 8.0 * double(bytes) / double(voxels) : 0.0}};
+        for (size_t i = 0; i < reports.size(); ++i) {
+            reports[i]["frame"] = frames[i].number;
+            reports[i]["output"] = output;
+        }
+        report["per_frame"] = reports;
+        if (opt->json) printJson(report);
+        else
+            fmt::print("{}: {} frames ({} to {}), {} active voxels -> {} bytes ({:.3f} bits/active voxel; the frames alone {} bytes) in {:.2f} s\n", output,
+                       frames.size(), frames.front().number, frames.back().number, voxels, bytes, report["bits_per_active_voxel"].get<double>(), frameBytes,
+                       seconds);
+        exitCode = 0;
+    };
+    cmd->callback([opt, &exitCode, encodeOne, encodeSequence] {
+        // A sequence: a frame pattern (smoke.####.vdb, %04d, $F4), or
+        // several inputs that are not DICOM with -o NAME.ssvdag.
+        if (opt->inputs.size() == 1 && isFramePattern(opt->inputs[0]) && !std::filesystem::exists(opt->inputs[0])) {
+            const std::vector<FrameFile> frames = expandFramePattern(opt->inputs[0]);
+            if (frames.empty()) throw Error(opt->inputs[0] + ": no file matches this frame pattern");
+            if (opt->output.empty()) opt->output = defaultOutputFor(withoutFrameToken(opt->inputs[0]));
+            encodeSequence(frames, opt->inputs[0]);
+            return;
+        }
         // Several inputs none of which is DICOM (frames of a cache, scans):
         // each encoded alone, to the folder -o names (made when missing; a
         // name ending in .ssvdag is refused) or beside itself, as
@@ -330,6 +430,10 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             opt->input = opt->dense.takeInputs(opt->inputs);
             if (opt->output.empty()) opt->output = defaultOutputFor(opt->input);
             encodeOne(nullptr);
+            return;
+        }
+        if (lowerExtension(opt->output) == ".ssvdag" && !std::filesystem::is_directory(opt->output)) {
+            encodeSequence(framesOfList(opt->inputs), std::to_string(opt->inputs.size()) + " files");
             return;
         }
         const std::string folder = opt->output;

@@ -177,6 +177,14 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
             addGridHeader(report["grids"][g], grid.record, bridge::gridHeaderFacts(grid.record, summary.indexBox, what), summary, false);
         }
         report["file_metadata"] = metadataJson(bridge::fileMetadataEntries(scene.fileMetadata, input + " file metadata"));
+        if (!scene.frames.empty()) {  // a sequence: each frame's grids and its .vdb file's metadata
+            report["frames"] = nlohmann::json::array();
+            for (const format::SceneFrame& f : scene.frames) {
+                report["frames"].push_back({{"frame", f.number}, {"first_grid", f.firstGrid}, {"grid_count", f.gridCount},
+                                            {"file_metadata", metadataJson(bridge::fileMetadataEntries(f.metadata, input + " frame " + std::to_string(f.number) + " metadata"))}});
+                for (uint32_t g = f.firstGrid; g < f.firstGrid + f.gridCount; ++g) report["grids"][g]["frame"] = f.number;
+            }
+        }
     } else {
         // OpenVDB's own figures (the reference vdb_print shows), then the
         // DAG figures of its encoding in memory.
@@ -197,7 +205,19 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
         report["file_metadata"] = metadataJson(facts.fileMetadata);
     }
     addVersions(report);  // the text names the format version too
-    return {report, formatSceneReport(report)};
+    std::string text = formatSceneReport(report);
+    if (report.contains("frames")) {  // after the file's line: the frames and their grids
+        const auto& frames = report["frames"];
+        std::string lines = fmt::format("{} frames, {} to {}:\n", frames.size(), frames.front()["frame"].get<int64_t>(), frames.back()["frame"].get<int64_t>());
+        for (const auto& f : frames) {
+            const auto first = f["first_grid"].get<uint64_t>(), count = f["grid_count"].get<uint64_t>();
+            lines += fmt::format("  frame {}: grid{} {}\n", f["frame"].get<int64_t>(), count > 1 ? "s" : "",
+                                 count > 1 ? fmt::format("{} to {}", first, first + count - 1) : std::to_string(first));
+        }
+        const size_t eol = text.find('\n');
+        text.insert(eol == std::string::npos ? text.size() : eol + 1, lines);
+    }
+    return {report, text};
 }
 
 } // namespace

@@ -8,7 +8,10 @@
 // folder, and is compared cube by cube (vdb_bridge/VdbStreamCompare.h):
 // neither side is ever a whole grid. An OpenVDB stream is read, encoded
 // and compared whole, in memory (vdb_bridge/VdbCompare.h).
+#include <algorithm>
 #include <filesystem>
+#include <optional>
+#include <set>
 #include <fstream>
 
 #include <fmt/core.h>
@@ -23,6 +26,8 @@
 #include "src/pipeline/CubeEncoder.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
+#include "src/util/FramePattern.h"
+#include "src/format/FrameSequence.h"
 #include "src/util/Progress.h"
 #include "src/util/TemporaryFiles.h"
 #include "src/util/ParallelFor.h"
@@ -39,6 +44,7 @@ namespace {
 
 struct VerifyOptions {
     std::string input, scratch, encoded;
+    std::optional<uint32_t> frame;  // --encoded is a sequence: the frame compared with the input (an index)
     bool json = false, noSymmetry = false, topologyOnly = false;
     uint64_t memoryLimit = 0;
     ReadLimitOptions limits;  // what the .ssvdag file may expand to (a file from elsewhere, --encoded)
@@ -67,6 +73,7 @@ void compareByCubes(const VerifyOptions& opt, const std::string& encoded, Progre
     readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
     readOptions.keepValueWindows = true;
     readOptions.limits = opt.limits.limits(0);  // compared cube by cube: no copy of the whole
+    if (encoded == opt.encoded) readOptions.frame = opt.frame;
     const format::SsvdagScene scene = format::readSceneFile(encoded, readOptions);
     out.grids = scene.grids.size();
     std::string step;
@@ -144,15 +151,56 @@ Verified verifyNanoVdb(const VerifyOptions& opt) {
     return bridge::canReadVdbByCubes(asVdb.input) ? verifyByCubes(asVdb) : verifyWhole(asVdb);
 }
 
+// Verifies one input and prints (or, with `batch`, adds) its report;
+// true when identical.
+bool verifyAndReport(const VerifyOptions& opt, std::optional<int64_t> frame, nlohmann::json* batch) {
+    const Verified verified = bridge::inputKindOf(opt.input) == bridge::InputKind::NanoVdb ? verifyNanoVdb(opt)
+                              : !opt.encoded.empty()                   ? verifyEncoded(opt)
+                              : bridge::canReadVdbByCubes(opt.input) ? verifyByCubes(opt)
+                                                                     : verifyWhole(opt);
+    const bridge::CompareResult& result = verified.result;
+    nlohmann::json report{{"input", opt.input}, {"identical", result.identical}, {"ssvdag_bytes", verified.bytes},
+                          {"header_differences", result.headerDifferences}, {"grids", nlohmann::json::array()}};
+    if (frame) report["frame"] = *frame;
+    for (const auto& d : result.topology)
+        report["grids"].push_back({{"index", d.gridIndex}, {"name", d.gridName}, {"only_in_original", d.onlyInA},
+                                   {"only_in_decoded", d.onlyInB}, {"examples", d.examples}});
+    report["values"] = nlohmann::json::array();
+    for (const auto& d : result.values)
+        report["values"].push_back({{"index", d.gridIndex}, {"name", d.gridName}, {"active_values_differing", d.activeValues},
+                                    {"inactive_values_differing", d.inactiveValues}, {"examples", d.examples}});
+    if (opt.json) {
+        if (batch) batch->push_back(report);
+        else printJson(report);
+    } else if (result.identical) {
+        fmt::print("{}: identical after the round trip ({} grid(s), {} bytes encoded)\n", opt.input, verified.grids, verified.bytes);
+    } else {
+        fmt::print("{}: DIFFERS after the round trip\n", opt.input);
+        for (const auto& h : result.headerDifferences) fmt::print("  {}\n", h);
+        for (const auto& d : result.topology) {
+            fmt::print("  grid {} '{}': {} voxels only in the original, {} only in the decoded grid\n", d.gridIndex, d.gridName, d.onlyInA, d.onlyInB);
+            for (const auto& e : d.examples) fmt::print("    {}\n", e);
+        }
+        for (const auto& d : result.values) {
+            fmt::print("  grid {} '{}': {} active and {} inactive values differ\n", d.gridIndex, d.gridName, d.activeValues, d.inactiveValues);
+            for (const auto& e : d.examples) fmt::print("    {}\n", e);
+        }
+    }
+    return result.identical;
+}
+
 } // namespace
 
 void addVerifyCommand(CLI::App& app, int& exitCode) {
     auto opt = std::make_shared<VerifyOptions>();
     CLI::App* cmd = app.add_subcommand("verify", "Check that a .vdb file survives the round trip through .ssvdag bit for bit (or that an .ssvdag file holds it), region by region");
-    cmd->add_option("input", opt->input, "input .vdb file (or a NanoVDB .nvdb, as its grids read through NanoVDB)")->required();
+    cmd->add_option("input", opt->input,
+                    "input .vdb file (or a NanoVDB .nvdb, as its grids read through NanoVDB), or a frame pattern (smoke.####.vdb): each frame, "
+                    "against its frame of the sequence file --encoded names")
+        ->required();
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "verify the plain SVDAG encoding");
     cmd->add_flag("--topology-only", opt->topologyOnly, "verify the geometry-only encoding (topology and headers)");
-    cmd->add_option("--encoded", opt->encoded, "compare this .ssvdag file (e.g. what `encode` wrote) with the input, instead of encoding one")
+    cmd->add_option("--encoded", opt->encoded, "compare this .ssvdag file (e.g. what `encode` wrote) with the input, instead of encoding one; a sequence file: the frame of the input's number")
         ->check(CLI::ExistingFile);
     cmd->add_option("--memory-limit", opt->memoryLimit, "working memory of the encode, as for `encode` (default: half the physical memory)")
         ->transform(byteSize());
@@ -161,39 +209,56 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
     cmd->add_flag("--json", opt->json, "print JSON");
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
-        setActivity(opt->input, "verifying");
         if (opt->json) setQuiet(true);
-        const Verified verified = bridge::inputKindOf(opt->input) == bridge::InputKind::NanoVdb ? verifyNanoVdb(*opt)
-                                  : !opt->encoded.empty()                   ? verifyEncoded(*opt)
-                                  : bridge::canReadVdbByCubes(opt->input) ? verifyByCubes(*opt)
-                                                                          : verifyWhole(*opt);
-        const bridge::CompareResult& result = verified.result;
-        nlohmann::json report{{"input", opt->input}, {"identical", result.identical}, {"ssvdag_bytes", verified.bytes},
-                              {"header_differences", result.headerDifferences}, {"grids", nlohmann::json::array()}};
-        for (const auto& d : result.topology)
-            report["grids"].push_back({{"index", d.gridIndex}, {"name", d.gridName}, {"only_in_original", d.onlyInA},
-                                       {"only_in_decoded", d.onlyInB}, {"examples", d.examples}});
-        report["values"] = nlohmann::json::array();
-        for (const auto& d : result.values)
-            report["values"].push_back({{"index", d.gridIndex}, {"name", d.gridName}, {"active_values_differing", d.activeValues},
-                                        {"inactive_values_differing", d.inactiveValues}, {"examples", d.examples}});
-        if (opt->json) {
-            printJson(report);
-        } else if (result.identical) {
-            fmt::print("{}: identical after the round trip ({} grid(s), {} bytes encoded)\n", opt->input, verified.grids, verified.bytes);
+        // Frames: a pattern (smoke.####.vdb), each frame verified; with
+        // --encoded a sequence file, each against its frame of that number.
+        std::vector<FrameFile> frames;
+        const bool pattern = isFramePattern(opt->input) && !std::filesystem::exists(opt->input);
+        if (pattern) {
+            frames = expandFramePattern(opt->input);
+            if (frames.empty()) throw Error(opt->input + ": no file matches this frame pattern");
         } else {
-            fmt::print("{}: DIFFERS after the round trip\n", opt->input);
-            for (const auto& h : result.headerDifferences) fmt::print("  {}\n", h);
-            for (const auto& d : result.topology) {
-                fmt::print("  grid {} '{}': {} voxels only in the original, {} only in the decoded grid\n", d.gridIndex, d.gridName, d.onlyInA, d.onlyInB);
-                for (const auto& e : d.examples) fmt::print("    {}\n", e);
-            }
-            for (const auto& d : result.values) {
-                fmt::print("  grid {} '{}': {} active and {} inactive values differ\n", d.gridIndex, d.gridName, d.activeValues, d.inactiveValues);
-                for (const auto& e : d.examples) fmt::print("    {}\n", e);
+            frames.push_back({frameNumberOf(opt->input).value_or(0), opt->input});
+        }
+        std::optional<format::FrameList> sequence;
+        if (!opt->encoded.empty()) {
+            sequence = format::readFrameList(opt->encoded);
+            if (!sequence->sequence) {
+                if (pattern) throw Error(opt->encoded + ": holds one volume, not the sequence " + opt->input);
+                sequence.reset();
             }
         }
-        exitCode = result.identical ? 0 : 1;
+        nlohmann::json reports = nlohmann::json::array();
+        bool identical = true;
+        std::set<int64_t> compared;
+        for (const FrameFile& f : frames) {
+            VerifyOptions one = *opt;
+            one.input = f.path;
+            if (sequence) {
+                const auto& list = sequence->frames;
+                const auto it = std::find_if(list.begin(), list.end(), [&](const format::FrameEntry& e) { return e.number == f.number; });
+                if (it == list.end()) {
+                    if (!pattern) throw Error(opt->encoded + ": a sequence with no frame " + std::to_string(f.number) + " (the number of " + f.path + ")");
+                    identical = false;
+                    reports.push_back({{"input", f.path}, {"frame", f.number}, {"identical", false}, {"header_differences", {"frame missing in " + opt->encoded}}});
+                    if (!opt->json) fmt::print("{}: DIFFERS: {} has no frame {}\n", f.path, opt->encoded, f.number);
+                    continue;
+                }
+                one.frame = uint32_t(it - list.begin());
+                compared.insert(f.number);
+            }
+            setActivity(one.input, "verifying");
+            identical = verifyAndReport(one, pattern ? std::optional<int64_t>(f.number) : std::nullopt, pattern ? &reports : nullptr) && identical;
+        }
+        if (sequence && pattern)
+            for (const format::FrameEntry& e : sequence->frames)
+                if (!compared.contains(e.number)) {
+                    identical = false;
+                    reports.push_back({{"frame", e.number}, {"identical", false}, {"header_differences", {"frame only in " + opt->encoded}}});
+                    if (!opt->json) fmt::print("{}: DIFFERS: frame {} has no file matching {}\n", opt->encoded, e.number, opt->input);
+                }
+        if (pattern && opt->json) printJson(reports);
+        exitCode = identical ? 0 : 1;
     });
 }
 

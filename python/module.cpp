@@ -193,7 +193,25 @@ PYBIND11_MODULE(_vdbdag, m) {
                                    for (size_t i = 0; i < f->gridCount(); ++i) grids.append(PyGrid{f, &f->grid(i)});
                                    return grids;
                                })
-        .def("grid", [](const std::shared_ptr<vdbdag::File>& f, const std::string& name) { return PyGrid{f, &f->grid(name)}; }, py::arg("name"))
+        .def(
+            "grid",
+            [](const std::shared_ptr<vdbdag::File>& f, const std::string& name, std::optional<int64_t> frame) {
+                return PyGrid{f, frame ? &f->grid(name, *frame) : &f->grid(name)};
+            },
+            py::arg("name"), py::arg("frame") = py::none(), "the first grid of that name, or the one of that name in the frame of that number")
+        .def(
+            "frames",
+            [](const std::shared_ptr<vdbdag::File>& f) {
+                py::list frames;
+                for (const vdbdag::Frame& fr : f->frames()) {
+                    py::list grids;
+                    for (size_t i = fr.firstGrid; i < fr.firstGrid + fr.gridCount; ++i) grids.append(PyGrid{f, &f->grid(i)});
+                    frames.append(py::make_tuple(fr.number, grids));
+                }
+                return frames;
+            },
+            "the frames in order, each (number, [grids]); a file of one volume is one frame numbered 0")
+        .def_property_readonly("is_sequence", &vdbdag::File::isSequence)
         .def("__repr__", [](const vdbdag::File& f) { return "<vdbdag.File '" + f.path() + "'>"; });
 
     m.def(

@@ -31,6 +31,7 @@
 #include <memory>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <vdbdag/Error.h>
 
@@ -205,6 +206,13 @@ struct OpenLimits {
     uint64_t maxMemory = 0;
 };
 
+// A frame of a sequence file (the frames of a cache in one file): its
+// number (smoke.0042.vdb: 42) and its grids, grid(firstGrid) on.
+struct Frame {
+    int64_t number = 0;
+    size_t firstGrid = 0, gridCount = 0;
+};
+
 class VDBDAG_API File {
 public:
     // Maps the file and checks it (format version, checksums, every DAG)
@@ -215,6 +223,13 @@ public:
     size_t gridCount() const;
     const Grid& grid(size_t index) const;
     const Grid& grid(const std::string& name) const;  // the first grid of that name
+    // The frames, in order: a sequence file's, or for a file of one volume
+    // one frame numbered 0 holding every grid.
+    const std::vector<Frame>& frames() const;
+    bool isSequence() const;  // the file holds frames (a Frames section)
+    // The grid of that name in the frame of that number; throws
+    // vdbdag::Error naming the file when there is none.
+    const Grid& grid(const std::string& name, int64_t frame) const;
     uint32_t formatVersion() const;                    // of this file
     const std::string& path() const;
 

@@ -232,6 +232,8 @@ const char* sectionKindName(SectionKind kind) {
     switch (kind) {
         case SectionKind::FileInfo: return "FileInfo";
         case SectionKind::FileMetadata: return "FileMetadata";
+        case SectionKind::Frames: return "Frames";
+        case SectionKind::FrameMetadata: return "FrameMetadata";
         case SectionKind::GridInfo: return "GridInfo";
         case SectionKind::VdbDescriptor: return "VdbDescriptor";
         case SectionKind::DagLevels: return "DagLevels";
@@ -263,6 +265,53 @@ bool isPrecompressed(SectionKind kind) {
 
 namespace {
 
+// An open regular file (O_NONBLOCK: opening a FIFO must not block; it is
+// refused), closed when done.
+struct InputFile {
+    int fd = -1;
+    uint64_t size = 0;
+    explicit InputFile(const std::string& path) {
+        auto fail = [&](const std::string& why, int err) { throw Error(path + ": " + why + " (" + std::strerror(err) + ")"); };
+        fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+        if (fd < 0) {
+            const int err = errno;
+            if (err == ENOENT || err == ENOTDIR) throw Error(path + ": no such file");
+            fail("cannot be opened for reading", err);
+        }
+        struct stat st{};
+        if (::fstat(fd, &st) != 0) {
+            const int err = errno;
+            ::close(fd);
+            fail("cannot be read", err);
+        }
+        if (!S_ISREG(st.st_mode)) {
+            ::close(fd);
+            throw Error(path + ": is " + fileKindName(st.st_mode) + ", not an .ssvdag file");  // a device could be read forever, a FIFO block
+        }
+        size = uint64_t(st.st_size);
+    }
+    ~InputFile() { ::close(fd); }
+    InputFile(const InputFile&) = delete;
+    InputFile& operator=(const InputFile&) = delete;
+    // Up to `n` bytes at `offset` (fewer when the file shrank meanwhile).
+    std::vector<uint8_t> read(uint64_t offset, uint64_t n, const std::string& path) const {
+        std::vector<uint8_t> bytes(static_cast<size_t>(n));
+        size_t done = 0;
+        while (done < bytes.size()) {
+            const ssize_t got = ::pread(fd, bytes.data() + done, bytes.size() - done, off_t(offset + done));
+            if (got < 0) {
+                if (errno == EINTR) continue;
+                throw Error(path + ": read error (" + std::string(std::strerror(errno)) + ")");
+            }
+            if (got == 0) break;
+            done += size_t(got);
+        }
+        bytes.resize(done);
+        return bytes;
+    }
+};
+
+
 // Compresses the sections (into `packed`, or in place when `release`: each
 // raw payload is dropped once compressed), then hands the header, the table
 // and each payload to `put` in file order (with `release`, dropping each
@@ -277,6 +326,14 @@ uint64_t emitContainer(std::vector<Section>& sections, bool release, const Conta
     std::vector<std::vector<uint8_t>> packed(sections.size());
     auto stored = [&](size_t i) -> const std::vector<uint8_t>& { return codec[i] == kCodecZstd && !release ? packed[i] : sections[i].data; };
     for (size_t i = 0; i < sections.size(); ++i) {
+        if (const auto& from = sections[i].stored) {  // copied as it is (its checksum is checked as it is copied)
+            if (!sections[i].data.empty() || sections[i].spilled) throw Error("internal error: a copied section holds data of its own");
+            codec[i] = from->zstd ? kCodecZstd : kCodecRaw;
+            rawSize[i] = from->rawBytes;
+            storedSize[i] = from->storedBytes;
+            checksum[i] = from->checksum;
+            continue;
+        }
         if (const auto& file = sections[i].spilled) {
             if (!isPrecompressed(sections[i].kind) || !sections[i].data.empty()) throw Error("internal error: only a precompressed section is spilled");
             rawSize[i] = storedSize[i] = file->size();
@@ -323,7 +380,21 @@ uint64_t emitContainer(std::vector<Section>& sections, bool release, const Conta
     w.put<uint64_t>(XXH3_64bits(w.bytes().data(), w.bytes().size()));
     put(std::span<const uint8_t>(w.bytes()));
     for (size_t i = 0; i < sections.size(); ++i) {
-        if (const auto& file = sections[i].spilled) {
+        if (const auto& from = sections[i].stored) {
+            const InputFile file(from->path);
+            std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
+            if (!state) throw std::bad_alloc();
+            XXH3_64bits_reset(state.get());
+            for (uint64_t at = 0; at < from->storedBytes; at += kPiece) {
+                const uint64_t n = std::min<uint64_t>(kPiece, from->storedBytes - at);
+                const std::vector<uint8_t> piece = file.read(from->offset + at, n, from->path);
+                if (piece.size() != n) throw Error(from->path + ": the file was cut short while it was copied");
+                XXH3_64bits_update(state.get(), piece.data(), piece.size());
+                put(std::span<const uint8_t>(piece));
+            }
+            if (XXH3_64bits_digest(state.get()) != from->checksum)
+                throw Error(from->path + ": " + describe(i, uint32_t(sections[i].kind), sections[i].grid) + " changed while it was copied: checksum mismatch");
+        } else if (const auto& file = sections[i].spilled) {
             std::vector<uint8_t> piece;
             for (uint64_t at = 0; at < file->size(); at += kPiece) {
                 file->read(at, size_t(std::min<uint64_t>(kPiece, file->size() - at)), piece);
@@ -334,6 +405,7 @@ uint64_t emitContainer(std::vector<Section>& sections, bool release, const Conta
         }
         if (release) {
             sections[i].spilled.reset();
+            sections[i].stored.reset();
             std::vector<uint8_t>().swap(sections[i].data);
         }
         std::vector<uint8_t>().swap(packed[i]);
@@ -386,59 +458,12 @@ std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::st
     return sections;
 }
 
+
 namespace {
 
-// An open regular file (O_NONBLOCK: opening a FIFO must not block; it is
-// refused), closed when done.
-struct InputFile {
-    int fd = -1;
-    uint64_t size = 0;
-    explicit InputFile(const std::string& path) {
-        auto fail = [&](const std::string& why, int err) { throw Error(path + ": " + why + " (" + std::strerror(err) + ")"); };
-        fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-        if (fd < 0) {
-            const int err = errno;
-            if (err == ENOENT || err == ENOTDIR) throw Error(path + ": no such file");
-            fail("cannot be opened for reading", err);
-        }
-        struct stat st{};
-        if (::fstat(fd, &st) != 0) {
-            const int err = errno;
-            ::close(fd);
-            fail("cannot be read", err);
-        }
-        if (!S_ISREG(st.st_mode)) {
-            ::close(fd);
-            throw Error(path + ": is " + fileKindName(st.st_mode) + ", not an .ssvdag file");  // a device could be read forever, a FIFO block
-        }
-        size = uint64_t(st.st_size);
-    }
-    ~InputFile() { ::close(fd); }
-    InputFile(const InputFile&) = delete;
-    InputFile& operator=(const InputFile&) = delete;
-    // Up to `n` bytes at `offset` (fewer when the file shrank meanwhile).
-    std::vector<uint8_t> read(uint64_t offset, uint64_t n, const std::string& path) const {
-        std::vector<uint8_t> bytes(static_cast<size_t>(n));
-        size_t done = 0;
-        while (done < bytes.size()) {
-            const ssize_t got = ::pread(fd, bytes.data() + done, bytes.size() - done, off_t(offset + done));
-            if (got < 0) {
-                if (errno == EINTR) continue;
-                throw Error(path + ": read error (" + std::string(std::strerror(errno)) + ")");
-            }
-            if (got == 0) break;
-            done += size_t(got);
-        }
-        bytes.resize(done);
-        return bytes;
-    }
-};
-
-} // namespace
-
-std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds, const ReadLimits& limits) {
-    const InputFile file(path);
-    // The header first, for the table's size, then header and table together.
+// The checked table of an open file: the header first, for the table's
+// size, then header and table together.
+std::vector<Entry> readTable(const InputFile& file, const std::string& path) {
     std::vector<uint8_t> head = file.read(0, std::min<uint64_t>(file.size, kHeaderBytes), path);
     if (head.size() == kHeaderBytes && std::memcmp(head.data(), kMagic, sizeof(kMagic)) == 0) {
         uint32_t count;
@@ -447,19 +472,53 @@ std::vector<Section> readContainerFile(const std::string& path, bool unknownKind
     } else {
         head = file.read(0, std::min<uint64_t>(file.size, 352), path);  // enough to tell a NIfTI or DICOM file in the refusal
     }
-    const std::vector<Entry> entries = parseTable(head, path, file.size);
+    return parseTable(head, path, file.size);
+}
+
+} // namespace
+
+std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds, const ReadLimits& limits) {
+    return readContainerFile(path, unknownKinds, limits, nullptr);
+}
+
+std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds, const ReadLimits& limits, const SectionFilter& keep) {
+    const InputFile file(path);
+    std::vector<Entry> entries = readTable(file, path);
+    std::vector<size_t> index(entries.size());  // each kept entry's place in the table, for the messages
+    for (size_t i = 0; i < entries.size(); ++i) index[i] = i;
+    if (keep) {
+        size_t n = 0;
+        for (size_t i = 0; i < entries.size(); ++i)
+            if (keep(SectionKind(entries[i].kind), entries[i].grid)) {
+                entries[n] = entries[i];
+                index[n++] = i;
+            }
+        entries.resize(n);
+        index.resize(n);
+    }
     checkInflatedSize(entries, unknownKinds, limits, path);
     std::vector<Section> sections;
     sections.reserve(entries.size());
     for (size_t i = 0; i < entries.size(); ++i) {
         const Entry& e = entries[i];
-        const std::string what = path + ": " + describe(i, e.kind, e.grid);
+        const std::string what = path + ": " + describe(index[i], e.kind, e.grid);
         std::vector<uint8_t> stored = file.read(e.offset, e.stored, path);
         if (stored.size() != e.stored) throw Error(what + ": the file was cut short while it was read");
         if (XXH3_64bits(stored.data(), stored.size()) != e.checksum) throw Error(what + ": checksum mismatch, the file is corrupted");
         if (!unknownKinds && isUnknownKind(e.kind)) continue;  // checked, never inflated
         if (e.codec == kCodecRaw) sections.push_back({SectionKind(e.kind), e.grid, std::move(stored)});  // no copy
         else sections.push_back({SectionKind(e.kind), e.grid, zstdInflateFrame(stored, e.raw, what)});
+    }
+    return sections;
+}
+
+std::vector<Section> storedSectionsOf(const std::string& path) {
+    const InputFile file(path);
+    std::vector<Section> sections;
+    for (const Entry& e : readTable(file, path)) {
+        Section s{SectionKind(e.kind), e.grid, {}};
+        s.stored = std::make_shared<const StoredPayload>(StoredPayload{path, e.offset, e.stored, e.raw, e.checksum, e.codec == kCodecZstd});
+        sections.push_back(std::move(s));
     }
     return sections;
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <vector>
@@ -46,6 +47,8 @@ enum class SectionKind : uint32_t {
     PredictedValues = 20,          // per grid: integer active values predicted in attribute order (instead of Values; written before PredictedWindows, still read)
     InactivePredictedValues = 21,  // the same for the inactive layer (instead of InactiveValues)
     FileMetadata = 22,  // file-level: the .vdb file's own metadata (opaque, vdb_bridge); absent when it has none
+    Frames = 23,         // file-level, sequence files only: each frame's number and grid count (FrameSequence.h)
+    FrameMetadata = 24,  // sequence files: a frame's .vdb file metadata (as FileMetadata); grid = the frame's first grid
 };
 const char* sectionKindName(SectionKind kind);
 // Sections whose payload is compressed already (the writer stores them raw).
@@ -59,6 +62,17 @@ struct Section {
     // value windows of a grid encoded in bounded memory) is this whole
     // scratch file instead of `data`, copied into the file as it is.
     std::shared_ptr<const ScratchFile> spilled = nullptr;
+    // For the writer only: a section copied as it is stored in another
+    // .ssvdag file (storedSectionsOf), never inflated or compressed again;
+    // its checksum is checked as it is copied.
+    std::shared_ptr<const struct StoredPayload> stored = nullptr;
+};
+
+// Where a section lies in an .ssvdag file, as its table says.
+struct StoredPayload {
+    std::string path;
+    uint64_t offset = 0, storedBytes = 0, rawBytes = 0, checksum = 0;
+    bool zstd = false;
 };
 
 // What a reader learns about a section without decoding it (for `info`).
@@ -101,11 +115,20 @@ std::vector<Section> readContainer(std::span<const uint8_t> bytes, const std::st
 // the section summaries.
 std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, const std::string& sourceName);
 
+// The sections of the .ssvdag file at `path` as it stores them (header and
+// table checked as readContainer checks them; the payloads are checked when
+// written): for a writer that copies them into another file unchanged.
+std::vector<Section> storedSectionsOf(const std::string& path);
+
 // Reads a whole file into memory (throws Error naming the file if missing or
 // unreadable).
 std::vector<uint8_t> readFileBytes(const std::string& path);
 // readContainer of the file at `path`, read section by section: memory
 // holds the sections, never the file as well.
 std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds = true, const ReadLimits& limits = {});
+// The same, keeping only the sections `keep(kind, grid)` accepts: the others
+// are neither read nor weighed against the limits (one frame of a sequence).
+using SectionFilter = std::function<bool(SectionKind kind, uint32_t grid)>;
+std::vector<Section> readContainerFile(const std::string& path, bool unknownKinds, const ReadLimits& limits, const SectionFilter& keep);
 
 } // namespace vdbdag::format

@@ -44,6 +44,7 @@
 #include "src/attributes/ValueWindows.h"
 #include "src/format/ByteIO.h"
 #include "src/format/DagBounds.h"
+#include "src/format/FrameSequence.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/util/Error.h"
 
@@ -150,7 +151,15 @@ std::vector<Section> toSections(SsvdagScene& scene, bool take) {
         sections.push_back({SectionKind::FileInfo, 0, w.take()});
     }
     if (!scene.fileMetadata.empty()) sections.push_back({SectionKind::FileMetadata, 0, scene.fileMetadata});
+    std::vector<FrameEntry> frames;
+    for (const SceneFrame& f : scene.frames) frames.push_back({f.number, f.gridCount});
+    if (!frames.empty()) sections.push_back({SectionKind::Frames, 0, serializeFrames(frames)});
+    size_t nextFrame = 0;
     for (uint32_t g = 0; g < scene.grids.size(); ++g) {
+        if (nextFrame < scene.frames.size() && scene.frames[nextFrame].firstGrid == g) {
+            SceneFrame& f = scene.frames[nextFrame++];
+            if (!f.metadata.empty()) sections.push_back({SectionKind::FrameMetadata, g, takeOrCopy(f.metadata, take)});
+        }
         EncodedGrid& grid = scene.grids[g];
         ByteWriter info;
         info.putString(grid.record.name);
@@ -209,12 +218,20 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
 
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options) {
     const Section* fileInfo = nullptr;
+    const Section* framesSection = nullptr;
     Section* fileMetadata = nullptr;
+    std::map<uint32_t, Section*> frameMetadata;  // by the frame's first grid
     std::map<std::pair<uint32_t, SectionKind>, Section*> byGrid;
     for (Section& s : sections) {
-        if (s.kind == SectionKind::FileInfo) {
-            if (fileInfo) throw Error(sourceName + ": two FileInfo sections");
-            fileInfo = &s;
+        if (s.kind == SectionKind::FileInfo || s.kind == SectionKind::Frames) {
+            const Section*& slot = s.kind == SectionKind::FileInfo ? fileInfo : framesSection;
+            if (slot) throw Error(sourceName + ": two " + sectionKindName(s.kind) + " sections");
+            if (s.grid != 0) throw Error(sourceName + ": a " + sectionKindName(s.kind) + " section belongs to the file, not to grid " + std::to_string(s.grid));
+            slot = &s;
+            continue;
+        }
+        if (s.kind == SectionKind::FrameMetadata) {
+            if (!frameMetadata.emplace(s.grid, &s).second) throw Error(sourceName + ": two FrameMetadata sections for grid " + std::to_string(s.grid));
             continue;
         }
         if (s.kind == SectionKind::FileMetadata) {
@@ -230,7 +247,23 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     ByteReader fr(fileInfo->data, sourceName + ": FileInfo");
     const uint32_t gridCount = fr.get<uint32_t>();
     fr.getString();
-    if (gridCount > sections.size()) throw Error(sourceName + ": FileInfo claims " + std::to_string(gridCount) + " grids, more than its sections can hold");
+    // The frames, and the grids [first, end) this read builds: all of
+    // them, or one frame's (ReadOptions::frame).
+    std::vector<FrameEntry> frames;
+    if (framesSection) frames = parseFrames(framesSection->data, gridCount, sourceName + ": Frames");
+    if (framesSection && fileMetadata) throw Error(sourceName + ": a sequence file keeps each frame's metadata in FrameMetadata, not FileMetadata");
+    if (!framesSection && !frameMetadata.empty()) throw Error(sourceName + ": FrameMetadata in a file without frames");
+    uint32_t first = 0, end = gridCount;
+    if (options.frame) {
+        const size_t count = frames.empty() ? 1 : frames.size();
+        if (*options.frame >= count)
+            throw Error(sourceName + ": has " + std::to_string(count) + " frame(s); frame index " + std::to_string(*options.frame) + " asked for");
+        if (!frames.empty()) {
+            for (uint32_t f = 0; f < *options.frame; ++f) first += frames[f].gridCount;
+            end = first + frames[*options.frame].gridCount;
+        }
+    }
+    if (end - first > sections.size()) throw Error(sourceName + ": FileInfo claims " + std::to_string(gridCount) + " grids, more than its sections can hold");
 
     auto find = [&](uint32_t g, SectionKind kind, bool required) -> Section* {
         auto it = byGrid.find({g, kind});
@@ -243,11 +276,26 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
 
     SsvdagScene scene;
     if (fileMetadata) scene.fileMetadata = std::move(fileMetadata->data);
+    {
+        uint32_t firstGrid = 0;
+        for (const FrameEntry& f : frames) {
+            std::vector<uint8_t> metadata;
+            if (auto meta = frameMetadata.find(firstGrid); meta != frameMetadata.end()) {
+                metadata = std::move(meta->second->data);
+                frameMetadata.erase(meta);
+            }
+            if (!options.frame) scene.frames.push_back({f.number, firstGrid, f.gridCount, std::move(metadata)});
+            else if (firstGrid == first) scene.fileMetadata = std::move(metadata);
+            firstGrid += f.gridCount;
+        }
+        if (!frameMetadata.empty())
+            throw Error(sourceName + ": FrameMetadata for grid " + std::to_string(frameMetadata.begin()->first) + ", which does not begin a frame");
+    }
     uint64_t expanded = 0;  // bytes the sections and what is decoded from them take
     for (const Section& s : sections) expanded = saturatingAdd(expanded, s.data.size());
-    scene.grids.resize(gridCount);
-    for (uint32_t g = 0; g < gridCount; ++g) {
-        EncodedGrid& grid = scene.grids[g];
+    scene.grids.resize(end - first);
+    for (uint32_t g = first; g < end; ++g) {
+        EncodedGrid& grid = scene.grids[g - first];
         const std::string what = sourceName + ": grid " + std::to_string(g);
         {
             ByteReader r(find(g, SectionKind::GridInfo, true)->data, what + " GridInfo");
@@ -446,7 +494,24 @@ SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceN
 SsvdagScene readSceneFile(const std::string& path) { return readSceneFile(path, ReadOptions{}); }
 
 SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
-    return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false, options.limits), path, options);
+    if (!options.frame) return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false, options.limits), path, options);
+    // One frame: its sections only (and the file's FileInfo and Frames).
+    const FrameList list = readFrameList(path);
+    if (*options.frame >= list.frames.size())
+        throw Error(path + ": has " + std::to_string(list.frames.size()) + " frame(s); frame index " + std::to_string(*options.frame) + " asked for");
+    uint32_t first = 0;
+    for (uint32_t f = 0; f < *options.frame; ++f) first += list.frames[f].gridCount;
+    const uint32_t end = first + list.frames[*options.frame].gridCount;
+    const auto keep = [first, end](SectionKind kind, uint32_t grid) {
+        switch (kind) {
+            case SectionKind::FileInfo:
+            case SectionKind::Frames:
+            case SectionKind::FileMetadata: return true;
+            case SectionKind::FrameMetadata: return grid == first;
+            default: return grid >= first && grid < end;
+        }
+    };
+    return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false, options.limits, keep), path, options);
 }
 
 } // namespace vdbdag::format

@@ -59,9 +59,21 @@ struct EncodedGrid {
     std::vector<uint8_t> inactivePredictedValues;
 };
 
+// One frame of a sequence file (docs/FORMAT.md 4.3): the grids
+// [firstGrid, firstGrid + gridCount) of the scene.
+struct SceneFrame {
+    int64_t number = 0;            // the frame number of its source (smoke.0042.vdb: 42)
+    uint32_t firstGrid = 0, gridCount = 0;
+    std::vector<uint8_t> metadata;  // its .vdb file's metadata (opaque, as fileMetadata)
+};
+
 struct SsvdagScene {
     std::vector<EncodedGrid> grids;
-    std::vector<uint8_t> fileMetadata;  // Volume::fileMetadata (opaque)
+    std::vector<uint8_t> fileMetadata;  // Volume::fileMetadata (opaque); empty in a sequence
+    // A sequence file's frames, in order, covering every grid; empty for a
+    // file of one volume. A scene read with ReadOptions::frame is that frame
+    // alone, as a file of one volume (its metadata in fileMetadata).
+    std::vector<SceneFrame> frames;
 };
 
 // The traceable channel of a layer (palettes): format/TraceableValues.h.
@@ -88,6 +100,9 @@ struct ReadOptions {
     // How predicted windows are decoded (util::tbbParallelFor in the core
     // library's users; the reader library: one after another).
     attributes::ParallelFor parallel;
+    // Read one frame of a sequence file (an index into its frames; a file
+    // of one volume has frame 0 only): only its sections are read.
+    std::optional<uint32_t> frame;
 };
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options);
 

@@ -87,6 +87,9 @@ std::shared_ptr<FileData> FileData::read(const std::string& path, const OpenLimi
     format::SsvdagScene scene = format::readSceneFile(path, options);
     auto file = std::make_shared<FileData>();
     file->path = path;
+    file->sequence = !scene.frames.empty();
+    for (const format::SceneFrame& f : scene.frames) file->frames.push_back({f.number, f.firstGrid, f.gridCount});
+    if (scene.frames.empty()) file->frames.push_back({0, 0, scene.grids.size()});
     for (format::EncodedGrid& g : scene.grids) {
         auto data = std::make_unique<GridData>();
         data->grid = std::move(g);
@@ -126,6 +129,19 @@ const Grid& File::grid(const std::string& name) const {
     for (size_t g = 0; g < data_->grids.size(); ++g)
         if (data_->grids[g].name() == name) return data_->grids[g];
     throw Error(data_->path + ": no grid named '" + name + "'");
+}
+
+const std::vector<Frame>& File::frames() const { return data_->frames; }
+bool File::isSequence() const { return data_->sequence; }
+
+const Grid& File::grid(const std::string& name, int64_t frame) const {
+    for (const Frame& f : data_->frames) {
+        if (f.number != frame) continue;
+        for (size_t g = f.firstGrid; g < f.firstGrid + f.gridCount; ++g)
+            if (data_->grids[g].name() == name) return data_->grids[g];
+        throw Error(data_->path + ": frame " + std::to_string(frame) + " has no grid named '" + name + "'");
+    }
+    throw Error(data_->path + ": has no frame " + std::to_string(frame));
 }
 
 uint32_t File::formatVersion() const { return format::kFormatVersion; }

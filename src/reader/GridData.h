@@ -65,6 +65,8 @@ struct FileData {
     std::string path;
     std::vector<std::unique_ptr<GridData>> data;
     std::vector<Grid> grids;
+    std::vector<Frame> frames;
+    bool sequence = false;
     static std::shared_ptr<FileData> read(const std::string& path, const OpenLimits& limits);
 };
 

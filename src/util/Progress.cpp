@@ -32,6 +32,8 @@ std::string duration(double seconds) {
 
 void Progress::setQuiet(bool quiet) { gQuiet = quiet; }
 void setQuiet(bool quiet) { Progress::setQuiet(quiet); }
+bool Progress::quiet() { return gQuiet; }
+bool isQuiet() { return Progress::quiet(); }
 
 Progress::Progress(std::string label, uint64_t total)
     : label_(std::move(label)), total_(total), startNs_(nowNs()), enabled_(!gQuiet && isatty(STDERR_FILENO) == 1) {}

@@ -24,6 +24,7 @@ public:
     void setLabel(std::string label);  // e.g. the current step
 
     static void setQuiet(bool quiet);  // e.g. for --json output
+    static bool quiet();
     bool enabled() const { return enabled_; }
 
 private:
@@ -42,5 +43,6 @@ private:
 
 // Silences every progress line created afterwards (global).
 void setQuiet(bool quiet);
+bool isQuiet();
 
 } // namespace vdbdag

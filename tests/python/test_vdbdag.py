@@ -227,3 +227,33 @@ def test_bunny_level_set_100000_lookups(work):
     path = encoded(work, vdb)
     name = vdbdag.open(path).grids[0].name
     check_grid(vdb, path, name, 100000, seed=2)
+
+
+def test_sequence_frames_equal_pyopenvdb(work):
+    """A cache of three frames (spheres growing, numbered 10, 11, 13) in one
+    file: File.frames() gives the numbers, grid(name, frame) each frame's
+    values, and decode writes each frame back."""
+    radii = {10: 12.0, 11: 13.5, 13: 15.0}
+    for number, radius in radii.items():
+        ls = openvdb.createLevelSetSphere(radius=radius, center=(1.0, 2.0, 3.0), voxelSize=0.5, halfWidth=3.0)
+        ls.name = "surface"
+        openvdb.write(os.path.join(work, "cache.%04d.vdb" % number), grids=[ls])
+    seq = os.path.join(work, "cache.ssvdag")
+    vdbdag.encode(os.path.join(work, "cache.####.vdb"), seq)
+    f = vdbdag.open(seq)
+    assert f.is_sequence
+    assert [number for number, _ in f.frames()] == [10, 11, 13]
+    for number, grids in f.frames():
+        assert [g.name for g in grids] == ["surface"]
+        ref = openvdb.read(os.path.join(work, "cache.%04d.vdb" % number), "surface")
+        ijk = sample_coords(ref, 2000, number)
+        want_values, want_active = reference(ref, ijk)
+        g = f.grid("surface", frame=number)
+        assert np.array_equal(g.is_active(ijk), want_active)
+        assert g.values(ijk).tobytes() == np.array(want_values, dtype=np.float32).tobytes()
+    with pytest.raises(vdbdag.Error, match="no frame 12"):
+        f.grid("surface", frame=12)
+    vdbdag.decode(seq, os.path.join(work, "back.%04d.vdb"), frames="11")
+    back = openvdb.read(os.path.join(work, "back.0011.vdb"), "surface")
+    assert back.activeVoxelCount() == openvdb.read(os.path.join(work, "cache.0011.vdb"), "surface").activeVoxelCount()
+    assert not os.path.exists(os.path.join(work, "back.0010.vdb"))

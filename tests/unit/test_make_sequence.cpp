@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -98,10 +99,18 @@ TEST(MakeSequence, SeveralFramesEncodeOneFileEachAsEachAlone) {
         ASSERT_EQ(vdbdag::testing::runCli("encode " + (dir / "in" / (stem + ".vdb")).string() + " -o " + alone.string()).exitCode, 0);
         EXPECT_EQ(vdbdag::testing::runShell("cmp -s " + alone.string() + " " + (dir / "out" / (stem + ".ssvdag")).string()).exitCode, 0) << stem;
     }
+    // -o naming an .ssvdag file: one sequence file of the three frames.
     const fs::path file = dir / "a_file.ssvdag";
-    const vdbdag::testing::CommandResult refused = vdbdag::testing::runCli("encode" + inputs + " -o " + file.string());
+    ASSERT_EQ(vdbdag::testing::runCli("encode" + inputs + " -o " + file.string()).exitCode, 0);
+    const vdbdag::testing::CommandResult info = vdbdag::testing::runCli("info " + file.string() + " --json");
+    ASSERT_EQ(info.exitCode, 0) << info.err;
+    EXPECT_EQ(nlohmann::json::parse(info.out)["frames"].size(), 3u);
+    // -o naming another file that exists: refused, the file untouched.
+    const fs::path other = dir / "notes.txt";
+    std::ofstream(other) << "keep";
+    const vdbdag::testing::CommandResult refused = vdbdag::testing::runCli("encode" + inputs + " -o " + other.string());
     EXPECT_NE(refused.exitCode, 0);
     EXPECT_NE(refused.err.find("-o names a folder"), std::string::npos) << refused.err;
-    EXPECT_FALSE(fs::exists(file));
+    EXPECT_EQ(fs::file_size(other), 4u);
     fs::remove_all(dir);
 }
