@@ -167,6 +167,8 @@ with tempfile.TemporaryDirectory() as work:
     frames = [w("seq/levelset.%04d" % n) for n in (1, 2, 3)]
     for f in frames:
         run(os.path.join(BUILD, "vdbdag"), "encode", f + ".vdb", "-o", f + ".ssvdag", "-q")
+    # The same frames in one sequence file: its frames are the time steps.
+    run(os.path.join(BUILD, "vdbdag"), "encode", w("seq/levelset.####.vdb"), "-o", w("seq/all.ssvdag"), "-q")
     cases = [
         {"file": w("sphere_ls.ssvdag"), "out": w("sphere0.npz")},
         {"file": w("sphere_ls.ssvdag"), "out": w("sphere2.npz"), "properties": {"LevelOfDetail": 2}},
@@ -181,6 +183,8 @@ with tempfile.TemporaryDirectory() as work:
         {"file": w("sphere_ls.ssvdag"), "out": w("diff.npz"), "properties": {"CompareWith": w("sphere_mod.ssvdag")}},
         {"file": w("sphere_ls.ssvdag"), "out": w("diff_vdb.npz"), "properties": {"CompareWith": w("sphere_mod.vdb")}},
     ] + [{"file": [f + ".ssvdag" for f in frames], "time": float(t), "out": w("frame%d.npz" % t)} for t in (2, 0, 1)]
+    cases += [{"file": w("seq/all.ssvdag"), "time": float(n), "out": w("seqframe%d.npz" % n)} for n in (3, 1, 2)]
+    cases += [{"file": w("seq/all.ssvdag"), "time": 2.0, "out": w("seqcells.npz"), "properties": {"OutputType": 1}}]
     cases += [{"file": w(name), "out": w(name + ".cells.npz"), "properties": {"OutputType": 1, "UseBox": 1, "Box": box}}
               for name, box in (("fog_tiles.ssvdag", [-60, 20, -30, 40, -50, 10]), ("fog_tiles.vdb", [-60, 20, -30, 40, -50, 10]),
                                 ("multi_grid.ssvdag", [-50, 50, -50, 50, -50, 50]), ("multi_grid.vdb", [-50, 50, -50, 50, -50, 50]))]
@@ -277,6 +281,23 @@ with tempfile.TemporaryDirectory() as work:
         check(list(image["times"]) == [0.0, 1.0, 2.0], "frame%d.npz: the series has time steps %s" % (t, list(image["times"])))
         check_geometry("frame%d.npz" % t, image, grid, lo, 1)
         check_values("frame%d.npz (levelset.%04d)" % (t, t + 1), pv_values(image, 0), vdb_dense(grid, lo, hi))
+
+    # The sequence file: its frame numbers are the time steps; each is the
+    # image of its frame over the box of all frames.
+    grids = [vdb.read(f + ".vdb", "surface") for f in frames]
+    boxes = [g.evalActiveVoxelBoundingBox() for g in grids]
+    lo = [min(b[0][a] for b in boxes) for a in range(3)]
+    hi = [max(b[1][a] for b in boxes) for a in range(3)]
+    for n in (1, 2, 3):
+        image = load("seqframe%d.npz" % n)
+        check(list(image["times"]) == [1.0, 2.0, 3.0], "seqframe%d.npz: the sequence file has time steps %s" % (n, list(image["times"])))
+        check_geometry("seqframe%d.npz" % n, image, grids[n - 1], lo, 1)
+        check_values("seqframe%d.npz (frame %d of all.ssvdag)" % (n, n), pv_values(image, 0), vdb_dense(grids[n - 1], lo, hi))
+    cells = load("seqcells.npz")
+    edges = np.rint((cells["hi_0"] - cells["lo_0"]) / grids[1].transform.voxelSize()[0]).astype(np.int64)
+    voxels = int(np.prod(edges, axis=1).sum())
+    check(voxels == grids[1].activeVoxelCount(),
+          "seqcells.npz: the active cells at time 2 hold frame 2's %d active voxels (%d)" % (grids[1].activeVoxelCount(), voxels))
 
     if os.path.exists(bunny):
         grid = vdb.read(bunny, vdb.readAllGridMetadata(bunny)[0].name)

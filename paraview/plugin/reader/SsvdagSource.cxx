@@ -14,6 +14,9 @@ public:
       const vdbdag::Grid& grid = this->File.grid(g);
       this->Grids.push_back({ grid.name(), grid.valueType(), grid.valueSize(), grid.indexToWorld(), grid.indexBBox() });
     }
+    if (this->File.isSequence())
+      for (const vdbdag::Frame& f : this->File.frames())
+        this->Frames.push_back({ f.number, f.firstGrid, f.gridCount });
   }
   void sample(size_t g, const vdbdag::IndexBBox& box, uint64_t stride, void* out) const override
   {

@@ -25,11 +25,30 @@ struct VolumeGrid
   vdbdag::IndexBBox box; // of the active voxels
 };
 
+// A frame of a sequence file (vdbdag::File::frames): its grids are
+// grids()[firstGrid, firstGrid + gridCount).
+struct VolumeFrame
+{
+  int64_t number = 0;
+  size_t firstGrid = 0, gridCount = 0;
+};
+
 class VolumeSource
 {
 public:
   virtual ~VolumeSource() = default;
   const std::vector<VolumeGrid>& grids() const { return this->Grids; }
+  // A sequence file's frames; empty for a file of one volume.
+  const std::vector<VolumeFrame>& frames() const { return this->Frames; }
+  // The grids of the first frame (every grid of a file of one volume).
+  size_t firstFrameGrids() const { return this->Frames.empty() ? this->Grids.size() : this->Frames.front().gridCount; }
+  // The grid of frame `frame` that stands for grid g of the first frame: the
+  // same name and type, the k-th of that name when names repeat; g itself
+  // for a file of one volume; SIZE_MAX when the frame has none.
+  size_t gridInFrame(size_t g, size_t frame) const;
+  // The frame shown at time `time`: the last whose number is <= time (the
+  // first before them all); 0 for a file of one volume.
+  size_t frameAt(double time) const;
   // Grid g's values at box.min + n * stride; callable from several threads
   // at once for disjoint outputs.
   virtual void sample(size_t g, const vdbdag::IndexBBox& box, uint64_t stride, void* out) const = 0;
@@ -48,6 +67,7 @@ public:
 
 protected:
   std::vector<VolumeGrid> Grids;
+  std::vector<VolumeFrame> Frames;
 };
 
 std::unique_ptr<VolumeSource> openSsvdagSource(const std::string& path);

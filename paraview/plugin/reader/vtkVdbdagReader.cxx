@@ -25,6 +25,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -120,6 +121,10 @@ struct vtkVdbdagReader::Internals
   // The plan of the last RequestInformation.
   std::vector<size_t> Grids;    // A's grids read, in file order
   std::vector<size_t> Partners; // with CompareWith: the grid of B of each
+  // Of a sequence file, grids of its first frame; RequestData reads the
+  // grids that stand for them in the frame of the time asked for (Current:
+  // A's, CurrentPartners: B's; SIZE_MAX where the frame lacks one).
+  std::vector<size_t> Current, CurrentPartners;
   vdbdag::IndexBBox Box;
   uint64_t Stride = 1;
   std::array<double, 16> IndexToWorld{};
@@ -206,8 +211,9 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
       // Selection names: the grid's name ("grid" when it has none), made
       // unique with " (2)", " (3)".
       std::vector<std::string> names;
-      for (const VolumeGrid& g : in.A.Source->grids())
+      for (size_t i = 0; i < in.A.Source->firstFrameGrids(); ++i)
       {
+        const VolumeGrid& g = in.A.Source->grids()[i];
         const std::string base = g.name.empty() ? "grid" : g.name;
         std::string name = base;
         for (int n = 2; std::find(names.begin(), names.end(), name) != names.end(); ++n)
@@ -235,7 +241,7 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
     const std::vector<VolumeGrid>& grids = in.A.Source->grids();
     in.Grids.clear();
     in.Partners.clear();
-    for (size_t g = 0; g < grids.size(); ++g)
+    for (size_t g = 0; g < in.A.Source->firstFrameGrids(); ++g)
     {
       if (!this->GridSelection->ArrayIsEnabled(in.Names[g].c_str()))
         continue;
@@ -248,8 +254,9 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
       if (compare)
       {
         const std::vector<VolumeGrid>& other = in.B.Source->grids();
-        const auto it = std::find_if(other.begin(), other.end(), [&](const VolumeGrid& o) { return o.name == grids[g].name; });
-        if (it == other.end() || it->type != grids[g].type)
+        const auto end = other.begin() + long(in.B.Source->firstFrameGrids());
+        const auto it = std::find_if(other.begin(), end, [&](const VolumeGrid& o) { return o.name == grids[g].name; });
+        if (it == end || it->type != grids[g].type)
         {
           vtkWarningMacro(<< this->CompareWith << ": no " << grids[g].type << " grid named '" << grids[g].name
                           << "' to compare with; it is left out");
@@ -287,12 +294,17 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
     }
     else
     {
-      for (size_t n = 0; n < in.Grids.size(); ++n)
-      {
-        grow(grids[in.Grids[n]].box);
-        if (compare)
-          grow(in.B.Source->grids()[in.Partners[n]].box);
-      }
+      // (Of a sequence, every frame's: one image for all its time steps.)
+      const size_t frames = std::max<size_t>(1, in.A.Source->frames().size());
+      for (size_t f = 0; f < frames; ++f)
+        for (size_t n = 0; n < in.Grids.size(); ++n)
+          if (const size_t g = in.A.Source->gridInFrame(in.Grids[n], f); g != SIZE_MAX)
+            grow(grids[g].box);
+      if (compare)
+        for (size_t f = 0; f < std::max<size_t>(1, in.B.Source->frames().size()); ++f)
+          for (size_t n = 0; n < in.Grids.size(); ++n)
+            if (const size_t g = in.B.Source->gridInFrame(in.Partners[n], f); g != SIZE_MAX)
+              grow(in.B.Source->grids()[g].box);
     }
 
     // The level: as asked, or the finest within the budget.
@@ -323,6 +335,21 @@ int vtkVdbdagReader::RequestInformation(vtkInformation*, vtkInformationVector**,
     const std::array<double, 3> origin = WorldOf(in.IndexToWorld, in.Box.empty() ? std::array<int64_t, 3>{ 0, 0, 0 } : in.Box.min);
     std::copy(origin.begin(), origin.end(), in.Origin);
     std::copy(extent, extent + 6, in.WholeExtent);
+    // A sequence file's frames are its time steps, by frame number.
+    if (!in.A.Source->frames().empty())
+    {
+      std::vector<double> steps;
+      for (const VolumeFrame& f : in.A.Source->frames())
+        steps.push_back(double(f.number));
+      outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), steps.data(), int(steps.size()));
+      const double range[2] = { steps.front(), steps.back() };
+      outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+    }
+    else
+    {
+      outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+      outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+    }
     if (this->OutputType == 1) // cells: no extent
     {
       outInfo->Remove(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT());
@@ -370,6 +397,27 @@ int vtkVdbdagReader::RequestDataObject(vtkInformation*, vtkInformationVector**, 
 int vtkVdbdagReader::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  Internals& in = *this->Internal;
+  if (!in.A.Source)
+    return 0;
+  // The frame of the time asked for (a sequence file), and B's of the same number.
+  const std::vector<VolumeFrame>& frames = in.A.Source->frames();
+  const double time = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+    : (frames.empty() ? 0.0 : double(frames.front().number));
+  const size_t frame = in.A.Source->frameAt(time);
+  const double number = frames.empty() ? time : double(frames[frame].number);
+  in.Current.clear();
+  in.CurrentPartners.clear();
+  for (size_t n = 0; n < in.Grids.size(); ++n)
+  {
+    in.Current.push_back(in.A.Source->gridInFrame(in.Grids[n], frame));
+    if (in.B.Source)
+      in.CurrentPartners.push_back(in.B.Source->gridInFrame(in.Partners[n], in.B.Source->frameAt(number)));
+  }
+  vtkDataObject* out = vtkDataObject::GetData(outInfo);
+  if (out && !frames.empty())
+    out->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), number);
   return this->OutputType == 1 ? this->RequestActiveCells(outInfo) : this->RequestImage(outInfo);
 }
 
@@ -386,7 +434,10 @@ int vtkVdbdagReader::RequestActiveCells(vtkInformation* outInfo)
     for (size_t n = 0; n < in.Grids.size(); ++n)
     {
       const size_t g = in.Grids[n];
-      blocks.push_back(BuildActiveCells(*in.A.Source, g, in.Box, in.Names[g], maxCells, in.A.Path));
+      if (in.Current[n] == SIZE_MAX) // not in this frame: an empty block
+        blocks.push_back(vtkSmartPointer<vtkUnstructuredGrid>::New());
+      else
+        blocks.push_back(BuildActiveCells(*in.A.Source, in.Current[n], in.Box, in.Names[g], maxCells, in.A.Path));
       this->UpdateProgress(double(n + 1) / double(in.Grids.size()));
     }
     out->SetNumberOfBlocks(unsigned(blocks.size()));
@@ -503,7 +554,10 @@ int vtkVdbdagReader::RequestImage(vtkInformation* outInfo)
     const std::vector<VolumeGrid>& grids = in.A.Source->grids();
     for (size_t n = 0; n < in.Grids.size(); ++n)
     {
-      const size_t g = in.Grids[n];
+      const size_t g = in.Grids[n];   // its name and type: the first frame's grid
+      const size_t read = in.Current[n]; // the grid read: this frame's
+      if (read == SIZE_MAX || (compare && in.CurrentPartners[n] == SIZE_MAX))
+        continue; // not in this frame
       const VolumeGrid& grid = grids[g];
       const size_t row = std::max(1u, grid.valueSize);
       if (!compare)
@@ -511,7 +565,7 @@ int vtkVdbdagReader::RequestImage(vtkInformation* outInfo)
         vtkSmartPointer<vtkDataArray> values = ValueArray(grid, in.Names[g], points);
         auto* bytes = static_cast<uint8_t*>(values->GetVoidPointer(0));
         if (!forSlabs([&](uint64_t zb, uint64_t, const vdbdag::IndexBBox& slab) {
-              in.A.Source->sample(g, slab, in.Stride, bytes + zb * slice * row);
+              in.A.Source->sample(read, slab, in.Stride, bytes + zb * slice * row);
             }))
           return 0;
         out->GetPointData()->AddArray(values);
@@ -536,11 +590,11 @@ int vtkVdbdagReader::RequestImage(vtkInformation* outInfo)
       const ComponentReader component = ComponentReaderFor(grid.type);
       if (!forSlabs([&](uint64_t zb, uint64_t ze, const vdbdag::IndexBBox& slab) {
             const uint64_t first = zb * slice, count = (ze - zb) * slice;
-            in.A.Source->sample(g, slab, in.Stride, aBytes + first * row);
-            in.B.Source->sample(in.Partners[n], slab, in.Stride, bBytes + first * row);
+            in.A.Source->sample(read, slab, in.Stride, aBytes + first * row);
+            in.B.Source->sample(in.CurrentPartners[n], slab, in.Stride, bBytes + first * row);
             std::vector<uint8_t> aOn(count), bOn(count);
-            in.A.Source->sampleActive(g, slab, in.Stride, aOn.data());
-            in.B.Source->sampleActive(in.Partners[n], slab, in.Stride, bOn.data());
+            in.A.Source->sampleActive(read, slab, in.Stride, aOn.data());
+            in.B.Source->sampleActive(in.CurrentPartners[n], slab, in.Stride, bOn.data());
             for (uint64_t p = 0; p < count; ++p)
             {
               const uint8_t* va = aBytes + (first + p) * row;
