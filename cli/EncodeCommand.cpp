@@ -345,42 +345,68 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         for (const FrameFile& f : frames) inputs.push_back(f.path);
         checkOutputPath(output, inputs, {{".ssvdag"}, "encode", opt->force});
         const std::filesystem::path near = opt->scratch.empty() ? std::filesystem::path(output) : std::filesystem::path(opt->scratch) / std::filesystem::path(output).filename();
-        const std::string folder = temporaryNameFor(near.string());
-        const TemporaryGuard guard(folder, /*folder=*/true);
+        // Under mpirun the frames are spread over the processes, each frame
+        // encoded by one process alone (the same bytes), into process 0's
+        // folder (the output's folder: a shared file system, as for the
+        // input); process 0 then gathers them.
+        pipeline::CubeTeam& team = cubeTeam();
+        std::string folder = team.isRoot() ? temporaryNameFor(near.string()) : std::string();
+        std::optional<TemporaryGuard> guard;
         struct Removed {
             std::string path;
             ~Removed() {
                 std::error_code ignored;
-                std::filesystem::remove_all(path, ignored);
+                if (!path.empty()) std::filesystem::remove_all(path, ignored);
             }
-        } removed{folder};
-        std::error_code ec;
-        if (!std::filesystem::create_directory(folder, ec) || ec)
-            throw Error(folder + ": cannot make the folder for the frames being encoded (" + (ec ? ec.message() : "it exists") + ")");
+        } removed;
+        if (team.isRoot()) {
+            guard.emplace(folder, /*folder=*/true);
+            removed.path = folder;
+            std::error_code ec;
+            if (!std::filesystem::create_directory(folder, ec) || ec)
+                throw Error(folder + ": cannot make the folder for the frames being encoded (" + (ec ? ec.message() : "it exists") + ")");
+        }
+        if (team.size() > 1) {  // (after process 0 made it)
+            const std::vector<uint8_t> name = team.broadcast(std::vector<uint8_t>(folder.begin(), folder.end()));
+            folder.assign(name.begin(), name.end());
+        }
         Progress progress("encode " + std::filesystem::path(output).filename().string(), frames.size() * 1000);
         const bool wasQuiet = isQuiet();
         setQuiet(true);  // the frames' own progress lines
         struct Restore {
             bool quiet;
             Options& o;
+            pipeline::CubeTeam& team;
             ~Restore() {
                 setQuiet(quiet);
                 o.sequenceProgress = nullptr;
+                setCubeTeam(team);
             }
-        } restore{wasQuiet, *opt};
+        } restore{wasQuiet, *opt, team};
         opt->sequenceProgress = &progress;
         std::vector<format::FramePart> parts;
         nlohmann::json reports = nlohmann::json::array();
         for (size_t i = 0; i < frames.size(); ++i) {
+            parts.push_back({frames[i].number, (std::filesystem::path(folder) / fmt::format("frame{:06}.ssvdag", i)).string()});
+            if (i % team.size() != team.rank()) continue;
             progress.setLabel(fmt::format("encode frame {} ({} of {})", frames[i].number, i + 1, frames.size()));
             opt->frameIndex = i;
             opt->input = frames[i].path;
-            opt->output = (std::filesystem::path(folder) / fmt::format("frame{:06}.ssvdag", i)).string();
+            opt->output = parts.back().path;
+            setCubeTeam(pipeline::soloTeam());
             encodeOne(&reports);
-            parts.push_back({frames[i].number, opt->output});
+            setCubeTeam(team);
+            reports.back()["frame_index"] = i;
         }
         opt->output = output;
-        if (!cubeTeam().isRoot()) {
+        if (team.size() > 1) {  // every process's reports on process 0, once its frames are written
+            const std::string mine = reports.dump();
+            reports = nlohmann::json::array();
+            for (const std::vector<uint8_t>& theirs : team.gather(std::vector<uint8_t>(mine.begin(), mine.end())))
+                for (auto& r : nlohmann::json::parse(theirs.begin(), theirs.end())) reports.push_back(std::move(r));
+            std::sort(reports.begin(), reports.end(), [](const nlohmann::json& a, const nlohmann::json& b) { return a["frame_index"] < b["frame_index"]; });
+        }
+        if (!team.isRoot()) {
             exitCode = 0;
             return;
         }
@@ -400,6 +426,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         for (size_t i = 0; i < reports.size(); ++i) {
             reports[i]["frame"] = frames[i].number;
             reports[i]["output"] = output;
+            reports[i].erase("frame_index");
         }
         report["per_frame"] = reports;
         if (opt->json) printJson(report);

@@ -9,6 +9,7 @@
 // sanitizer report, another exception, a timeout or an out-of-memory) is a
 // bug, and so is summarizeContainer disagreeing with readContainer.
 // Run: scripts/fuzz.sh [SECONDS]
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -87,6 +88,15 @@ void readAll(std::span<const uint8_t> bytes, bool deep) {
         format::ReadOptions options;
         options.limits.maxVoxels = uint64_t(1) << 22;
         options.limits.maxMemory = uint64_t(512) << 20;
+        // A sequence file: one frame read alone too (the second, or the only one).
+        if (std::any_of(sections.begin(), sections.end(), [](const format::Section& s) { return s.kind == format::SectionKind::Frames; })) {
+            format::ReadOptions one = options;
+            one.frame = 1;
+            try {
+                format::sectionsToScene(sections, "fuzz", one);
+            } catch (const Error&) {
+            }
+        }
         const format::SsvdagScene scene = format::sectionsToScene(std::move(sections), "fuzz", options);
         for (const auto& grid : scene.grids) {
             // An expansion bomb (a few KB that decode to 2^40 bricks) is a

@@ -82,6 +82,16 @@ int main(int argc, char** argv) {
         std::ofstream(std::string(argv[1]) + "/seed" + std::to_string(n++) + ".ssvdag", std::ios::binary)
             .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
     }
+    // The same grids as a sequence file: two frames, the first with file
+    // metadata (format 4.3: Frames and FrameMetadata sections).
+    {
+        format::SsvdagScene sequence = scene;
+        const uint32_t count = uint32_t(sequence.grids.size());
+        sequence.frames = {{7, 0, 1, {1, 2, 3, 4}}, {9, 1, count - 1, {}}};
+        const auto bytes = format::writeScene(sequence);
+        std::ofstream(std::string(argv[1]) + "/sequence.ssvdag", std::ios::binary)
+            .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
     // Bare containers: no sections, and a few sections (empty, compressible,
     // incompressible, an unknown kind), zstd and raw.
     std::vector<format::Section> bare;

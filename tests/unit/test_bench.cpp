@@ -102,7 +102,7 @@ TEST(Bench, CommandWritesTheReportAndHoldsItsBounds) {
     EXPECT_EQ(lossless, 1);
     EXPECT_EQ(normalRows, 1);
     for (const auto& p : j["points"])  // the normals cost bytes on top of the exact values
-        if (p["family"] == "vdbdag normals") EXPECT_GT(p["bytes"].get<uint64_t>(), losslessBytes);
+        if (p["family"] == "vdbdag normals") { EXPECT_GT(p["bytes"].get<uint64_t>(), losslessBytes); }
     EXPECT_TRUE(fs::exists(report / "error_vs_size_sphere_normal_angle_deg.png"));
     EXPECT_GE(fpn, 2);
     EXPECT_GE(matched, fpn);

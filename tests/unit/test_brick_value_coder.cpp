@@ -67,7 +67,7 @@ void expectRoundTrip(const Channel& c, IntCoderOptions o, const std::string& wha
     size_t outside = 0;
     for (size_t i = 0; i < back.size(); ++i) outside += std::abs(int64_t(back[i]) - c.entries[i]) > o.near;
     EXPECT_EQ(outside, 0u) << what << ": entries beyond near = " << o.near;
-    if (o.near == 0) EXPECT_EQ(back, c.entries) << what;
+    if (o.near == 0) { EXPECT_EQ(back, c.entries) << what; }
 }
 
 TEST(BrickValueCoder, LosslessAndNearLosslessOverEveryKindOfBrick) {

@@ -220,8 +220,8 @@ TEST(Cli, RenderOnVulkanAndCpuGivesTheSamePngAndAutoFallsBackWithoutADevice) {
     EXPECT_TRUE(r.err.starts_with("vdbdag: note: no Vulkan device")) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     // --quiet (before or after the command's name) drops the note, not the result.
-    for (const std::string& quiet : {"-q render ", "render --quiet "}) {
-        r = runCli(quiet + encoded.string() + " -o " + fallbackPng.string() + " -f --width 96 --height 64 --json", noDriver);
+    for (const char* quiet : {"-q render ", "render --quiet "}) {
+        r = runCli(std::string(quiet) + encoded.string() + " -o " + fallbackPng.string() + " -f --width 96 --height 64 --json", noDriver);
         ASSERT_EQ(r.exitCode, 0) << r.err;
         EXPECT_EQ(nlohmann::json::parse(r.out)["backend"], "cpu");
         EXPECT_EQ(r.err, "") << quiet;
@@ -449,8 +449,9 @@ TEST(Cli, EveryJsonReportCarriesTheVersionsAndTheCommonKeys) {
         EXPECT_TRUE(j["tool_version"].is_string()) << args;
         EXPECT_EQ(j["format_version"].get<uint32_t>(), 1u) << args;
         EXPECT_TRUE(j.contains(inputKey)) << args;
-        if (j.contains("ssvdag_bytes") && (args.starts_with("encode") || args.starts_with("info " + s)))
+        if (j.contains("ssvdag_bytes") && (args.starts_with("encode") || args.starts_with("info " + s))) {
             EXPECT_EQ(j["ssvdag_bytes"].get<uint64_t>(), fs::file_size(ss)) << args;
+        }
     }
     const CommandResult version = runCli("--version");
     const CommandResult info = runCli("info " + s + " --json");

@@ -107,8 +107,9 @@ void checkQuantised(const GridT& original, const GridT& decoded, const attribute
         ASSERT_TRUE(acc.probeValue(it.getCoord(), q)) << "voxel stays active";
         distinct.insert({double(q[0]), double(q[1]), double(q[2])});
         const V o = *it;
-        if constexpr (std::is_same_v<V, openvdb::Vec3i>)
+        if constexpr (std::is_same_v<V, openvdb::Vec3i>) {
             for (int k = 0; k < 3; ++k) ASSERT_TRUE(q[k] >= 0 && q[k] <= 255);
+        }
         for (int k = 0; k < 3; ++k) {
             const double e = std::fabs(double(q[k]) - double(o[k])) * scale;
             sumAbs[k] += e;

@@ -165,9 +165,9 @@ TEST(Container, RoundTripsRawAndCompressed) {
                 EXPECT_EQ(summary[i].rawBytes, sections[i].data.size());
                 if (!summary[i].compressed) EXPECT_EQ(summary[i].storedBytes, summary[i].rawBytes);
                 else EXPECT_LT(summary[i].storedBytes, summary[i].rawBytes) << "zstd kept although it does not shrink";
-                if (!compress) EXPECT_FALSE(summary[i].compressed);
-                if (compress && sections[i].data == big) EXPECT_LT(summary[i].storedBytes, big.size() / 20);
-                if (sections[i].data == random) EXPECT_FALSE(summary[i].compressed) << "random data should stay raw";
+                if (!compress) { EXPECT_FALSE(summary[i].compressed); }
+                if (compress && sections[i].data == big) { EXPECT_LT(summary[i].storedBytes, big.size() / 20); }
+                if (sections[i].data == random) { EXPECT_FALSE(summary[i].compressed) << "random data should stay raw"; }
                 stored += summary[i].storedBytes;
             }
             EXPECT_EQ(bytes.size(), kHeader + kEntry * sections.size() + 8 + stored) << "payloads are back to back";
@@ -206,7 +206,7 @@ TEST(Container, ByteLayoutIsAsDocumented) {
         const uint64_t stored = load<uint64_t>(bytes, e + kStoredAt);
         EXPECT_EQ(load<uint64_t>(bytes, e + kRawAt), sections[i].data.size());
         EXPECT_EQ(load<uint64_t>(bytes, e + kSumAt), XXH3_64bits(bytes.data() + next, stored));
-        if (codec == 0 && stored) EXPECT_EQ(std::memcmp(bytes.data() + next, sections[i].data.data(), stored), 0);
+        if (codec == 0 && stored) { EXPECT_EQ(std::memcmp(bytes.data() + next, sections[i].data.data(), stored), 0); }
         next += stored;
     }
     EXPECT_EQ(next, bytes.size());

@@ -339,7 +339,7 @@ TEST(DagBuilder, MorePlacementTrialsNeverEnlargeTheFile) {
             format::SsvdagScene scene;
             scene.grids.push_back(pipeline::encodeGrid(record, options));
             const uint64_t bytes = format::writeScene(scene).size();
-            if (trials > 1) EXPECT_LE(bytes, previous) << "tilt " << tilt << ", " << trials << " trials";
+            if (trials > 1) { EXPECT_LE(bytes, previous) << "tilt " << tilt << ", " << trials << " trials"; }
             previous = bytes;
             EXPECT_EQ(selftest::firstDifference(selftest::flatten(record), selftest::flatten(pipeline::decodeGrid(scene.grids[0]))), "")
                 << "tilt " << tilt << ", " << trials << " trials";

@@ -33,6 +33,12 @@ using namespace vdbdag;
 
 namespace {
 
+bridge::ImportOptions skipUnsupported() {
+    bridge::ImportOptions options;
+    options.skipUnsupported = true;
+    return options;
+}
+
 const fs::path& folder() {
     static const fs::path d = vdbdag::testing::testFolder("grid_summary");
     return d;
@@ -115,7 +121,7 @@ TEST(GridSummary, BoxAndRangeOfAnEncodedFileAreOpenVdbsOwn) {
     size_t grids = 0;
     for (const fs::path& path : files) {
         if (fs::file_size(path) > (64u << 20)) continue;
-        const bridge::ImportResult imported = bridge::importVdb(path.string(), {.skipUnsupported = true});
+        const bridge::ImportResult imported = bridge::importVdb(path.string(), skipUnsupported());
         const format::SsvdagScene scene = encodedAndReadBack(imported.volume);
         // OpenVDB's grids in file order (names may repeat within a file).
         std::ifstream in(path, std::ios::binary);
@@ -269,13 +275,14 @@ TEST(GridSummary, InfoOfAVdbAndOfItsSsvdagPrintWhatVdbPrintPrints) {
             const size_t k = seen[name]++;
             ASSERT_LT(k, it->second.size()) << vdb << " " << name;
             const PrintedGrid& p = it->second[k];
-            if (!ga["index_bbox"].is_null()) EXPECT_EQ(bboxText(gb["index_bbox"]), p.bbox) << vdb;
+            if (!ga["index_bbox"].is_null()) { EXPECT_EQ(bboxText(gb["index_bbox"]), p.bbox) << vdb; }
             if (!gb["value_range"].is_null()) {
                 EXPECT_TRUE(printsAs(gb["value_range"]["min"], p.min)) << vdb << " " << gb["value_range"]["min"] << " vs " << p.min;
                 EXPECT_TRUE(printsAs(gb["value_range"]["max"], p.max)) << vdb << " " << gb["value_range"]["max"] << " vs " << p.max;
             }
-            if (gb.contains("background") && !p.background.empty())
+            if (gb.contains("background") && !p.background.empty()) {
                 EXPECT_TRUE(printsAs(gb["background"], p.background)) << vdb << " " << gb["background"] << " vs " << p.background;
+            }
             const auto& vs = gb["voxel_size"];
             if (!p.voxelSize.empty() && vs[0] == vs[1] && vs[1] == vs[2]) {
                 EXPECT_TRUE(printsAs(vs[0], p.voxelSize)) << vdb << " " << vs[0] << " vs " << p.voxelSize;
@@ -283,7 +290,7 @@ TEST(GridSummary, InfoOfAVdbAndOfItsSsvdagPrintWhatVdbPrintPrints) {
             std::map<std::string, std::string> listed;
             for (const auto& [k, e] : gb["metadata"].items()) listed[k] = e["value"].get<std::string>();
             for (const auto& [k, v] : p.metadata)
-                if (k.rfind("file_", 0) != 0) EXPECT_EQ(listed[k], v) << vdb << " metadata " << k;  // file_* are the writer's statistics
+                if (k.rfind("file_", 0) != 0) { EXPECT_EQ(listed[k], v) << vdb << " metadata " << k; }  // file_* are the writer's statistics
             ++checked;
         }
     }

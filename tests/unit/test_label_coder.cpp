@@ -106,8 +106,9 @@ TEST(LabelCoder, PredictedWindowsStoreLabelsAsCoding7) {
 std::vector<uint8_t> oneWindowByHand(std::span<const uint8_t> raw, uint64_t entries) {
     std::vector<uint8_t> out;
     const auto put = [&](auto v) {
-        const auto* p = reinterpret_cast<const uint8_t*>(&v);
-        out.insert(out.end(), p, p + sizeof v);
+        const size_t at = out.size();
+        out.resize(at + sizeof v);
+        std::memcpy(out.data() + at, &v, sizeof v);
     };
     put(uint32_t(4)), put(entries), put(uint64_t(1) << 22), put(uint64_t(1));
     out.insert(out.end(), raw.begin(), raw.end());

@@ -157,7 +157,7 @@ TEST(NanoVdb, DamagedFilesAreRefusedBeforeNanoVdbWalksThem) {
             EXPECT_NE(r.err.find(bad.string()), std::string::npos) << r.err;
             EXPECT_FALSE(fs::exists(out));
         }
-        if (copy == 40) EXPECT_NE(r.err.find("grid name does not end"), std::string::npos) << r.err;
+        if (copy == 40) { EXPECT_NE(r.err.find("grid name does not end"), std::string::npos) << r.err; }
     }
     // The file carries a partial checksum only, so a flip in a voxel value is
     // a value (the copy converts); flips in the tree's offsets and masks are

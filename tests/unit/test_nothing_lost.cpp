@@ -56,7 +56,6 @@ CommandResult vdbdag(const std::string& args) { return runCli(args, kTimeout); }
 CommandResult probe(const std::string& args) { return runShell(kTimeout + std::string(VDBDAG_VDB_PROBE) + " " + args); }
 
 fs::path sharedData() { return fs::path(VDBDAG_SHARED_DATA); }
-bool haveSharedData() { return fs::is_directory(sharedData() / "vdb"); }
 
 fs::path baseDir() {
     static const fs::path dir = [] {

@@ -333,7 +333,7 @@ TEST(IsoSurface, FirstCrossingsEqualABruteForceOverTheDenseBlock) {
                 }
                 ++met;
                 differ += !got || got->box.voxel != std::array<int64_t, 3>{want->x, want->y, want->z};
-                if (got) EXPECT_GE(valueAt(int(got->box.voxel[0]), int(got->box.voxel[1]), int(got->box.voxel[2])), iso);
+                if (got) { EXPECT_GE(valueAt(int(got->box.voxel[0]), int(got->box.voxel[1]), int(got->box.voxel[2])), iso); }
             }
         EXPECT_GT(met, 200u) << iso;
         EXPECT_EQ(differ, 0u) << "of " << met << " pixels, iso " << iso;
@@ -369,7 +369,7 @@ TEST(VolumeRender, CompositingEqualsABruteForceOverTheDenseBlock) {
                                        "Points": [250, 0, 0.5, 0, 600, 0.8, 0.5, 0, 800, 0.8, 0.5, 0, 1000, 1, 0.5, 0]}])";
     const trace::TransferFunction fromFile = trace::readTransferFunction(presetPath.string());
     fs::remove(presetPath);
-    for (const trace::TransferFunction& tf : {trace::TransferFunction{200, 900}, fromFile}) {
+    for (const trace::TransferFunction& tf : {trace::TransferFunction{200, 900, {}, {}}, fromFile}) {
         trace::RenderOptions options;
         const trace::Image image = trace::renderVolume(grid, camera, options, tf);
         const glm::dvec3 light = trace::defaultLight(camera.eye, camera.target, camera.up);
@@ -545,7 +545,7 @@ TEST(SliceView, SliceValuesEqualABruteForceOverTheDenseBlock) {
 TEST(Legend, TheBarShowsTheScaleFromHighToLowWithItsNumbers) {
     trace::Image image;
     image.resize(320, 240);
-    const trace::LegendScale scale{-1000, 3000, [](double v) { return glm::dvec3((v + 1000) / 4000); }};
+    const trace::LegendScale scale{-1000, 3000, [](double v) { return glm::dvec3((v + 1000) / 4000); }, ""};
     trace::drawLegend(image, scale);
     // The bar: the rightmost opaque column run in the middle of the image.
     int column = -1;
@@ -599,7 +599,7 @@ TEST(Legend, UnitsComeFromTheMetadataAndFollowTheHighValue) {
                 if (image.rgb[3 * (size_t(y) * size_t(image.width) + size_t(x))] == 1.0f) left = std::min(left, x);
         return left;
     };
-    trace::LegendScale scale{0, 1500, [](double v) { return glm::dvec3(v / 1500); }};
+    trace::LegendScale scale{0, 1500, [](double v) { return glm::dvec3(v / 1500); }, ""};
     trace::Image plain, withUnits;
     plain.resize(320, 240), withUnits.resize(320, 240);
     trace::drawLegend(plain, scale);

@@ -139,7 +139,7 @@ TEST(ScalarTolerance, IntegersAreNearLosslessWithinTheIntegerBound) {
     for (size_t i = 0; i < v.size(); ++i) {
         const int64_t e = std::llabs(int64_t(q[i]) - v[i]);
         ASSERT_LE(e, 2) << i;
-        if (i > 0) EXPECT_EQ(((int64_t(q[i]) % 5) + 5) % 5, 0) << i;  // multiples of 2*2+1
+        if (i > 0) { EXPECT_EQ(((int64_t(q[i]) % 5) + 5) % 5, 0) << i; }  // multiples of 2*2+1
         maxErr = std::max(maxErr, double(e));
         sum += double(e);
         changed += e != 0;

@@ -34,7 +34,7 @@ TEST(ScratchFile, MemoryThenFileReadsBackAsOneSpace) {
         ASSERT_EQ(scratch.size(), reference.size());
         // Spilled exactly when the appends outgrew what memory may keep.
         EXPECT_EQ(scratch.path().empty(), keep >= reference.size());
-        if (!scratch.path().empty()) EXPECT_TRUE(std::filesystem::exists(scratch.path()));
+        if (!scratch.path().empty()) { EXPECT_TRUE(std::filesystem::exists(scratch.path())); }
         // Overwrites anywhere, also across the memory/file boundary.
         std::mt19937 rng(7);
         for (int k = 0; k < 50; ++k) {

@@ -169,6 +169,21 @@ TEST(SequenceFile, SameBytesFromAListAndUnderAMemoryLimitAndOneThread) {
     EXPECT_LE(fs::file_size(a), frameFiles);
 }
 
+#ifdef VDBDAG_MPI_BINARY
+// Under mpirun the frames are spread over the processes, each frame encoded
+// by one alone: the same bytes as one process.
+TEST(SequenceFile, SameBytesUnderMpirun) {
+    const fs::path dir = frames().dir;
+    const std::string one = (dir / "one.ssvdag").string(), three = (dir / "three.ssvdag").string();
+    ASSERT_EQ(runShell(kVdbdag + " encode '" + (dir / "both.####.vdb").string() + "' -o " + one).exitCode, 0);
+    const auto r = runShell(std::string(VDBDAG_MPIRUN) + " --oversubscribe --allow-run-as-root -np 3 " + VDBDAG_MPI_BINARY + " encode '" +
+                            (dir / "both.####.vdb").string() + "' -o " + three + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["per_frame"].size(), std::size(kFrames));
+    EXPECT_EQ(bytesOf(one), bytesOf(three));
+}
+#endif
+
 TEST(SequenceFile, ReaderLibraryGivesEachFramesValues) {
     const fs::path dir = frames().dir;
     const std::string seq = (dir / "lib.ssvdag").string();

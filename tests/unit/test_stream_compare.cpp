@@ -182,7 +182,7 @@ TEST(StreamCompare, FindsWhatTheWholeGridComparisonFinds) {
         ASSERT_EQ(byCubes.topology.size(), whole.topology.size());
         EXPECT_EQ(onlyInFile(byCubes), onlyInFile(whole));
         EXPECT_EQ(onlyInDecoded(byCubes), onlyInDecoded(whole));
-        if (!byCubes.topology.empty()) EXPECT_EQ(byCubes.topology[0].gridIndex, whole.topology[0].gridIndex);
+        if (!byCubes.topology.empty()) { EXPECT_EQ(byCubes.topology[0].gridIndex, whole.topology[0].gridIndex); }
         if (change.sameValueCounts) {
             EXPECT_EQ(activeValues(byCubes), activeValues(whole));
             EXPECT_EQ(inactiveValues(byCubes), inactiveValues(whole));

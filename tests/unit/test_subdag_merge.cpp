@@ -62,7 +62,7 @@ void checkAllCubeSizes(const GridTopology& topo, const std::string& name, dag::B
             const encoding::CompactDag compact = encoding::encodeCompact(merged, true);
             EXPECT_EQ(compact.inner, wholeInner) << what;
             EXPECT_EQ(compact.leaves, wholeLeaves) << what;
-            if (cube == 3 || cube + 1 == whole.log2Size) EXPECT_EQ(cellsOf(encoding::decodeTopology(compact)), cellsOf(topo)) << what;
+            if (cube == 3 || cube + 1 == whole.log2Size) { EXPECT_EQ(cellsOf(encoding::decodeTopology(compact)), cellsOf(topo)) << what; }
             if (::testing::Test::HasFailure()) return;
         }
     }

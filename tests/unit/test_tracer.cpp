@@ -220,7 +220,7 @@ TEST(CpuTracer, SegmentWalkVisitsEveryOccupiedBoxInOrderAndPointQueriesAgree) {
         for (size_t k = 0; k < want.size(); ++k) {
             expectSameHit(got[k], want[k], ray, "segment " + std::to_string(k));
             EXPECT_GT(leave[k], got[k].t);
-            if (k + 1 < want.size()) EXPECT_LE(leave[k], want[k + 1].t);
+            if (k + 1 < want.size()) { EXPECT_LE(leave[k], want[k + 1].t); }
         }
         segments += want.size();
     }

@@ -143,7 +143,7 @@ TEST(VtkStructure, LevelsAreTheOctreeCellsWithConsistentRefcountsAndMirrors) {
             EXPECT_EQ(it->second, c.nodeId) << "parent node " << pair.first << " slot " << pair.second << " leads to two nodes";
             parentsOf[c.nodeId].insert(pair);
             instancesOf[c.nodeId] += 1;
-            if (refcountOf.count(c.nodeId)) EXPECT_EQ(refcountOf[c.nodeId], c.refcount);
+            if (refcountOf.count(c.nodeId)) { EXPECT_EQ(refcountOf[c.nodeId], c.refcount); }
             refcountOf[c.nodeId] = c.refcount;
             (void)fresh;
         }

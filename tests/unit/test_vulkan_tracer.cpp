@@ -414,7 +414,7 @@ void expectSameImage(const trace::Image& gpu, const trace::Image& cpu, double ma
             worst = std::max(worst, double(std::fabs(gpu.rgb[3 * i + a] - cpu.rgb[3 * i + a])));
             worst = std::max(worst, double(std::fabs(gpu.normal[3 * i + a] - cpu.normal[3 * i + a])));
         }
-        if (std::isfinite(cpu.depth[i]) || std::isfinite(gpu.depth[i])) EXPECT_EQ(gpu.depth[i], cpu.depth[i]) << label << " pixel " << i;
+        if (std::isfinite(cpu.depth[i]) || std::isfinite(gpu.depth[i])) { EXPECT_EQ(gpu.depth[i], cpu.depth[i]) << label << " pixel " << i; }
     }
     EXPECT_GT(covered, cpu.alpha.size() / 10) << label;
     EXPECT_EQ(coverageDiff, 0u) << label;
