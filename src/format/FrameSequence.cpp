@@ -1,7 +1,10 @@
 #include "src/format/FrameSequence.h"
 
+#include <algorithm>
 #include <cstring>
+#include <fstream>
 #include <limits>
+#include <map>
 
 #include "src/format/ByteIO.h"
 #include "src/util/Error.h"
@@ -40,6 +43,60 @@ std::vector<FrameEntry> parseFrames(std::span<const uint8_t> payload, uint64_t g
 
 namespace {
 
+bool isGridKind(SectionKind kind) {
+    return kind != SectionKind::FileInfo && kind != SectionKind::Frames && kind != SectionKind::FileMetadata && kind != SectionKind::FrameMetadata &&
+           kind != SectionKind::SameAs && std::strcmp(sectionKindName(kind), "unknown") != 0;
+}
+
+} // namespace
+
+std::vector<uint8_t> serializeSameAs(std::span<const SameAsEntry> entries) {
+    ByteWriter w;
+    w.put<uint32_t>(uint32_t(entries.size()));
+    for (const SameAsEntry& e : entries) {
+        w.put<uint32_t>(uint32_t(e.kind));
+        w.put<uint32_t>(e.grid);
+    }
+    return w.take();
+}
+
+std::vector<SameAsEntry> parseSameAs(std::span<const uint8_t> payload, uint32_t grid, const std::string& what) {
+    ByteReader r(payload, what);
+    const uint32_t n = r.get<uint32_t>();
+    if (n == 0 || n > 32) r.fail("names " + std::to_string(n) + " sections (1 to 32)");
+    std::vector<SameAsEntry> entries(n);
+    for (uint32_t i = 0; i < n; ++i) {
+        entries[i].kind = SectionKind(r.get<uint32_t>());
+        entries[i].grid = r.get<uint32_t>();
+        if (!isGridKind(entries[i].kind)) r.fail("names section kind " + std::to_string(uint32_t(entries[i].kind)) + ", not a grid's");
+        if (entries[i].grid >= grid)
+            r.fail("takes grid " + std::to_string(grid) + "'s " + sectionKindName(entries[i].kind) + " from grid " + std::to_string(entries[i].grid) +
+                   ", which is not an earlier grid");
+        for (uint32_t j = 0; j < i; ++j)
+            if (entries[j].kind == entries[i].kind) r.fail(std::string("names ") + sectionKindName(entries[i].kind) + " twice");
+    }
+    r.expectEnd();
+    return entries;
+}
+
+namespace {
+
+// Whether two stored payloads hold the same bytes (read a piece at a time).
+bool sameStoredBytes(const StoredPayload& a, const StoredPayload& b) {
+    if (a.storedBytes != b.storedBytes || a.rawBytes != b.rawBytes || a.checksum != b.checksum || a.zstd != b.zstd) return false;
+    std::ifstream fa(a.path, std::ios::binary), fb(b.path, std::ios::binary);
+    fa.seekg(std::streamoff(a.offset));
+    fb.seekg(std::streamoff(b.offset));
+    std::vector<char> pa(size_t(1) << 20), pb(pa.size());
+    for (uint64_t left = a.storedBytes; left > 0;) {
+        const size_t n = size_t(std::min<uint64_t>(left, pa.size()));
+        if (!fa.read(pa.data(), std::streamsize(n)) || !fb.read(pb.data(), std::streamsize(n))) throw Error(a.path + ": cannot be read back");
+        if (std::memcmp(pa.data(), pb.data(), n) != 0) return false;
+        left -= n;
+    }
+    return true;
+}
+
 // The grid count of a FileInfo payload.
 uint32_t fileInfoGrids(std::span<const uint8_t> payload, const std::string& what) {
     ByteReader r(payload, what);
@@ -74,6 +131,10 @@ uint64_t writeSequence(std::span<const FramePart> parts, std::ostream& out) {
     std::vector<FrameEntry> frames;
     std::vector<uint8_t> fileInfo;
     uint64_t grids = 0;
+    // The sections stored so far by their stored size and checksum (indices
+    // into `sections`), and each grid's SameAs section being filled.
+    std::map<std::pair<uint64_t, uint64_t>, std::vector<size_t>> stored;
+    std::map<uint32_t, std::pair<size_t, std::vector<SameAsEntry>>> sameAs;
     for (size_t i = 0; i < parts.size(); ++i) {
         const FramePart& part = parts[i];
         if (i > 0 && part.number <= parts[i - 1].number)
@@ -98,11 +159,34 @@ uint64_t writeSequence(std::span<const FramePart> parts, std::ostream& out) {
                 if (s.grid >= list.gridCount) throw Error(part.path + ": a section for grid " + std::to_string(s.grid) + " of " + std::to_string(list.gridCount));
                 s.grid += uint32_t(grids);
             }
+            // Stored once: a grid's section equal to an earlier frame's
+            // (worth it above the 8 bytes a SameAs entry takes).
+            if (i > 0 && isGridKind(s.kind) && s.stored->storedBytes > 8) {
+                const auto it = stored.find({s.stored->storedBytes, s.stored->checksum});
+                const size_t* same = nullptr;
+                if (it != stored.end())
+                    for (const size_t& k : it->second)
+                        if (sections[k].kind == s.kind && sections[k].grid < uint32_t(grids) && sameStoredBytes(*sections[k].stored, *s.stored)) {
+                            same = &k;
+                            break;
+                        }
+                if (same) {
+                    auto [entry, fresh] = sameAs.try_emplace(s.grid);
+                    if (fresh) {
+                        entry->second.first = sections.size();  // its place: where the first section it stands for was
+                        sections.push_back({SectionKind::SameAs, s.grid, {}});
+                    }
+                    entry->second.second.push_back({s.kind, sections[*same].grid});
+                    continue;
+                }
+            }
+            if (s.stored && isGridKind(s.kind)) stored[{s.stored->storedBytes, s.stored->checksum}].push_back(sections.size());
             sections.push_back(std::move(s));
         }
         frames.push_back({part.number, list.gridCount});
         grids += list.gridCount;
     }
+    for (auto& [grid, entry] : sameAs) sections[entry.first].data = serializeSameAs(entry.second);
     const uint32_t count = uint32_t(grids);
     std::memcpy(fileInfo.data(), &count, sizeof count);  // (readFrameList checked it holds a u32)
     sections[0] = {SectionKind::FileInfo, 0, std::move(fileInfo)};

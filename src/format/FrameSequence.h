@@ -33,6 +33,18 @@ std::vector<uint8_t> serializeFrames(std::span<const FrameEntry> frames);
 // increasing, grid counts summing to `gridCount` (the FileInfo's), nothing after.
 std::vector<FrameEntry> parseFrames(std::span<const uint8_t> payload, uint64_t gridCount, const std::string& what);
 
+// SameAs (a grid's sections that hold the same bytes as an earlier grid's:
+// a grid that does not change between frames is stored once): u32 n, then
+// per section u32 kind and u32 the earlier grid. Checks: 1 <= n <= 32, each
+// kind a grid's own (not FileInfo, Frames, FileMetadata, FrameMetadata or
+// SameAs) and named once, each earlier grid below `grid`, nothing after.
+struct SameAsEntry {
+    SectionKind kind{};
+    uint32_t grid = 0;  // the earlier grid holding the bytes
+};
+std::vector<uint8_t> serializeSameAs(std::span<const SameAsEntry> entries);
+std::vector<SameAsEntry> parseSameAs(std::span<const uint8_t> payload, uint32_t grid, const std::string& what);
+
 // A frame's own .ssvdag file and its number.
 struct FramePart {
     int64_t number = 0;
@@ -40,7 +52,10 @@ struct FramePart {
 };
 // Writes the sequence of `parts` (numbers strictly increasing) to `out`;
 // returns the bytes written. Each part must be a file of one volume (not a
-// sequence itself); its FileMetadata becomes the frame's FrameMetadata.
+// sequence itself); its FileMetadata becomes the frame's FrameMetadata. A
+// section whose stored bytes equal an earlier frame's section of the same
+// kind (compared byte for byte) is not stored again: its grid's SameAs
+// section names the earlier one.
 uint64_t writeSequence(std::span<const FramePart> parts, std::ostream& out);
 
 // The frames of the .ssvdag file at `path` (its Frames section; a file of

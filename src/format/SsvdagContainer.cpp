@@ -234,6 +234,7 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::FileMetadata: return "FileMetadata";
         case SectionKind::Frames: return "Frames";
         case SectionKind::FrameMetadata: return "FrameMetadata";
+        case SectionKind::SameAs: return "SameAs";
         case SectionKind::GridInfo: return "GridInfo";
         case SectionKind::VdbDescriptor: return "VdbDescriptor";
         case SectionKind::DagLevels: return "DagLevels";

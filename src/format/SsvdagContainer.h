@@ -49,6 +49,7 @@ enum class SectionKind : uint32_t {
     FileMetadata = 22,  // file-level: the .vdb file's own metadata (opaque, vdb_bridge); absent when it has none
     Frames = 23,         // file-level, sequence files only: each frame's number and grid count (FrameSequence.h)
     FrameMetadata = 24,  // sequence files: a frame's .vdb file metadata (as FileMetadata); grid = the frame's first grid
+    SameAs = 25,         // sequence files: this grid's section of a kind holds the bytes of an earlier grid's (a grid that does not change between frames)
 };
 const char* sectionKindName(SectionKind kind);
 // Sections whose payload is compressed already (the writer stores them raw).

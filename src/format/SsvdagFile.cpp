@@ -36,7 +36,9 @@
 #include "src/format/SsvdagFile.h"
 
 #include <limits>
+#include <algorithm>
 #include <map>
+#include <set>
 #include <optional>
 
 #include "src/attributes/PredictedChannel.h"
@@ -216,7 +218,45 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     return sectionsToScene(std::move(sections), sourceName, ReadOptions{});
 }
 
+namespace {
+
+// A sequence file's SameAs sections (4.3) replaced by copies of the
+// sections they name, weighed against the memory limit before any is made.
+void resolveSameAs(std::vector<Section>& sections, const std::string& sourceName, const ReadOptions& options) {
+    std::vector<std::pair<uint32_t, std::vector<SameAsEntry>>> wanted;
+    for (const Section& s : sections)
+        if (s.kind == SectionKind::SameAs) wanted.push_back({s.grid, parseSameAs(s.data, s.grid, sourceName + ": SameAs of grid " + std::to_string(s.grid))});
+    if (wanted.empty()) return;
+    std::map<std::pair<uint32_t, SectionKind>, size_t> real;
+    for (size_t i = 0; i < sections.size(); ++i)
+        if (sections[i].kind != SectionKind::SameAs) real.emplace(std::make_pair(sections[i].grid, sections[i].kind), i);
+    uint64_t copies = 0;
+    std::vector<std::pair<size_t, Section>> made;  // (source, the copy's kind and grid)
+    for (const auto& [grid, entries] : wanted)
+        for (const SameAsEntry& e : entries) {
+            const auto it = real.find({e.grid, e.kind});
+            if (it == real.end()) {
+                // Reading one frame, only its own grids need their sections.
+                if (options.frame) continue;
+                throw Error(sourceName + ": grid " + std::to_string(grid) + " takes its " + sectionKindName(e.kind) + " from grid " +
+                            std::to_string(e.grid) + ", which has none");
+            }
+            if (real.contains({grid, e.kind}))
+                throw Error(sourceName + ": grid " + std::to_string(grid) + " has its own " + sectionKindName(e.kind) + " and takes one from grid " +
+                            std::to_string(e.grid));
+            copies = saturatingAdd(copies, sections[it->second].data.size());
+            made.push_back({it->second, Section{e.kind, grid, {}}});
+        }
+    checkMemory(options.limits, copies, sourceName, "the sections its unchanged grids share,");
+    for (auto& [source, copy] : made) copy.data = sections[source].data;
+    sections.erase(std::remove_if(sections.begin(), sections.end(), [](const Section& s) { return s.kind == SectionKind::SameAs; }), sections.end());
+    for (auto& [source, copy] : made) sections.push_back(std::move(copy));
+}
+
+} // namespace
+
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options) {
+    resolveSameAs(sections, sourceName, options);
     const Section* fileInfo = nullptr;
     const Section* framesSection = nullptr;
     Section* fileMetadata = nullptr;
@@ -511,7 +551,20 @@ SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
             default: return grid >= first && grid < end;
         }
     };
-    return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false, options.limits, keep), path, options);
+    std::vector<Section> sections = readContainerFile(path, /*unknownKinds=*/false, options.limits, keep);
+    // The sections this frame's unchanged grids take from earlier frames.
+    std::set<std::pair<uint32_t, uint32_t>> shared;  // (grid, kind)
+    for (const Section& s : sections)
+        if (s.kind == SectionKind::SameAs && s.grid >= first && s.grid < end)
+            for (const SameAsEntry& e : parseSameAs(s.data, s.grid, path + ": SameAs of grid " + std::to_string(s.grid)))
+                if (e.grid < first) shared.insert({e.grid, uint32_t(e.kind)});
+    if (!shared.empty()) {
+        std::vector<Section> more = readContainerFile(path, false, options.limits, [&](SectionKind kind, uint32_t grid) {
+            return shared.contains({grid, uint32_t(kind)});
+        });
+        for (Section& s : more) sections.push_back(std::move(s));
+    }
+    return sectionsToScene(std::move(sections), path, options);
 }
 
 } // namespace vdbdag::format

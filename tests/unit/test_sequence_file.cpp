@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetSphere.h>
 #include <vdbdag/vdbdag.h>
 
 #include "src/format/FrameSequence.h"
@@ -66,7 +67,7 @@ struct Frames {
             out.close();
         }
     }
-    ~Frames() { fs::remove_all(dir); }
+    ~Frames() { if (!getenv("KEEP_TEST_DIR")) fs::remove_all(dir); }
 };
 
 const Frames& frames() {
@@ -237,6 +238,102 @@ TEST(SequenceFile, RefusalsNameTheFileAndWriteNothing) {
     EXPECT_NE(r.err.find("bad.0001.vdb"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "bad.ssvdag"));
     for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+}
+
+// A cache whose frames also hold a grid that does not change (a collider):
+// its sections are stored once (SameAs), every frame still decodes whole,
+// and one frame read alone takes them from the first frame.
+openvdb::FloatGrid::Ptr staticFrames(const fs::path& dir) {
+    openvdb::FloatGrid::Ptr collider = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.2f, openvdb::Vec3f(0.5f), 1.0f / 64);
+    collider->setName("collider");
+    for (int f : kFrames) {
+        openvdb::GridPtrVec grids{readGrids(frameName(dir, "both", f))->at(0), collider};
+        openvdb::io::File out(frameName(dir, "static", f));
+        out.write(grids);
+        out.close();
+    }
+    return collider;
+}
+
+TEST(SequenceFile, AnUnchangedGridIsStoredOnce) {
+    const fs::path dir = frames().dir;
+    const openvdb::FloatGrid::Ptr collider = staticFrames(dir);
+    const std::string seq = (dir / "static.ssvdag").string();
+    ASSERT_EQ(runShell(kVdbdag + " encode '" + (dir / "static.####.vdb").string() + "' -o " + seq).exitCode, 0);
+    uint64_t frameFiles = 0, colliderAlone = 0;
+    for (int f : kFrames) {
+        const std::string one = (dir / ("static" + std::to_string(f) + ".ssvdag")).string();
+        ASSERT_EQ(runShell(kVdbdag + " encode " + frameName(dir, "static", f) + " -o " + one).exitCode, 0);
+        frameFiles += fs::file_size(one);
+    }
+    {
+        openvdb::io::File out((dir / "collider.vdb").string());
+        out.write({collider});
+        out.close();
+        ASSERT_EQ(runShell(kVdbdag + " encode " + (dir / "collider.vdb").string() + " -o " + (dir / "collider.ssvdag").string()).exitCode, 0);
+        colliderAlone = fs::file_size(dir / "collider.ssvdag");
+    }
+    // The collider's sections once instead of four times.
+    EXPECT_LT(fs::file_size(seq) + 2 * colliderAlone, frameFiles) << fs::file_size(seq) << " vs " << frameFiles << ", collider " << colliderAlone;
+    const auto info = runShell(kVdbdag + " info " + seq);
+    EXPECT_NE(info.out.find("SameAs"), std::string::npos);
+    // Every frame back whole, and the last one alone.
+    ASSERT_EQ(runShell(kVdbdag + " decode " + seq + " -o '" + (dir / "sback.####.vdb").string() + "'").exitCode, 0);
+    for (int f : kFrames) {
+        const auto a = readGrids(frameName(dir, "static", f)), b = readGrids(frameName(dir, "sback", f));
+        ASSERT_EQ(a->size(), 2u);
+        ASSERT_EQ(b->size(), 2u);
+        for (size_t g = 0; g < 2; ++g)
+            expectSameGrid(*openvdb::gridPtrCast<openvdb::FloatGrid>(a->at(g)), *openvdb::gridPtrCast<openvdb::FloatGrid>(b->at(g)), "frame " + std::to_string(f));
+    }
+    ASSERT_EQ(runShell(kVdbdag + " decode " + seq + " --frames 7 -o " + (dir / "last.vdb").string()).exitCode, 0);
+    openvdb::io::File last((dir / "last.vdb").string());
+    last.open();
+    expectSameGrid(*collider, *openvdb::gridPtrCast<openvdb::FloatGrid>(last.readGrid("collider")), "frame 7 alone");
+    last.close();
+    EXPECT_EQ(runShell(kVdbdag + " verify '" + (dir / "static.####.vdb").string() + "' --encoded " + seq).exitCode, 0);
+    const vdbdag::File file = vdbdag::File::open(seq);
+    vdbdag::Accessor acc = file.grid("collider", 7).accessor();
+    uint64_t differ = 0;
+    for (auto it = collider->tree().cbeginValueOn(); it; ++it)
+        if (acc.value<float>(it.getCoord().x(), it.getCoord().y(), it.getCoord().z()) != *it) ++differ;
+    EXPECT_EQ(differ, 0u);
+}
+
+// SameAs payloads against forged ones.
+TEST(SequenceFile, ForgedSameAsIsRefused) {
+    using vdbdag::format::SameAsEntry;
+    using vdbdag::format::SectionKind;
+    const std::vector<SameAsEntry> good{{SectionKind::GridInfo, 0}, {SectionKind::DagInner, 1}};
+    EXPECT_EQ(vdbdag::format::parseSameAs(vdbdag::format::serializeSameAs(good), 3, "s").size(), 2u);
+    auto refused = [](const std::vector<SameAsEntry>& entries, uint32_t grid, const std::string& why) {
+        try {
+            vdbdag::format::parseSameAs(vdbdag::format::serializeSameAs(entries), grid, "x.ssvdag: SameAs");
+            ADD_FAILURE() << "accepted: " << why;
+        } catch (const vdbdag::Error& e) {
+            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+        }
+    };
+    refused(good, 1, "not an earlier grid");
+    refused({{SectionKind::Frames, 0}}, 2, "not a grid's");
+    refused({{SectionKind::SameAs, 0}}, 2, "not a grid's");
+    refused({{SectionKind(77), 0}}, 2, "not a grid's");
+    refused({{SectionKind::DagInner, 0}, {SectionKind::DagInner, 1}}, 2, "twice");
+    refused({}, 2, "names 0 sections");
+    // A file whose SameAs names a section no grid has: one line, no crash.
+    const std::string dir = frames().dir.string();
+    staticFrames(frames().dir);
+    const std::string seq = dir + "/forge.ssvdag";
+    ASSERT_EQ(runShell(kVdbdag + " encode '" + dir + "/static.####.vdb' -o " + seq + " --force").exitCode, 0);
+    std::vector<vdbdag::format::Section> sections = vdbdag::format::readContainerFile(seq);
+    bool forged = false;
+    for (auto& s : sections)
+        if (s.kind == SectionKind::SameAs && !forged) {
+            s.data = vdbdag::format::serializeSameAs(std::vector<SameAsEntry>{{SectionKind::Normals, 0}});
+            forged = true;
+        }
+    ASSERT_TRUE(forged);
+    EXPECT_THROW(vdbdag::format::sectionsToScene(sections, "forge.ssvdag"), vdbdag::Error);
 }
 
 // The Frames section read against forged payloads (the format's checks).
