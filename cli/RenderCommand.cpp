@@ -3,6 +3,8 @@
 // frame through OpenImageIO; prints rays/s and ms per frame.
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
+#include <optional>
 #include <unordered_set>
 #include <cmath>
 #include <sstream>
@@ -30,6 +32,8 @@
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/ImageWriter.h"
 #include "vdb_bridge/InputScene.h"
+#include "src/format/FrameSequence.h"
+#include "src/util/FramePattern.h"
 #include "vdb_bridge/VdbSummary.h"
 
 namespace vdbdag::cli {
@@ -99,7 +103,7 @@ bool looksLikeLabels(const format::EncodedGrid& grid) {
 
 void addRenderCommand(CLI::App& app, int& exitCode) {
     struct Options {
-        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels, iso, slice, tf;
+        std::string input, output, grid, camera, backend = "auto", up = "y", view = "iso", shading = "auto", window, labels, iso, slice, tf, frame;
         int width = 1024, height = 768, frames = 1, device = -1;
         double fov = 35, lodPixels = 0, densityScale = 0.08;
         bool shadows = false, json = false, force = false, legend = false;
@@ -149,131 +153,168 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                     "fog: extinction per voxel length at the largest density (default: the scale at which the median optical depth of the "
                     "camera's rays through the fog is 1)")->check(finiteNumber())->check(CLI::Range(0.0, 1e6));
     cmd->add_option("--frames", opt->frames, "render this many frames and report the median time")->check(CLI::Range(1, 1000));
+    cmd->add_option("--frame", opt->frame,
+                    "a sequence file: the frame to render (its number), or with a frame token in -o (f.####.png) the frames to render "
+                    "(12, 10-20, 1,5,9-12; default: all), one image each, seen from one camera");
     cmd->add_flag("-f,--force", opt->force, "replace an existing output file (never an input, a link or a device)");
     cmd->add_flag("--json", opt->json, "print the report as JSON");
     opt->limits.add(*cmd);
     cmd->callback([opt, cmd, &exitCode] {
         const bool cmdDensityScaleGiven = cmd->count("--density-scale") > 0, cmdUpGiven = cmd->count("--up") > 0, cmdViewGiven = cmd->count("--view") > 0;
         setActivity(opt->input, "rendering");
-        checkOutputPath(opt->output, {opt->input}, {{".png", ".exr"}, "render", opt->force});
         format::ReadOptions readOptions;
         readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
         readOptions.limits = opt->limits.limits(0);  // traced where it lies, compressed
-        // A .vdb, .nvdb or scan is encoded in memory first, as `encode` would.
-        const format::SsvdagScene scene = bridge::sceneOfInput(opt->input, readOptions);
-        const format::EncodedGrid* chosen = nullptr;
-        for (const format::EncodedGrid& g : scene.grids)
-            if (opt->grid.empty() || g.record.name == opt->grid) { chosen = &g; break; }
-        if (!chosen) throw Error(opt->input + ": no grid named '" + opt->grid + "'");
-        if (chosen->dag.empty()) throw Error(opt->input + ": grid '" + chosen->record.name + "' is empty: nothing to render");
-        trace::Shading shading = trace::parseShading(opt->shading);
-        // A dense scan (every voxel of its box active: a CT's air too) shown
-        // as voxel blocks is an opaque box: by default it is volume rendered
-        // (VolumeRender.h), its air transparent, or shown as labels. Not with
-        // --backend vulkan, which has neither yet.
-        if (shading == trace::Shading::Auto && opt->backend != "vulkan" && denseScalarScan(*chosen)) {
-            shading = looksLikeLabels(*chosen) ? trace::Shading::Labels : trace::Shading::Volume;
-            note("grid '" + chosen->record.name + "' is a dense scan: shown as " +
-                 (shading == trace::Shading::Labels ? std::string("labels, a colour each") : std::string("a volume, air transparent")) +
-                 " (--shading mip, iso or values for the others)");
-        }
-        const trace::RenderGrid grid = trace::makeRenderGrid(*chosen, shading);
-        // Every option takes effect or is refused.
-        if (cmdDensityScaleGiven && !grid.fog)
-            throw Error(opt->input + ": --density-scale applies to fog shading, and grid '" + chosen->record.name + "' is shown as " +
-                        trace::shadingOf(grid) + " (use --shading fog)");
-        if (!opt->window.empty() && !grid.mip && !grid.volume && !grid.slice) throw Error(opt->input + ": --window applies to --shading mip, volume and slice");
-        if (!opt->slice.empty() && !grid.slice) throw Error(opt->input + ": --slice applies to --shading slice");
-        if (!opt->tf.empty() && !grid.volume) throw Error(opt->input + ": --tf applies to --shading volume");
-        if (!opt->tf.empty() && !opt->window.empty()) throw Error(opt->input + ": --tf and --window both set the transfer function: give one");
-        if (opt->legend && !trace::legendScale(grid, std::pair{0.0, 1.0}))
-            throw Error(opt->input + ": --legend applies to value shading, mip, slice and volume, and grid '" + chosen->record.name + "' is shown as " +
-                        trace::shadingOf(grid));
-        if (grid.slice && opt->slice.empty()) throw Error(opt->input + ": --shading slice needs --slice AXIS=INDEX (e.g. z=40)");
-        const std::optional<trace::SlicePlane> slicePlane = grid.slice ? std::optional(trace::parseSlicePlane(opt->slice)) : std::nullopt;
-        if (!opt->labels.empty() && !grid.labels) throw Error(opt->input + ": --labels applies to --shading labels");
-        if (!opt->iso.empty() && !grid.iso) throw Error(opt->input + ": --iso applies to --shading iso");
-        const bool cpuOnly = grid.mip || grid.labels || grid.iso || grid.volume || grid.slice;
-        if (cpuOnly && opt->backend == "vulkan")
-            throw Error(opt->input + ": --shading " + trace::shadingOf(grid) + " is rendered by the CPU tracer only for now (use --backend cpu or auto)");
-        if (cpuOnly && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
-        if (opt->shadows && grid.fog)
-            throw Error(opt->input + ": --shadows applies to surfaces; grid '" + chosen->record.name + "' is shown as fog, which has no shadows yet");
-        if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");
-        const trace::GridFrame frame(grid.indexToWorld);
-        trace::ViewSpec view{trace::parseUpAxis(opt->up), trace::parseView(opt->view)};
-        // A scan in patient space (LPS: x left, y posterior, z superior; RAS
-        // flips x and y) is shown head up from the front unless told otherwise.
-        if (slicePlane && !cmdUpGiven && !cmdViewGiven && opt->camera.empty()) {
-            view = {slicePlane->axis, trace::View::Top};  // straight along the slice's axis
-        } else if (!cmdUpGiven && !cmdViewGiven && opt->camera.empty())
-            if (const std::optional<bridge::ScanProvenance> scan = bridge::scanProvenanceOf(chosen->record); scan && (scan->space == "LPS" || scan->space == "RAS")) {
-                view = {2, scan->space == "LPS" ? trace::View::Front : trace::View::Back};
-                note("grid '" + chosen->record.name + "' is a scan in " + scan->space + " space: shown head up, from the front (--up/--view to change)");
-            }
-        trace::Camera camera = trace::frameBounds(frame, grid.cellLo, grid.cellHi, opt->width, opt->height, opt->fov, view);
-        if (!opt->camera.empty()) {
-            const auto v = parseNumbers(opt->camera, 9, "--camera");
-            camera.eye = {v[0], v[1], v[2]};
-            camera.target = {v[3], v[4], v[5]};
-            camera.up = {v[6], v[7], v[8]};
-            if (glm::length(camera.target - camera.eye) == 0 || glm::length(glm::cross(camera.target - camera.eye, camera.up)) == 0)
-                throw Error("--camera: the eye must differ from the target and UP must not be parallel to the view direction");
-        }
-        trace::RenderOptions options;
-        options.lodPixels = opt->lodPixels;
-        options.shadows = opt->shadows;
-        options.densityScale = cmdDensityScaleGiven || !grid.fog ? opt->densityScale : trace::autoDensityScale(grid, camera, opt->densityScale);
-
-        if (slicePlane) options.slice = *slicePlane;
-        if ((grid.mip || grid.volume || grid.slice) && !opt->window.empty()) {  // else the renderer chooses it from the image (RenderStats::window)
-            const auto w = parseNumbers(opt->window, 2, "--window");
-            if (!(w[1] > w[0])) throw Error("--window: HIGH must be greater than LOW");
-            options.window = std::pair{w[0], w[1]};
-        }
-        if (grid.volume && !opt->tf.empty()) options.transfer = trace::readTransferFunction(opt->tf);
-        if (grid.iso && !opt->iso.empty()) options.iso = parseNumbers(opt->iso, 1, "--iso")[0];
-        if (grid.labels && !opt->labels.empty())
-            for (const double l : parseNumbers(opt->labels, size_t(std::count(opt->labels.begin(), opt->labels.end(), ',') + 1), "--labels")) {
-                if (l != std::trunc(l)) throw Error("--labels: " + std::to_string(l) + " is not an integer");
-                options.labels.push_back(int64_t(l));
-            }
-        auto backend = makeRenderBackend(cpuOnly ? "cpu" : opt->backend, opt->device);
-        std::vector<double> times;
-        trace::Image image;
-        trace::RenderStats stats;
-        for (int f = 0; f < opt->frames; ++f) {
-            image = backend->render(grid, camera, options, stats);
-            times.push_back(stats.milliseconds);
-        }
-        std::sort(times.begin(), times.end());
-        const double ms = times[times.size() / 2];
-        if (opt->legend) {
-            trace::LegendScale scale = *trace::legendScale(grid, stats.window, options.transfer ? &*options.transfer : nullptr);
-            std::vector<std::pair<std::string, std::string>> metadata;
-            for (const bridge::MetadataEntry& m : bridge::gridHeaderFacts(chosen->record, std::nullopt, opt->input).metadata) metadata.emplace_back(m.name, m.value);
-            scale.units = trace::valueUnits(metadata);
-            trace::drawLegend(image, scale);
-        }
-        bridge::writeImage(opt->output, image);
-        const double raysPerSecond = double(stats.primaryRays + stats.secondaryRays) / (ms / 1000.0);
-        if (opt->json) {
-            nlohmann::json j{{"input", opt->input},       {"output", opt->output},          {"grid", chosen->record.name},
-                             {"backend", backend->name()}, {"device", backend->device()}, {"width", opt->width},           {"height", opt->height},
-                             {"frames", opt->frames},      {"ms_per_frame", ms},            {"ms_min", times.front()},
-                             {"ms_max", times.back()},     {"primary_rays", stats.primaryRays}, {"secondary_rays", stats.secondaryRays},
-                             {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows},
-                             {"shading", trace::shadingOf(grid)}, {"density_scale", grid.fog ? nlohmann::json(options.densityScale) : nlohmann::json()},
-                             {"window", stats.window ? nlohmann::json({stats.window->first, stats.window->second}) : nlohmann::json()},
-                             {"iso", stats.iso ? nlohmann::json(*stats.iso) : nlohmann::json()},
-                             {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}, {"target", {camera.target.x, camera.target.y, camera.target.z}},
-                                         {"up", {camera.up.x, camera.up.y, camera.up.z}}}}};
-            printJson(j);
+        // The frames of a sequence file rendered: (index, output); else the
+        // input whole to -o.
+        std::vector<std::pair<std::optional<uint32_t>, std::string>> jobs;
+        const bool pattern = isFramePattern(opt->output) && !std::filesystem::exists(opt->output);
+        const std::optional<format::FrameList> list =
+            bridge::inputKindOf(opt->input) == bridge::InputKind::Ssvdag ? std::optional(format::readFrameList(opt->input)) : std::nullopt;
+        if (list && list->sequence) {
+            const std::optional<FrameSelection> selection = opt->frame.empty() ? std::nullopt : std::optional(parseFrameSelection(opt->frame));
+            for (uint32_t i = 0; i < list->frames.size(); ++i)
+                if (!selection || selection->contains(list->frames[i].number))
+                    jobs.push_back({i, pattern ? framePath(opt->output, list->frames[i].number) : opt->output});
+            const std::string range = fmt::format("{} frames, {} to {}", list->frames.size(), list->frames.front().number, list->frames.back().number);
+            if (jobs.empty()) throw Error(opt->input + ": --frame " + opt->frame + " selects none of its " + range);
+            if (!pattern && jobs.size() > 1)
+                throw Error(opt->input + ": holds " + range + "; render one with --frame N, or each to its image with a frame token in -o (f.####.png)");
         } else {
-            fmt::print("render '{}' ({}x{}) on {} ({}): {:.1f} ms per frame (median of {}), {:.2f} M rays/s ({} primary, {} shadow) -> {}\n",
-                       chosen->record.name, opt->width, opt->height, backend->name(), backend->device(), ms, opt->frames, raysPerSecond / 1e6,
-                       stats.primaryRays, stats.secondaryRays, opt->output);
+            if (!opt->frame.empty()) throw Error(opt->input + ": --frame applies to sequence files; this file holds one volume");
+            if (pattern) throw Error(opt->output + ": " + opt->input + " holds one volume, not a sequence: -o names one image");
+            jobs.push_back({std::nullopt, opt->output});
         }
+        for (const auto& job : jobs) checkOutputPath(job.second, {opt->input}, {{".png", ".exr"}, "render", opt->force});
+        // One camera (and fog density) for every frame: the first frame's.
+        std::optional<trace::Camera> sharedCamera;
+        std::optional<double> sharedDensity;
+        nlohmann::json reports = nlohmann::json::array();
+        for (const auto& [frameIndex, output] : jobs) {
+            readOptions.frame = frameIndex;
+            // A .vdb, .nvdb or scan is encoded in memory first, as `encode` would.
+            const format::SsvdagScene scene = bridge::sceneOfInput(opt->input, readOptions);
+            const format::EncodedGrid* chosen = nullptr;
+            for (const format::EncodedGrid& g : scene.grids)
+                if (opt->grid.empty() || g.record.name == opt->grid) { chosen = &g; break; }
+            if (!chosen) throw Error(opt->input + ": no grid named '" + opt->grid + "'");
+            if (chosen->dag.empty()) throw Error(opt->input + ": grid '" + chosen->record.name + "' is empty: nothing to render");
+            trace::Shading shading = trace::parseShading(opt->shading);
+            // A dense scan (every voxel of its box active: a CT's air too) shown
+            // as voxel blocks is an opaque box: by default it is volume rendered
+            // (VolumeRender.h), its air transparent, or shown as labels. Not with
+            // --backend vulkan, which has neither yet.
+            if (shading == trace::Shading::Auto && opt->backend != "vulkan" && denseScalarScan(*chosen)) {
+                shading = looksLikeLabels(*chosen) ? trace::Shading::Labels : trace::Shading::Volume;
+                note("grid '" + chosen->record.name + "' is a dense scan: shown as " +
+                     (shading == trace::Shading::Labels ? std::string("labels, a colour each") : std::string("a volume, air transparent")) +
+                     " (--shading mip, iso or values for the others)");
+            }
+            const trace::RenderGrid grid = trace::makeRenderGrid(*chosen, shading);
+            // Every option takes effect or is refused.
+            if (cmdDensityScaleGiven && !grid.fog)
+                throw Error(opt->input + ": --density-scale applies to fog shading, and grid '" + chosen->record.name + "' is shown as " +
+                            trace::shadingOf(grid) + " (use --shading fog)");
+            if (!opt->window.empty() && !grid.mip && !grid.volume && !grid.slice) throw Error(opt->input + ": --window applies to --shading mip, volume and slice");
+            if (!opt->slice.empty() && !grid.slice) throw Error(opt->input + ": --slice applies to --shading slice");
+            if (!opt->tf.empty() && !grid.volume) throw Error(opt->input + ": --tf applies to --shading volume");
+            if (!opt->tf.empty() && !opt->window.empty()) throw Error(opt->input + ": --tf and --window both set the transfer function: give one");
+            if (opt->legend && !trace::legendScale(grid, std::pair{0.0, 1.0}))
+                throw Error(opt->input + ": --legend applies to value shading, mip, slice and volume, and grid '" + chosen->record.name + "' is shown as " +
+                            trace::shadingOf(grid));
+            if (grid.slice && opt->slice.empty()) throw Error(opt->input + ": --shading slice needs --slice AXIS=INDEX (e.g. z=40)");
+            const std::optional<trace::SlicePlane> slicePlane = grid.slice ? std::optional(trace::parseSlicePlane(opt->slice)) : std::nullopt;
+            if (!opt->labels.empty() && !grid.labels) throw Error(opt->input + ": --labels applies to --shading labels");
+            if (!opt->iso.empty() && !grid.iso) throw Error(opt->input + ": --iso applies to --shading iso");
+            const bool cpuOnly = grid.mip || grid.labels || grid.iso || grid.volume || grid.slice;
+            if (cpuOnly && opt->backend == "vulkan")
+                throw Error(opt->input + ": --shading " + trace::shadingOf(grid) + " is rendered by the CPU tracer only for now (use --backend cpu or auto)");
+            if (cpuOnly && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
+            if (opt->shadows && grid.fog)
+                throw Error(opt->input + ": --shadows applies to surfaces; grid '" + chosen->record.name + "' is shown as fog, which has no shadows yet");
+            if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");
+            const trace::GridFrame frame(grid.indexToWorld);
+            trace::ViewSpec view{trace::parseUpAxis(opt->up), trace::parseView(opt->view)};
+            // A scan in patient space (LPS: x left, y posterior, z superior; RAS
+            // flips x and y) is shown head up from the front unless told otherwise.
+            if (slicePlane && !cmdUpGiven && !cmdViewGiven && opt->camera.empty()) {
+                view = {slicePlane->axis, trace::View::Top};  // straight along the slice's axis
+            } else if (!cmdUpGiven && !cmdViewGiven && opt->camera.empty())
+                if (const std::optional<bridge::ScanProvenance> scan = bridge::scanProvenanceOf(chosen->record); scan && (scan->space == "LPS" || scan->space == "RAS")) {
+                    view = {2, scan->space == "LPS" ? trace::View::Front : trace::View::Back};
+                    note("grid '" + chosen->record.name + "' is a scan in " + scan->space + " space: shown head up, from the front (--up/--view to change)");
+                }
+            trace::Camera camera = sharedCamera ? *sharedCamera : trace::frameBounds(frame, grid.cellLo, grid.cellHi, opt->width, opt->height, opt->fov, view);
+            if (!opt->camera.empty()) {
+                const auto v = parseNumbers(opt->camera, 9, "--camera");
+                camera.eye = {v[0], v[1], v[2]};
+                camera.target = {v[3], v[4], v[5]};
+                camera.up = {v[6], v[7], v[8]};
+                if (glm::length(camera.target - camera.eye) == 0 || glm::length(glm::cross(camera.target - camera.eye, camera.up)) == 0)
+                    throw Error("--camera: the eye must differ from the target and UP must not be parallel to the view direction");
+            }
+            trace::RenderOptions options;
+            options.lodPixels = opt->lodPixels;
+            options.shadows = opt->shadows;
+            options.densityScale = cmdDensityScaleGiven || !grid.fog ? opt->densityScale
+                                   : sharedDensity                   ? *sharedDensity
+                                                                     : trace::autoDensityScale(grid, camera, opt->densityScale);
+            sharedCamera = camera;
+            sharedDensity = options.densityScale;
+
+            if (slicePlane) options.slice = *slicePlane;
+            if ((grid.mip || grid.volume || grid.slice) && !opt->window.empty()) {  // else the renderer chooses it from the image (RenderStats::window)
+                const auto w = parseNumbers(opt->window, 2, "--window");
+                if (!(w[1] > w[0])) throw Error("--window: HIGH must be greater than LOW");
+                options.window = std::pair{w[0], w[1]};
+            }
+            if (grid.volume && !opt->tf.empty()) options.transfer = trace::readTransferFunction(opt->tf);
+            if (grid.iso && !opt->iso.empty()) options.iso = parseNumbers(opt->iso, 1, "--iso")[0];
+            if (grid.labels && !opt->labels.empty())
+                for (const double l : parseNumbers(opt->labels, size_t(std::count(opt->labels.begin(), opt->labels.end(), ',') + 1), "--labels")) {
+                    if (l != std::trunc(l)) throw Error("--labels: " + std::to_string(l) + " is not an integer");
+                    options.labels.push_back(int64_t(l));
+                }
+            auto backend = makeRenderBackend(cpuOnly ? "cpu" : opt->backend, opt->device);
+            std::vector<double> times;
+            trace::Image image;
+            trace::RenderStats stats;
+            for (int f = 0; f < opt->frames; ++f) {
+                image = backend->render(grid, camera, options, stats);
+                times.push_back(stats.milliseconds);
+            }
+            std::sort(times.begin(), times.end());
+            const double ms = times[times.size() / 2];
+            if (opt->legend) {
+                trace::LegendScale scale = *trace::legendScale(grid, stats.window, options.transfer ? &*options.transfer : nullptr);
+                std::vector<std::pair<std::string, std::string>> metadata;
+                for (const bridge::MetadataEntry& m : bridge::gridHeaderFacts(chosen->record, std::nullopt, opt->input).metadata) metadata.emplace_back(m.name, m.value);
+                scale.units = trace::valueUnits(metadata);
+                trace::drawLegend(image, scale);
+            }
+            bridge::writeImage(output, image);
+            const double raysPerSecond = double(stats.primaryRays + stats.secondaryRays) / (ms / 1000.0);
+            if (opt->json) {
+                nlohmann::json j{{"input", opt->input},       {"output", output},          {"grid", chosen->record.name},
+                                 {"backend", backend->name()}, {"device", backend->device()}, {"width", opt->width},           {"height", opt->height},
+                                 {"frames", opt->frames},      {"ms_per_frame", ms},            {"ms_min", times.front()},
+                                 {"ms_max", times.back()},     {"primary_rays", stats.primaryRays}, {"secondary_rays", stats.secondaryRays},
+                                 {"rays_per_second", raysPerSecond}, {"lod_pixels", opt->lodPixels}, {"shadows", opt->shadows},
+                                 {"shading", trace::shadingOf(grid)}, {"density_scale", grid.fog ? nlohmann::json(options.densityScale) : nlohmann::json()},
+                                 {"window", stats.window ? nlohmann::json({stats.window->first, stats.window->second}) : nlohmann::json()},
+                                 {"iso", stats.iso ? nlohmann::json(*stats.iso) : nlohmann::json()},
+                                 {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}, {"target", {camera.target.x, camera.target.y, camera.target.z}},
+                                             {"up", {camera.up.x, camera.up.y, camera.up.z}}}}};
+                if (frameIndex) j["frame"] = list->frames[*frameIndex].number;
+                if (jobs.size() > 1) reports.push_back(std::move(j));
+                else printJson(j);
+            } else {
+                fmt::print("render '{}' ({}x{}) on {} ({}): {:.1f} ms per frame (median of {}), {:.2f} M rays/s ({} primary, {} shadow) -> {}\n",
+                           chosen->record.name, opt->width, opt->height, backend->name(), backend->device(), ms, opt->frames, raysPerSecond / 1e6,
+                           stats.primaryRays, stats.secondaryRays, output);
+            }
+        }
+        if (opt->json && jobs.size() > 1) printJson(reports);
         exitCode = 0;
     });
 }

@@ -185,6 +185,39 @@ TEST(SequenceFile, SameBytesUnderMpirun) {
 }
 #endif
 
+// render: each chosen frame to its image, one camera for all; a frame's
+// image is the one its own file gives from that camera.
+TEST(SequenceFile, RenderDrawsEachFrameFromOneCamera) {
+    const fs::path dir = frames().dir;
+    const std::string seq = (dir / "render.ssvdag").string();
+    ASSERT_EQ(runShell(kVdbdag + " encode '" + (dir / "both.####.vdb").string() + "' -o " + seq + " --grid surface").exitCode, 0);
+    const std::string common = " --backend cpu --width 64 --height 48 --json";
+    const auto r = runShell(kVdbdag + " render " + seq + " -o '" + (dir / "r.####.png").string() + "' --frame 4-5" + common);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto reports = nlohmann::json::parse(r.out);
+    ASSERT_EQ(reports.size(), 2u);
+    EXPECT_EQ(reports[0]["camera"], reports[1]["camera"]);
+    EXPECT_FALSE(fs::exists(frameName(dir, "r", 3)));
+    const auto& c = reports[1]["camera"];
+    std::string camera;
+    for (const char* key : {"eye", "target", "up"})
+        for (const auto& v : c[key]) camera += (camera.empty() ? "" : ",") + nlohmann::json(v.get<double>()).dump();
+    const std::string own = (dir / "own5.ssvdag").string();
+    ASSERT_EQ(runShell(kVdbdag + " encode " + frameName(dir, "both", 5) + " -o " + own + " --grid surface").exitCode, 0);
+    ASSERT_EQ(runShell(kVdbdag + " render " + own + " -o " + (dir / "own5.png").string() + " --camera " + camera + common).exitCode, 0);
+    std::string r5 = frameName(dir, "r", 5);
+    r5.replace(r5.size() - 4, 4, ".png");
+    std::string r4 = frameName(dir, "r", 4);
+    r4.replace(r4.size() - 4, 4, ".png");
+    EXPECT_EQ(bytesOf(r5), bytesOf((dir / "own5.png").string()));
+    EXPECT_NE(bytesOf(r4), bytesOf(r5));  // the surface moved
+    // Several frames to one image: refused, nothing written.
+    const auto refused = runShell(kVdbdag + " render " + seq + " -o " + (dir / "all.png").string() + common);
+    EXPECT_NE(refused.exitCode, 0);
+    EXPECT_NE(refused.err.find("--frame N"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(dir / "all.png"));
+}
+
 TEST(SequenceFile, ReaderLibraryGivesEachFramesValues) {
     const fs::path dir = frames().dir;
     const std::string seq = (dir / "lib.ssvdag").string();
