@@ -439,6 +439,25 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->callback([opt, &exitCode, encodeOne, encodeSequence] {
         // A sequence: a frame pattern (smoke.####.vdb, %04d, $F4), or
         // several inputs that are not DICOM with -o NAME.ssvdag.
+        // A folder of .vdb or .nvdb files (frames of a cache, no DICOM among
+        // them): its files as a sequence, numbered by their names.
+        if (opt->inputs.size() == 1 && std::filesystem::is_directory(opt->inputs[0])) {
+            std::vector<std::string> files;
+            bool other = false;
+            std::error_code ec;
+            for (const auto& e : std::filesystem::directory_iterator(opt->inputs[0], ec)) {
+                if (!e.is_regular_file(ec)) continue;
+                const std::string ext = lowerExtension(e.path().string());
+                if (ext == ".vdb" || ext == ".nvdb") files.push_back(e.path().string());
+                else if (e.path().filename().string()[0] != '.') other = true;
+            }
+            if (!files.empty() && !other) {
+                std::sort(files.begin(), files.end());
+                if (opt->output.empty()) opt->output = defaultOutputFor(opt->inputs[0]);
+                encodeSequence(framesOfList(files), opt->inputs[0]);
+                return;
+            }
+        }
         if (opt->inputs.size() == 1 && isFramePattern(opt->inputs[0]) && !std::filesystem::exists(opt->inputs[0])) {
             const std::vector<FrameFile> frames = expandFramePattern(opt->inputs[0]);
             if (frames.empty()) throw Error(opt->inputs[0] + ": no file matches this frame pattern");

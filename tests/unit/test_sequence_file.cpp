@@ -160,6 +160,12 @@ TEST(SequenceFile, SameBytesFromAListAndUnderAMemoryLimitAndOneThread) {
     ASSERT_EQ(runShell(kVdbdag + " encode '" + (dir / "both.####.vdb").string() + "' -o " + c + " --memory-limit 64M").exitCode, 0);
     EXPECT_EQ(bytesOf(a), bytesOf(b));
     EXPECT_EQ(bytesOf(a), bytesOf(c));
+    // A folder holding the frames (and nothing else): the same sequence.
+    fs::create_directories(dir / "folder");
+    for (int f : kFrames) fs::copy_file(frameName(dir, "both", f), frameName(dir / "folder", "both", f));
+    const std::string d = (dir / "folder.ssvdag").string();
+    ASSERT_EQ(runShell(kVdbdag + " encode " + (dir / "folder").string() + " -o " + d).exitCode, 0);
+    EXPECT_EQ(bytesOf(a), bytesOf(d));
     // The frames' own files hold the same grids: the sequence is no larger than them together.
     uint64_t frameFiles = 0;
     for (int f : kFrames) {
