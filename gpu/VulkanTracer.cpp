@@ -5,9 +5,11 @@
 #include "gpu/VulkanTracer.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <fmt/core.h>
 
@@ -18,6 +20,7 @@
 #include "gpu/DevicePaletteChannel.h"
 #include "gpu/EmbeddedShaders.h"
 #include "gpu/VulkanContext.h"
+#include "src/trace/Projection.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::gpu {
@@ -111,6 +114,7 @@ struct VulkanTracer::Impl {
         // Only what this pipeline reads is specialised, so grids share
         // pipelines: first-hit rays read no values, hits need no colours.
         const bool fog = mode == Mode::Render && grid.fog;
+        const bool mip = mode == Mode::Render && grid.mip;
         const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
         // Level-set hits test inside bits (trace_inside.glsl), not values; renders read values for gradients and colours.
         const bool readsValues = mode == Mode::Render || (levelSet && !grid.inside);
@@ -118,7 +122,7 @@ struct VulkanTracer::Impl {
         const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
         const bool normals = mode == Mode::Render && !fog && grid.normals;  // only surface shading reads them
         const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
-                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u);
+                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -133,6 +137,7 @@ struct VulkanTracer::Impl {
                 constants.setBool(6, shadows);
                 constants.setBool(7, oneChunk);
                 constants.setBool(8, normals);
+                constants.setBool(9, mip);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
                                                            "trace.comp", true);
             }
@@ -336,6 +341,21 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     TracePush push{0, out.address(), impl.counter.address(), uint32_t(items), 0};
     lastDeviceMs_ = pipe.dispatch(items, push, impl.paramsSet).deviceMs;
 
+    uint32_t secondary = 0;
+    std::memcpy(&secondary, impl.counter.mappedData(), 4);
+    stats.primaryRays = pixels;
+    stats.secondaryRays = secondary;
+    if (grid.mip) {  // the maxima through the window, as the CPU's renderMip does
+        std::vector<double> maxima(pixels, std::numeric_limits<double>::quiet_NaN());
+        const auto* u = static_cast<const uint32_t*>(out.mappedData());
+        for (size_t i = 0; i < pixels; ++i)
+            if (u[8 * i + 2]) maxima[i] = std::bit_cast<double>(uint64_t(u[8 * i]) | uint64_t(u[8 * i + 1]) << 32);
+        const auto [low, high] = options.window ? *options.window : trace::automaticWindow(maxima);
+        stats.window = std::pair{low, high};
+        trace::Image image = trace::windowedGrey(maxima, camera.width, camera.height, low, high, true);
+        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return image;
+    }
     trace::Image image;
     image.resize(camera.width, camera.height);
     const auto* f = static_cast<const float*>(out.mappedData());
@@ -347,10 +367,6 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
         image.alpha[i] = f[8 * i + 3];
         image.depth[i] = f[8 * i + 4];
     }
-    uint32_t secondary = 0;
-    std::memcpy(&secondary, impl.counter.mappedData(), 4);
-    stats.primaryRays = pixels;
-    stats.secondaryRays = secondary;
     stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return image;
 }

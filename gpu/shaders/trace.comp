@@ -13,7 +13,8 @@
 //            t (bits), entry;
 //  - render: items are pixels in 8x8 tiles (one workgroup of 64 per tile:
 //            neighbouring rays walk the same nodes); writes 8 floats per
-//            pixel: rgb, alpha, depth, normal xyz;
+//            pixel: rgb, alpha, depth, normal xyz (MIP: 8 uints, the
+//            largest value's double bits low and high, 1 if any box);
 //  - primary: the camera rays of render, traced only (the hits of hits
 //            mode per pixel): what the benchmark measures.
 // Only what the scene has is compiled in: value type, level set, fog,
@@ -37,6 +38,7 @@ layout(constant_id = 5) const uint COLOURING = 0u;     // ValueColouring: none, 
 layout(constant_id = 6) const bool SHADOWS = false;    // render: shadow rays
 layout(constant_id = 7) const bool ONE_CHUNK_DAG = false;  // inner words and leaves each in one chunk
 layout(constant_id = 8) const bool HAS_NORMALS = false;    // render: shade with the stored ONV normals
+layout(constant_id = 9) const bool MIP = false;            // render: each pixel's largest value (bits), windowed on the host
 
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
@@ -204,6 +206,17 @@ void renderPixel(uint i) {
     dvec3 colour = vec3At(P.background);
     float alpha = 0.0, depth = uintBitsToFloat(0x7F800000u);
     vec3 normalOut = vec3(0.0);
+    if (MIP) {  // every occupied box, no level of detail (PixelSegments.h)
+        gMipAny = false;
+        gMipMax = 0.0lf;
+        walkRay(o, d, 0.0lf, tMax, kVisitMip, 0.0lf, 0.0lf);
+        U32Array bits = U32Array(pc.results);
+        const uvec2 m = unpackDouble2x32(gMipMax);
+        bits.v[8u * pixel] = m.x;
+        bits.v[8u * pixel + 1u] = m.y;
+        bits.v[8u * pixel + 2u] = gMipAny ? 1u : 0u;
+        return;
+    }
     if (FOG) {
         gFogTransmittance = 1.0lf;
         gFogFirstHit = -1.0lf;

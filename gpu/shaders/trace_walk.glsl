@@ -78,7 +78,7 @@ uint64_t leafMask(uint64_t index) {
 #define VDBDAG_INNER_WORD(buf, index) innerWord(index)
 #include "vdbdag/dag_access.h"
 
-const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u;
+const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u, kVisitMip = 3u;
 
 struct Hit {
     bool hit;
@@ -152,6 +152,10 @@ uint bitWidth64(uint64_t x) {
 // Fog state (CpuRenderer.cpp): transmittance, emitted light, first box entered.
 double gFogTransmittance, gFogFirstHit;
 dvec3 gFogSum;
+// Maximum intensity projection (Projection.cpp maximaAlongRays): the largest
+// value met so far, once any box was.
+double gMipMax;
+bool gMipAny;
 
 // exp(x) in double (GLSL has exp for float only): x = k ln2 + r, |r| <= ln2/2,
 // a degree-13 Taylor polynomial, then ldexp. Relative error ~1e-15.
@@ -186,6 +190,14 @@ bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore,
         found = box;
         return true;
     }
+    if (visitKind == kVisitMip) {
+        const double v = valueAsDoubles(box.entry).x;
+        if (!isnan(v) && (!gMipAny || v > gMipMax)) {
+            gMipMax = v;
+            gMipAny = true;
+        }
+        return false;
+    }
     // kVisitFog
     if (gFogFirstHit < 0.0lf) gFogFirstHit = box.t;
     const double v = valueAsDoubles(box.entry).x;
@@ -217,7 +229,7 @@ Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, ui
 }
 
 // walkRay. kVisitFirstHit returns the first occupied box, kVisitZeroCrossing
-// the first box the visitor accepts, kVisitFog the last box (unused).
+// the first box the visitor accepts, kVisitFog and kVisitMip the last box (unused).
 Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitKind, double ignoreBefore, double lodScale) {
     const bool firstOnly = visitKind == kVisitFirstHit;
     Hit result = noHit();

@@ -4,7 +4,8 @@
 // display window maps [low, high] to black..white; values at or below low
 // leave the pixel transparent, so a CT's air does not paint the volume's box.
 // Without a window given, low is Otsu's threshold of the pixels' maxima (air
-// against tissue) and high their 99.5th percentile. The CPU tracer only.
+// against tissue) and high their 99.5th percentile. The Vulkan tracer finds
+// the same maxima (trace.comp, MIP) and windows them with these functions.
 #pragma once
 #include <optional>
 #include <utility>

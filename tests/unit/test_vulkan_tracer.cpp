@@ -495,6 +495,47 @@ TEST(VulkanTracer, RendersAFogSphereLikeTheCpuRenderer) {
     expectSameImage(gpuTracer.render(grid, camera, options, stats), trace::renderCpu(grid, camera, options), 1e-5, "fog sphere");
 }
 
+// --shading mip: each pixel's largest value along its ray, through the
+// window chosen from the maxima; the GPU walks every occupied box as the CPU
+// does and its maxima are the same doubles, so the images are identical.
+TEST(VulkanTracer, MaximumIntensityProjectionEqualsTheCpuRenderer) {
+    VULKAN_OR_SKIP();
+    openvdb::initialize();
+    auto fog = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.0f), 1.0f / 24.0f, 3.0f);
+    openvdb::tools::sdfToFogVolume(*fog);
+    fog->setName("density");
+    // An int32 block of noise with a bright core: a scan's integers.
+    auto scan = openvdb::Int32Grid::create(0);
+    scan->setName("ct");
+    auto acc = scan->getAccessor();
+    std::mt19937 rng(3);
+    for (int i = 0; i < 40; ++i)
+        for (int j = 0; j < 36; ++j)
+            for (int k = 0; k < 30; ++k) {
+                const int core = (i - 20) * (i - 20) + (j - 18) * (j - 18) + (k - 15) * (k - 15) < 64 ? 1200 : 0;
+                acc.setValue(openvdb::Coord(i, j, k), int(rng() % 400) - 1000 + core);
+            }
+    for (const auto& [grid, name] : {std::pair<openvdb::GridBase::Ptr, std::string>{fog, "vdbdag_vk_mip_fog"}, {scan, "vdbdag_vk_mip_ct"}}) {
+        const format::EncodedGrid encoded = encodeVdbGrid(grid, name);
+        const trace::RenderGrid rg = trace::makeRenderGrid(encoded, trace::Shading::Mip);
+        ASSERT_TRUE(rg.mip);
+        const trace::Camera camera = trace::frameBounds(trace::GridFrame(rg.indexToWorld), rg.cellLo, rg.cellHi, 96, 72);
+        gpu::VulkanTracer gpuTracer(*context(), rg);
+        for (const auto& window : {std::optional<std::pair<double, double>>{}, std::optional(std::pair{-500.0, 100.0})}) {
+            trace::RenderOptions options;
+            options.window = window;
+            trace::RenderStats cpuStats, gpuStats;
+            const trace::Image cpu = trace::renderCpu(rg, camera, options, &cpuStats);
+            const trace::Image gpu = gpuTracer.render(rg, camera, options, gpuStats);
+            ASSERT_TRUE(cpuStats.window && gpuStats.window) << name;
+            EXPECT_EQ(*gpuStats.window, *cpuStats.window) << name;
+            EXPECT_EQ(gpu.rgb, cpu.rgb) << name;
+            EXPECT_EQ(gpu.alpha, cpu.alpha) << name;
+            EXPECT_GT(std::count(cpu.alpha.begin(), cpu.alpha.end(), 1.0f), 100) << name;
+        }
+    }
+}
+
 // `encode --normals K` on a level set: the GPU decodes the stored ONV codes
 // (palette lookup, octahedral unfold) bit for bit as the CPU does and shades
 // with them, gradient-sourced so never flipped.
