@@ -43,9 +43,10 @@ struct TraceParamsGpu {
     double eyeCell[3], inverse[9], normalMatrix[9], light[3], lightCell[3], background[3];
     double shadowBias, fogScale;
     uint64_t offsetWordsPacked[2];
-    uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, pad;
+    int64_t sliceIndex;
+    uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, sliceAxis;
 };
-static_assert(sizeof(TraceParamsGpu) == 1176, "must match trace_params.glsl");
+static_assert(sizeof(TraceParamsGpu) == 1184, "must match trace_params.glsl");
 
 struct TracePush {
     uint64_t rays, results, counter;
@@ -115,6 +116,7 @@ struct VulkanTracer::Impl {
         // pipelines: first-hit rays read no values, hits need no colours.
         const bool fog = mode == Mode::Render && grid.fog;
         const bool mip = mode == Mode::Render && grid.mip;
+        const bool slice = mode == Mode::Render && grid.slice;
         const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
         // Level-set hits test inside bits (trace_inside.glsl), not values; renders read values for gradients and colours.
         const bool readsValues = mode == Mode::Render || (levelSet && !grid.inside);
@@ -122,7 +124,7 @@ struct VulkanTracer::Impl {
         const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
         const bool normals = mode == Mode::Render && !fog && grid.normals;  // only surface shading reads them
         const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
-                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u);
+                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -138,6 +140,7 @@ struct VulkanTracer::Impl {
                 constants.setBool(7, oneChunk);
                 constants.setBool(8, normals);
                 constants.setBool(9, mip);
+                constants.setBool(10, slice);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
                                                            "trace.comp", true);
             }
@@ -328,6 +331,8 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     setCamera(camera, options.lodPixels);
     for (int a = 0; a < 3; ++a) p.background[a] = options.background[a];
     p.fogScale = options.densityScale / (grid.valueMax * frame.voxelSize());
+    p.sliceIndex = options.slice.index;
+    p.sliceAxis = uint32_t(options.slice.axis);
     const uint32_t tilesY = (p.height + 7) / 8;
     impl.writeParams();
     std::memset(impl.counter.mappedData(), 0, 16);
@@ -345,14 +350,14 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     std::memcpy(&secondary, impl.counter.mappedData(), 4);
     stats.primaryRays = pixels;
     stats.secondaryRays = secondary;
-    if (grid.mip) {  // the maxima through the window, as the CPU's renderMip does
+    if (grid.mip || grid.slice) {  // the maxima (the slice's values) through the window, as the CPU's renderMip (renderSlice) does
         std::vector<double> maxima(pixels, std::numeric_limits<double>::quiet_NaN());
         const auto* u = static_cast<const uint32_t*>(out.mappedData());
         for (size_t i = 0; i < pixels; ++i)
             if (u[8 * i + 2]) maxima[i] = std::bit_cast<double>(uint64_t(u[8 * i]) | uint64_t(u[8 * i + 1]) << 32);
         const auto [low, high] = options.window ? *options.window : trace::automaticWindow(maxima);
         stats.window = std::pair{low, high};
-        trace::Image image = trace::windowedGrey(maxima, camera.width, camera.height, low, high, true);
+        trace::Image image = trace::windowedGrey(maxima, camera.width, camera.height, low, high, grid.mip);
         stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         return image;
     }

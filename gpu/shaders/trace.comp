@@ -39,6 +39,7 @@ layout(constant_id = 6) const bool SHADOWS = false;    // render: shadow rays
 layout(constant_id = 7) const bool ONE_CHUNK_DAG = false;  // inner words and leaves each in one chunk
 layout(constant_id = 8) const bool HAS_NORMALS = false;    // render: shade with the stored ONV normals
 layout(constant_id = 9) const bool MIP = false;            // render: each pixel's largest value (bits), windowed on the host
+layout(constant_id = 10) const bool SLICE = false;         // render: each pixel's voxel on the slice plane (its value's bits), windowed on the host
 
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
@@ -206,6 +207,27 @@ void renderPixel(uint i) {
     dvec3 colour = vec3At(P.background);
     float alpha = 0.0, depth = uintBitsToFloat(0x7F800000u);
     vec3 normalOut = vec3(0.0);
+    if (SLICE) {  // SliceView.cpp sliceValues: the voxel where the ray meets the plane through the voxel centres
+        U32Array bits = U32Array(pc.results);
+        bits.v[8u * pixel + 2u] = 0u;
+        const uint a = P.sliceAxis;
+        if (d[a] == 0.0lf) return;
+        precise double t = (double(P.sliceIndex) + 0.5lf - o[a]) / d[a];
+        if (!(t >= 0.0lf) || isinf(t)) return;
+        i64vec3 voxel;
+        for (uint k = 0u; k < 3u; ++k) {
+            precise double c = k == a ? double(P.sliceIndex) : floor(o[k] + t * d[k]);
+            if (!(abs(c) < 4e18lf)) return;  // far outside any grid
+            voxel[k] = int64_t(c);
+        }
+        uint64_t entry;
+        if (!findVoxel(voxel, entry)) return;
+        const uvec2 m = unpackDouble2x32(valueAsDoubles(entry).x);
+        bits.v[8u * pixel] = m.x;
+        bits.v[8u * pixel + 1u] = m.y;
+        bits.v[8u * pixel + 2u] = 1u;
+        return;
+    }
     if (MIP) {  // every occupied box, no level of detail (PixelSegments.h)
         gMipAny = false;
         gMipMax = 0.0lf;

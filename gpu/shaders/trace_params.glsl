@@ -40,6 +40,7 @@ layout(set = 0, binding = 0, std430) uniform TraceParams {
     double shadowBias;      // level sets: boxes entered before this are ignored by shadow rays
     double fogScale;        // densityScale / (valueMax * voxelSize)
     uint64_t offsetWordsPacked[2];  // offsetWords of each level (<= 4), 3 bits per level: levels 0-20, then 21-39
+    int64_t sliceIndex;     // --shading slice: the plane's index along sliceAxis
     uint log2Size;
     uint rootReflection;
     uint innerLevels;
@@ -47,6 +48,7 @@ layout(set = 0, binding = 0, std430) uniform TraceParams {
     uint width, height, tilesX;
     uint normalBits;        // k of the ONV codes
     uint normalsOriented;   // 1: gradient-sourced normals (outward: not flipped towards the viewer)
+    uint sliceAxis;         // 0, 1, 2: x, y, z
 } P;
 
 #endif

@@ -498,7 +498,8 @@ TEST(VulkanTracer, RendersAFogSphereLikeTheCpuRenderer) {
 // --shading mip: each pixel's largest value along its ray, through the
 // window chosen from the maxima; the GPU walks every occupied box as the CPU
 // does and its maxima are the same doubles, so the images are identical.
-TEST(VulkanTracer, MaximumIntensityProjectionEqualsTheCpuRenderer) {
+// --shading slice: each pixel's voxel on a plane, the same way.
+TEST(VulkanTracer, MaximumIntensityProjectionAndSliceEqualTheCpuRenderer) {
     VULKAN_OR_SKIP();
     openvdb::initialize();
     auto fog = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.0f), 1.0f / 24.0f, 3.0f);
@@ -515,15 +516,18 @@ TEST(VulkanTracer, MaximumIntensityProjectionEqualsTheCpuRenderer) {
                 const int core = (i - 20) * (i - 20) + (j - 18) * (j - 18) + (k - 15) * (k - 15) < 64 ? 1200 : 0;
                 acc.setValue(openvdb::Coord(i, j, k), int(rng() % 400) - 1000 + core);
             }
-    for (const auto& [grid, name] : {std::pair<openvdb::GridBase::Ptr, std::string>{fog, "vdbdag_vk_mip_fog"}, {scan, "vdbdag_vk_mip_ct"}}) {
+    for (const auto& [grid, name] : {std::pair<openvdb::GridBase::Ptr, std::string>{fog, "vdbdag_vk_mip_fog"}, {scan, "vdbdag_vk_mip_ct"}})
+      for (const trace::Shading shading : {trace::Shading::Mip, trace::Shading::Slice}) {
         const format::EncodedGrid encoded = encodeVdbGrid(grid, name);
-        const trace::RenderGrid rg = trace::makeRenderGrid(encoded, trace::Shading::Mip);
-        ASSERT_TRUE(rg.mip);
+        const trace::RenderGrid rg = trace::makeRenderGrid(encoded, shading);
+        ASSERT_TRUE(shading == trace::Shading::Mip ? rg.mip : rg.slice);
         const trace::Camera camera = trace::frameBounds(trace::GridFrame(rg.indexToWorld), rg.cellLo, rg.cellHi, 96, 72);
         gpu::VulkanTracer gpuTracer(*context(), rg);
         for (const auto& window : {std::optional<std::pair<double, double>>{}, std::optional(std::pair{-500.0, 100.0})}) {
             trace::RenderOptions options;
             options.window = window;
+            // A slice through the middle, seen from the default camera's slant.
+            options.slice = {1 + int(window.has_value()), grid == scan ? 15 : 0};
             trace::RenderStats cpuStats, gpuStats;
             const trace::Image cpu = trace::renderCpu(rg, camera, options, &cpuStats);
             const trace::Image gpu = gpuTracer.render(rg, camera, options, gpuStats);
@@ -533,7 +537,7 @@ TEST(VulkanTracer, MaximumIntensityProjectionEqualsTheCpuRenderer) {
             EXPECT_EQ(gpu.alpha, cpu.alpha) << name;
             EXPECT_GT(std::count(cpu.alpha.begin(), cpu.alpha.end(), 1.0f), 100) << name;
         }
-    }
+      }
 }
 
 // `encode --normals K` on a level set: the GPU decodes the stored ONV codes
