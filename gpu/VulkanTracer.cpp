@@ -20,6 +20,7 @@
 #include "gpu/DevicePaletteChannel.h"
 #include "gpu/EmbeddedShaders.h"
 #include "gpu/VulkanContext.h"
+#include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/util/Error.h"
 
@@ -43,14 +44,14 @@ struct TraceParamsGpu {
     double eyeCell[3], inverse[9], normalMatrix[9], light[3], lightCell[3], background[3];
     double shadowBias, fogScale;
     uint64_t offsetWordsPacked[2];
-    int64_t sliceIndex;
+    int64_t sliceIndex, labelBackground;
     uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, sliceAxis;
 };
-static_assert(sizeof(TraceParamsGpu) == 1184, "must match trace_params.glsl");
+static_assert(sizeof(TraceParamsGpu) == 1192, "must match trace_params.glsl");
 
 struct TracePush {
     uint64_t rays, results, counter;
-    uint32_t itemCount, pad;
+    uint32_t itemCount, labelCount;
 };
 static_assert(sizeof(TracePush) == 32);
 
@@ -117,6 +118,7 @@ struct VulkanTracer::Impl {
         const bool fog = mode == Mode::Render && grid.fog;
         const bool mip = mode == Mode::Render && grid.mip;
         const bool slice = mode == Mode::Render && grid.slice;
+        const bool labels = mode == Mode::Render && grid.labels;
         const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
         // Level-set hits test inside bits (trace_inside.glsl), not values; renders read values for gradients and colours.
         const bool readsValues = mode == Mode::Render || (levelSet && !grid.inside);
@@ -124,7 +126,7 @@ struct VulkanTracer::Impl {
         const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
         const bool normals = mode == Mode::Render && !fog && grid.normals;  // only surface shading reads them
         const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
-                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u);
+                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u) | (labels ? 1u << 20 : 0u);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -141,6 +143,7 @@ struct VulkanTracer::Impl {
                 constants.setBool(8, normals);
                 constants.setBool(9, mip);
                 constants.setBool(10, slice);
+                constants.setBool(11, labels);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
                                                            "trace.comp", true);
             }
@@ -333,23 +336,44 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     p.fogScale = options.densityScale / (grid.valueMax * frame.voxelSize());
     p.sliceIndex = options.slice.index;
     p.sliceAxis = uint32_t(options.slice.axis);
+    p.labelBackground = grid.labelBackground;
     const uint32_t tilesY = (p.height + 7) / 8;
     impl.writeParams();
     std::memset(impl.counter.mappedData(), 0, 16);
 
     ComputePipeline& pipe = impl.pipeline(grid_, Mode::Render, grid_.levelSet, options.shadows && !grid_.fog);
     const size_t pixels = size_t(camera.width) * size_t(camera.height);
-    if (!renderedPixels_ || renderedPixels_->size() < pixels * 32)  // reused between frames, like the primary hits
-        renderedPixels_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 32, MemoryKind::HostVisible, "rendered pixels", false);
+    if (!renderedPixels_ || renderedPixels_->size() < pixels * 48)  // reused between frames, like the primary hits (labels: a hit each)
+        renderedPixels_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 48, MemoryKind::HostVisible, "rendered pixels", false);
     DeviceBuffer& out = *renderedPixels_;
     const uint64_t items = uint64_t(p.tilesX) * tilesY * kWorkgroup;
     TracePush push{0, out.address(), impl.counter.address(), uint32_t(items), 0};
+    std::unique_ptr<DeviceBuffer> shown;  // --labels: the labels shown
+    if (grid.labels && !options.labels.empty()) {
+        shown = std::make_unique<DeviceBuffer>(impl.context, options.labels.size() * 8, MemoryKind::HostVisible, "labels shown", false);
+        std::memcpy(shown->mappedData(), options.labels.data(), options.labels.size() * 8);
+        push.rays = shown->address();
+        push.labelCount = uint32_t(options.labels.size());
+    }
     lastDeviceMs_ = pipe.dispatch(items, push, impl.paramsSet).deviceMs;
 
     uint32_t secondary = 0;
     std::memcpy(&secondary, impl.counter.mappedData(), 4);
     stats.primaryRays = pixels;
     stats.secondaryRays = secondary;
+    if (grid.labels) {  // the first shown voxels, shaded as the CPU's renderLabels does
+        std::vector<trace::RayHit> boxes(pixels);
+        unpackHits(out.mappedData(), boxes);
+        std::vector<std::optional<trace::LabelHit>> hits(pixels);
+        for (size_t i = 0; i < pixels; ++i)
+            if (boxes[i].hit) {
+                const double v = trace::valueAsDoubles(grid, boxes[i].attribute)[0];
+                hits[i] = trace::LabelHit{boxes[i], std::isfinite(v) ? int64_t(v) : 0};
+            }
+        trace::Image image = trace::shadeLabels(grid, camera, options, hits);
+        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return image;
+    }
     if (grid.mip || grid.slice) {  // the maxima (the slice's values) through the window, as the CPU's renderMip (renderSlice) does
         std::vector<double> maxima(pixels, std::numeric_limits<double>::quiet_NaN());
         const auto* u = static_cast<const uint32_t*>(out.mappedData());

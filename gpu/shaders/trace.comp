@@ -40,16 +40,28 @@ layout(constant_id = 7) const bool ONE_CHUNK_DAG = false;  // inner words and le
 layout(constant_id = 8) const bool HAS_NORMALS = false;    // render: shade with the stored ONV normals
 layout(constant_id = 9) const bool MIP = false;            // render: each pixel's largest value (bits), windowed on the host
 layout(constant_id = 10) const bool SLICE = false;         // render: each pixel's voxel on the slice plane (its value's bits), windowed on the host
+layout(constant_id = 11) const bool LABELS = false;        // render: each pixel's first voxel whose label is shown (a hit), shaded on the host
 
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
 layout(push_constant, std430) uniform Push {
-    uint64_t rays;    // hits: F64Array, 8 per ray
-    uint64_t results; // hits: U64Array, 6 per ray; render: F32Array, 8 per pixel
+    uint64_t rays;    // hits: F64Array, 8 per ray; LABELS: I64Array, the labels shown
+    uint64_t results; // hits: U64Array, 6 per ray; render: F32Array, 8 per pixel (LABELS: hits, 6 uint64)
     uint64_t counter; // render: U32Array[1], shadow rays cast
     uint itemCount;
-    uint pad;
+    uint labelCount;  // LABELS: the labels shown (0: any but 0 and the background)
 } pc;
+
+layout(buffer_reference, std430, buffer_reference_align = 8) buffer I64Array { int64_t v[]; };
+
+// LabelRender.cpp firstLabels' isShown.
+bool labelShown(int64_t label) {
+    if (pc.labelCount == 0u) return label != 0l && label != P.labelBackground;
+    I64Array shown = I64Array(pc.rays);
+    for (uint k = 0u; k < pc.labelCount; ++k)
+        if (shown.v[k] == label) return true;
+    return false;
+}
 
 #include "trace_values.glsl"
 #include "trace_normals.glsl"
@@ -207,6 +219,10 @@ void renderPixel(uint i) {
     dvec3 colour = vec3At(P.background);
     float alpha = 0.0, depth = uintBitsToFloat(0x7F800000u);
     vec3 normalOut = vec3(0.0);
+    if (LABELS) {  // every occupied box until a shown label, no level of detail (PixelSegments.h)
+        writeHit(pixel, walkRay(o, d, 0.0lf, tMax, kVisitLabel, 0.0lf, 0.0lf));
+        return;
+    }
     if (SLICE) {  // SliceView.cpp sliceValues: the voxel where the ray meets the plane through the voxel centres
         U32Array bits = U32Array(pc.results);
         bits.v[8u * pixel + 2u] = 0u;

@@ -41,6 +41,7 @@ layout(set = 0, binding = 0, std430) uniform TraceParams {
     double fogScale;        // densityScale / (valueMax * voxelSize)
     uint64_t offsetWordsPacked[2];  // offsetWords of each level (<= 4), 3 bits per level: levels 0-20, then 21-39
     int64_t sliceIndex;     // --shading slice: the plane's index along sliceAxis
+    int64_t labelBackground;  // --shading labels: the grid's background label
     uint log2Size;
     uint rootReflection;
     uint innerLevels;

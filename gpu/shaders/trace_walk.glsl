@@ -78,7 +78,7 @@ uint64_t leafMask(uint64_t index) {
 #define VDBDAG_INNER_WORD(buf, index) innerWord(index)
 #include "vdbdag/dag_access.h"
 
-const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u, kVisitMip = 3u;
+const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u, kVisitMip = 3u, kVisitLabel = 4u;
 
 struct Hit {
     bool hit;
@@ -190,6 +190,12 @@ bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore,
         found = box;
         return true;
     }
+    if (visitKind == kVisitLabel) {  // LabelRender.cpp firstLabels: the first box whose label is shown
+        const double v = valueAsDoubles(box.entry).x;
+        if (!labelShown(isnan(v) || isinf(v) ? 0l : int64_t(v))) return false;
+        found = box;
+        return true;
+    }
     if (visitKind == kVisitMip) {
         const double v = valueAsDoubles(box.entry).x;
         if (!isnan(v) && (!gMipAny || v > gMipMax)) {
@@ -229,7 +235,8 @@ Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, ui
 }
 
 // walkRay. kVisitFirstHit returns the first occupied box, kVisitZeroCrossing
-// the first box the visitor accepts, kVisitFog and kVisitMip the last box (unused).
+// and kVisitLabel the first box the visitor accepts, kVisitFog and kVisitMip
+// the last box (unused).
 Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitKind, double ignoreBefore, double lodScale) {
     const bool firstOnly = visitKind == kVisitFirstHit;
     Hit result = noHit();

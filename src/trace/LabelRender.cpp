@@ -45,9 +45,12 @@ glm::dvec3 labelColour(int64_t label) {
 }
 
 Image renderLabels(const RenderGrid& grid, const Camera& camera, const RenderOptions& options) {
+    return shadeLabels(grid, camera, options, firstLabels(grid, camera, options.labels));
+}
+
+Image shadeLabels(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const std::vector<std::optional<LabelHit>>& hits) {
     const GridFrame frame(grid.indexToWorld);
     const glm::dvec3 light = defaultLight(camera.eye, camera.target, camera.up);
-    const std::vector<std::optional<LabelHit>> hits = firstLabels(grid, camera, options.labels);
     Image image;
     image.resize(camera.width, camera.height);
     for (int py = 0; py < camera.height; ++py)

@@ -2,8 +2,9 @@
 // pixel shows the first voxel along its ray whose label is shown - any but
 // 0 and the grid's background, or only those of `--labels` - in a stable
 // categorical colour of its label (a hash, so a label keeps its colour
-// across files and views), lit by its entry face as surfaces are. The CPU
-// tracer only.
+// across files and views), lit by its entry face as surfaces are. The
+// Vulkan tracer finds the same first voxels and shades them with
+// shadeLabels.
 #pragma once
 #include <optional>
 #include <vector>
@@ -29,6 +30,8 @@ std::vector<std::optional<LabelHit>> firstLabels(const RenderGrid& grid, const C
 // A label's colour (linear RGB): its hash's hue, fixed saturation and value.
 glm::dvec3 labelColour(int64_t label);
 
+// The image of those hits: each its label's colour, lit by its entry face.
+Image shadeLabels(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const std::vector<std::optional<LabelHit>>& hits);
 Image renderLabels(const RenderGrid& grid, const Camera& camera, const RenderOptions& options);
 
 } // namespace vdbdag::trace

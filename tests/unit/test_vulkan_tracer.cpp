@@ -540,6 +540,42 @@ TEST(VulkanTracer, MaximumIntensityProjectionAndSliceEqualTheCpuRenderer) {
       }
 }
 
+// --shading labels: the first voxel whose label is shown, found on the GPU
+// and shaded as the CPU does: identical images, with every label shown and
+// with a chosen few.
+TEST(VulkanTracer, LabelsEqualTheCpuRenderer) {
+    VULKAN_OR_SKIP();
+    openvdb::initialize();
+    auto atlas = openvdb::Int32Grid::create(0);
+    atlas->setName("atlas");
+    auto acc = atlas->getAccessor();
+    for (int i = 0; i < 48; ++i)
+        for (int j = 0; j < 40; ++j)
+            for (int k = 0; k < 36; ++k) {
+                // Nested shells of labels 1..4 around two centres, 7 in a slab, 0 elsewhere (still active: a dense atlas).
+                const int r1 = (i - 16) * (i - 16) + (j - 20) * (j - 20) + (k - 18) * (k - 18), r2 = (i - 34) * (i - 34) + (j - 18) * (j - 18) + (k - 16) * (k - 16);
+                const int label = r1 < 49 ? 1 + r1 / 13 : r2 < 64 ? 3 + r2 / 33 : (j > 30 && k < 8) ? 7 : 0;
+                acc.setValue(openvdb::Coord(i, j, k), label);
+            }
+    const format::EncodedGrid encoded = encodeVdbGrid(atlas, "vdbdag_vk_labels");
+    const trace::RenderGrid rg = trace::makeRenderGrid(encoded, trace::Shading::Labels);
+    ASSERT_TRUE(rg.labels);
+    const trace::Camera camera = trace::frameBounds(trace::GridFrame(rg.indexToWorld), rg.cellLo, rg.cellHi, 96, 72);
+    gpu::VulkanTracer gpuTracer(*context(), rg);
+    for (const std::vector<int64_t>& shown : {std::vector<int64_t>{}, std::vector<int64_t>{2, 7}}) {
+        trace::RenderOptions options;
+        options.labels = shown;
+        trace::RenderStats stats;
+        const trace::Image cpu = trace::renderCpu(rg, camera, options);
+        const trace::Image gpu = gpuTracer.render(rg, camera, options, stats);
+        EXPECT_EQ(gpu.rgb, cpu.rgb) << shown.size();
+        EXPECT_EQ(gpu.alpha, cpu.alpha) << shown.size();
+        EXPECT_EQ(gpu.depth, cpu.depth) << shown.size();
+        EXPECT_EQ(gpu.normal, cpu.normal) << shown.size();
+        EXPECT_GT(std::count(cpu.alpha.begin(), cpu.alpha.end(), 1.0f), 200) << shown.size();
+    }
+}
+
 // `encode --normals K` on a level set: the GPU decodes the stored ONV codes
 // (palette lookup, octahedral unfold) bit for bit as the CPU does and shades
 // with them, gradient-sourced so never flipped.
