@@ -226,10 +226,10 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             const std::optional<trace::SlicePlane> slicePlane = grid.slice ? std::optional(trace::parseSlicePlane(opt->slice)) : std::nullopt;
             if (!opt->labels.empty() && !grid.labels) throw Error(opt->input + ": --labels applies to --shading labels");
             if (!opt->iso.empty() && !grid.iso) throw Error(opt->input + ": --iso applies to --shading iso");
-            const bool cpuOnly = grid.iso || grid.volume;  // mip, slice, labels: either tracer
+            const bool cpuOnly = grid.volume;  // mip, slice, labels, iso: either tracer
             if (cpuOnly && opt->backend == "vulkan")
                 throw Error(opt->input + ": --shading " + trace::shadingOf(grid) + " is rendered by the CPU tracer only for now (use --backend cpu or auto)");
-            if ((cpuOnly || grid.mip || grid.slice || grid.labels) && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
+            if ((cpuOnly || grid.mip || grid.slice || grid.labels || grid.iso) && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
             if (opt->shadows && grid.fog)
                 throw Error(opt->input + ": --shadows applies to surfaces; grid '" + chosen->record.name + "' is shown as fog, which has no shadows yet");
             if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");

@@ -20,6 +20,7 @@
 #include "gpu/DevicePaletteChannel.h"
 #include "gpu/EmbeddedShaders.h"
 #include "gpu/VulkanContext.h"
+#include "src/trace/IsoSurface.h"
 #include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/util/Error.h"
@@ -42,12 +43,12 @@ struct TraceParamsGpu {
     double forward[3], right[3], trueUp[3];
     double halfWidth, halfHeight;
     double eyeCell[3], inverse[9], normalMatrix[9], light[3], lightCell[3], background[3];
-    double shadowBias, fogScale;
+    double shadowBias, fogScale, iso;
     uint64_t offsetWordsPacked[2];
     int64_t sliceIndex, labelBackground;
     uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, sliceAxis;
 };
-static_assert(sizeof(TraceParamsGpu) == 1192, "must match trace_params.glsl");
+static_assert(sizeof(TraceParamsGpu) == 1200, "must match trace_params.glsl");
 
 struct TracePush {
     uint64_t rays, results, counter;
@@ -119,6 +120,7 @@ struct VulkanTracer::Impl {
         const bool mip = mode == Mode::Render && grid.mip;
         const bool slice = mode == Mode::Render && grid.slice;
         const bool labels = mode == Mode::Render && grid.labels;
+        const bool iso = mode == Mode::Render && grid.iso;
         const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
         // Level-set hits test inside bits (trace_inside.glsl), not values; renders read values for gradients and colours.
         const bool readsValues = mode == Mode::Render || (levelSet && !grid.inside);
@@ -126,7 +128,7 @@ struct VulkanTracer::Impl {
         const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
         const bool normals = mode == Mode::Render && !fog && grid.normals;  // only surface shading reads them
         const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
-                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u) | (labels ? 1u << 20 : 0u);
+                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u) | (labels ? 1u << 20 : 0u) | (iso ? 1u << 21 : 0u);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -144,6 +146,7 @@ struct VulkanTracer::Impl {
                 constants.setBool(9, mip);
                 constants.setBool(10, slice);
                 constants.setBool(11, labels);
+                constants.setBool(12, iso);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
                                                            "trace.comp", true);
             }
@@ -337,14 +340,18 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     p.sliceIndex = options.slice.index;
     p.sliceAxis = uint32_t(options.slice.axis);
     p.labelBackground = grid.labelBackground;
+    const double iso = grid.iso ? (options.iso ? *options.iso : trace::automaticIso(grid)) : 0.0;
+    p.iso = iso;
     const uint32_t tilesY = (p.height + 7) / 8;
     impl.writeParams();
     std::memset(impl.counter.mappedData(), 0, 16);
 
     ComputePipeline& pipe = impl.pipeline(grid_, Mode::Render, grid_.levelSet, options.shadows && !grid_.fog);
     const size_t pixels = size_t(camera.width) * size_t(camera.height);
-    if (!renderedPixels_ || renderedPixels_->size() < pixels * 48)  // reused between frames, like the primary hits (labels: a hit each)
-        renderedPixels_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 48, MemoryKind::HostVisible, "rendered pixels", false);
+    // Reused between frames, like the primary hits: 32 bytes a pixel; labels
+    // a hit each (48), iso a hit and its crossing's t (56).
+    if (!renderedPixels_ || renderedPixels_->size() < pixels * 56)
+        renderedPixels_ = std::make_unique<DeviceBuffer>(impl.context, pixels * 56, MemoryKind::HostVisible, "rendered pixels", false);
     DeviceBuffer& out = *renderedPixels_;
     const uint64_t items = uint64_t(p.tilesX) * tilesY * kWorkgroup;
     TracePush push{0, out.address(), impl.counter.address(), uint32_t(items), 0};
@@ -361,6 +368,18 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     std::memcpy(&secondary, impl.counter.mappedData(), 4);
     stats.primaryRays = pixels;
     stats.secondaryRays = secondary;
+    if (grid.iso) {  // the first crossings, shaded as the CPU's renderIso does
+        std::vector<trace::RayHit> boxes(pixels);
+        unpackHits(out.mappedData(), boxes);
+        const auto* ts = reinterpret_cast<const double*>(static_cast<const uint8_t*>(out.mappedData()) + 48 * pixels);
+        std::vector<std::optional<trace::IsoHit>> hits(pixels);
+        for (size_t i = 0; i < pixels; ++i)
+            if (boxes[i].hit) hits[i] = trace::IsoHit{boxes[i], ts[i]};
+        trace::Image image = trace::shadeIso(grid, camera, options, hits);
+        stats.iso = iso;
+        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return image;
+    }
     if (grid.labels) {  // the first shown voxels, shaded as the CPU's renderLabels does
         std::vector<trace::RayHit> boxes(pixels);
         unpackHits(out.mappedData(), boxes);

@@ -41,6 +41,7 @@ layout(constant_id = 8) const bool HAS_NORMALS = false;    // render: shade with
 layout(constant_id = 9) const bool MIP = false;            // render: each pixel's largest value (bits), windowed on the host
 layout(constant_id = 10) const bool SLICE = false;         // render: each pixel's voxel on the slice plane (its value's bits), windowed on the host
 layout(constant_id = 11) const bool LABELS = false;        // render: each pixel's first voxel whose label is shown (a hit), shaded on the host
+layout(constant_id = 12) const bool ISO = false;           // render: each pixel's first crossing of P.iso (a hit and its t), shaded on the host
 
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
@@ -219,6 +220,19 @@ void renderPixel(uint i) {
     dvec3 colour = vec3At(P.background);
     float alpha = 0.0, depth = uintBitsToFloat(0x7F800000u);
     vec3 normalOut = vec3(0.0);
+    if (ISO) {  // every occupied box until the first crossing, no level of detail (PixelSegments.h)
+        gIsoValue = packDouble2x32(uvec2(0u, 0x7FF80000u));  // NaN: no box before
+        gIsoCentre = 0.0lf;
+        gIsoLeave = -1.0lf;
+        gIsoT = 0.0lf;
+        writeHit(pixel, walkRay(o, d, 0.0lf, tMax, kVisitIso, 0.0lf, 0.0lf));
+        const uvec2 tb = unpackDouble2x32(gIsoT);  // after every pixel's hit: the crossing's t
+        U32Array bits = U32Array(pc.results);
+        const uint at = 12u * P.width * P.height + 2u * pixel;
+        bits.v[at] = tb.x;
+        bits.v[at + 1u] = tb.y;
+        return;
+    }
     if (LABELS) {  // every occupied box until a shown label, no level of detail (PixelSegments.h)
         writeHit(pixel, walkRay(o, d, 0.0lf, tMax, kVisitLabel, 0.0lf, 0.0lf));
         return;

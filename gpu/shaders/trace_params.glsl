@@ -39,6 +39,7 @@ layout(set = 0, binding = 0, std430) uniform TraceParams {
     double background[3];
     double shadowBias;      // level sets: boxes entered before this are ignored by shadow rays
     double fogScale;        // densityScale / (valueMax * voxelSize)
+    double iso;             // --shading iso: the surface's value
     uint64_t offsetWordsPacked[2];  // offsetWords of each level (<= 4), 3 bits per level: levels 0-20, then 21-39
     int64_t sliceIndex;     // --shading slice: the plane's index along sliceAxis
     int64_t labelBackground;  // --shading labels: the grid's background label

@@ -78,7 +78,7 @@ uint64_t leafMask(uint64_t index) {
 #define VDBDAG_INNER_WORD(buf, index) innerWord(index)
 #include "vdbdag/dag_access.h"
 
-const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u, kVisitMip = 3u, kVisitLabel = 4u;
+const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u, kVisitMip = 3u, kVisitLabel = 4u, kVisitIso = 5u;
 
 struct Hit {
     bool hit;
@@ -152,6 +152,9 @@ uint bitWidth64(uint64_t x) {
 // Fog state (CpuRenderer.cpp): transmittance, emitted light, first box entered.
 double gFogTransmittance, gFogFirstHit;
 dvec3 gFogSum;
+// Isosurface (IsoSurface.cpp firstCrossings): the box before on the ray (its
+// value, centre and exit), and the crossing's ray parameter.
+double gIsoValue, gIsoCentre, gIsoLeave, gIsoT;
 // Maximum intensity projection (Projection.cpp maximaAlongRays): the largest
 // value met so far, once any box was.
 double gMipMax;
@@ -187,6 +190,23 @@ bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore,
     if (visitKind == kVisitZeroCrossing) {
         if (box.t < ignoreBefore) return false;
         if (!knownInside && (gHasInside ? !insideAt(box.entry) : !(valueAsDoubles(box.entry).x <= 0.0lf))) return false;
+        found = box;
+        return true;
+    }
+    if (visitKind == kVisitIso) {
+        const double v = valueAsDoubles(box.entry).x;
+        if (!(v >= P.iso)) {  // below, or NaN
+            gIsoValue = v;
+            gIsoCentre = 0.5lf * (box.t + tLeave);
+            gIsoLeave = tLeave;
+            return false;
+        }
+        precise double t = box.t;
+        if (gIsoValue < P.iso && gIsoLeave == box.t) {  // touching boxes: between their centres
+            precise double centre = 0.5lf * (box.t + tLeave);
+            t = gIsoCentre + (P.iso - gIsoValue) / (v - gIsoValue) * (centre - gIsoCentre);
+        }
+        gIsoT = t;
         found = box;
         return true;
     }
@@ -234,8 +254,8 @@ Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, ui
     return h;
 }
 
-// walkRay. kVisitFirstHit returns the first occupied box, kVisitZeroCrossing
-// and kVisitLabel the first box the visitor accepts, kVisitFog and kVisitMip
+// walkRay. kVisitFirstHit returns the first occupied box, kVisitZeroCrossing,
+// kVisitLabel and kVisitIso the first box the visitor accepts, kVisitFog and kVisitMip
 // the last box (unused).
 Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitKind, double ignoreBefore, double lodScale) {
     const bool firstOnly = visitKind == kVisitFirstHit;

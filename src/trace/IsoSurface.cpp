@@ -43,10 +43,13 @@ double automaticIso(const RenderGrid& grid) {
 }
 
 Image renderIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, double iso) {
+    return shadeIso(grid, camera, options, firstCrossings(grid, camera, iso));
+}
+
+Image shadeIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const std::vector<std::optional<IsoHit>>& hits) {
     const GridFrame frame(grid.indexToWorld);
     const DagTracer tracer(*grid.dag);
     const glm::dvec3 light = defaultLight(camera.eye, camera.target, camera.up);
-    const std::vector<std::optional<IsoHit>> hits = firstCrossings(grid, camera, iso);
     Image image;
     image.resize(camera.width, camera.height);
     tbb::parallel_for(tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& rows) {

@@ -5,7 +5,8 @@
 // centres at the linear interpolation of their values (a CT's skull surface
 // rather than its voxel faces); else at the box's entry. It is shaded by
 // the central difference gradient of the values there (pointing to lower
-// values: out of the bone), lit as surfaces are. The CPU tracer only.
+// values: out of the bone), lit as surfaces are. The Vulkan tracer finds the
+// same crossings and shades them with shadeIso.
 #pragma once
 #include <optional>
 #include <vector>
@@ -32,6 +33,8 @@ std::vector<std::optional<IsoHit>> firstCrossings(const RenderGrid& grid, const 
 double automaticIso(const RenderGrid& grid);
 
 // `iso`: the value of the surface (RenderOptions::iso, else automaticIso).
+// The image of those crossings: lit by the values' gradient (else the entry face).
+Image shadeIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const std::vector<std::optional<IsoHit>>& hits);
 Image renderIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, double iso);
 
 } // namespace vdbdag::trace

@@ -576,6 +576,43 @@ TEST(VulkanTracer, LabelsEqualTheCpuRenderer) {
     }
 }
 
+// --shading iso: the first crossing of the value, found on the GPU (the
+// interpolated t between touching boxes in the same arithmetic) and shaded
+// as the CPU does: identical images, at the automatic and a given value.
+TEST(VulkanTracer, IsosurfaceEqualsTheCpuRenderer) {
+    VULKAN_OR_SKIP();
+    openvdb::initialize();
+    auto scan = openvdb::FloatGrid::create(0.0f);
+    scan->setName("ct");
+    auto acc = scan->getAccessor();
+    std::mt19937 rng(5);
+    for (int i = 0; i < 44; ++i)
+        for (int j = 0; j < 40; ++j)
+            for (int k = 0; k < 32; ++k) {
+                const double r = std::sqrt((i - 22.0) * (i - 22.0) + (j - 19.0) * (j - 19.0) + 1.6 * (k - 15.0) * (k - 15.0));
+                acc.setValue(openvdb::Coord(i, j, k), float(1000.0 / (1.0 + std::exp(r - 12.0)) + double(rng() % 50)));
+            }
+    const format::EncodedGrid encoded = encodeVdbGrid(scan, "vdbdag_vk_iso");
+    const trace::RenderGrid rg = trace::makeRenderGrid(encoded, trace::Shading::Iso);
+    ASSERT_TRUE(rg.iso);
+    const trace::Camera camera = trace::frameBounds(trace::GridFrame(rg.indexToWorld), rg.cellLo, rg.cellHi, 96, 72);
+    gpu::VulkanTracer gpuTracer(*context(), rg);
+    for (const std::optional<double> iso : {std::optional<double>{}, std::optional(420.5)}) {
+        trace::RenderOptions options;
+        options.iso = iso;
+        trace::RenderStats cpuStats, gpuStats;
+        const trace::Image cpu = trace::renderCpu(rg, camera, options, &cpuStats);
+        const trace::Image gpu = gpuTracer.render(rg, camera, options, gpuStats);
+        ASSERT_TRUE(cpuStats.iso && gpuStats.iso);
+        EXPECT_EQ(*gpuStats.iso, *cpuStats.iso);
+        EXPECT_EQ(gpu.rgb, cpu.rgb);
+        EXPECT_EQ(gpu.alpha, cpu.alpha);
+        EXPECT_EQ(gpu.depth, cpu.depth);
+        EXPECT_EQ(gpu.normal, cpu.normal);
+        EXPECT_GT(std::count(cpu.alpha.begin(), cpu.alpha.end(), 1.0f), 300);
+    }
+}
+
 // `encode --normals K` on a level set: the GPU decodes the stored ONV codes
 // (palette lookup, octahedral unfold) bit for bit as the CPU does and shades
 // with them, gradient-sourced so never flipped.
