@@ -202,9 +202,8 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             trace::Shading shading = trace::parseShading(opt->shading);
             // A dense scan (every voxel of its box active: a CT's air too) shown
             // as voxel blocks is an opaque box: by default it is volume rendered
-            // (VolumeRender.h), its air transparent, or shown as labels. Not with
-            // --backend vulkan, which has neither yet.
-            if (shading == trace::Shading::Auto && opt->backend != "vulkan" && denseScalarScan(*chosen)) {
+            // (VolumeRender.h), its air transparent, or shown as labels.
+            if (shading == trace::Shading::Auto && denseScalarScan(*chosen)) {
                 shading = looksLikeLabels(*chosen) ? trace::Shading::Labels : trace::Shading::Volume;
                 note("grid '" + chosen->record.name + "' is a dense scan: shown as " +
                      (shading == trace::Shading::Labels ? std::string("labels, a colour each") : std::string("a volume, air transparent")) +
@@ -226,10 +225,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
             const std::optional<trace::SlicePlane> slicePlane = grid.slice ? std::optional(trace::parseSlicePlane(opt->slice)) : std::nullopt;
             if (!opt->labels.empty() && !grid.labels) throw Error(opt->input + ": --labels applies to --shading labels");
             if (!opt->iso.empty() && !grid.iso) throw Error(opt->input + ": --iso applies to --shading iso");
-            const bool cpuOnly = grid.volume;  // mip, slice, labels, iso: either tracer
-            if (cpuOnly && opt->backend == "vulkan")
-                throw Error(opt->input + ": --shading " + trace::shadingOf(grid) + " is rendered by the CPU tracer only for now (use --backend cpu or auto)");
-            if ((cpuOnly || grid.mip || grid.slice || grid.labels || grid.iso) && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
+            if ((grid.volume || grid.mip || grid.slice || grid.labels || grid.iso) && opt->shadows) throw Error(opt->input + ": --shadows applies to surfaces, not to --shading " + trace::shadingOf(grid));
             if (opt->shadows && grid.fog)
                 throw Error(opt->input + ": --shadows applies to surfaces; grid '" + chosen->record.name + "' is shown as fog, which has no shadows yet");
             if (!opt->camera.empty() && (cmdUpGiven || cmdViewGiven)) throw Error("--camera sets the view itself: give --up and --view without it");
@@ -275,7 +271,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                     if (l != std::trunc(l)) throw Error("--labels: " + std::to_string(l) + " is not an integer");
                     options.labels.push_back(int64_t(l));
                 }
-            auto backend = makeRenderBackend(cpuOnly ? "cpu" : opt->backend, opt->device);
+            auto backend = makeRenderBackend(opt->backend, opt->device);
             std::vector<double> times;
             trace::Image image;
             trace::RenderStats stats;

@@ -21,6 +21,7 @@
 #include "gpu/EmbeddedShaders.h"
 #include "gpu/VulkanContext.h"
 #include "src/trace/IsoSurface.h"
+#include "src/trace/VolumeRender.h"
 #include "src/trace/LabelRender.h"
 #include "src/trace/Projection.h"
 #include "src/util/Error.h"
@@ -43,12 +44,13 @@ struct TraceParamsGpu {
     double forward[3], right[3], trueUp[3];
     double halfWidth, halfHeight;
     double eyeCell[3], inverse[9], normalMatrix[9], light[3], lightCell[3], background[3];
-    double shadowBias, fogScale, iso;
+    double shadowBias, fogScale, iso, tfLow, tfHigh;
     uint64_t offsetWordsPacked[2];
     int64_t sliceIndex, labelBackground;
     uint32_t log2Size, rootReflection, innerLevels, maxSteps, width, height, tilesX, normalBits, normalsOriented, sliceAxis;
+    uint32_t tfColourPoints, tfOpacityPoints;
 };
-static_assert(sizeof(TraceParamsGpu) == 1200, "must match trace_params.glsl");
+static_assert(sizeof(TraceParamsGpu) == 1224, "must match trace_params.glsl");
 
 struct TracePush {
     uint64_t rays, results, counter;
@@ -121,6 +123,7 @@ struct VulkanTracer::Impl {
         const bool slice = mode == Mode::Render && grid.slice;
         const bool labels = mode == Mode::Render && grid.labels;
         const bool iso = mode == Mode::Render && grid.iso;
+        const bool volume = mode == Mode::Render && grid.volume;
         const uint32_t colouring = mode == Mode::Render ? uint32_t(grid.colouring) : 0u;  // hits and primary rays: no colours
         // Level-set hits test inside bits (trace_inside.glsl), not values; renders read values for gradients and colours.
         const bool readsValues = mode == Mode::Render || (levelSet && !grid.inside);
@@ -128,7 +131,7 @@ struct VulkanTracer::Impl {
         const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
         const bool normals = mode == Mode::Render && !fog && grid.normals;  // only surface shading reads them
         const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
-                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u) | (labels ? 1u << 20 : 0u) | (iso ? 1u << 21 : 0u);
+                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u) | (labels ? 1u << 20 : 0u) | (iso ? 1u << 21 : 0u) | (volume ? 1u << 22 : 0u);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -147,6 +150,7 @@ struct VulkanTracer::Impl {
                 constants.setBool(10, slice);
                 constants.setBool(11, labels);
                 constants.setBool(12, iso);
+                constants.setBool(13, volume);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
                                                            "trace.comp", true);
             }
@@ -342,6 +346,16 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     p.labelBackground = grid.labelBackground;
     const double iso = grid.iso ? (options.iso ? *options.iso : trace::automaticIso(grid)) : 0.0;
     p.iso = iso;
+    // Volume rendering's transfer function, as the CPU renderer chooses it.
+    trace::TransferFunction tf;
+    if (grid.volume) {
+        tf = options.transfer ? *options.transfer : trace::automaticTransfer(grid);
+        if (options.window && !options.transfer) tf.low = options.window->first, tf.high = options.window->second;
+    }
+    p.tfLow = tf.low;
+    p.tfHigh = tf.high;
+    p.tfColourPoints = uint32_t(tf.colourPoints.size());
+    p.tfOpacityPoints = uint32_t(tf.opacityPoints.size());
     const uint32_t tilesY = (p.height + 7) / 8;
     impl.writeParams();
     std::memset(impl.counter.mappedData(), 0, 16);
@@ -355,6 +369,15 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     DeviceBuffer& out = *renderedPixels_;
     const uint64_t items = uint64_t(p.tilesX) * tilesY * kWorkgroup;
     TracePush push{0, out.address(), impl.counter.address(), uint32_t(items), 0};
+    std::unique_ptr<DeviceBuffer> points;  // --tf: the transfer function's control points
+    if (grid.volume && (!tf.colourPoints.empty() || !tf.opacityPoints.empty())) {
+        std::vector<double> flat;
+        for (const auto& c : tf.colourPoints) flat.insert(flat.end(), c.begin(), c.end());
+        for (const auto& o : tf.opacityPoints) flat.insert(flat.end(), o.begin(), o.end());
+        points = std::make_unique<DeviceBuffer>(impl.context, flat.size() * 8, MemoryKind::HostVisible, "transfer function", false);
+        std::memcpy(points->mappedData(), flat.data(), flat.size() * 8);
+        push.rays = points->address();
+    }
     std::unique_ptr<DeviceBuffer> shown;  // --labels: the labels shown
     if (grid.labels && !options.labels.empty()) {
         shown = std::make_unique<DeviceBuffer>(impl.context, options.labels.size() * 8, MemoryKind::HostVisible, "labels shown", false);
@@ -404,6 +427,7 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
         stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         return image;
     }
+    if (grid.volume) stats.window = std::pair{tf.low, tf.high};
     trace::Image image;
     image.resize(camera.width, camera.height);
     const auto* f = static_cast<const float*>(out.mappedData());

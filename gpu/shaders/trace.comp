@@ -42,6 +42,7 @@ layout(constant_id = 9) const bool MIP = false;            // render: each pixel
 layout(constant_id = 10) const bool SLICE = false;         // render: each pixel's voxel on the slice plane (its value's bits), windowed on the host
 layout(constant_id = 11) const bool LABELS = false;        // render: each pixel's first voxel whose label is shown (a hit), shaded on the host
 layout(constant_id = 12) const bool ISO = false;           // render: each pixel's first crossing of P.iso (a hit and its t), shaded on the host
+layout(constant_id = 13) const bool VOLUME = false;        // render: emission-absorption through the transfer function (VolumeRender.cpp)
 
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
@@ -132,6 +133,107 @@ dvec3 mixD(dvec3 x, dvec3 y, double a) {
     return r;
 }
 
+// Volume rendering (VolumeRender.cpp): the ray's state, and the transfer
+// function (TransferFunction.cpp) with pow, log and exp in double.
+double gVolTransmittance, gVolFirstHit, gVolPerVoxel;
+dvec3 gVolSum, gVolDir;
+
+// log(x) for x > 0 normal: x = m 2^k, m in [sqrt(1/2), sqrt(2)), log m = 2 atanh(s), s = (m-1)/(m+1).
+double logDouble(double x) {
+    int k;
+    double m = frexp(x, k);  // [0.5, 1)
+    if (m < 0.70710678118654752lf) {
+        m = 2.0lf * m;
+        k -= 1;
+    }
+    precise double s = (m - 1.0lf) / (m + 1.0lf);
+    precise double s2 = s * s;
+    precise double sum = 0.0lf;
+    for (int n = 25; n >= 1; n -= 2) sum = sum * s2 + 1.0lf / double(n);
+    precise double r = 2.0lf * s * sum + double(k) * 0.69314718055994530942lf;
+    return r;
+}
+// pow(b, e) for 0 <= b <= 1, e >= 0 (1 - opacity, a length in voxels).
+double powUnit(double b, double e) {
+    if (e == 0.0lf || b == 1.0lf) return 1.0lf;
+    if (!(b > 0.0lf)) return 0.0lf;
+    return expDouble(e * logDouble(b));
+}
+
+F64Array tfPoints() { return F64Array(pc.rays); }
+// TransferFunction.cpp interpolate: the point array at `first`, `n` points of `width` doubles.
+double tfInterpolate(uint first, uint n, uint width, uint component, double v) {
+    F64Array pts = tfPoints();
+    if (!(v > pts.v[first])) return pts.v[first + component];
+    if (!(v < pts.v[first + (n - 1u) * width])) return pts.v[first + (n - 1u) * width + component];
+    uint upper = 1u;
+    while (upper < n - 1u && !(v < pts.v[first + upper * width])) ++upper;
+    const double a0 = pts.v[first + (upper - 1u) * width], b0 = pts.v[first + upper * width];
+    const double ak = pts.v[first + (upper - 1u) * width + component], bk = pts.v[first + upper * width + component];
+    precise double t = b0 > a0 ? (v - a0) / (b0 - a0) : 0.0lf;
+    precise double r = ak + (bk - ak) * t;
+    return r;
+}
+double tfOpacity(double v) {
+    if (isnan(v)) return 0.0lf;
+    if (P.tfOpacityPoints != 0u) return tfInterpolate(4u * P.tfColourPoints, P.tfOpacityPoints, 2u, 1u, v);
+    if (!(v > P.tfLow)) return 0.0lf;
+    precise double t = (v - P.tfLow) / (P.tfHigh > P.tfLow ? P.tfHigh - P.tfLow : 1.0lf);
+    t = t < 1.0lf ? t : 1.0lf;
+    precise double r = kMaxOpacity * t * t;
+    return r;
+}
+dvec3 tfColour(double v) {
+    if (P.tfColourPoints != 0u) {
+        const double x = isnan(v) ? P.tfLow : v;
+        return dvec3(tfInterpolate(0u, P.tfColourPoints, 4u, 1u, x), tfInterpolate(0u, P.tfColourPoints, 4u, 2u, x), tfInterpolate(0u, P.tfColourPoints, 4u, 3u, x));
+    }
+    precise double t = (v - P.tfLow) / (P.tfHigh > P.tfLow ? P.tfHigh - P.tfLow : 1.0lf);
+    t = clampUnit(t);
+    const dvec3 dark = dvec3(0.45lf, 0.12lf, 0.06lf), ivory = dvec3(0.95lf, 0.90lf, 0.78lf);
+    precise dvec3 r = dark + (ivory - dark) * sqrt(t);
+    return r;
+}
+// ValueGradient.cpp valueGradient: central differences of the stored values, normalised; false where none.
+bool valueGradientAt(i64vec3 voxel, double centre, out dvec3 g) {
+    g = dvec3(0.0lf);
+    for (int a = 0; a < 3; ++a) {
+        i64vec3 plus = voxel, minus = voxel;
+        plus[a] += 1l;
+        minus[a] -= 1l;
+        uint64_t pe, me;
+        const bool p = findVoxel(plus, pe), m = findVoxel(minus, me);
+        if (p && m) g[a] = (valueAsDoubles(pe).x - valueAsDoubles(me).x) * 0.5lf;
+        else if (p) g[a] = valueAsDoubles(pe).x - centre;
+        else if (m) g[a] = centre - valueAsDoubles(me).x;
+    }
+    const double len = sqrt(dot3(g, g));
+    if (!(len > 0.0lf) || !finite(len)) return false;
+    g = g / len;
+    return true;
+}
+bool visitVolume(Hit box, double tLeave) {
+    const double v = valueAsDoubles(box.entry).x;
+    const double a = tfOpacity(v);
+    if (a <= 0.0lf) return false;
+    precise double alpha = 1.0lf - powUnit(1.0lf - a, (tLeave - box.t) / gVolPerVoxel);
+    if (!(alpha > 0.0lf)) return false;
+    if (gVolFirstHit < 0.0lf) gVolFirstHit = box.t;
+    double lit = 1.0lf;
+    dvec3 g;
+    if (alpha > 0.01lf && valueGradientAt(box.voxel, v, g)) {  // lit as a surface facing the viewer (Shading.cpp facingNormal)
+        dvec3 normal = normalToWorld(-g);
+        if (dot3(normal, gVolDir) > 0.0lf) normal = -normal;
+        const double lambert = dot3(normal, vec3At(P.light));
+        precise double l = kAmbient + (1.0lf - kAmbient) * (0.0lf < lambert ? lambert : 0.0lf);
+        lit = l;
+    }
+    precise dvec3 add = gVolTransmittance * alpha * lit * tfColour(v);
+    gVolSum = gVolSum + add;
+    gVolTransmittance *= 1.0lf - alpha;
+    return gVolTransmittance < 0.02lf;
+}
+
 // Shading.cpp baseColour.
 dvec3 baseColour(uint64_t entry) {
     if (COLOURING == 1u) {
@@ -220,6 +322,26 @@ void renderPixel(uint i) {
     dvec3 colour = vec3At(P.background);
     float alpha = 0.0, depth = uintBitsToFloat(0x7F800000u);
     vec3 normalOut = vec3(0.0);
+    if (VOLUME) {  // every occupied box until the light is spent, no level of detail
+        gVolTransmittance = 1.0lf;
+        gVolFirstHit = -1.0lf;
+        gVolSum = dvec3(0.0lf);
+        gVolDir = dir;
+        gVolPerVoxel = 1.0lf / sqrt(dot3(d, d));
+        walkRay(o, d, 0.0lf, tMax, kVisitVolume, 0.0lf, 0.0lf);
+        precise dvec3 c = gVolSum + gVolTransmittance * vec3At(P.background);
+        F32Array res = F32Array(pc.results);
+        const uint w = 8u * pixel;
+        res.v[w] = float(c.x);
+        res.v[w + 1u] = float(c.y);
+        res.v[w + 2u] = float(c.z);
+        res.v[w + 3u] = float(1.0lf - gVolTransmittance);
+        res.v[w + 4u] = gVolFirstHit >= 0.0lf ? float(gVolFirstHit) : uintBitsToFloat(0x7F800000u);
+        res.v[w + 5u] = 0.0;
+        res.v[w + 6u] = 0.0;
+        res.v[w + 7u] = 0.0;
+        return;
+    }
     if (ISO) {  // every occupied box until the first crossing, no level of detail (PixelSegments.h)
         gIsoValue = packDouble2x32(uvec2(0u, 0x7FF80000u));  // NaN: no box before
         gIsoCentre = 0.0lf;

@@ -40,6 +40,7 @@ layout(set = 0, binding = 0, std430) uniform TraceParams {
     double shadowBias;      // level sets: boxes entered before this are ignored by shadow rays
     double fogScale;        // densityScale / (valueMax * voxelSize)
     double iso;             // --shading iso: the surface's value
+    double tfLow, tfHigh;   // --shading volume: the transfer function's ramp (TransferFunction.h)
     uint64_t offsetWordsPacked[2];  // offsetWords of each level (<= 4), 3 bits per level: levels 0-20, then 21-39
     int64_t sliceIndex;     // --shading slice: the plane's index along sliceAxis
     int64_t labelBackground;  // --shading labels: the grid's background label
@@ -51,6 +52,7 @@ layout(set = 0, binding = 0, std430) uniform TraceParams {
     uint normalBits;        // k of the ONV codes
     uint normalsOriented;   // 1: gradient-sourced normals (outward: not flipped towards the viewer)
     uint sliceAxis;         // 0, 1, 2: x, y, z
+    uint tfColourPoints, tfOpacityPoints;  // its control points (at the push constants' `rays`: 4 doubles each, then 2 each)
 } P;
 
 #endif

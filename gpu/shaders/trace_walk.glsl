@@ -78,7 +78,7 @@ uint64_t leafMask(uint64_t index) {
 #define VDBDAG_INNER_WORD(buf, index) innerWord(index)
 #include "vdbdag/dag_access.h"
 
-const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u, kVisitMip = 3u, kVisitLabel = 4u, kVisitIso = 5u;
+const uint kVisitFirstHit = 0u, kVisitZeroCrossing = 1u, kVisitFog = 2u, kVisitMip = 3u, kVisitLabel = 4u, kVisitIso = 5u, kVisitVolume = 6u;
 
 struct Hit {
     bool hit;
@@ -184,6 +184,9 @@ double expDouble(double x) {
     return ldexp(p, int(k));
 }
 
+// Volume rendering's visitor (trace.comp, after the shading helpers it uses).
+bool visitVolume(Hit box, double tLeave);
+
 // The visitor of the segment walks; true stops the walk.
 // `knownInside`: the walk has tested the box's inside bit already.
 bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore, inout Hit found, bool knownInside) {
@@ -193,6 +196,7 @@ bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore,
         found = box;
         return true;
     }
+    if (visitKind == kVisitVolume) return visitVolume(box, tLeave);
     if (visitKind == kVisitIso) {
         const double v = valueAsDoubles(box.entry).x;
         if (!(v >= P.iso)) {  // below, or NaN
@@ -255,8 +259,8 @@ Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, ui
 }
 
 // walkRay. kVisitFirstHit returns the first occupied box, kVisitZeroCrossing,
-// kVisitLabel and kVisitIso the first box the visitor accepts, kVisitFog and kVisitMip
-// the last box (unused).
+// kVisitLabel and kVisitIso the first box the visitor accepts, kVisitFog,
+// kVisitMip and kVisitVolume the last box (unused).
 Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitKind, double ignoreBefore, double lodScale) {
     const bool firstOnly = visitKind == kVisitFirstHit;
     Hit result = noHit();

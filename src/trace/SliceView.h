@@ -5,7 +5,7 @@
 // (--window LOW,HIGH, else Otsu's threshold of the slice's values to their
 // 99.5th percentile: air black, tissue grey to white); where the ray meets
 // the plane outside the stored voxels, or not at all, it is transparent.
-// The CPU tracer only.
+// The Vulkan tracer finds the same voxels (trace.comp SLICE).
 #pragma once
 #include <cstdint>
 #include <optional>

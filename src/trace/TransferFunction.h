@@ -6,6 +6,7 @@
 // from dark red to ivory. Or, read from a file (`render --tf FILE`,
 // readTransferFunction), piecewise-linear colour and opacity points.
 #pragma once
+#include "src/trace/shading_constants.h"
 #include <array>
 #include <string>
 #include <vector>
@@ -14,7 +15,7 @@
 
 namespace vdbdag::trace {
 
-inline constexpr double kMaxOpacity = 0.35;  // per voxel length, at `high` and above
+inline constexpr double kMaxOpacity = access::kMaxOpacity;  // 0.35 per voxel length, at `high` and above (shading_constants.h: the shader's too)
 
 struct TransferFunction {
     double low = 0, high = 1;

@@ -23,6 +23,9 @@ VDBDAG_CONST double kShadowBias = 3.0;
 // ... and start this many voxels off the surface along its gradient.
 VDBDAG_CONST double kShadowNormalOffset = 1.5;
 
+// Volume rendering: the opacity per voxel length at the ramp's top (TransferFunction.h).
+VDBDAG_CONST double kMaxOpacity = VDBDAG_RATIO(35, 100);
+
 VDBDAG_RGB(kMaterialRgb, 80, 78, 74);    // surfaces without value colouring
 VDBDAG_RGB(kFogEmissionRgb, 92, 92, 95); // fog's emitted light
 // ParaView's "Cool to Warm" colour map, as three stops (scalar colouring).
