@@ -3,8 +3,9 @@
 // grids it holds; the grids follow in frame order, each frame's sections as
 // its own file would hold them, and a frame's .vdb file metadata is its
 // FrameMetadata section (docs/FORMAT.md 4.3). A reader that predates
-// sequences drops the two kinds it does not know and sees every frame's
-// grids as the grids of one file.
+// sequences drops the kinds it does not know and sees every frame's grids
+// as the grids of one file (or, where SameAs stands for sections, refuses
+// the file: a grid lacks a required section).
 //
 // writeSequence gathers files encoded one frame at a time: their sections
 // are copied as they are stored (never inflated or compressed again), so a
