@@ -8,13 +8,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/FrameJobs.h"
 #include "cli/JsonReport.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/pipeline/LayerScatter.h"
 #include "src/util/Error.h"
-#include "src/util/FramePattern.h"
 #include "src/format/FrameSequence.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
@@ -190,39 +190,20 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         if (opt->json) setQuiet(true);
-        const format::FrameList list = format::readFrameList(opt->input);
-        const bool pattern = isFramePattern(opt->output) && !std::filesystem::exists(opt->output);
-        if (!list.sequence) {
-            if (!opt->frames.empty()) throw Error(opt->input + ": --frames applies to sequence files; this file holds one volume");
-            if (pattern) throw Error(opt->output + ": " + opt->input + " holds one volume, not a sequence: -o names one file");
-            decodeOne(*opt, opt->output, std::nullopt, nullptr);
-            exitCode = 0;
-            return;
-        }
-        // A sequence: the frames chosen, each to its own file.
-        std::vector<uint32_t> chosen;
-        const std::optional<FrameSelection> selection = opt->frames.empty() ? std::nullopt : std::optional(parseFrameSelection(opt->frames));
-        for (uint32_t i = 0; i < list.frames.size(); ++i)
-            if (!selection || selection->contains(list.frames[i].number)) chosen.push_back(i);
-        const std::string range = fmt::format("{} frames, {} to {}", list.frames.size(), list.frames.front().number, list.frames.back().number);
-        if (chosen.empty()) throw Error(opt->input + ": --frames " + opt->frames + " selects none of its " + range);
-        if (!pattern) {
-            if (chosen.size() != 1)
-                throw Error(opt->input + ": holds " + range + "; write them with a frame token in -o (out.####.vdb, out.%04d.vdb) or pick one with --frames N");
-            decodeOne(*opt, opt->output, chosen.front(), nullptr);
+        const std::vector<FrameJob> jobs = frameJobs({opt->input, opt->output, opt->frames, "--frames", "file",
+                                                      "write them with a frame token in -o (out.####.vdb, out.%04d.vdb) or pick one with --frames N"},
+                                                     format::readFrameList(opt->input));
+        if (jobs.size() == 1 && jobs.front().output == opt->output) {  // one output: a file of one volume, or one frame to -o itself
+            decodeOne(*opt, jobs.front().output, jobs.front().index, nullptr);
             exitCode = 0;
             return;
         }
         // Every output checked before any is written.
-        std::vector<std::string> outputs;
-        for (uint32_t i : chosen) {
-            outputs.push_back(framePath(opt->output, list.frames[i].number));
-            checkOutputPath(outputs.back(), {opt->input}, {{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt->force});
-        }
+        for (const FrameJob& job : jobs) checkOutputPath(job.output, {opt->input}, {{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt->force});
         nlohmann::json reports = nlohmann::json::array();
-        for (size_t k = 0; k < chosen.size(); ++k) {
-            decodeOne(*opt, outputs[k], chosen[k], &reports);
-            reports.back()["frame"] = list.frames[chosen[k]].number;
+        for (const FrameJob& job : jobs) {
+            decodeOne(*opt, job.output, job.index, &reports);
+            reports.back()["frame"] = job.number;
         }
         if (opt->json) printJson(reports);
         exitCode = 0;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/Commands.h"
+#include "cli/FrameJobs.h"
 #include "cli/GlobalOptions.h"
 #include "cli/JsonReport.h"
 #include "cli/RunContext.h"
@@ -33,7 +34,6 @@
 #include "vdb_bridge/ImageWriter.h"
 #include "vdb_bridge/InputScene.h"
 #include "src/format/FrameSequence.h"
-#include "src/util/FramePattern.h"
 #include "vdb_bridge/VdbSummary.h"
 
 namespace vdbdag::cli {
@@ -167,31 +167,17 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         readOptions.limits = opt->limits.limits(0);  // traced where it lies, compressed
         // The frames of a sequence file rendered: (index, output); else the
         // input whole to -o.
-        std::vector<std::pair<std::optional<uint32_t>, std::string>> jobs;
-        const bool pattern = isFramePattern(opt->output) && !std::filesystem::exists(opt->output);
-        const std::optional<format::FrameList> list =
-            bridge::inputKindOf(opt->input) == bridge::InputKind::Ssvdag ? std::optional(format::readFrameList(opt->input)) : std::nullopt;
-        if (list && list->sequence) {
-            const std::optional<FrameSelection> selection = opt->frame.empty() ? std::nullopt : std::optional(parseFrameSelection(opt->frame));
-            for (uint32_t i = 0; i < list->frames.size(); ++i)
-                if (!selection || selection->contains(list->frames[i].number))
-                    jobs.push_back({i, pattern ? framePath(opt->output, list->frames[i].number) : opt->output});
-            const std::string range = fmt::format("{} frames, {} to {}", list->frames.size(), list->frames.front().number, list->frames.back().number);
-            if (jobs.empty()) throw Error(opt->input + ": --frame " + opt->frame + " selects none of its " + range);
-            if (!pattern && jobs.size() > 1)
-                throw Error(opt->input + ": holds " + range + "; render one with --frame N, or each to its image with a frame token in -o (f.####.png)");
-        } else {
-            if (!opt->frame.empty()) throw Error(opt->input + ": --frame applies to sequence files; this file holds one volume");
-            if (pattern) throw Error(opt->output + ": " + opt->input + " holds one volume, not a sequence: -o names one image");
-            jobs.push_back({std::nullopt, opt->output});
-        }
-        for (const auto& job : jobs) checkOutputPath(job.second, {opt->input}, {{".png", ".exr"}, "render", opt->force});
+        const std::vector<FrameJob> jobs =
+            frameJobs({opt->input, opt->output, opt->frame, "--frame", "image", "render one with --frame N, or each to its image with a frame token in -o (f.####.png)"},
+                      bridge::inputKindOf(opt->input) == bridge::InputKind::Ssvdag ? std::optional(format::readFrameList(opt->input)) : std::nullopt);
+        for (const FrameJob& job : jobs) checkOutputPath(job.output, {opt->input}, {{".png", ".exr"}, "render", opt->force});
         // One camera (and fog density) for every frame: the first frame's.
         std::optional<trace::Camera> sharedCamera;
         std::optional<double> sharedDensity;
         nlohmann::json reports = nlohmann::json::array();
-        for (const auto& [frameIndex, output] : jobs) {
-            readOptions.frame = frameIndex;
+        for (const FrameJob& job : jobs) {
+            const std::string& output = job.output;
+            readOptions.frame = job.index;
             // A .vdb, .nvdb or scan is encoded in memory first, as `encode` would.
             const format::SsvdagScene scene = bridge::sceneOfInput(opt->input, readOptions);
             const format::EncodedGrid* chosen = nullptr;
@@ -301,7 +287,7 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
                                  {"iso", stats.iso ? nlohmann::json(*stats.iso) : nlohmann::json()},
                                  {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}, {"target", {camera.target.x, camera.target.y, camera.target.z}},
                                              {"up", {camera.up.x, camera.up.y, camera.up.z}}}}};
-                if (frameIndex) j["frame"] = list->frames[*frameIndex].number;
+                if (job.index) j["frame"] = job.number;
                 if (jobs.size() > 1) reports.push_back(std::move(j));
                 else printJson(j);
             } else {

@@ -344,14 +344,9 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     p.sliceIndex = options.slice.index;
     p.sliceAxis = uint32_t(options.slice.axis);
     p.labelBackground = grid.labelBackground;
-    const double iso = grid.iso ? (options.iso ? *options.iso : trace::automaticIso(grid)) : 0.0;
+    const double iso = grid.iso ? trace::chosenIso(grid, options) : 0.0;
     p.iso = iso;
-    // Volume rendering's transfer function, as the CPU renderer chooses it.
-    trace::TransferFunction tf;
-    if (grid.volume) {
-        tf = options.transfer ? *options.transfer : trace::automaticTransfer(grid);
-        if (options.window && !options.transfer) tf.low = options.window->first, tf.high = options.window->second;
-    }
+    const trace::TransferFunction tf = grid.volume ? trace::chosenTransfer(grid, options) : trace::TransferFunction{};
     p.tfLow = tf.low;
     p.tfHigh = tf.high;
     p.tfColourPoints = uint32_t(tf.colourPoints.size());
@@ -391,53 +386,47 @@ trace::Image VulkanTracer::render(const trace::RenderGrid& grid, const trace::Ca
     std::memcpy(&secondary, impl.counter.mappedData(), 4);
     stats.primaryRays = pixels;
     stats.secondaryRays = secondary;
-    if (grid.iso) {  // the first crossings, shaded as the CPU's renderIso does
+    // What the shader left per pixel, finished as the CPU renderer finishes it.
+    trace::Image image;
+    if (grid.iso || grid.labels) {  // hits, shaded by the CPU's shadeIso / shadeLabels
         std::vector<trace::RayHit> boxes(pixels);
         unpackHits(out.mappedData(), boxes);
-        const auto* ts = reinterpret_cast<const double*>(static_cast<const uint8_t*>(out.mappedData()) + 48 * pixels);
-        std::vector<std::optional<trace::IsoHit>> hits(pixels);
-        for (size_t i = 0; i < pixels; ++i)
-            if (boxes[i].hit) hits[i] = trace::IsoHit{boxes[i], ts[i]};
-        trace::Image image = trace::shadeIso(grid, camera, options, hits);
-        stats.iso = iso;
-        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        return image;
-    }
-    if (grid.labels) {  // the first shown voxels, shaded as the CPU's renderLabels does
-        std::vector<trace::RayHit> boxes(pixels);
-        unpackHits(out.mappedData(), boxes);
-        std::vector<std::optional<trace::LabelHit>> hits(pixels);
-        for (size_t i = 0; i < pixels; ++i)
-            if (boxes[i].hit) {
-                const double v = trace::valueAsDoubles(grid, boxes[i].attribute)[0];
-                hits[i] = trace::LabelHit{boxes[i], std::isfinite(v) ? int64_t(v) : 0};
-            }
-        trace::Image image = trace::shadeLabels(grid, camera, options, hits);
-        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        return image;
-    }
-    if (grid.mip || grid.slice) {  // the maxima (the slice's values) through the window, as the CPU's renderMip (renderSlice) does
+        if (grid.iso) {
+            const auto* ts = reinterpret_cast<const double*>(static_cast<const uint8_t*>(out.mappedData()) + 48 * pixels);  // each crossing's t
+            std::vector<std::optional<trace::IsoHit>> hits(pixels);
+            for (size_t i = 0; i < pixels; ++i)
+                if (boxes[i].hit) hits[i] = trace::IsoHit{boxes[i], ts[i]};
+            image = trace::shadeIso(grid, camera, options, hits);
+            stats.iso = iso;
+        } else {
+            std::vector<std::optional<trace::LabelHit>> hits(pixels);
+            for (size_t i = 0; i < pixels; ++i)
+                if (boxes[i].hit) {
+                    const double v = trace::valueAsDoubles(grid, boxes[i].attribute)[0];
+                    hits[i] = trace::LabelHit{boxes[i], std::isfinite(v) ? int64_t(v) : 0};
+                }
+            image = trace::shadeLabels(grid, camera, options, hits);
+        }
+    } else if (grid.mip || grid.slice) {  // the maxima (the slice's values) through the window, as renderMip (renderSlice) does
         std::vector<double> maxima(pixels, std::numeric_limits<double>::quiet_NaN());
         const auto* u = static_cast<const uint32_t*>(out.mappedData());
         for (size_t i = 0; i < pixels; ++i)
             if (u[8 * i + 2]) maxima[i] = std::bit_cast<double>(uint64_t(u[8 * i]) | uint64_t(u[8 * i + 1]) << 32);
         const auto [low, high] = options.window ? *options.window : trace::automaticWindow(maxima);
         stats.window = std::pair{low, high};
-        trace::Image image = trace::windowedGrey(maxima, camera.width, camera.height, low, high, grid.mip);
-        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        return image;
-    }
-    if (grid.volume) stats.window = std::pair{tf.low, tf.high};
-    trace::Image image;
-    image.resize(camera.width, camera.height);
-    const auto* f = static_cast<const float*>(out.mappedData());
-    for (size_t i = 0; i < pixels; ++i) {
-        for (int a = 0; a < 3; ++a) {
-            image.rgb[3 * i + a] = f[8 * i + a];
-            image.normal[3 * i + a] = f[8 * i + 5 + a];
+        image = trace::windowedGrey(maxima, camera.width, camera.height, low, high, grid.mip);
+    } else {  // colours, alpha, depth and normals
+        if (grid.volume) stats.window = std::pair{tf.low, tf.high};
+        image.resize(camera.width, camera.height);
+        const auto* f = static_cast<const float*>(out.mappedData());
+        for (size_t i = 0; i < pixels; ++i) {
+            for (int a = 0; a < 3; ++a) {
+                image.rgb[3 * i + a] = f[8 * i + a];
+                image.normal[3 * i + a] = f[8 * i + 5 + a];
+            }
+            image.alpha[i] = f[8 * i + 3];
+            image.depth[i] = f[8 * i + 4];
         }
-        image.alpha[i] = f[8 * i + 3];
-        image.depth[i] = f[8 * i + 4];
     }
     stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return image;

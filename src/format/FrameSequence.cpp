@@ -45,7 +45,7 @@ namespace {
 
 bool isGridKind(SectionKind kind) {
     return kind != SectionKind::FileInfo && kind != SectionKind::Frames && kind != SectionKind::FileMetadata && kind != SectionKind::FrameMetadata &&
-           kind != SectionKind::SameAs && std::strcmp(sectionKindName(kind), "unknown") != 0;
+           kind != SectionKind::SameAs && isKnownKind(kind);
 }
 
 } // namespace
@@ -122,7 +122,18 @@ FrameList readFrameList(const std::string& path) {
     list.sequence = frames != nullptr;
     if (frames) list.frames = parseFrames(frames->data, list.gridCount, path + ": Frames");
     else list.frames = {FrameEntry{0, list.gridCount}};
+    list.fileInfo = info->data;
     return list;
+}
+
+GridRange frameGrids(std::span<const FrameEntry> frames, uint32_t gridCount, uint32_t index, const std::string& what) {
+    const size_t count = frames.empty() ? 1 : frames.size();
+    if (index >= count) throw Error(what + ": has " + std::to_string(count) + " frame(s); frame index " + std::to_string(index) + " asked for");
+    if (frames.empty()) return {0, gridCount};
+    GridRange range;
+    for (uint32_t f = 0; f < index; ++f) range.first += frames[f].gridCount;
+    range.end = range.first + frames[index].gridCount;
+    return range;
 }
 
 uint64_t writeSequence(std::span<const FramePart> parts, std::ostream& out) {
@@ -146,10 +157,7 @@ uint64_t writeSequence(std::span<const FramePart> parts, std::ostream& out) {
         std::vector<Section> own = storedSectionsOf(part.path);
         for (Section& s : own) {
             if (s.kind == SectionKind::FileInfo) {
-                // Its writer string is kept; the count becomes the sequence's.
-                if (fileInfo.empty()) fileInfo = readContainerFile(part.path, false, {}, [](SectionKind k, uint32_t) { return k == SectionKind::FileInfo; })
-                                                     .front()
-                                                     .data;
+                if (fileInfo.empty()) fileInfo = list.fileInfo;  // its writer string is kept; the count becomes the sequence's
                 continue;
             }
             if (s.kind == SectionKind::FileMetadata) {

@@ -65,8 +65,16 @@ uint64_t writeSequence(std::span<const FramePart> parts, std::ostream& out);
 struct FrameList {
     std::vector<FrameEntry> frames;
     uint32_t gridCount = 0;
-    bool sequence = false;  // the file has a Frames section
+    bool sequence = false;       // the file has a Frames section
+    std::vector<uint8_t> fileInfo;  // the FileInfo payload
 };
 FrameList readFrameList(const std::string& path);
+
+// The grids [first, end) of frame `index` (a file of one volume: frame 0
+// holds all `gridCount`); throws vdbdag::Error naming `what` past the last frame.
+struct GridRange {
+    uint32_t first = 0, end = 0;
+};
+GridRange frameGrids(std::span<const FrameEntry> frames, uint32_t gridCount, uint32_t index, const std::string& what);
 
 } // namespace vdbdag::format

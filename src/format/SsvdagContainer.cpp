@@ -197,7 +197,7 @@ std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string&
     return entries;
 }
 
-bool isUnknownKind(uint32_t kind) { return std::strcmp(sectionKindName(SectionKind(kind)), "unknown") == 0; }
+bool isUnknownKind(uint32_t kind) { return !isKnownKind(SectionKind(kind)); }
 
 // What the sections to be kept claim to inflate to, against --max-memory,
 // before any is inflated (a zstd frame inflates to exactly its declared size).
@@ -258,6 +258,8 @@ const char* sectionKindName(SectionKind kind) {
     }
     return "unknown";
 }
+
+bool isKnownKind(SectionKind kind) { return std::strcmp(sectionKindName(kind), "unknown") != 0; }
 
 bool isPrecompressed(SectionKind kind) {
     return kind == SectionKind::ValueWindows || kind == SectionKind::InactiveValueWindows || kind == SectionKind::PredictedWindows ||

@@ -51,7 +51,8 @@ enum class SectionKind : uint32_t {
     FrameMetadata = 24,  // sequence files: a frame's .vdb file metadata (as FileMetadata); grid = the frame's first grid
     SameAs = 25,         // sequence files: this grid's section of a kind holds the bytes of an earlier grid's (a grid that does not change between frames)
 };
-const char* sectionKindName(SectionKind kind);
+const char* sectionKindName(SectionKind kind);  // "unknown" for a kind this build does not know
+bool isKnownKind(SectionKind kind);
 // Sections whose payload is compressed already (the writer stores them raw).
 bool isPrecompressed(SectionKind kind);
 

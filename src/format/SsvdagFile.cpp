@@ -293,16 +293,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     if (framesSection) frames = parseFrames(framesSection->data, gridCount, sourceName + ": Frames");
     if (framesSection && fileMetadata) throw Error(sourceName + ": a sequence file keeps each frame's metadata in FrameMetadata, not FileMetadata");
     if (!framesSection && !frameMetadata.empty()) throw Error(sourceName + ": FrameMetadata in a file without frames");
-    uint32_t first = 0, end = gridCount;
-    if (options.frame) {
-        const size_t count = frames.empty() ? 1 : frames.size();
-        if (*options.frame >= count)
-            throw Error(sourceName + ": has " + std::to_string(count) + " frame(s); frame index " + std::to_string(*options.frame) + " asked for");
-        if (!frames.empty()) {
-            for (uint32_t f = 0; f < *options.frame; ++f) first += frames[f].gridCount;
-            end = first + frames[*options.frame].gridCount;
-        }
-    }
+    const GridRange range = options.frame ? frameGrids(frames, gridCount, *options.frame, sourceName) : GridRange{0, gridCount};
+    const uint32_t first = range.first, end = range.end;
     if (end - first > sections.size()) throw Error(sourceName + ": FileInfo claims " + std::to_string(gridCount) + " grids, more than its sections can hold");
 
     auto find = [&](uint32_t g, SectionKind kind, bool required) -> Section* {
@@ -537,11 +529,8 @@ SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
     if (!options.frame) return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false, options.limits), path, options);
     // One frame: its sections only (and the file's FileInfo and Frames).
     const FrameList list = readFrameList(path);
-    if (*options.frame >= list.frames.size())
-        throw Error(path + ": has " + std::to_string(list.frames.size()) + " frame(s); frame index " + std::to_string(*options.frame) + " asked for");
-    uint32_t first = 0;
-    for (uint32_t f = 0; f < *options.frame; ++f) first += list.frames[f].gridCount;
-    const uint32_t end = first + list.frames[*options.frame].gridCount;
+    const GridRange range = frameGrids(list.frames, list.gridCount, *options.frame, path);
+    const uint32_t first = range.first, end = range.end;  // (named, for the lambdas)
     const auto keep = [first, end](SectionKind kind, uint32_t grid) {
         switch (kind) {
             case SectionKind::FileInfo:

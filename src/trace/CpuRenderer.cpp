@@ -48,12 +48,11 @@ Image renderCpu(const RenderGrid& grid, const Camera& camera, const RenderOption
             image = std::move(p.image);
             window = std::pair{p.low, p.high};
         } else if (grid.volume) {
-            TransferFunction tf = options.transfer ? *options.transfer : automaticTransfer(grid);
-            if (options.window && !options.transfer) tf.low = options.window->first, tf.high = options.window->second;
+            const TransferFunction tf = chosenTransfer(grid, options);
             image = renderVolume(grid, camera, options, tf);
             window = std::pair{tf.low, tf.high};
         } else if (grid.iso) {
-            iso = options.iso ? *options.iso : automaticIso(grid);
+            iso = chosenIso(grid, options);
             image = renderIso(grid, camera, options, *iso);
         } else {
             image = renderLabels(grid, camera, options);

@@ -42,6 +42,8 @@ double automaticIso(const RenderGrid& grid) {
     return storedValueWindow(grid).first;
 }
 
+double chosenIso(const RenderGrid& grid, const RenderOptions& options) { return options.iso ? *options.iso : automaticIso(grid); }
+
 Image renderIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, double iso) {
     return shadeIso(grid, camera, options, firstCrossings(grid, camera, iso));
 }

@@ -31,10 +31,12 @@ std::vector<std::optional<IsoHit>> firstCrossings(const RenderGrid& grid, const 
 // The value shown when none is given: Otsu's threshold of the stored values
 // (a sample of at most 2^20 entries), which parts air from tissue.
 double automaticIso(const RenderGrid& grid);
+// The value a render uses: --iso's, else automaticIso (both tracers).
+double chosenIso(const RenderGrid& grid, const RenderOptions& options);
 
-// `iso`: the value of the surface (RenderOptions::iso, else automaticIso).
 // The image of those crossings: lit by the values' gradient (else the entry face).
 Image shadeIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const std::vector<std::optional<IsoHit>>& hits);
+// `iso`: the value of the surface (chosenIso).
 Image renderIso(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, double iso);
 
 } // namespace vdbdag::trace

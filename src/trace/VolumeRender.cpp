@@ -22,6 +22,12 @@ TransferFunction automaticTransfer(const RenderGrid& grid) {
     return tf;
 }
 
+TransferFunction chosenTransfer(const RenderGrid& grid, const RenderOptions& options) {
+    TransferFunction tf = options.transfer ? *options.transfer : automaticTransfer(grid);
+    if (options.window && !options.transfer) tf.low = options.window->first, tf.high = options.window->second;
+    return tf;
+}
+
 Image renderVolume(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const TransferFunction& tf) {
     const GridFrame frame(grid.indexToWorld);
     const DagTracer tracer(*grid.dag);

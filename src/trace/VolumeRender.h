@@ -22,6 +22,9 @@ namespace vdbdag::trace {
 // The default window: Otsu's threshold of the stored values (a sample of at
 // most 2^20 entries) to their 99.5th percentile.
 TransferFunction automaticTransfer(const RenderGrid& grid);
+// The transfer function a render uses: --tf's, else the automatic one with
+// --window's range when given (both tracers).
+TransferFunction chosenTransfer(const RenderGrid& grid, const RenderOptions& options);
 
 Image renderVolume(const RenderGrid& grid, const Camera& camera, const RenderOptions& options, const TransferFunction& tf);
 
