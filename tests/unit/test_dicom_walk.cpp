@@ -1,0 +1,74 @@
+// The element walk that guards GDCM (vdb_bridge/detail/DicomElementWalk.h)
+// on files that start like no DICOM: GDCM parses them as a data set all the
+// same, and Debian's GDCM asserts (aborts) where an element is cut off after
+// its tag. In-process, so that an abort ends the test rather than passing
+// as a refusal. Needs no ../shared data.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include "src/util/Error.h"
+#include "vdb_bridge/DicomSeries.h"
+#include "vdb_bridge/detail/DicomElementWalk.h"
+
+namespace fs = std::filesystem;
+using namespace vdbdag;
+using namespace vdbdag::bridge;
+
+namespace {
+
+// An explicit-VR little-endian element with a 2-byte length.
+std::string element(uint16_t group, uint16_t elem, const char* vr, const std::string& value) {
+    std::string e;
+    e += char(group & 0xFF), e += char(group >> 8), e += char(elem & 0xFF), e += char(elem >> 8);
+    e += vr;
+    e += char(value.size() & 0xFF), e += char(value.size() >> 8);
+    return e + value;
+}
+
+fs::path write(const std::string& name, const std::string& bytes) {
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_dicom_walk_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    return dir / name;
+}
+
+} // namespace
+
+// Found by fuzz_scan_headers (issue 38): no preamble, a first element of
+// group 0000 (so the file starts like no DICOM), a CT's header elements, an
+// element whose VR bytes are zero (read as implicit), then 5 bytes: a tag
+// and one byte of a VR. GDCM aborted in VR16ExplicitDataElement::ReadPreValue
+// (gdcmVR16ExplicitDataElement.txx:146); the walk now refuses the cut-off
+// element whatever the file starts with, so the scan skips the file as not
+// DICOM, saying why.
+TEST(DicomWalk, AnElementCutOffAfterItsTagIsRefusedWhateverTheFileStartsWith) {
+    std::string bytes = std::string("\0\0\0\0OB\0\0\x02\0\0\0\0\x01", 14);
+    bytes += element(0x0002, 0x0010, "UI", std::string("1.2.840.10008.1.2.\0", 18));
+    bytes += element(0x0008, 0x0016, "UI", std::string("1.2.840.10008.5.1.4.1.1.2\0", 26));
+    bytes += element(0x0008, 0x0060, "CS", "CT");
+    bytes += element(0x0028, 0x0010, "US", std::string("\xff\xff", 2));
+    bytes += std::string("\x28\0\0\0\0\0\0\0", 8);     // (0028,0000), VR bytes 00 00: implicit, length 0
+    bytes += std::string("\x28\0\x10\0\0", 5);         // a tag and one byte
+    const fs::path file = write("cut.dcm", bytes);
+    const std::string problem = detail::elementLengthProblem(file.string(), true);
+    EXPECT_EQ(problem.rfind("not a DICOM file (no DICM preamble", 0), 0u) << problem;
+    EXPECT_NE(problem.find("the file ends inside an element (its last 5 bytes"), std::string::npos) << problem;
+    const DicomScan scan = scanDicom(file.parent_path().string());
+    EXPECT_TRUE(scan.series.empty());
+    ASSERT_EQ(scan.skipped.size(), 1u);
+    EXPECT_NE(scan.skipped[0].find("not a DICOM file"), std::string::npos) << scan.skipped[0];
+    // The same file without its last 5 bytes walks to its end, and GDCM
+    // reads it (its Rows alone make no image: skipped, saying so).
+    fs::remove(file);
+    const fs::path whole = write("whole.dcm", bytes.substr(0, bytes.size() - 5));
+    EXPECT_EQ(detail::elementLengthProblem(whole.string(), true), "");
+    const DicomScan again = scanDicom(whole.parent_path().string());
+    ASSERT_EQ(again.skipped.size(), 1u);
+    EXPECT_EQ(again.skipped[0].find("not a DICOM file"), std::string::npos) << again.skipped[0];
+    fs::remove_all(file.parent_path());
+}
