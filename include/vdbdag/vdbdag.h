@@ -27,6 +27,7 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <string>
@@ -69,16 +70,26 @@ constexpr int valueTypeCodeOf() {
     else return -1;
 }
 
-// Throws vdbdag::Error unless a T of value type `code` (valueTypeCodeOf)
-// and `size` bytes may be read from `grid`: the grid's own type, or any
-// other type of the value's size.
-VDBDAG_API void checkValueType(const GridData* grid, int code, size_t size);
+// Whether a T of value type `code` (valueTypeCodeOf) and `size` bytes may
+// be read from `grid`: the grid's own type, or any other type of the
+// value's size. refuseValueType throws the vdbdag::Error that says why not.
+VDBDAG_API bool valueTypeFits(const GridData* grid, int code, size_t size) noexcept;
+[[noreturn]] VDBDAG_API void refuseValueType(const GridData* grid, int code, size_t size);
+inline void checkValueType(const GridData* grid, int code, size_t size) {
+    if (!valueTypeFits(grid, code, size)) refuseValueType(grid, code, size);
+}
 } // namespace detail
 
 // Random access to one grid's voxels. Cheap to make (make one per thread);
 // it remembers the path to the last voxel it found, per layer, and starts
 // the next walk from the deepest node that still holds the new voxel, as
 // NanoVDB's ReadAccessor does, so coherent lookups cost a few steps.
+// A 4^3 brick missed a second time, or next to the brick of the last miss,
+// has its 64 values and active states copied into a cache of 1024 bricks
+// (BrickCache), so a sweep through a box of up to 128 voxels a side finds
+// each voxel there with a compare and a load (docs/LIBRARY.md). The cache
+// is made on first use: 40 KB, plus 64 KB per byte of the value type once
+// a brick is copied (256 KB for float).
 class VDBDAG_API Accessor {
 public:
     bool isActive(int64_t i, int64_t j, int64_t k);
@@ -94,9 +105,21 @@ public:
         if constexpr (std::is_same_v<T, bool>) {
             if (maskGrid()) return isActive(i, j, k);
         }
-        detail::checkValueType(grid_, detail::valueTypeCodeOf<T>(), sizeof(T));
+        // The calls below that may fail do not throw (the failure is thrown
+        // by a call that does not return): a caller's loop around value<T>
+        // then keeps its sums in registers, which a call that may unwind
+        // through the accessor's destructor keeps GCC from doing.
+        constexpr int64_t asked = int64_t(detail::valueTypeCodeOf<T>()) << 32 | int64_t(sizeof(T));
+        if (checkedType_ != asked) [[unlikely]] {
+            if (!detail::valueTypeFits(grid_, detail::valueTypeCodeOf<T>(), sizeof(T))) detail::refuseValueType(grid_, detail::valueTypeCodeOf<T>(), sizeof(T));
+            checkedType_ = asked;
+        }
         T out;
-        valueBytes(i, j, k, &out);
+        if (const uint8_t* cached = cachedValue<sizeof(T)>(i, j, k)) [[likely]] {
+            std::memcpy(&out, cached, sizeof(T));
+            return out;
+        }
+        if (!valueBytesOrFailure(i, j, k, &out)) rethrowFailure();
         return out;
     }
     unsigned valueSize() const;
@@ -133,12 +156,56 @@ public:
         uint8_t value[24] = {};  // the largest value: vec3d
     };
 
+    // Whole 4^3 bricks (internal; see Accessor.cpp): the brick of world
+    // voxels (4 bx .. 4 bx + 3, ...) goes in slot slotOf(bx, by, bz). A slot
+    // is claimed the first time one of its brick's voxels is looked up and
+    // filled the second time (or the first, next to the last brick missed),
+    // so scattered lookups copy nothing.
+    struct BrickCache {
+        static constexpr size_t kSlots = 1024;
+        // Injective on every 32 x 32 square of bricks in an axis-aligned
+        // plane, whichever two axes it spans: a sweep with any axis outermost
+        // keeps each brick of a 128-voxel slab until the next slab reuses it.
+        static size_t slotOf(int64_t bx, int64_t by, int64_t bz) { return size_t((bx ^ by) & 31) | size_t((bx ^ bz) & 31) << 5; }
+        struct Key {
+            int64_t x = INT64_MIN, y = 0, z = 0;  // INT64_MIN: none (no brick's x)
+            bool is(int64_t bx, int64_t by, int64_t bz) const { return ((x ^ bx) | (y ^ by) | (z ^ bz)) == 0; }
+        };
+        std::vector<Key> filled;      // kSlots once a brick is filled: the brick each slot holds
+        std::vector<Key> claimed;     // kSlots once a lookup missed: the brick last seen once in each slot
+        Key lastMiss;                 // the brick of the last lookup the cache did not answer
+        std::vector<uint64_t> active; // per slot, bit x + 4 y + 16 z: the voxel is active
+        std::vector<uint8_t> values;  // kSlots x 64 values, voxel x + 4 y + 16 z
+        bool usable = true;           // false where a layer's bricks are not on the 4-voxel grid
+    };
+
 private:
     friend class Grid;
-    explicit Accessor(const detail::GridData* grid) : grid_(grid) {}
+    explicit Accessor(const detail::GridData* grid);
     bool maskGrid() const;
+    // The cached value of voxel (i, j, k) (its N bytes), or null.
+    template <size_t N>
+    const uint8_t* cachedValue(int64_t i, int64_t j, int64_t k) const {
+        if (cache_.filled.empty()) return nullptr;
+        const int64_t bx = i >> 2, by = j >> 2, bz = k >> 2;
+        const size_t s = BrickCache::slotOf(bx, by, bz);
+        if (!cache_.filled[s].is(bx, by, bz)) return nullptr;
+        return cache_.values.data() + (s * 64 + size_t((i & 3) | (j & 3) << 2 | (k & 3) << 4)) * N;
+    }
+    // valueBytes, with what it throws kept in failure_ (false) for
+    // rethrowFailure to throw.
+    bool valueBytesOrFailure(int64_t i, int64_t j, int64_t k, void* out) noexcept;
+    [[noreturn]] void rethrowFailure();
+    // The slot of voxel (i, j, k)'s brick if it is filled (found, or filled
+    // now because the brick was claimed before); else -1, the brick claimed.
+    int64_t brickSlot(int64_t i, int64_t j, int64_t k);
+    void fillSlot(size_t s, int64_t bx, int64_t by, int64_t bz);
     const detail::GridData* grid_;
+    unsigned valueSize_ = 0;
+    int64_t checkedType_ = -1;  // value<T>'s type (code << 32 | size), once checked
+    std::exception_ptr failure_;
     Path active_, inactive_;
+    BrickCache cache_;
 };
 
 class VDBDAG_API Grid {

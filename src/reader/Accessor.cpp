@@ -7,13 +7,18 @@
 // A solid node holds one entry for its whole cube; in a 4^3 leaf the entry
 // is the base plus the rank of the voxel's stored bit among the brick's set
 // bits. The words are read by <vdbdag/dag_access.h>, the one parser of
-// the compact DAG for C++ and GLSL.
+// the compact DAG for C++ and GLSL. Above the walk, the brick cache
+// (Accessor::BrickCache, docs/LIBRARY.md) holds whole 4^3 bricks of values
+// for coherent lookups.
 #include <vdbdag/vdbdag.h>
 #include <vdbdag/dag_access.h>
 
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <tuple>
+#include <utility>
+#include <cstdio>
 
 #include "src/encoding/CompactDag.h"
 #include "src/reader/GridData.h"
@@ -90,9 +95,137 @@ bool Layer::find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t
     }
 }
 
+Layer::Brick Layer::brick(int64_t i, int64_t j, int64_t k, Accessor::Path& path) const {
+    const encoding::CompactDag& d = *dag;
+    Brick b;
+    if (d.empty() || d.innerLevelCount() == 0 || d.log2Size > 62) return b;
+    const uint64_t size = uint64_t(1) << d.log2Size;
+    if (uint64_t(i) - uint64_t(d.origin[0]) >= size || uint64_t(j) - uint64_t(d.origin[1]) >= size || uint64_t(k) - uint64_t(d.origin[2]) >= size) return b;
+    uint64_t entry = 0;
+    const bool found = find(i, j, k, path, entry);
+    // The walk ended in the brick's leaf, or in a solid or empty cube around it.
+    if (path.leaf.valid) b = {Brick::kLeaf, path.leaf.base, path.leaf.stored, path.leaf.mirror};
+    else if (found) b = {Brick::kUniform, entry, 0, 0};
+    return b;
+}
+
 } // namespace detail
 
+// The brick cache. A brick's 64 voxels take the background, then the
+// inactive layer's values, then the active layer's (a voxel is in one
+// layer at most). A leaf's stored bit of spatial voxel s under mirror mask
+// m is s ^ x, where x flips the two bits of each mirrored axis (3 - c = c ^ 3
+// for c in 0..3); its entries are consecutive in stored-bit order.
+Accessor::Accessor(const detail::GridData* grid) : grid_(grid), valueSize_(grid->valueSize) {
+    for (const encoding::CompactDag* d : {&grid->grid.dag, &grid->grid.inactiveDag})
+        for (const int64_t o : d->origin)
+            if (o % 4 != 0) cache_.usable = false;  // not what the encoder writes (a multiple of the alignment, at least 4)
+}
+
+int64_t Accessor::brickSlot(int64_t i, int64_t j, int64_t k) {
+    if (!cache_.usable) return -1;
+    if (cache_.claimed.empty()) cache_.claimed.resize(BrickCache::kSlots);
+    const int64_t bx = i >> 2, by = j >> 2, bz = k >> 2;
+    const size_t s = BrickCache::slotOf(bx, by, bz);
+    if (!cache_.filled.empty() && cache_.filled[s].is(bx, by, bz)) return int64_t(s);
+    // A brick next to the last one missed (a sweep), or claimed before, is
+    // copied; any other is claimed, to be copied if it is asked for again.
+    const BrickCache::Key last = cache_.lastMiss;
+    cache_.lastMiss = {bx, by, bz};
+    const bool near = last.x != INT64_MIN && uint64_t(bx - last.x + 1) <= 2 && uint64_t(by - last.y + 1) <= 2 && uint64_t(bz - last.z + 1) <= 2;
+    if (!near && !cache_.claimed[s].is(bx, by, bz)) {
+        cache_.claimed[s] = {bx, by, bz};
+        return -1;
+    }
+    fillSlot(s, bx, by, bz);
+    return int64_t(s);
+}
+
+namespace {
+
+// One layer's part of a brick (detail::Layer::brick) and, unless the grid
+// is a mask, the values of its entries (a solid node's one, or a leaf's in
+// stored-bit order).
+struct BrickPart {
+    detail::Layer::Brick brick;
+    uint8_t values[64 * sizeof(Accessor::Path::value)];
+};
+
+// Writes a brick's 64 values (N bytes each; N = 0: none) into `dst`: the
+// background, then each part's. Returns the active mask of the last part
+// (the active layer). N known to the compiler for the value types' sizes:
+// copying with libc's memmove per voxel was a quarter of a coherent sweep.
+template <unsigned N>
+uint64_t writeBrick(uint8_t* dst, const uint8_t* background, const BrickPart* parts, size_t partCount, unsigned vs) {
+    const unsigned size = N ? N : vs;
+    const auto copy = [&](uint8_t* to, const uint8_t* from) {
+        if constexpr (N > 0) std::memcpy(to, from, N);
+        else std::memcpy(to, from, size);
+    };
+    if (size > 0)
+        for (unsigned v = 0; v < 64; ++v) copy(dst + v * size, background);
+    uint64_t active = 0;
+    for (size_t p = 0; p < partCount; ++p) {
+        const detail::Layer::Brick& b = parts[p].brick;
+        active = 0;
+        if (b.kind == detail::Layer::Brick::kNone) continue;
+        if (b.kind == detail::Layer::Brick::kUniform) {
+            active = ~uint64_t(0);
+            if (size > 0)
+                for (unsigned v = 0; v < 64; ++v) copy(dst + v * size, parts[p].values);
+            continue;
+        }
+        const unsigned flip = ((b.mirror & 1u) ? 3u : 0u) | ((b.mirror & 2u) ? 12u : 0u) | ((b.mirror & 4u) ? 48u : 0u);
+        unsigned r = 0;
+        for (uint64_t bits = b.stored; bits != 0; bits &= bits - 1, ++r) {
+            const unsigned v = unsigned(std::countr_zero(bits)) ^ flip;
+            active |= uint64_t(1) << v;
+            if (size > 0) copy(dst + v * size, parts[p].values + r * size);
+        }
+    }
+    return active;
+}
+
+} // namespace
+
+void Accessor::fillSlot(size_t s, int64_t bx, int64_t by, int64_t bz) {
+    const unsigned vs = valueSize_;
+    if (cache_.filled.empty()) {
+        cache_.active.resize(BrickCache::kSlots);
+        cache_.values.resize(BrickCache::kSlots * 64 * vs);
+        cache_.filled.resize(BrickCache::kSlots);
+    }
+    BrickPart parts[2];  // the inactive layer's, then the active one's (a voxel is in one layer at most)
+    const std::array<std::pair<const detail::Layer*, Path*>, 2> layers{{{&grid_->inactive, &inactive_}, {&grid_->active, &active_}}};
+    for (size_t p = 0; p < 2; ++p) {
+        const auto [layer, path] = layers[p];
+        const detail::Layer::Brick b = parts[p].brick = layer->brick(bx * 4, by * 4, bz * 4, *path);
+        if (vs == 0 || b.kind == detail::Layer::Brick::kNone) continue;
+        layer->values(b.entry, b.kind == detail::Layer::Brick::kUniform ? 1 : uint64_t(std::popcount(b.stored)), parts[p].values, path->paletteHint);
+    }
+    uint8_t* dst = cache_.values.data() + s * 64 * vs;
+    const uint8_t* background = grid_->grid.record.background.data();
+    uint64_t active = 0;
+    switch (vs) {
+    case 0: active = writeBrick<0>(dst, background, parts, 2, vs); break;
+    case 1: active = writeBrick<1>(dst, background, parts, 2, vs); break;
+    case 4: active = writeBrick<4>(dst, background, parts, 2, vs); break;
+    case 8: active = writeBrick<8>(dst, background, parts, 2, vs); break;
+    case 12: active = writeBrick<12>(dst, background, parts, 2, vs); break;
+    case 24: active = writeBrick<24>(dst, background, parts, 2, vs); break;
+    default: active = writeBrick<0>(dst, background, parts, 2, vs);
+    }
+    cache_.active[s] = active;
+    cache_.filled[s] = {bx, by, bz};
+}
+
 bool Accessor::isActive(int64_t i, int64_t j, int64_t k) {
+    // A brick of a grid with values is copied by a value's lookup only, so
+    // that asking for active states decodes no values.
+    const int64_t bx = i >> 2, by = j >> 2, bz = k >> 2;
+    const size_t at = BrickCache::slotOf(bx, by, bz);
+    const int64_t s = valueSize_ == 0 ? brickSlot(i, j, k) : !cache_.filled.empty() && cache_.filled[at].is(bx, by, bz) ? int64_t(at) : -1;
+    if (s >= 0) return (cache_.active[size_t(s)] >> ((i & 3) | (j & 3) << 2 | (k & 3) << 4)) & 1u;
     uint64_t entry = 0;
     return grid_->active.find(i, j, k, active_, entry);
 }
@@ -100,6 +233,10 @@ bool Accessor::isActive(int64_t i, int64_t j, int64_t k) {
 void Accessor::valueBytes(int64_t i, int64_t j, int64_t k, void* out) {
     if (grid_->valueSize == 0) return;
     auto* bytes = static_cast<uint8_t*>(out);
+    if (const int64_t s = brickSlot(i, j, k); s >= 0) {
+        std::memcpy(bytes, cache_.values.data() + (size_t(s) * 64 + size_t((i & 3) | (j & 3) << 2 | (k & 3) << 4)) * valueSize_, valueSize_);
+        return;
+    }
     uint64_t entry = 0;
     const auto read = [&](const detail::Layer& layer, Path& path) {
         if (entry != path.valueEntry) {
@@ -213,12 +350,27 @@ void Grid::forEachActive(const IndexBBox& box, const ActiveVisitor& visit) const
 unsigned Accessor::valueSize() const { return grid_->valueSize; }
 bool Accessor::maskGrid() const { return grid_->grid.record.valueType == ValueType::Mask; }
 
-void detail::checkValueType(const GridData* grid, int code, size_t size) {
+bool detail::valueTypeFits(const GridData* grid, int code, size_t size) noexcept {
+    return code >= 0 ? code == int(grid->grid.record.valueType) : size == grid->valueSize;
+}
+
+void detail::refuseValueType(const GridData* grid, int code, size_t size) {
     const ValueType held = grid->grid.record.valueType;
-    if (code >= 0 ? code == int(held) : size == grid->valueSize) return;
     const std::string asked = code >= 0 ? std::string(valueTypeName(ValueType(code))) : "a " + std::to_string(size) + "-byte type";
     throw Error("grid '" + grid->grid.record.name + "': a value asked as " + asked + " of a " + valueTypeName(held) + " grid (" +
                 std::to_string(grid->valueSize) + " bytes; use its own type)");
 }
+
+bool Accessor::valueBytesOrFailure(int64_t i, int64_t j, int64_t k, void* out) noexcept {
+    try {
+        valueBytes(i, j, k, out);
+        return true;
+    } catch (...) {
+        failure_ = std::current_exception();
+        return false;
+    }
+}
+
+void Accessor::rethrowFailure() { std::rethrow_exception(std::exchange(failure_, nullptr)); }
 
 } // namespace vdbdag

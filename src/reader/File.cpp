@@ -47,34 +47,40 @@ void Layer::load() const {
     });
 }
 
-void Layer::value(uint64_t entry, uint8_t* out, size_t& hint) const {
+void Layer::values(uint64_t first, uint64_t count, uint8_t* out, size_t& hint) const {
     load();
     const unsigned vs = valueSize(grid->record.valueType);
+    if (vs == 0 || count == 0) return;
     if (palette_) {
-        channel_.lookup(entry, out, hint);
+        for (uint64_t e = first; e < first + count; ++e, out += vs) channel_.lookup(e, out, hint);
         return;
     }
     if (windows_) {
         Windows& w = *windows_;
         const auto& list = w.directory.windows;
-        size_t k = hint;
-        if (k >= list.size() || entry < list[k].firstEntry || entry - list[k].firstEntry >= list[k].entries) {
-            const auto after = std::upper_bound(list.begin(), list.end(), entry, [](uint64_t e, const auto& window) { return e < window.firstEntry; });
-            k = size_t(after - list.begin()) - 1;  // the directory's first window starts at entry 0
-            if (after == list.begin() || entry - list[k].firstEntry >= list[k].entries)
-                throw Error(what + ": value entry " + std::to_string(entry) + " is past the channel's end");
-            hint = k;
+        while (count > 0) {  // a run of entries may span windows
+            size_t k = hint;
+            if (k >= list.size() || first < list[k].firstEntry || first - list[k].firstEntry >= list[k].entries) {
+                const auto after = std::upper_bound(list.begin(), list.end(), first, [](uint64_t e, const auto& window) { return e < window.firstEntry; });
+                k = size_t(after - list.begin()) - 1;  // the directory's first window starts at entry 0
+                if (after == list.begin() || first - list[k].firstEntry >= list[k].entries)
+                    throw Error(what + ": value entry " + std::to_string(first) + " is past the channel's end");
+                hint = k;
+            }
+            std::call_once(w.decoded[k], [&] {
+                std::vector<uint8_t> decoded = attributes::decodePredictedWindow(w.payload, w.directory, k, w.layout, what + " predicted windows", w.places);
+                if (decoded.size() != list[k].entries * vs) throw Error(what + " predicted windows window " + std::to_string(k) + ": decoded to the wrong size");
+                w.values[k] = std::move(decoded);
+            });
+            const uint64_t at = first - list[k].firstEntry, n = std::min(count, list[k].entries - at);
+            std::memcpy(out, w.values[k].data() + at * vs, n * vs);
+            out += n * vs, first += n, count -= n;
         }
-        std::call_once(w.decoded[k], [&] {
-            std::vector<uint8_t> values = attributes::decodePredictedWindow(w.payload, w.directory, k, w.layout, what + " predicted windows", w.places);
-            if (values.size() != list[k].entries * vs) throw Error(what + " predicted windows window " + std::to_string(k) + ": decoded to the wrong size");
-            w.values[k] = std::move(values);
-        });
-        std::memcpy(out, w.values[k].data() + (entry - list[k].firstEntry) * vs, vs);
         return;
     }
-    if ((entry + 1) * vs > flat_.size()) throw Error(what + ": value entry " + std::to_string(entry) + " is past the channel's end");
-    std::memcpy(out, flat_.data() + entry * vs, vs);
+    if (first > flat_.size() / vs || count > flat_.size() / vs - first)
+        throw Error(what + ": value entry " + std::to_string(first + count - 1) + " is past the channel's end");
+    std::memcpy(out, flat_.data() + first * vs, count * vs);
 }
 
 static_assert(OpenLimits{}.maxVoxels == format::kDefaultMaxVoxels, "the public default is the command line's");

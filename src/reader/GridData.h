@@ -23,10 +23,23 @@ struct Layer {
     // 2), walking from where `path` left off; false when the layer has no
     // such voxel.
     bool find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t& entry) const;
+    // What the layer holds of the 4^3 brick whose minimum corner is (i, j,
+    // k) (a multiple of 4 from the DAG's origin): nothing, one entry for
+    // every voxel (a solid node), or a leaf's stored bits, mirror mask and
+    // first entry. Walks as find does, from where `path` left off.
+    struct Brick {
+        enum Kind { kNone, kUniform, kLeaf } kind = kNone;
+        uint64_t entry = 0;   // kUniform: the entry; kLeaf: that of its first stored bit
+        uint64_t stored = 0;  // kLeaf
+        unsigned mirror = 0;  // kLeaf
+    };
+    Brick brick(int64_t i, int64_t j, int64_t k, Accessor::Path& path) const;
     // Entry `entry`'s value (valueSize bytes); its window (or an older
     // file's channel) is decoded the first time. `hint` remembers the last
     // window or palette block.
-    void value(uint64_t entry, uint8_t* out, size_t& hint) const;
+    void value(uint64_t entry, uint8_t* out, size_t& hint) const { values(entry, 1, out, hint); }
+    // The values of `count` consecutive entries from `first`.
+    void values(uint64_t first, uint64_t count, uint8_t* out, size_t& hint) const;
 
     // Set by the file reader; the channel is built from them once.
     const format::EncodedGrid* grid = nullptr;

@@ -95,6 +95,27 @@ Case shell(ValueType type, const std::string& name, std::mt19937& rng, MakeValue
     return c;
 }
 
+// A shell of each value type (named by its type), values from `rng`.
+std::vector<Case> everyType(std::mt19937& rng) {
+    std::vector<Case> cases;
+    cases.push_back(shell(ValueType::Float, "float", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const float v = (r() % 4 == 0) ? float(r() % 7) : float(d);
+        std::memcpy(out, &v, 4);
+    }));
+    cases.push_back(shell(ValueType::Int32, "int32", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const int32_t v = int32_t(std::floor(d * 3)) + int32_t(r() % 2);
+        std::memcpy(out, &v, 4);
+    }));
+    cases.push_back(shell(ValueType::Vec3S, "vec3s", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const float v[3] = {float(d), float(r() % 5), -0.0f};
+        std::memcpy(out, v, 12);
+    }));
+    cases.push_back(shell(ValueType::Double, "double", rng, [](double d, std::mt19937&, uint8_t* out) { std::memcpy(out, &d, 8); }));
+    cases.push_back(shell(ValueType::Bool, "bool", rng, [](double d, std::mt19937&, uint8_t* out) { out[0] = d > 0.25 ? 1 : 0; }));
+    cases.push_back(shell(ValueType::Mask, "mask", rng, [](double, std::mt19937&, uint8_t*) {}));
+    return cases;
+}
+
 std::filesystem::path writeFile(const std::vector<std::pair<Case*, bool>>& grids, const pipeline::EncodeOptions& options, const std::string& stem) {
     format::SsvdagScene scene;
     for (const auto& [c, withInactive] : grids) {
@@ -147,22 +168,7 @@ void expectSameAnswers(const Grid& grid, const Case& c, bool withInactive, std::
 
 TEST(Reader, AccessorAnswersAsTheGridsThatMadeTheFile) {
     std::mt19937 rng(11);
-    std::vector<Case> cases;
-    cases.push_back(shell(ValueType::Float, "float", rng, [](double d, std::mt19937& r, uint8_t* out) {
-        const float v = (r() % 4 == 0) ? float(r() % 7) : float(d);
-        std::memcpy(out, &v, 4);
-    }));
-    cases.push_back(shell(ValueType::Int32, "int32", rng, [](double d, std::mt19937& r, uint8_t* out) {
-        const int32_t v = int32_t(std::floor(d * 3)) + int32_t(r() % 2);
-        std::memcpy(out, &v, 4);
-    }));
-    cases.push_back(shell(ValueType::Vec3S, "vec3s", rng, [](double d, std::mt19937& r, uint8_t* out) {
-        const float v[3] = {float(d), float(r() % 5), -0.0f};
-        std::memcpy(out, v, 12);
-    }));
-    cases.push_back(shell(ValueType::Double, "double", rng, [](double d, std::mt19937&, uint8_t* out) { std::memcpy(out, &d, 8); }));
-    cases.push_back(shell(ValueType::Bool, "bool", rng, [](double d, std::mt19937&, uint8_t* out) { out[0] = d > 0.25 ? 1 : 0; }));
-    cases.push_back(shell(ValueType::Mask, "mask", rng, [](double, std::mt19937&, uint8_t*) {}));
+    std::vector<Case> cases = everyType(rng);
     for (const bool symmetry : {true, false}) {
         pipeline::EncodeOptions options;
         options.symmetry = symmetry;
@@ -180,6 +186,118 @@ TEST(Reader, AccessorAnswersAsTheGridsThatMadeTheFile) {
         }
         std::filesystem::remove(path);
     }
+}
+
+namespace {
+// value<T> of the case's own type, as the value's bytes (a mask: the
+// active state, as value<bool> reads it).
+std::string typedLookup(Accessor& a, ValueType type, int64_t x, int64_t y, int64_t z) {
+    const auto bytes = [](const auto& v) { return std::string(reinterpret_cast<const char*>(&v), sizeof(v)); };
+    switch (type) {
+    case ValueType::Float: return bytes(a.value<float>(x, y, z));
+    case ValueType::Double: return bytes(a.value<double>(x, y, z));
+    case ValueType::Int32: return bytes(a.value<int32_t>(x, y, z));
+    case ValueType::Vec3S: return bytes(a.value<std::array<float, 3>>(x, y, z));
+    case ValueType::Bool: return std::string(1, a.value<bool>(x, y, z) ? '\1' : '\0');
+    case ValueType::Mask: return a.value<bool>(x, y, z) ? "on" : "off";
+    default: return "?";
+    }
+}
+} // namespace
+
+// The accessor's brick cache (a brick is copied whole on its second lookup,
+// or its first next to the last brick missed): sweeps of a box that is not
+// on the 4-voxel grid, crosses the origin and holds active and inactive
+// voxels, tiles and background, in each axis order and twice (the second
+// time from the cache), through value<T>, with scattered lookups between
+// the sweeps; every answer is the brute-force one from the synthetic grids.
+TEST(Reader, SweepsInEveryOrderAnswerFromTheBrickCacheAsTheGrids) {
+    std::mt19937 rng(23);
+    std::vector<Case> cases = everyType(rng);
+    std::vector<std::pair<Case*, bool>> grids;
+    for (Case& c : cases) grids.push_back({&c, true});
+    const auto path = writeFile(grids, {}, "reader_cache");
+    const File file = File::open(path.string());
+    for (const Case& c : cases) {
+        Reference ref;
+        ref.vs = valueSize(c.active.type);
+        Reference::add(c.active, ref.vs, ref.active, ref.activeTiles);
+        if (ref.vs) Reference::add(c.inactive, ref.vs, ref.inactive, ref.inactiveTiles);
+        ref.background.assign(ref.vs, '\0');
+        const auto want = [&](int64_t x, int64_t y, int64_t z) {
+            if (c.active.type == ValueType::Mask) return std::string(ref.isActive(x, y, z) ? "on" : "off");
+            if (c.active.type == ValueType::Bool) return std::string(1, ref.value(x, y, z)[0] ? '\1' : '\0');
+            return ref.value(x, y, z);
+        };
+        Accessor a = file.grid(c.name).accessor();
+        uint64_t checked = 0, failures = 0;
+        const auto check = [&](int64_t x, int64_t y, int64_t z) {
+            ++checked;
+            const std::string got = typedLookup(a, c.active.type, x, y, z);
+            const bool on = a.isActive(x, y, z);
+            if ((got != want(x, y, z) || on != ref.isActive(x, y, z)) && ++failures <= 5)
+                ADD_FAILURE() << c.name << ": voxel (" << x << "," << y << "," << z << ") " << selftest::hexValue(got) << " active " << on << ", expected "
+                              << selftest::hexValue(want(x, y, z)) << " active " << ref.isActive(x, y, z);
+        };
+        const int64_t lo[3] = {-31, -29, 1}, hi[3] = {6, 30, 35};  // through the shell's wall and its inactive inside
+        for (int outer = 0; outer < 3; ++outer)
+            for (int pass = 0; pass < 2; ++pass) {
+                const int inner = (outer + 2) % 3, middle = (outer + 1) % 3;
+                int64_t p[3];
+                for (p[outer] = lo[outer]; p[outer] <= hi[outer]; ++p[outer])
+                    for (p[middle] = lo[middle]; p[middle] <= hi[middle]; ++p[middle])
+                        for (p[inner] = lo[inner]; p[inner] <= hi[inner]; ++p[inner]) check(p[0], p[1], p[2]);
+                std::uniform_int_distribution<int64_t> around(-140, 200);
+                for (int i = 0; i < 2000; ++i) check(around(rng), around(rng), around(rng));
+            }
+        for (int64_t x = 120; x < 200; ++x) check(x, 130, 3);  // across an active tile's edge
+        for (int64_t x = -100; x < -60; ++x) check(x, -90, -70);  // an inactive tile
+        EXPECT_EQ(failures, 0u) << c.name << ": " << failures << " of " << checked << " lookups differ";
+    }
+    std::filesystem::remove(path);
+}
+
+// A value that cannot be decoded is an Error from value<T> (thrown past
+// the lookup's inline part, which does not throw), every time it is asked
+// for; the voxels whose values do decode, the active states and the
+// background still answer.
+TEST(Reader, AValueThatCannotBeDecodedIsAnErrorEachTimeItIsAsked) {
+    std::mt19937 rng(29);
+    Case c = shell(ValueType::Float, "density", rng, [](double d, std::mt19937& r, uint8_t* out) {
+        const float v = float(d) + float(r() % 1000) * 1e-3f;
+        std::memcpy(out, &v, 4);
+    });
+    format::SsvdagScene scene;
+    scene.grids.push_back(pipeline::encodeGrid(selftest::toRecord(c.active, c.name)));
+    std::vector<uint8_t>& windows = scene.grids[0].valueWindows.bytes;
+    ASSERT_GT(windows.size(), 64u);
+    for (size_t i = 28; i < 36; ++i) windows[i] = 0;  // the first window's first bytes (after the 28-byte head, PredictedWindows.h): no zstd frame
+    const auto path = std::filesystem::temp_directory_path() / ("reader_cut_" + std::to_string(::getpid()) + ".ssvdag");
+    const std::vector<uint8_t> bytes = format::writeScene(scene);
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    const File file = File::open(path.string());
+    Accessor a = file.grid(0).accessor();
+    uint64_t refused = 0, answered = 0;
+    for (size_t n = 0; n < c.active.voxels.size(); ++n) {
+        const auto& p = c.active.voxels[n];
+        for (int again = 0; again < 2; ++again) {
+            try {
+                const float v = a.value<float>(p[0], p[1], p[2]);
+                float want = 0;
+                std::memcpy(&want, c.active.voxelValues.data() + n * 4, 4);
+                EXPECT_EQ(std::memcmp(&v, &want, 4), 0) << "voxel " << n;
+                ++answered;
+            } catch (const Error& e) {
+                EXPECT_NE(std::string(e.what()).find("grid 'density'"), std::string::npos) << e.what();
+                ++refused;
+            }
+        }
+    }
+    EXPECT_EQ(refused, 2 * c.active.voxels.size() - answered);
+    EXPECT_GT(refused, 0u);
+    for (const auto& p : c.active.voxels) EXPECT_TRUE(a.isActive(p[0], p[1], p[2]));  // active states need no values
+    EXPECT_EQ(a.value<float>(1000, 1000, 1000), 0.0f);  // nor does the background
+    std::filesystem::remove(path);
 }
 
 TEST(Reader, GridFactsAndTypedValues) {
