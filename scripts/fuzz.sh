@@ -51,6 +51,13 @@ printf '\000NRRD0004\ntype: uint8\ndimension: 3\nsizes: 1000 1000 1000\nendian: 
 # Raw: format byte 5, the file name (its layout), a NUL, the samples.
 { printf '\005vol_4x4x4_uint16le\000'; printf '%0128d' 7; } > build-fuzz/corpus_scan_headers/seed_5_raw_u16
 { printf '\005ct_8x2x2_float32\000'; printf '%0128d' 3; } > build-fuzz/corpus_scan_headers/seed_5_raw_f32
+# Inputs a target once failed on (tests/fuzz/regressions/NAME, NAME as in
+# corpus_NAME): replayed first by every run, CI's short one included.
+for d in tests/fuzz/regressions/*/; do
+  name=$(basename "$d")
+  mkdir -p "build-fuzz/corpus_$name"
+  cp "$d"* "build-fuzz/corpus_$name/"
+done
 
 status=0
 for target in "${TARGETS[@]}"; do

@@ -91,6 +91,7 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
     char magic[4];
     if (readAt(128, magic, 4) && std::memcmp(magic, "DICM", 4) == 0) pos = 132;
     bool explicitVr = true, bigEndian = false, metaGroup = pos == 132, declaredImplicit = false;
+    bool datasetStarted = false;  // an element after the file meta group was walked
     unknownStart = false;
     if (pos == 0) {  // no preamble: walk only what starts like a DICOM dataset (else GDCM refuses it as not DICOM)
         uint8_t h[6];
@@ -194,9 +195,20 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
                                                    "OL", "OV", "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC", "UI", "UL", "UN",
                                                    "UR", "US", "UT", "UV"};
         if (inMeta && !knownVr.count(vr)) return fmt::format("file meta element ({:04X},{:04X}) at byte {} has no valid VR", group, element, pos);
-        // An implicit transfer syntax is read as implicit (as GDCM does); under
-        // an explicit one, an element whose VR bytes are no VR as implicit.
-        if (!inMeta && !declaredImplicit) explicitVr = knownVr.count(vr) > 0;
+        // An implicit transfer syntax is read as implicit (as GDCM does).
+        // Under an explicit one, a data set whose first element's VR bytes
+        // are no VR is read as implicit (a writer that declared the wrong
+        // syntax), and any later element without a VR is refused: GDCM
+        // guesses how to read such an element, and a 462-byte file whose
+        // guessed length GDCM allocated took 1.7 GB (found by
+        // fuzz_scan_headers; the walk had read it as implicit).
+        if (!inMeta && !declaredImplicit) {
+            const bool known = knownVr.count(vr) > 0;
+            if (!datasetStarted && !known) declaredImplicit = true, explicitVr = false;
+            else if (!known) return fmt::format("element ({:04X},{:04X}) at byte {} has no valid VR under an explicit transfer syntax", group, element, pos);
+            else explicitVr = true;
+        }
+        if (!inMeta) datasetStarted = true;
         if (inMeta || explicitVr) {
             static const std::set<std::string> longVr{"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
             if (longVr.count(vr)) {
