@@ -12,7 +12,7 @@ set(VDBDAG_READER_SOURCES
     src/format/SsvdagFile.cpp src/format/FrameSequence.cpp src/format/ZstdFrame.cpp
     src/encoding/AttributeLayout.cpp src/encoding/CompactDag.cpp src/encoding/DagStructure.cpp
     src/attributes/NormalChannel.cpp src/attributes/OctahedralNormal.cpp src/attributes/PaletteChannel.cpp
-    src/attributes/ContextChannel.cpp src/attributes/PredictedChannel.cpp src/attributes/PredictedWindows.cpp src/attributes/RescaledFloats.cpp src/coding/BrickValueCoder.cpp src/coding/LeastSquaresKernels.cpp src/coding/FloatValueCoder.cpp src/coding/LabelCoder.cpp
+    src/attributes/ContextChannel.cpp src/attributes/PredictedChannel.cpp src/attributes/PredictedWindows.cpp src/attributes/RescaledFloats.cpp src/coding/BrickValueCoder.cpp src/coding/LeastSquaresKernels.cpp src/coding/FloatValueCoder.cpp src/coding/FloatIntegerCoder.cpp src/coding/LabelCoder.cpp
     src/attributes/ValueWindows.cpp src/attributes/WindowCursor.cpp
     src/volume/GridRecord.cpp src/volume/GridTopology.cpp
     src/util/InputPath.cpp src/util/ScratchFile.cpp src/util/TemporaryFiles.cpp)

@@ -11,6 +11,7 @@
 #include "src/attributes/ContextChannel.h"
 #include "src/attributes/PredictedChannel.h"
 #include "src/attributes/RescaledFloats.h"
+#include "src/coding/FloatIntegerCoder.h"
 #include "src/coding/FloatValueCoder.h"
 #include "src/format/ByteIO.h"
 #include "src/format/ZstdFrame.h"
@@ -36,7 +37,8 @@ std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, u
 const char* predictedCodingName(uint8_t coding) {
     static const char* const names[] = {"palettes", "brick residuals", "context-coded", "placed context-coded", "placed labels",
                                         "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors",
-                                        "fitted context-coded", "fitted rescaled floats"};
+                                        "fitted context-coded", "fitted rescaled floats", "float integers"};
+    static_assert(std::size(names) == detail::kCodingCount);
     return coding < std::size(names) ? names[coding] : "unknown";
 }
 
@@ -142,6 +144,15 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
         std::vector<uint32_t> bits(size_t(e.entries));
         coding::decodePlacedFloats(body, bricks, places.subspan(size_t(e.firstBrick), size_t(e.bricks)), bits, where);
+        std::vector<uint8_t> out(bits.size() * 4);
+        std::memcpy(out.data(), bits.data(), out.size());
+        return out;
+    }
+    if (raw[0] == detail::kFloatIntegerCoding) {
+        if (dir.valueSize != 4) throw Error(where + ": float integers of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
+        if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
+        std::vector<uint32_t> bits(size_t(e.entries));
+        coding::decodePlacedFloatIntegers(body, bricks, places.subspan(size_t(e.firstBrick), size_t(e.bricks)), bits, where);
         std::vector<uint8_t> out(bits.size() * 4);
         std::memcpy(out.data(), bits.data(), out.size());
         return out;
