@@ -2,11 +2,12 @@
 // approach: one source, compiled as either language). Everything that
 // decodes the inner words and 4^3 leaves of a .ssvdag DAG (docs/FORMAT.md
 // §5) lives here: child tags, tagged pointers with their reflection and
-// attribute offset, the stored bit of a voxel in a mirrored leaf and its
-// popcount rank, and the reflection of a leaf mask. The public reader
-// (src/reader/Accessor.cpp), the encoder's checks (encoding::readChild), the
-// CPU tracer (src/trace/DagWalk.h) and the Vulkan shaders
-// (gpu/shaders/trace_walk.glsl) all include it.
+// attribute offset, a node's word count, the stored bit of a voxel in a
+// mirrored leaf and its popcount rank, and the reflection of a leaf mask;
+// and what writes the pointers (dagPointerTag, dagPointerWord0/1). The
+// public reader (src/reader/Accessor.cpp), the writer and its checks
+// (src/encoding/CompactDag.cpp), the CPU tracer (src/trace/DagWalk.h) and
+// the Vulkan shaders (gpu/shaders/trace_walk.glsl) all include it.
 //
 // C++: include it as is; the functions are in namespace vdbdag::access and
 // read inner words from a `const uint16_t*`.
@@ -71,6 +72,33 @@ VDBDAG_FN void dagChildPointer(VDBDAG_INNER_BUF buf, uint64_t pos, uint header, 
         }
     }
 }
+
+// Words of the node whose header is `header` (nonzero: a solid node is its
+// header alone): the header, each stored child's pointer (one word for
+// tag 01, two for 1x) and, for every child but the first, `offsetWords`
+// words of attribute offset.
+VDBDAG_PURE uint dagNodeWords(uint header, uint offsetWords) {
+    const uint tags = header & 0xFFFFu;
+    const uint children = uint(bitCount((tags | (tags >> 1u)) & 0x5555u));
+    const uint longPointers = uint(bitCount((tags >> 1u) & 0x5555u));
+    return 1u + children + longPointers + (children > 1u ? (children - 1u) * offsetWords : 0u);
+}
+
+// The writer's side of dagChildPointer. The tag of a pointer to a child at
+// word `offset` of the next level: 1 (one word) below 2^13 where one-word
+// pointers are allowed, else 2 or 3 (two words; the tag's low bit is
+// offset bit 29) below 2^30, else 0 (no pointer can reach it).
+VDBDAG_PURE uint dagPointerTag(uint64_t offset, bool oneWord) {
+    if (oneWord && offset < 8192ul) return 1u;
+    if (offset < 1073741824ul) return 2u | uint(offset >> 29u);
+    return 0u;
+}
+// The pointer's first word (the reflection in its top 3 bits, then the
+// offset, or bits 16-28 of it) and, for tags 2 and 3, its second (bits 0-15).
+VDBDAG_PURE uint dagPointerWord0(uint64_t offset, uint reflection, uint tag) {
+    return (reflection << 13u) | uint((tag == 1u ? offset : offset >> 16u) & 0x1FFFul);
+}
+VDBDAG_PURE uint dagPointerWord1(uint64_t offset) { return uint(offset & 0xFFFFul); }
 
 // Bit of a 4^3 leaf stored under reflection m for spatial voxel (x, y, z),
 // each in 0..3: bit x + 4y + 16z of the stored mask after mirroring.

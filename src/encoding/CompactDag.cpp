@@ -53,8 +53,6 @@
 namespace vdbdag::encoding {
 namespace {
 
-constexpr uint64_t kShortOffsetLimit = uint64_t(1) << 13;
-constexpr uint64_t kLongOffsetLimit = uint64_t(1) << 30;
 constexpr unsigned kMaxLog2Size = 40;
 constexpr uint64_t kMaxEmittedPieces = uint64_t(1) << 31;
 
@@ -69,21 +67,12 @@ std::vector<uint32_t> frequencyOrder(const Refcounts& refcount) {
     return order;
 }
 
-unsigned tagWords(unsigned tag) { return tag == 0 ? 0 : tag == 1 ? 1 : 2; }
 
 uint64_t saturatingAdd(uint64_t a, uint64_t b) { return a > std::numeric_limits<uint64_t>::max() - b ? std::numeric_limits<uint64_t>::max() : a + b; }
 
 } // namespace
 
-unsigned nodeWordCount(uint16_t header, unsigned offsetWords) {
-    unsigned words = 1, children = 0;
-    for (unsigned j = 0; j < 8; ++j) {
-        const unsigned tag = (header >> (2 * j)) & 3u;
-        words += tagWords(tag);
-        children += tag != 0;
-    }
-    return words + (children > 1 ? (children - 1) * offsetWords : 0);
-}
+unsigned nodeWordCount(uint16_t header, unsigned offsetWords) { return access::dagNodeWords(header, offsetWords); }
 
 ChildPointer readChild(const std::vector<uint16_t>& inner, uint64_t pos, unsigned j, unsigned offsetWords) {
     ChildPointer child{};
@@ -140,18 +129,13 @@ CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets, bool
                 const dag::ChildRef child = level.nodes[index][j];
                 if (!child) continue;
                 const uint64_t offset = position[dag::childIndex(child)];
-                const uint16_t mirror = uint16_t(dag::childReflection(child) << 13);
-                if (offset < kShortOffsetLimit && compactPointers) {
-                    header |= uint16_t(1u << (2 * j));
-                    words.push_back(uint16_t(mirror | offset));
-                } else if (offset < kLongOffsetLimit) {
-                    header |= uint16_t((2u | unsigned(offset >> 29)) << (2 * j));
-                    words.push_back(uint16_t(mirror | ((offset >> 16) & 0x1FFFu)));
-                    words.push_back(uint16_t(offset & 0xFFFFu));
-                } else {
+                const unsigned tag = access::dagPointerTag(offset, compactPointers);
+                if (tag == 0)
                     throw Error("DAG level " + std::to_string(k + 3) + " needs a child offset of " + std::to_string(offset) +
                                 " words, beyond the 30-bit pointer format (2^30 words)");
-                }
+                header |= uint16_t(tag << (2 * j));
+                words.push_back(uint16_t(access::dagPointerWord0(offset, unsigned(dag::childReflection(child)), tag)));
+                if (tag != 1) words.push_back(uint16_t(access::dagPointerWord1(offset)));
                 if (!first)
                     for (unsigned w = 0; w < ow; ++w) words.push_back(uint16_t(preceding >> (16 * w)));
                 first = false;
