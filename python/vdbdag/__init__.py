@@ -9,8 +9,11 @@
     vdbdag.decode("out.ssvdag", "back.vdb")
 
 encode and decode run the vdbdag command: $VDBDAG_EXECUTABLE, else the one
-installed beside this package's prefix, else vdbdag on the PATH.
+installed beside this package's prefix, else vdbdag on the PATH. Each
+returns the command's report (its --json output) as a dict: bytes written,
+seconds, per-grid facts and, for a lossy encode, the errors measured.
 """
+import json
 import os
 import shutil
 import subprocess
@@ -37,10 +40,14 @@ def _executable():
 
 
 def _run(arguments):
-    result = subprocess.run([_executable(), *arguments, "--quiet"], capture_output=True, text=True)
+    result = subprocess.run([_executable(), *arguments, "--quiet", "--json"], capture_output=True, text=True)
     if result.returncode != 0:
         message = (result.stderr.strip().splitlines() or ["vdbdag exited with status %d" % result.returncode])[-1]
         raise Error(message)
+    try:
+        return json.loads(result.stdout)
+    except ValueError:
+        raise Error("vdbdag printed no report: " + result.stdout[:200])
 
 
 def _flags(options):
@@ -64,10 +71,15 @@ def encode(src, dst, **options):
 
     Keyword options are the command's: abs_error=0.01 -> --abs-error 0.01,
     force=True -> --force, grid=["a", "b"] -> --grid a --grid b.
+    Returns the report, as `vdbdag encode --json` prints it (a dict: "bytes",
+    "seconds", "grids", "grids_lossy" with each lossy grid's errors, ...).
     """
-    _run(["encode", os.fspath(src), "-o", os.fspath(dst), *_flags(options)])
+    return _run(["encode", os.fspath(src), "-o", os.fspath(dst), *_flags(options)])
 
 
 def decode(src, dst, **options):
-    """Decodes the .ssvdag src into dst (.vdb, or a dense format by its extension)."""
-    _run(["decode", os.fspath(src), "-o", os.fspath(dst), *_flags(options)])
+    """Decodes the .ssvdag src into dst (.vdb, or a dense format by its extension).
+
+    Returns the report, as `vdbdag decode --json` prints it (a dict).
+    """
+    return _run(["decode", os.fspath(src), "-o", os.fspath(dst), *_flags(options)])

@@ -211,14 +211,26 @@ def test_open_refuses_a_file_beyond_its_limits(work):
 def test_lossy_encode_keeps_its_bound(work):
     vdb = sphere_file(work)
     out = os.path.join(work, "lossy.ssvdag")
-    vdbdag.encode(vdb, out, abs_error=0.01, grid=["sphere"])
+    report = vdbdag.encode(vdb, out, abs_error=0.01, grid=["sphere"])
     ref = openvdb.read(vdb, "sphere")
     g = vdbdag.open(out).grid("sphere")
     ijk = sample_coords(ref, 10000, 9)
     want, active = reference(ref, ijk)
     got = g.values(ijk)
     assert np.array_equal(g.is_active(ijk), active)
-    assert np.max(np.abs(got[active] - np.array(want, dtype=np.float32)[active])) <= 0.01
+    measured = np.max(np.abs(got[active] - np.array(want, dtype=np.float32)[active]))
+    assert measured <= 0.01
+    # The report, as a dict: the file's size on disk, the grid's active
+    # voxel count as pyopenvdb counts it, and an error bound that covers
+    # what the lookups measured.
+    assert report["bytes"] == os.path.getsize(out)
+    assert report["grids"][0]["name"] == "sphere"
+    assert report["grids"][0]["active_voxels"] == ref.activeVoxelCount()
+    (lossy,) = report["grids_lossy"]
+    assert measured <= lossy["max_abs_error"] <= 0.01
+    back = os.path.join(work, "lossy_back.vdb")
+    assert isinstance(vdbdag.decode(out, back), dict)
+    assert os.path.exists(back)
 
 
 @pytest.mark.skipif(not os.path.exists(os.path.join(SHARED, "levelsets", "bunny_d512_ls.vdb")), reason="../shared/data absent")
