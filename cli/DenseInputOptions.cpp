@@ -72,25 +72,6 @@ bridge::DenseImportOptions DenseInputOptions::resolve(const std::string& path) c
     return o;
 }
 
-nlohmann::json thresholdJson(const bridge::ThresholdReport& r) {
-    if (!r.applied) return nullptr;
-    return {{"samples", r.samples},
-            {"inactive_samples", r.inactive},
-            {"changed_samples", r.changed},
-            {"background_value", r.background},
-            {"input_min", r.inputMin},
-            {"input_max", r.inputMax},
-            {"max_abs_change", r.maxAbsChange},
-            {"mean_abs_change", r.meanAbsChange},
-            {"rms_change", r.rmsChange},
-            {"psnr_db", std::isfinite(r.psnr) ? nlohmann::json(r.psnr) : nlohmann::json(nullptr)},
-            {"psnr_peak", "input range"},
-            {"stored_bits", r.storedBits},
-            {"psnr_stored_range_db", r.storedBits && std::isfinite(r.psnrStoredRange) ? nlohmann::json(r.psnrStoredRange) : nlohmann::json(nullptr)},
-            {"background_is", r.backgroundChosen ? "chosen" : "mean of removed samples"},
-            {"shared_background", r.sharedBackground}};
-}
-
 std::string thresholdText(const bridge::ThresholdReport& r) {
     if (!r.applied) return "";
     auto db = [](double x) { return std::isfinite(x) ? fmt::format("{:.2f} dB", x) : std::string("inf (lossless)"); };

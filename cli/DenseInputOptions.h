@@ -43,7 +43,6 @@ struct DenseInputOptions {
 // the series (an output must be none of them).
 std::vector<std::string> denseInputFiles(const std::string& input, const DenseInputOptions& options);
 
-nlohmann::json thresholdJson(const bridge::ThresholdReport& report);
 std::string thresholdText(const bridge::ThresholdReport& report);
 
 } // namespace vdbdag::cli

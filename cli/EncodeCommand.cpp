@@ -13,6 +13,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "app/EncodeFile.h"
 #include "cli/ByteSize.h"
 #include "cli/Commands.h"
 #include "cli/GlobalOptions.h"
@@ -20,7 +21,7 @@
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
 #include "cli/DenseInputOptions.h"
-#include "cli/MemoryBudget.h"
+#include "app/MemoryBudget.h"
 #include "cli/FiniteNumber.h"
 #include "src/pipeline/CubeEncoder.h"
 #include "src/pipeline/GridCodec.h"
@@ -122,208 +123,53 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     // to `batch` when given, else is printed.
     const auto encodeOne = [opt, &exitCode](nlohmann::json* batch) {
         setActivity(opt->input, "encoding");
-        const auto start = std::chrono::steady_clock::now();
-        std::optional<tbb::global_control> threads;
-        if (opt->threads) threads.emplace(tbb::global_control::max_allowed_parallelism, opt->threads);
-        bridge::ImportOptions importOptions;
-        importOptions.onlyGrids = opt->grids;
-        importOptions.skipUnsupported = opt->skipUnsupported;
-        importOptions.topologyOnly = opt->topologyOnly;
-        importOptions.normals = opt->normalBits != 0;
-        importOptions.normalGrid = opt->normalGrid;
-        if (opt->colourBits && opt->topologyOnly) throw Error("--colour-bits and --topology-only exclude each other: a topology-only file has no colours");
         const bool dense = bridge::denseFormatOf(opt->input) != bridge::DenseFormat::None;
-        checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".ssvdag"}, "encode", opt->force});
-        // Scratch files are named after the output, in its folder or in --scratch.
-        const std::string scratchNear = opt->scratch.empty() ? opt->output : (std::filesystem::path(opt->scratch) / std::filesystem::path(opt->output).filename()).string();
-        bridge::ImportResult imported;
-        std::optional<bridge::VdbCubeInput> cubeInput;  // --memory-limit on a .vdb: read region by region
-        std::vector<std::unique_ptr<CubeSource>> denseCubes;  // ... on a scalar scan: its samples in a scratch file
-        bridge::ThresholdReport threshold;
-        if (dense) {
-            if (!opt->grids.empty()) throw Error(opt->input + ": --grid applies to .vdb inputs only (a dense scan has one grid)");
-            bridge::DenseImportOptions denseOptions = opt->dense.resolve(opt->input);
-            // Cube by cube, its samples in a scratch file, with
-            // --memory-limit, under mpirun, or when the grid would not fit
-            // in memory (about 12 bytes per sample in all, against the
-            // default limit); the same bytes either way.
-            if (!opt->topologyOnly) {
-                if (opt->memoryLimit || cubeTeam().size() > 1 || bridge::describeDense(opt->input, denseOptions).sampleCount() > defaultMemoryLimit() / 12)
-                    denseOptions.cubesNear = scratchNear;
-            }
-            bridge::DenseImportResult dense = bridge::importDense(opt->input, denseOptions);
-            threshold = dense.threshold;
-            imported.warnings = dense.source.notes;
-            imported.volume = std::move(dense.volume);
-            denseCubes = std::move(dense.cubes);
-            if (opt->topologyOnly)
-                for (GridRecord& g : imported.volume.grids) {
-                    g.valueType = ValueType::Mask;
-                    g.values = {};
-                    g.background.clear();
-                }
-        } else {
+        if (!dense) {
             if (!opt->dense.series.empty()) throw Error(opt->input + ": --series applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
             if (!opt->dense.dims.empty() || !opt->dense.type.empty() || !opt->dense.endian.empty() || !opt->dense.spacing.empty() ||
                 !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
                 throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
                                          "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
-            // Cube by cube (region by region from the file) whenever the
-            // file allows it (grid offsets): less memory than the whole grid
-            // and faster too (the cubes' values are gathered in parallel,
-            // each through a small index). Whole, through OpenVDB's
-            // strictest reader, for a stream and for --normals (the
-            // gradient reads across cubes). The same bytes either way.
-            if (bridge::isNanoVdbPath(opt->input)) {  // NanoVDB: whole, through NanoVDB's own converter
-                imported = bridge::importNanoVdb(opt->input, importOptions);
-            } else if (!importOptions.normals && bridge::canReadVdbByCubes(opt->input)) {
-                cubeInput = bridge::openVdbCubes(opt->input, importOptions, scratchNear,
-                                                 scratchInMemory(opt->memoryLimit ? opt->memoryLimit : defaultMemoryLimit()));
-                imported.warnings = cubeInput->warnings;
-                for (const auto& g : cubeInput->grids) imported.volume.grids.push_back(g->header());  // headers only, for the checks
-            } else {
-                imported = bridge::importVdb(opt->input, importOptions);
-            }
         }
-        for (const auto& w : imported.warnings) fmt::print(stderr, "vdbdag: warning: {}\n", w);
-        if (imported.volume.grids.empty())
-            throw Error(opt->input + ": " + (imported.warnings.empty() ? "has no grids" : "has no grid vdbdag converts") + "; nothing to write to " + opt->output);
-        for (const std::string& name : opt->colourGrids) {
-            const auto& grids = imported.volume.grids;
-            const auto it = std::find_if(grids.begin(), grids.end(), [&](const GridRecord& g) { return g.name == name; });
-            if (it == grids.end()) throw Error(opt->input + ": no grid named '" + name + "' among the grids encoded, for --colour-grid");
-            if (!attributes::isVec3Type(it->valueType))
-                throw Error(opt->input + ": --colour-grid '" + name + "' holds " + valueTypeName(it->valueType) + " values, not vec3 colours");
-        }
-
-        pipeline::EncodeOptions encodeOptions;
-        encodeOptions.symmetry = !opt->noSymmetry;
-        encodeOptions.placementTrials = opt->placementTrials;
-        encodeOptions.predictIntegers = !opt->noPredict;
-        encodeOptions.computeSvdagStats = opt->svdagStats;
-        if (opt->absError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Absolute, opt->absError};
-        if (opt->relError > 0) encodeOptions.tolerance = {attributes::ScalarTolerance::Mode::Relative, opt->relError};
-        encodeOptions.colourBits = opt->colourBits;
-        encodeOptions.colourGrids = opt->colourGrids;
-        encodeOptions.normalBits = opt->normalBits;
-        // Each step is 1000 units, filled cube by cube where the encoder reports it.
-        constexpr uint64_t kUnits = 1000;
-        const uint64_t totalUnits = (imported.volume.grids.size() * pipeline::kEncodeSteps + 1) * kUnits;
-        Progress progress("encode", totalUnits);
+        app::EncodeRequest request;
+        request.input = opt->input, request.output = opt->output, request.force = opt->force;
+        request.inputFiles = denseInputFiles(opt->input, opt->dense);
+        request.grids = opt->grids, request.skipUnsupported = opt->skipUnsupported, request.topologyOnly = opt->topologyOnly;
+        if (dense) request.dense = opt->dense.resolve(opt->input);
+        request.noSymmetry = opt->noSymmetry, request.noCompress = opt->noCompress, request.noPredict = opt->noPredict, request.svdagStats = opt->svdagStats;
+        request.placementTrials = opt->placementTrials, request.absError = opt->absError, request.relError = opt->relError;
+        request.colourBits = opt->colourBits, request.normalBits = opt->normalBits, request.colourGrids = opt->colourGrids, request.normalGrid = opt->normalGrid;
+        request.memoryLimit = opt->memoryLimit, request.scratch = opt->scratch, request.threads = opt->threads;
+        app::EncodeHooks hooks;
+        hooks.team = &cubeTeam();
+        hooks.warning = [](const std::string& w) { fmt::print(stderr, "vdbdag: warning: {}\n", w); };
         // In a sequence the frame's share of the whole moves instead (this
-        // frame's own line stays silent: setQuiet while it runs).
-        const auto setProgress = [&](uint64_t units) {
-            progress.set(units);
-            if (opt->sequenceProgress) opt->sequenceProgress->set(opt->frameIndex * kUnits + std::min(units, totalUnits) * kUnits / totalUnits);
-        };
-        std::string gridName;
-        uint64_t stepsStarted = 0;
-        // Seconds spent in each step, reported with --json ("phases").
-        std::vector<std::pair<std::string, std::chrono::steady_clock::time_point>> phases{{"reading the input", start}};
-        encodeOptions.onStep = [&](const char* step) {
-            phases.push_back({fmt::format("{}: {}", gridName, step), std::chrono::steady_clock::now()});
-            progress.setLabel(fmt::format("encode '{}': {}", gridName, step));
-            setProgress(stepsStarted++ * kUnits);
-        };
-        encodeOptions.onStepProgress = [&](uint64_t done, uint64_t total) {
-            if (stepsStarted && total) setProgress((stepsStarted - 1) * kUnits + std::min<uint64_t>(kUnits, done * kUnits / total));
-        };
-        std::vector<std::string> gridNames;
-        for (const auto& g : imported.volume.grids) gridNames.push_back(g.name);
-        pipeline::CubeTeam& team = cubeTeam();
-        format::SsvdagScene scene;
-        const auto onGrid = [&](size_t i, size_t) { gridName = gridNames[i]; };
-        try {
-            // A grid read whole (a small scan, an OpenVDB stream) is encoded
-            // in memory, which costs least (the same bytes), except under
-            // mpirun, where the processes share its cubes.
-            if (cubeInput || !denseCubes.empty() || team.size() > 1) {
-                const pipeline::CubeBudget budget = cubeBudget(opt->memoryLimit, scratchNear);
-                std::vector<std::unique_ptr<CubeSource>> sources;
-                if (!denseCubes.empty()) {
-                    sources = std::move(denseCubes);
-                } else if (cubeInput) {
-                    sources = std::move(cubeInput->grids);
-                    imported.volume.fileMetadata = cubeInput->fileMetadata;
-                } else {
-                    for (const GridRecord& g : imported.volume.grids) sources.push_back(recordCubes(g));
-                }
-                scene = pipeline::encodeSourcesByCubes(std::move(sources), imported.volume.fileMetadata, encodeOptions, budget, onGrid, team);
-            } else {
-                scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, onGrid);
-            }
-        } catch (const Error& e) {
-            throw Error(opt->input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
-        }
-        // Neither the input voxels nor the attribute arrays are written:
-        // release them before the sections are built (a 512x512x999 scan
-        // holds 1 GB in each).
-        imported.volume = {};
-        for (auto& g : scene.grids) {
-            std::vector<uint8_t>().swap(g.attributes);
-            std::vector<uint8_t>().swap(g.inactiveAttributes);
-        }
-        if (!team.isRoot()) {  // process 0 writes and reports
+        // frame's own line stays silent: setQuiet while it runs), and the
+        // frames make no notes.
+        if (opt->sequenceProgress)
+            hooks.onProgress = [opt](double done) { opt->sequenceProgress->set(opt->frameIndex * 1000 + uint64_t(done * 1000)); };
+        else hooks.note = [](const std::string& n) { note(n); };
+        const app::EncodeResult result = app::encodeFile(request, hooks);
+        if (!result.written) {  // another process of the team writes and reports
             exitCode = 0;
             return;
         }
-        phases.push_back({"writing the file", std::chrono::steady_clock::now()});
-        progress.setLabel("encode: writing " + opt->output);
-        format::ContainerOptions containerOptions;
-        containerOptions.compress = !opt->noCompress;
-        // Section by section, the DAGs and values released as they go: the
-        // file is never whole in memory.
-        uint64_t fileBytes = 0, geometryBytes = 0;  // the DAGs, uncompressed (released by the writer)
-        for (const auto& g : scene.grids) geometryBytes += g.dag.byteSize() + g.inactiveDag.byteSize();
-        writeStreamAtomically(opt->output, [&](std::ostream& out) { fileBytes = format::writeSceneReleasing(scene, out, containerOptions); });
-        progress.finish();
-        // Where the geometry weighs, other root placements may shrink it
-        // (a tilted torus: 30%): say that the option exists.
-        if (opt->placementTrials == 1 && !opt->sequenceProgress && fileBytes && geometryBytes * 4 > fileBytes)
-            note("the geometry is a large part of this file: --placement-trials 4 tries other root placements and keeps the smallest file");
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-        uint64_t voxels = 0;
-        for (const auto& g : scene.grids) voxels += g.activeVoxels;
-        nlohmann::json grids = nlohmann::json::array();
-        for (size_t g = 0; g < scene.grids.size(); ++g)
-            grids.push_back({{"index", g}, {"name", scene.grids[g].record.name}, {"class", scene.grids[g].record.gridClass},
-                             {"value_type", valueTypeName(scene.grids[g].record.valueType)}, {"active_voxels", scene.grids[g].activeVoxels}});
-        // "bytes": the file written, as "ssvdag_bytes" (kept for scripts written before the common keys).
-        nlohmann::json report{{"input", opt->input}, {"output", opt->output}, {"ssvdag_bytes", fileBytes}, {"bytes", fileBytes},
-                              {"grid_count", scene.grids.size()}, {"grids", grids}, {"active_voxels", voxels}, {"seconds", seconds},
-                              {"bits_per_active_voxel", voxels ? 8.0 * double(fileBytes) / double(voxels) : 0.0}};
-        if (threshold.applied) report["threshold"] = thresholdJson(threshold);
-        report["phases"] = nlohmann::json::array();
-        for (size_t i = 0; i < phases.size(); ++i) {
-            const auto end = i + 1 < phases.size() ? phases[i + 1].second : start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
-            report["phases"].push_back({{"name", phases[i].first}, {"seconds", std::chrono::duration<double>(end - phases[i].second).count()}});
-        }
-        report["grids_lossy"] = nlohmann::json::array();
-        for (const auto& g : scene.grids) {
-            if (g.lossy.tolerance.mode == attributes::ScalarTolerance::Mode::Exact) continue;
-            report["grids_lossy"].push_back({{"name", g.record.name}, {"tolerance", attributes::describe(g.lossy.tolerance)},
-                                             {"entries", g.lossy.entries}, {"changed", g.lossy.changed}, {"kept_exact", g.lossy.keptExact},
-                                             {"max_abs_error", g.lossy.maxAbsError}, {"mean_abs_error", g.lossy.meanAbsError},
-                                             {"rms_error", g.lossy.rmsError}, {"max_rel_error", g.lossy.maxRelError}});
-        }
-        report["grids_colour"] = nlohmann::json::array();
-        report["grids_normals"] = nlohmann::json::array();
-        for (const auto& g : scene.grids) {
-            if (g.colour) report["grids_colour"].push_back(colourJson(g));
-            if (g.normals) report["grids_normals"].push_back(normalsJson(g));
-        }
+        const nlohmann::json& report = result.report;
+        const auto voxels = report["active_voxels"].get<uint64_t>();
+        const auto fileBytes = report["bytes"].get<uint64_t>();
+        const auto seconds = report["seconds"].get<double>();
+        const size_t gridCount = report["grid_count"].get<size_t>();
         if (batch) {
             batch->push_back(report);
             if (!opt->json && !opt->sequenceProgress)
-                fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output, scene.grids.size(),
+                fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output, gridCount,
                            voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);
         } else if (opt->json) {
             printJson(report);
         } else {
             fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output,
-                       scene.grids.size(), voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);
-            fmt::print("{}", thresholdText(threshold));
+                       gridCount, voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);
+            fmt::print("{}", thresholdText(result.threshold));
             for (const auto& l : report["grids_lossy"])
                 fmt::print("  grid '{}' {}: {} of {} values changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
                            l["name"].get<std::string>(), l["tolerance"].get<std::string>(), l["changed"].get<uint64_t>(), l["entries"].get<uint64_t>(),

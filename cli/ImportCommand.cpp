@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "app/EncodeReportJson.h"
 #include "cli/Commands.h"
 #include "cli/JsonReport.h"
 #include "cli/RunContext.h"
@@ -61,7 +62,7 @@ void addImportCommand(CLI::App& app, int& exitCode) {
                               {"value_type", valueTypeName(g.valueType)},
                               {"active_voxels", g.topology.activeVoxelCount()},
                               {"seconds", seconds},
-                              {"threshold", thresholdJson(imported.threshold)}};
+                              {"threshold", app::thresholdJson(imported.threshold)}};
         if (opt->json) {
             printJson(report);
         } else {

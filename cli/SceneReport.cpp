@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 
+#include "app/EncodeReportJson.h"
 #include "src/attributes/PaletteCompressor.h"
 #include "src/attributes/PredictedWindows.h"
 #include "src/encoding/AttributeLayout.h"
@@ -14,23 +15,6 @@
 #include "vdb_bridge/DenseImport.h"
 
 namespace vdbdag::cli {
-
-nlohmann::json colourJson(const format::EncodedGrid& grid) {
-    const attributes::ColourReport& c = *grid.colour;
-    return {{"name", grid.record.name}, {"bits", c.bits}, {"entries", c.entries}, {"distinct_before", c.distinctBefore},
-            {"distinct_after", c.distinctAfter}, {"changed", c.changed}, {"mean_abs_error_rgb", c.meanAbsError},
-            {"max_abs_error_rgb", c.maxAbsError}, {"mean_delta_e94", c.meanDeltaE94}, {"max_delta_e94", c.maxDeltaE94}};
-}
-
-nlohmann::json normalsJson(const format::EncodedGrid& grid) {
-    const attributes::NormalChannel& n = *grid.normals;
-    const std::vector<uint8_t> codes = n.codes.decodeAll();
-    return {{"name", grid.record.name}, {"bits", n.bits},
-            {"source", n.report.source == attributes::NormalReport::Source::Gradient ? "gradient" : "normal grid"},
-            {"entries", n.report.entries}, {"zero_length", n.report.zeroLength}, {"one_sided", n.report.oneSided},
-            {"mean_angle_degrees", n.report.meanAngleDegrees}, {"max_angle_degrees", n.report.maxAngleDegrees},
-            {"distinct_codes", attributes::channelStats(codes, 4, n.codes).unique}, {"palette_bytes", n.codes.byteSize()}};
-}
 
 std::string formatColour(const nlohmann::json& c) {
     const auto mean = c["mean_abs_error_rgb"], max = c["max_abs_error_rgb"];
@@ -209,9 +193,9 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
         }
         if (grid.normals) {
             traceable += grid.normals->codes.byteSize();
-            j["normals"] = normalsJson(grid);
+            j["normals"] = app::normalsJson(grid);
         }
-        if (grid.colour) j["colour"] = colourJson(grid);
+        if (grid.colour) j["colour"] = app::colourJson(grid);
         if (valueStats) j["traceable_bytes"] = traceable;
         if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
             j["lossy"] = {{"tolerance", attributes::describe(grid.lossy.tolerance)}, {"changed", grid.lossy.changed},

@@ -29,9 +29,7 @@ std::string formatGridHeader(const nlohmann::json& grid);
 nlohmann::json metadataJson(const std::vector<bridge::MetadataEntry>& entries);
 
 // The colour (--colour-bits) and normal (--normals) parts of a grid's
-// report, shared by `encode` and `info`; `grid` must have them.
-nlohmann::json colourJson(const format::EncodedGrid& grid);
-nlohmann::json normalsJson(const format::EncodedGrid& grid);
+// report (app/EncodeReportJson.h), as text.
 std::string formatColour(const nlohmann::json& colour);
 std::string formatNormals(const nlohmann::json& normals);
 

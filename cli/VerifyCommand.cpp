@@ -20,7 +20,7 @@
 #include "cli/ByteSize.h"
 #include "cli/Commands.h"
 #include "cli/JsonReport.h"
-#include "cli/MemoryBudget.h"
+#include "app/MemoryBudget.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
 #include "src/pipeline/CubeEncoder.h"
@@ -104,7 +104,7 @@ Verified verifyByCubes(const VerifyOptions& opt) {
     {
         bridge::ImportOptions importOptions;
         importOptions.topologyOnly = opt.topologyOnly;
-        bridge::VdbCubeInput input = bridge::openVdbCubes(opt.input, importOptions, encoded.path, scratchInMemory(opt.memoryLimit ? opt.memoryLimit : defaultMemoryLimit()));
+        bridge::VdbCubeInput input = bridge::openVdbCubes(opt.input, importOptions, encoded.path, app::scratchInMemory(opt.memoryLimit ? opt.memoryLimit : app::defaultMemoryLimit()));
         pipeline::EncodeOptions options;
         options.symmetry = !opt.noSymmetry;
         options.computeSvdagStats = false;  // as `encode` does by default: the same file, byte for byte
@@ -114,7 +114,7 @@ Verified verifyByCubes(const VerifyOptions& opt) {
         options.onStepProgress = [&](uint64_t done, uint64_t total) {
             if (stepsStarted && total) progress.set(((stepsStarted - 1) * kUnits + std::min(done, total) * kUnits / total) / steps);
         };
-        format::SsvdagScene scene = pipeline::encodeSourcesByCubes(std::move(input.grids), input.fileMetadata, options, cubeBudget(opt.memoryLimit, encoded.path));
+        format::SsvdagScene scene = pipeline::encodeSourcesByCubes(std::move(input.grids), input.fileMetadata, options, app::cubeBudget(opt.memoryLimit, encoded.path));
         std::ofstream file(encoded.path, std::ios::binary | std::ios::trunc);
         if (!file) throw Error(encoded.path + ": cannot be created (the verify's temporary file; choose another folder with --scratch)");
         out.bytes = format::writeSceneReleasing(scene, file);

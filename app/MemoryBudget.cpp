@@ -1,11 +1,11 @@
 // See MemoryBudget.h.
-#include "cli/MemoryBudget.h"
+#include "app/MemoryBudget.h"
 
 #include <unistd.h>
 
 #include <algorithm>
 
-namespace vdbdag::cli {
+namespace vdbdag::app {
 
 uint64_t defaultMemoryLimit() {
     const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
@@ -26,4 +26,4 @@ pipeline::CubeBudget cubeBudget(uint64_t memoryLimit, const std::string& spillNe
     return budget;
 }
 
-} // namespace vdbdag::cli
+} // namespace vdbdag::app

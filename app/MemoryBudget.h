@@ -7,7 +7,7 @@
 
 #include "src/pipeline/CubeEncoder.h"
 
-namespace vdbdag::cli {
+namespace vdbdag::app {
 
 // Without --memory-limit: half of the physical memory.
 uint64_t defaultMemoryLimit();
@@ -21,4 +21,4 @@ uint64_t scratchInMemory(uint64_t memoryLimit);
 // values spilled to a scratch file beside `spillNear`.
 pipeline::CubeBudget cubeBudget(uint64_t memoryLimit, const std::string& spillNear);
 
-} // namespace vdbdag::cli
+} // namespace vdbdag::app
