@@ -267,9 +267,13 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         }
         pos += header + length;
     }
-    // A file that ends inside its file meta group (GDCM asserts on it).
-    if (frames.size() > 1 && !unknownStart)
+    // A file that ends inside a sequence, an item or encapsulated pixel
+    // data, whatever it starts with: GDCM asserts on it (8 bytes, a Pixel
+    // Data tag of undefined length and nothing after it, aborted in
+    // BasicOffsetTable::Read: found by fuzz_scan_headers).
+    if (frames.size() > 1)
         return fmt::format("the file ends inside a sequence or item (at byte {} of {})", pos, size);
+    // A file that ends inside its file meta group (GDCM asserts on it).
     if (metaGroup) return fmt::format("the file ends inside its file meta group (at byte {} of {})", pos, size);
     return "";
 }
