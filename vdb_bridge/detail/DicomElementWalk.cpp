@@ -104,11 +104,16 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
             bigEndian = true;
             group = uint16_t(h[0] << 8 | h[1]);
         }
-        // Neither a file meta group nor a dataset's first group: GDCM still
-        // parses it as a dataset (and allocated 1.8 GB for a 107-byte file
-        // whose bytes read as a 1.8 GB element: found by fuzz_scan_headers),
-        // so it is walked the same way, its VRs taken as they come.
+        // Neither a file meta group nor a data set's first group: GDCM still
+        // parses it, guessing its byte order and VRs, and the walk cannot
+        // follow its guesses (it allocated 1.8 GB for a 107-byte file whose
+        // bytes read as a 1.8 GB element, 2 GB for 9 KB it read big-endian,
+        // and aborted on others: found by fuzz_scan_headers). Such a file is
+        // no DICOM vdbdag reads.
         unknownStart = group != 0x0002 && group != 0x0008;
+        if (unknownStart)
+            return fmt::format("its first element ({:04X},{:04X}) is of neither the file meta group (0002) nor a data set's first group (0008)", group,
+                               uint16_t(bigEndian ? h[2] << 8 | h[3] : h[2] | h[3] << 8));
         explicitVr = std::isupper(h[4]) && std::isupper(h[5]);
         declaredImplicit = !explicitVr && !unknownStart;
         metaGroup = group == 0x0002;
@@ -285,7 +290,7 @@ std::string elementLengthProblem(const std::string& path, bool beforePixels, uin
     if (pixels) *pixels = DicomPixelData{};
     const std::string problem = walkElementLengths(path, beforePixels, pixelLength, unknownStart, pixels);
     // What starts like no DICOM and does not walk as one is not DICOM.
-    if (!problem.empty() && unknownStart) return "not a DICOM file (no DICM preamble, and read as one: " + problem + ")";
+    if (!problem.empty() && unknownStart) return "not a DICOM file (no DICM preamble, and " + problem + ")";
     return problem;
 }
 

@@ -5,7 +5,10 @@
 // items of undefined length, keeping their nesting) and refuses a length past
 // the end of the file, a delimiter outside any sequence, an item tag DICOM
 // does not define, a file meta group cut short or with a VR DICOM does not
-// define. It also finds the top-level Pixel Data element, so native pixel
+// define, an element without a VR under an explicit transfer syntax, a file
+// that ends inside an element, a sequence or an item, and a file without
+// preamble whose first group is neither 0002 nor 0008 (GDCM guesses how to
+// read those). It also finds the top-level Pixel Data element, so native pixel
 // data are read by vdbdag itself (DicomSeries.cpp) and only compressed ones
 // are decoded by GDCM's image reader.
 #pragma once
