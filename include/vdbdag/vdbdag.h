@@ -84,12 +84,12 @@ inline void checkValueType(const GridData* grid, int code, size_t size) {
 // it remembers the path to the last voxel it found, per layer, and starts
 // the next walk from the deepest node that still holds the new voxel, as
 // NanoVDB's ReadAccessor does, so coherent lookups cost a few steps.
-// A 4^3 brick missed a second time, or next to the brick of the last miss,
-// has its 64 values and active states copied into a cache of 1024 bricks
+// A 4^3 brick missed again, or next to the brick of the last miss, has its
+// 64 values and active states copied into a cache of 1024 bricks
 // (BrickCache), so a sweep through a box of up to 128 voxels a side finds
 // each voxel there with a compare and a load (docs/LIBRARY.md). The cache
-// is made on first use: 40 KB, plus 64 KB per byte of the value type once
-// a brick is copied (256 KB for float).
+// is made when the first brick is copied: 32 KB, plus 64 KB per byte of
+// the value type (288 KB in all for float).
 class VDBDAG_API Accessor {
 public:
     bool isActive(int64_t i, int64_t j, int64_t k);
@@ -157,10 +157,10 @@ public:
     };
 
     // Whole 4^3 bricks (internal; see Accessor.cpp): the brick of world
-    // voxels (4 bx .. 4 bx + 3, ...) goes in slot slotOf(bx, by, bz). A slot
-    // is claimed the first time one of its brick's voxels is looked up and
-    // filled the second time (or the first, next to the last brick missed),
-    // so scattered lookups copy nothing.
+    // voxels (4 bx .. 4 bx + 3, ...) goes in slot slotOf(bx, by, bz). A
+    // brick is copied when a lookup the cache misses falls in the brick of
+    // the last miss or next to it (a sweep), so scattered lookups copy
+    // nothing.
     struct BrickCache {
         static constexpr size_t kSlots = 1024;
         // Injective on every 32 x 32 square of bricks in an axis-aligned
@@ -172,7 +172,6 @@ public:
             bool is(int64_t bx, int64_t by, int64_t bz) const { return ((x ^ bx) | (y ^ by) | (z ^ bz)) == 0; }
         };
         std::vector<Key> filled;      // kSlots once a brick is filled: the brick each slot holds
-        std::vector<Key> claimed;     // kSlots once a lookup missed: the brick last seen once in each slot
         Key lastMiss;                 // the brick of the last lookup the cache did not answer
         std::vector<uint64_t> active; // per slot, bit x + 4 y + 16 z: the voxel is active
         std::vector<uint8_t> values;  // kSlots x 64 values, voxel x + 4 y + 16 z
@@ -197,7 +196,7 @@ private:
     bool valueBytesOrFailure(int64_t i, int64_t j, int64_t k, void* out) noexcept;
     [[noreturn]] void rethrowFailure();
     // The slot of voxel (i, j, k)'s brick if it is filled (found, or filled
-    // now because the brick was claimed before); else -1, the brick claimed.
+    // now, next to the last miss); else -1.
     int64_t brickSlot(int64_t i, int64_t j, int64_t k);
     void fillSlot(size_t s, int64_t bx, int64_t by, int64_t bz);
     const detail::GridData* grid_;

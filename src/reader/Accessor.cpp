@@ -124,19 +124,15 @@ Accessor::Accessor(const detail::GridData* grid) : grid_(grid), valueSize_(grid-
 
 int64_t Accessor::brickSlot(int64_t i, int64_t j, int64_t k) {
     if (!cache_.usable) return -1;
-    if (cache_.claimed.empty()) cache_.claimed.resize(BrickCache::kSlots);
     const int64_t bx = i >> 2, by = j >> 2, bz = k >> 2;
     const size_t s = BrickCache::slotOf(bx, by, bz);
     if (!cache_.filled.empty() && cache_.filled[s].is(bx, by, bz)) return int64_t(s);
-    // A brick next to the last one missed (a sweep), or claimed before, is
-    // copied; any other is claimed, to be copied if it is asked for again.
+    // The brick of the last miss again, or one next to it (a sweep), is
+    // copied; a brick far from it (a scattered lookup) is not.
     const BrickCache::Key last = cache_.lastMiss;
     cache_.lastMiss = {bx, by, bz};
     const bool near = last.x != INT64_MIN && uint64_t(bx - last.x + 1) <= 2 && uint64_t(by - last.y + 1) <= 2 && uint64_t(bz - last.z + 1) <= 2;
-    if (!near && !cache_.claimed[s].is(bx, by, bz)) {
-        cache_.claimed[s] = {bx, by, bz};
-        return -1;
-    }
+    if (!near) return -1;
     fillSlot(s, bx, by, bz);
     return int64_t(s);
 }

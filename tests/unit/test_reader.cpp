@@ -205,8 +205,8 @@ std::string typedLookup(Accessor& a, ValueType type, int64_t x, int64_t y, int64
 }
 } // namespace
 
-// The accessor's brick cache (a brick is copied whole on its second lookup,
-// or its first next to the last brick missed): sweeps of a box that is not
+// The accessor's brick cache (a brick is copied whole when a lookup misses
+// in the brick of the last miss or next to it): sweeps of a box that is not
 // on the 4-voxel grid, crosses the origin and holds active and inactive
 // voxels, tiles and background, in each axis order and twice (the second
 // time from the cache), through value<T>, with scattered lookups between
