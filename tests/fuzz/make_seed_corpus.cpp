@@ -74,6 +74,25 @@ int main(int argc, char** argv) {
             std::memcpy(values->data() + at, &f, 4);
         }
     scene.grids.push_back(pipeline::encodeGrid(rescaled));
+    // Half floats (13 zero low bits) of a noisy field: a float window whose
+    // integers the writer may code as coding 12 (coding/FloatIntegerCoder.h).
+    GridRecord half = ints;
+    half.name = "half";
+    half.valueType = ValueType::Float;
+    half.rescale.reset();
+    uint32_t lcg = 12345;
+    for (auto* values : {&half.values.bricks, &half.values.tiles})
+        for (size_t at = 0; at + 4 <= values->size(); at += 4) {
+            int32_t k;
+            std::memcpy(&k, values->data() + at, 4);
+            lcg = lcg * 1664525u + 1013904223u;
+            const float f = 0.5f + 0.001f * float(k % 97) + float(lcg >> 20) * 1e-5f;
+            uint32_t bits;
+            std::memcpy(&bits, &f, 4);
+            bits &= ~uint32_t(0x1FFF);
+            std::memcpy(values->data() + at, &bits, 4);
+        }
+    scene.grids.push_back(pipeline::encodeGrid(half));
     int n = 0;
     for (bool compress : {true, false}) {
         format::ContainerOptions options;

@@ -48,7 +48,7 @@ std::vector<uint32_t> roundTrip(const Window& w, const std::vector<uint8_t>& pay
 // turbulence (noise of a fiftieth of its swing, the same at a voxel however
 // it is reached), positive, its low 13 mantissa bits zero.
 uint32_t halfDensity(int X, int Y, int Z) {
-    std::mt19937 at(uint32_t(X * 73856093 ^ Y * 19349663 ^ Z * 83492791));
+    std::mt19937 at(uint32_t(X) * 73856093u ^ uint32_t(Y) * 19349663u ^ uint32_t(Z) * 83492791u);
     const double noise = std::normal_distribution<double>(0.0, 0.02)(at);
     const double d = 0.6 + 0.5 * std::sin(X * 0.21 + Y * 0.07) * std::cos(Z * 0.17 - Y * 0.05) + 0.002 * X + noise;
     return std::bit_cast<uint32_t>(float(std::max(d, 1e-5))) & ~uint32_t(0x1FFF);
