@@ -4,6 +4,7 @@
 #include <bit>
 // mirrored bricks, predicted int32 values) into a folder, as the fuzzer's seed corpus.
 #include <cstdio>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -74,25 +75,31 @@ int main(int argc, char** argv) {
             std::memcpy(values->data() + at, &f, 4);
         }
     scene.grids.push_back(pipeline::encodeGrid(rescaled));
-    // Half floats (13 zero low bits) of a noisy field: a float window whose
-    // integers the writer may code as coding 12 (coding/FloatIntegerCoder.h).
-    GridRecord half = ints;
-    half.name = "half";
-    half.valueType = ValueType::Float;
-    half.rescale.reset();
-    uint32_t lcg = 12345;
-    for (auto* values : {&half.values.bricks, &half.values.tiles})
-        for (size_t at = 0; at + 4 <= values->size(); at += 4) {
-            int32_t k;
-            std::memcpy(&k, values->data() + at, 4);
-            lcg = lcg * 1664525u + 1013904223u;
-            const float f = 0.5f + 0.001f * float(k % 97) + float(lcg >> 20) * 1e-5f;
-            uint32_t bits;
-            std::memcpy(&bits, &f, 4);
-            bits &= ~uint32_t(0x1FFF);
-            std::memcpy(values->data() + at, &bits, 4);
-        }
-    scene.grids.push_back(pipeline::encodeGrid(half));
+    // Half floats (13 zero low bits) of a turbulent field filling a 16^3
+    // box: a float window stored as coding 12, the integers of the floats'
+    // order (coding/FloatIntegerCoder.h), for the reader fuzzers to mutate.
+    {
+        GridRecord half;
+        half.name = "half";
+        half.valueType = ValueType::Float;
+        half.background = {0, 0, 0, 0};
+        uint32_t lcg = 12345;
+        for (int bz = 0; bz < 16; bz += 4)
+            for (int by = 0; by < 16; by += 4)
+                for (int bx = 0; bx < 16; bx += 4) {
+                    half.topology.bricks.push_back({bx, by, bz, ~uint64_t(0)});
+                    for (int i = 0; i < 64; ++i) {  // stored order: x fastest
+                        const int x = bx + (i & 3), y = by + (i >> 2 & 3), z = bz + (i >> 4);
+                        lcg = lcg * 1664525u + 1013904223u;
+                        const float f = 0.6f + 0.5f * std::sin(0.21f * float(x) + 0.07f * float(y)) * std::cos(0.17f * float(z)) + float(lcg >> 20) * 2e-5f;
+                        uint32_t bits;
+                        std::memcpy(&bits, &f, 4);
+                        bits &= ~uint32_t(0x1FFF);
+                        half.values.bricks.insert(half.values.bricks.end(), reinterpret_cast<const uint8_t*>(&bits), reinterpret_cast<const uint8_t*>(&bits) + 4);
+                    }
+                }
+        scene.grids.push_back(pipeline::encodeGrid(half));
+    }
     int n = 0;
     for (bool compress : {true, false}) {
         format::ContainerOptions options;
