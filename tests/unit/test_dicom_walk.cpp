@@ -93,16 +93,18 @@ TEST(DicomWalk, AnElementWithoutAVrUnderAnExplicitSyntaxIsRefused) {
 
 // The DICOM inputs fuzz_scan_headers failed on (tests/fuzz/regressions,
 // format byte 4; its README says what each did). Each starts like no DICOM
-// (no preamble, a first group neither 0002 nor 0008), which GDCM parses by
-// guessing its byte order and VRs: the walk refuses it before GDCM sees it,
-// and `vdbdag info` of the file and of its folder, under a 1.5 GB
-// address-space cap, lists it as skipped.
+// (no preamble and a first group neither 0002 nor 0008, or a DICM prefix
+// without the file meta group after it), which GDCM parses by guessing its
+// byte order and VRs: the walk refuses it before GDCM sees it, and `vdbdag
+// info` of the file and of its folder, under a 1.5 GB address-space cap,
+// lists it as skipped.
 TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
     const fs::path dir = fs::path(VDBDAG_SOURCE_DIR) / "tests/fuzz/regressions/scan_headers";
     const std::pair<const char*, const char*> cases[] = {{"dicom_cut_after_tag_abort", "its first element (0000,0000) is of neither"},
                                                          {"dicom_element_without_vr_oom", "its first element (0000,0000) is of neither"},
                                                          {"dicom_open_pixel_data_abort", "its first element (7FE0,0010) is of neither"},
-                                                         {"dicom_guessed_big_endian_oom", "its first element (0028,0103) is of neither"}};
+                                                         {"dicom_guessed_big_endian_oom", "its first element (0028,0103) is of neither"},
+                                                         {"dicom_no_meta_group_oom", "no file meta group after the DICM prefix: its first element is (FFFF,FFFF)"}};
     for (const auto& [name, why] : cases) {
         std::ifstream in(dir / name, std::ios::binary);
         const std::string input((std::istreambuf_iterator<char>(in)), {});
@@ -110,7 +112,6 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
         ASSERT_EQ(input[0], '\4') << name << ": a DICOM input";
         const fs::path file = write(std::string(name) + ".dcm", input.substr(1));
         const std::string problem = detail::elementLengthProblem(file.string());  // the whole file, as a lone file's DICOMDIR check reads it
-        EXPECT_EQ(problem.rfind("not a DICOM file", 0), 0u) << name << ": " << problem;
         EXPECT_NE(problem.find(why), std::string::npos) << name << ": " << problem;
         // The file alone (the fuzz target's call) and its folder: skipped,
         // saying why (the folder's scan stops its walk at the pixel data,

@@ -93,6 +93,16 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
     bool explicitVr = true, bigEndian = false, metaGroup = pos == 132, declaredImplicit = false;
     bool datasetStarted = false;  // an element after the file meta group was walked
     unknownStart = false;
+    // After the DICM prefix the file meta group (0002) comes first; GDCM
+    // guesses its way through a file where it does not (it read 295 bytes
+    // whose first element was (FFFF,FFFF) big-endian and allocated 2 GB:
+    // found by fuzz_scan_headers).
+    if (pos == 132) {
+        uint8_t t[4];
+        if (readAt(132, t, 4) && (t[0] | t[1] << 8) != 0x0002)
+            return fmt::format("no file meta group after the DICM prefix: its first element is ({:04X},{:04X})", uint16_t(t[0] | t[1] << 8),
+                               uint16_t(t[2] | t[3] << 8));
+    }
     if (pos == 0) {  // no preamble: walk only what starts like a DICOM dataset (else GDCM refuses it as not DICOM)
         uint8_t h[6];
         // GDCM asserts (aborts) on a file shorter than one element header

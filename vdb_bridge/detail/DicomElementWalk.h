@@ -6,9 +6,9 @@
 // the end of the file, a delimiter outside any sequence, an item tag DICOM
 // does not define, a file meta group cut short or with a VR DICOM does not
 // define, an element without a VR under an explicit transfer syntax, a file
-// that ends inside an element, a sequence or an item, and a file without
-// preamble whose first group is neither 0002 nor 0008 (GDCM guesses how to
-// read those). It also finds the top-level Pixel Data element, so native pixel
+// that ends inside an element, a sequence or an item, a file without
+// preamble whose first group is neither 0002 nor 0008, and a DICM prefix
+// without the file meta group after it (GDCM guesses how to read those). It also finds the top-level Pixel Data element, so native pixel
 // data are read by vdbdag itself (DicomSeries.cpp) and only compressed ones
 // are decoded by GDCM's image reader.
 #pragma once
