@@ -1,14 +1,12 @@
-// `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]
-//  [--abs-error E | --rel-error R] [--colour-bits K [--colour-grid NAME]...] [--normals K [--normal-grid NAME]]`
+// `vdbdag encode IN -o OUT.ssvdag [options]`: the options parsed into an
+// app::EncodeRequest (app/EncodeFile.h does the work) and the report
+// printed; a frame pattern, a folder of frames or a list with -o
+// NAME.ssvdag makes one sequence file of every frame; several other inputs
+// make one file each.
 #include <algorithm>
-// `vdbdag encode IN.vdb -o OUT.ssvdag [--grid NAME]... [--no-symmetry] [--topology-only]`
-// Dense scans (.raw, .nrrd, .nhdr, .mhd, .mha, by extension) are read by
-// vdb_bridge/DenseImport.h instead, with the raw layout and threshold options.
 #include <chrono>
 #include <filesystem>
 #include <optional>
-
-#include <tbb/global_control.h>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -16,26 +14,20 @@
 #include "app/EncodeFile.h"
 #include "cli/ByteSize.h"
 #include "cli/Commands.h"
+#include "cli/DenseInputOptions.h"
+#include "cli/FiniteNumber.h"
 #include "cli/GlobalOptions.h"
 #include "cli/JsonReport.h"
 #include "cli/RunContext.h"
 #include "cli/SceneReport.h"
-#include "cli/DenseInputOptions.h"
-#include "app/MemoryBudget.h"
-#include "cli/FiniteNumber.h"
-#include "src/pipeline/CubeEncoder.h"
-#include "src/pipeline/GridCodec.h"
-#include "src/util/Error.h"
-#include "src/util/AtomicFile.h"
-#include "src/util/FramePattern.h"
-#include "src/util/TemporaryFiles.h"
 #include "src/format/FrameSequence.h"
+#include "src/util/AtomicFile.h"
+#include "src/util/Error.h"
+#include "src/util/FramePattern.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
+#include "src/util/TemporaryFiles.h"
 #include "vdb_bridge/DenseImport.h"
-#include "vdb_bridge/NanoVdb.h"
-#include "vdb_bridge/VdbCubes.h"
-#include "vdb_bridge/VdbImport.h"
 
 namespace vdbdag::cli {
 namespace {

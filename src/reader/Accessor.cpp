@@ -16,9 +16,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
-#include <tuple>
 #include <utility>
-#include <cstdio>
 
 #include "src/encoding/CompactDag.h"
 #include "src/reader/GridData.h"
