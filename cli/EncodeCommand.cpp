@@ -19,7 +19,7 @@
 #include "cli/GlobalOptions.h"
 #include "cli/JsonReport.h"
 #include "cli/RunContext.h"
-#include "cli/SceneReport.h"
+#include "app/SceneReport.h"
 #include "src/format/FrameSequence.h"
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
@@ -166,8 +166,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 fmt::print("  grid '{}' {}: {} of {} values changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
                            l["name"].get<std::string>(), l["tolerance"].get<std::string>(), l["changed"].get<uint64_t>(), l["entries"].get<uint64_t>(),
                            l["max_abs_error"].get<double>(), l["mean_abs_error"].get<double>(), l["rms_error"].get<double>(), l["max_rel_error"].get<double>());
-            for (const auto& c : report["grids_colour"]) fmt::print("  {}\n", formatColour(c));
-            for (const auto& n : report["grids_normals"]) fmt::print("  {}\n", formatNormals(n));
+            for (const auto& c : report["grids_colour"]) fmt::print("  {}\n", app::formatColour(c));
+            for (const auto& n : report["grids_normals"]) fmt::print("  {}\n", app::formatNormals(n));
         }
         exitCode = 0;
     };

@@ -18,7 +18,7 @@
 #include "cli/DenseInputOptions.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
-#include "cli/SceneReport.h"
+#include "app/SceneReport.h"
 #include "cli/JsonReport.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/ParallelFor.h"
@@ -128,7 +128,7 @@ std::pair<format::SsvdagScene, nlohmann::json> encodedReport(const InfoOptions& 
     options.symmetry = !opt.noSymmetry;
     options.computeSvdagStats = true;
     format::SsvdagScene scene = pipeline::encodeVolume(volume, options);
-    nlohmann::json report = sceneReport(scene, format::writeScene(scene), input, true);
+    nlohmann::json report = app::sceneReport(scene, format::writeScene(scene), input, true);
     return {std::move(scene), std::move(report)};
 }
 
@@ -154,7 +154,7 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
         for (size_t g = 0; g < scene.grids.size(); ++g) {
             const format::GridSummary summary = format::summarizeGrid(scene.grids[g]);
             const std::string what = input + " grid " + std::to_string(g);
-            addGridHeader(report["grids"][g], scene.grids[g].record, bridge::gridHeaderFacts(scene.grids[g].record, summary.indexBox, what), summary,
+            app::addGridHeader(report["grids"][g], scene.grids[g].record, bridge::gridHeaderFacts(scene.grids[g].record, summary.indexBox, what), summary,
                           false);
         }
     } else if (kind != bridge::InputKind::Vdb) {
@@ -167,21 +167,21 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
         readOptions.limits = opt.limits.limits(0);
         readOptions.keepValueWindows = !opt.values;
         const format::SsvdagScene scene = format::readScene(bytes, input, readOptions);
-        report = sceneReport(scene, bytes, input, opt.values);
+        report = app::sceneReport(scene, bytes, input, opt.values);
         report["format"] = "ssvdag";
         report["input_bytes"] = bytes.size();
         for (size_t g = 0; g < scene.grids.size(); ++g) {
             const format::EncodedGrid& grid = scene.grids[g];
             const std::string what = input + " grid " + std::to_string(g);
             const format::GridSummary summary = format::summarizeGrid(grid);
-            addGridHeader(report["grids"][g], grid.record, bridge::gridHeaderFacts(grid.record, summary.indexBox, what), summary, false);
+            app::addGridHeader(report["grids"][g], grid.record, bridge::gridHeaderFacts(grid.record, summary.indexBox, what), summary, false);
         }
-        report["file_metadata"] = metadataJson(bridge::fileMetadataEntries(scene.fileMetadata, input + " file metadata"));
+        report["file_metadata"] = app::metadataJson(bridge::fileMetadataEntries(scene.fileMetadata, input + " file metadata"));
         if (!scene.frames.empty()) {  // a sequence: each frame's grids and its .vdb file's metadata
             report["frames"] = nlohmann::json::array();
             for (const format::SceneFrame& f : scene.frames) {
                 report["frames"].push_back({{"frame", f.number}, {"first_grid", f.firstGrid}, {"grid_count", f.gridCount},
-                                            {"file_metadata", metadataJson(bridge::fileMetadataEntries(f.metadata, input + " frame " + std::to_string(f.number) + " metadata"))}});
+                                            {"file_metadata", app::metadataJson(bridge::fileMetadataEntries(f.metadata, input + " frame " + std::to_string(f.number) + " metadata"))}});
                 for (uint32_t g = f.firstGrid; g < f.firstGrid + f.gridCount; ++g) report["grids"][g]["frame"] = f.number;
             }
         }
@@ -200,12 +200,12 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoOptions& opt, con
             const bridge::VdbGridFacts& f = facts.grids[g];
             GridRecord header = f.header;
             header.background = scene.grids[g].record.background;
-            addGridHeader(report["grids"][g], header, f.facts, f.summary, true);
+            app::addGridHeader(report["grids"][g], header, f.facts, f.summary, true);
         }
-        report["file_metadata"] = metadataJson(facts.fileMetadata);
+        report["file_metadata"] = app::metadataJson(facts.fileMetadata);
     }
     addVersions(report);  // the text names the format version too
-    std::string text = formatSceneReport(report);
+    std::string text = app::formatSceneReport(report);
     if (report.contains("frames")) {  // after the file's line: the frames and their grids
         const auto& frames = report["frames"];
         std::string lines = fmt::format("{} frames, {} to {}:\n", frames.size(), frames.front()["frame"].get<int64_t>(), frames.back()["frame"].get<int64_t>());

@@ -1,5 +1,5 @@
 // See SceneReport.h.
-#include "cli/SceneReport.h"
+#include "app/SceneReport.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,7 @@
 #include "src/format/TraceableValues.h"
 #include "vdb_bridge/DenseImport.h"
 
-namespace vdbdag::cli {
+namespace vdbdag::app {
 
 std::string formatColour(const nlohmann::json& c) {
     const auto mean = c["mean_abs_error_rgb"], max = c["max_abs_error_rgb"];
@@ -193,9 +193,9 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
         }
         if (grid.normals) {
             traceable += grid.normals->codes.byteSize();
-            j["normals"] = app::normalsJson(grid);
+            j["normals"] = normalsJson(grid);
         }
-        if (grid.colour) j["colour"] = app::colourJson(grid);
+        if (grid.colour) j["colour"] = colourJson(grid);
         if (valueStats) j["traceable_bytes"] = traceable;
         if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact)
             j["lossy"] = {{"tolerance", attributes::describe(grid.lossy.tolerance)}, {"changed", grid.lossy.changed},
@@ -299,4 +299,4 @@ std::string formatSceneReport(const nlohmann::json& r) {
     return out;
 }
 
-} // namespace vdbdag::cli
+} // namespace vdbdag::app

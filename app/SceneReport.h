@@ -13,7 +13,7 @@
 #include "src/format/SsvdagFile.h"
 #include "vdb_bridge/VdbSummary.h"
 
-namespace vdbdag::cli {
+namespace vdbdag::app {
 
 // `encodedBytes`: the scene as a .ssvdag (the file read, or the encoding of
 // a .vdb). With `valueStats`, each value channel's statistics (Dado et al.'s
@@ -33,4 +33,4 @@ nlohmann::json metadataJson(const std::vector<bridge::MetadataEntry>& entries);
 std::string formatColour(const nlohmann::json& colour);
 std::string formatNormals(const nlohmann::json& normals);
 
-} // namespace vdbdag::cli
+} // namespace vdbdag::app
