@@ -18,7 +18,7 @@
 
 #include <fmt/core.h>
 
-#include "cli/BenchReport.h"
+#include "app/BenchReport.h"
 #include "cli/Commands.h"
 #include "cli/JsonReport.h"
 #include "src/bench/ImageMetrics.h"
@@ -134,7 +134,7 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
     cmd->callback([opt, &exitCode] {
         const auto start = Clock::now();
         const Sweep sweep = sweepFor(opt->sweep);
-        BenchRun run;
+        app::BenchRun run;
         run.input = opt->input;
         run.sweep = opt->sweep;
         run.repeats = opt->repeats ? opt->repeats : sweep.repeats;
@@ -364,9 +364,9 @@ void addBenchCommand(CLI::App& app, int& exitCode) {
         }
         progress.finish();
         run.seconds = msSince(start) / 1000.0;
-        writeBenchReport(run, opt->output);
+        app::writeBenchReport(run, opt->output);
         if (opt->json) {
-            printJson(benchToJson(run));
+            printJson(app::benchToJson(run));
         } else {
             fmt::print("bench: {} points on {} grid(s) in {:.0f} s -> {}/report.md\n", run.points.size(), chosen.size(), run.seconds, opt->output);
         }

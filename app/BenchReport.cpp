@@ -1,7 +1,8 @@
 // Report files of `vdbdag bench`; see BenchReport.h.
-#include "cli/BenchReport.h"
+#include "app/BenchReport.h"
 
-#include "cli/JsonReport.h"
+#include "app/ReportVersions.h"
+
 
 #include <cmath>
 #include <limits>
@@ -14,7 +15,7 @@
 #include "src/util/AtomicFile.h"
 #include "vdb_bridge/PlotWriter.h"
 
-namespace vdbdag::cli {
+namespace vdbdag::app {
 namespace {
 
 nlohmann::json timingJson(const bench::Timing& t) {
@@ -272,4 +273,4 @@ void writeBenchReport(const BenchRun& run, const std::string& directory) {
     writeFileAtomically((dir / "report.md").string(), std::vector<uint8_t>(md.begin(), md.end()));
 }
 
-} // namespace vdbdag::cli
+} // namespace vdbdag::app

@@ -10,7 +10,7 @@
 
 #include "src/bench/BenchPoint.h"
 
-namespace vdbdag::cli {
+namespace vdbdag::app {
 
 struct BenchRun {
     std::string input, sweep, machine;
@@ -24,4 +24,4 @@ nlohmann::json benchToJson(const BenchRun& run);
 // Writes all files into `directory` (created if missing).
 void writeBenchReport(const BenchRun& run, const std::string& directory);
 
-} // namespace vdbdag::cli
+} // namespace vdbdag::app
