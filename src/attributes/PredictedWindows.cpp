@@ -139,20 +139,15 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
         return decodeRescaledFloats(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
                                     raw[0] == detail::kFittedRescaledFloatCoding ? 2 : 1);
     }
-    if (raw[0] == detail::kFloatCoding) {
-        if (dir.valueSize != 4) throw Error(where + ": predicted floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
+    if (raw[0] == detail::kFloatCoding || raw[0] == detail::kFloatIntegerCoding) {  // float32 bits predicted, or their order's integers
+        const bool integers = raw[0] == detail::kFloatIntegerCoding;
+        if (dir.valueSize != 4)
+            throw Error(where + ": " + (integers ? "float integers" : "predicted floats") + " of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
         std::vector<uint32_t> bits(size_t(e.entries));
-        coding::decodePlacedFloats(body, bricks, places.subspan(size_t(e.firstBrick), size_t(e.bricks)), bits, where);
-        std::vector<uint8_t> out(bits.size() * 4);
-        std::memcpy(out.data(), bits.data(), out.size());
-        return out;
-    }
-    if (raw[0] == detail::kFloatIntegerCoding) {
-        if (dir.valueSize != 4) throw Error(where + ": float integers of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
-        if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
-        std::vector<uint32_t> bits(size_t(e.entries));
-        coding::decodePlacedFloatIntegers(body, bricks, places.subspan(size_t(e.firstBrick), size_t(e.bricks)), bits, where);
+        const auto placesHere = places.subspan(size_t(e.firstBrick), size_t(e.bricks));
+        if (integers) coding::decodePlacedFloatIntegers(body, bricks, placesHere, bits, where);
+        else coding::decodePlacedFloats(body, bricks, placesHere, bits, where);
         std::vector<uint8_t> out(bits.size() * 4);
         std::memcpy(out.data(), bits.data(), out.size());
         return out;
