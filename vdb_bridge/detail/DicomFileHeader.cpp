@@ -112,6 +112,14 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
     std::string sop = f.text(ds, 0x0008, 0x0016);
     if (sop.empty()) sop = trim(f.text(file.GetHeader(), 0x0002, 0x0002));
     if (const std::string why = nonImageClass(sop); !why.empty()) return why;
+    // The retired Recognition Code of ACR-NEMA files: GDCM's image reader
+    // asserts (aborts) on one that does not start as theirs did (found by
+    // fuzz_scan_headers: "1.2.3.4.5.6.7" in an RLE file).
+    if (ds.FindDataElement(gdcm::Tag(0x0008, 0x0010))) {
+        const std::string code = trim(f.text(ds, 0x0008, 0x0010));
+        if (!startsWith(code, "ACR-NEMA") && !startsWith(code, "ACRNEMA") && !startsWith(code, "MIPS 2.0"))
+            return "corrupt DICOM: its Recognition Code (0008,0010) '" + code + "' is none an ACR-NEMA file has";
+    }
     const auto rows = f.numbers(ds, 0x0028, 0x0010), cols = f.numbers(ds, 0x0028, 0x0011);
     if (!rows || !cols || rows->size() != 1 || cols->size() != 1 || (*rows)[0] < 1 || (*cols)[0] < 1)
         return "no image (no Rows/Columns; SOP class " + sopClassName(sop) + ")";
