@@ -182,14 +182,19 @@ private:
     friend class Grid;
     explicit Accessor(const detail::GridData* grid);
     bool maskGrid() const;
+    // The slot holding voxel (i, j, k)'s brick, or -1; the voxel's index in it.
+    int64_t filledSlot(int64_t i, int64_t j, int64_t k) const {
+        if (cache_.filled.empty()) return -1;
+        const int64_t bx = i >> 2, by = j >> 2, bz = k >> 2;
+        const size_t s = BrickCache::slotOf(bx, by, bz);
+        return cache_.filled[s].is(bx, by, bz) ? int64_t(s) : -1;
+    }
+    static size_t voxelInBrick(int64_t i, int64_t j, int64_t k) { return size_t((i & 3) | (j & 3) << 2 | (k & 3) << 4); }
     // The cached value of voxel (i, j, k) (its N bytes), or null.
     template <size_t N>
     const uint8_t* cachedValue(int64_t i, int64_t j, int64_t k) const {
-        if (cache_.filled.empty()) return nullptr;
-        const int64_t bx = i >> 2, by = j >> 2, bz = k >> 2;
-        const size_t s = BrickCache::slotOf(bx, by, bz);
-        if (!cache_.filled[s].is(bx, by, bz)) return nullptr;
-        return cache_.values.data() + (s * 64 + size_t((i & 3) | (j & 3) << 2 | (k & 3) << 4)) * N;
+        const int64_t s = filledSlot(i, j, k);
+        return s < 0 ? nullptr : cache_.values.data() + (size_t(s) * 64 + voxelInBrick(i, j, k)) * N;
     }
     // valueBytes, with what it throws kept in failure_ (false) for
     // rethrowFailure to throw.

@@ -122,9 +122,9 @@ Accessor::Accessor(const detail::GridData* grid) : grid_(grid), valueSize_(grid-
 
 int64_t Accessor::brickSlot(int64_t i, int64_t j, int64_t k) {
     if (!cache_.usable) return -1;
+    if (const int64_t found = filledSlot(i, j, k); found >= 0) return found;
     const int64_t bx = i >> 2, by = j >> 2, bz = k >> 2;
     const size_t s = BrickCache::slotOf(bx, by, bz);
-    if (!cache_.filled.empty() && cache_.filled[s].is(bx, by, bz)) return int64_t(s);
     // The brick of the last miss again, or one next to it (a sweep), is
     // copied; a brick far from it (a scattered lookup) is not.
     const BrickCache::Key last = cache_.lastMiss;
@@ -216,10 +216,8 @@ void Accessor::fillSlot(size_t s, int64_t bx, int64_t by, int64_t bz) {
 bool Accessor::isActive(int64_t i, int64_t j, int64_t k) {
     // A brick of a grid with values is copied by a value's lookup only, so
     // that asking for active states decodes no values.
-    const int64_t bx = i >> 2, by = j >> 2, bz = k >> 2;
-    const size_t at = BrickCache::slotOf(bx, by, bz);
-    const int64_t s = valueSize_ == 0 ? brickSlot(i, j, k) : !cache_.filled.empty() && cache_.filled[at].is(bx, by, bz) ? int64_t(at) : -1;
-    if (s >= 0) return (cache_.active[size_t(s)] >> ((i & 3) | (j & 3) << 2 | (k & 3) << 4)) & 1u;
+    const int64_t s = valueSize_ == 0 ? brickSlot(i, j, k) : filledSlot(i, j, k);
+    if (s >= 0) return (cache_.active[size_t(s)] >> voxelInBrick(i, j, k)) & 1u;
     uint64_t entry = 0;
     return grid_->active.find(i, j, k, active_, entry);
 }
@@ -228,7 +226,7 @@ void Accessor::valueBytes(int64_t i, int64_t j, int64_t k, void* out) {
     if (grid_->valueSize == 0) return;
     auto* bytes = static_cast<uint8_t*>(out);
     if (const int64_t s = brickSlot(i, j, k); s >= 0) {
-        std::memcpy(bytes, cache_.values.data() + (size_t(s) * 64 + size_t((i & 3) | (j & 3) << 2 | (k & 3) << 4)) * valueSize_, valueSize_);
+        std::memcpy(bytes, cache_.values.data() + (size_t(s) * 64 + voxelInBrick(i, j, k)) * valueSize_, valueSize_);
         return;
     }
     uint64_t entry = 0;
