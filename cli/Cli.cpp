@@ -69,8 +69,10 @@ int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
         {"bench", "vdbdag bench smoke.vdb -o report/ --sweep quick"},
         {"selftest", "vdbdag selftest --list"},
     };
-    for (const auto& [name, example] : examples)
-        for (CLI::App* sub : app.get_subcommands([&](CLI::App* s) { return s->get_name() == name; })) sub->footer(std::string("Example:\n  ") + example);
+    for (const auto& entry : examples) {
+        const std::string name(entry.first);
+        for (CLI::App* sub : app.get_subcommands([&](CLI::App* s) { return s->get_name() == name; })) sub->footer(std::string("Example:\n  ") + entry.second);
+    }
     app.footer("Exit status: 0 done (diff: the same), 1 failed (diff: they differ), 2 a mistake in the command line (diff: failed).\n"
                "vdbdag help COMMAND, or vdbdag COMMAND --help, describes a command.");
     if (const std::optional<int> helped = answerHelpCommand(app, argc, argv)) return *helped;
