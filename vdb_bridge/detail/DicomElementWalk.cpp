@@ -1,6 +1,7 @@
 // The element walk that guards GDCM (see DicomElementWalk.h).
 #include "vdb_bridge/detail/DicomElementWalk.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstring>
@@ -133,6 +134,7 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         return bigEndian ? uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | b[3] : uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
     };
     std::string transferSyntax;
+    bool declaredSyntax = false;  // the file meta group holds a transfer syntax (0002,0010)
     // Where the walk is: the data set, a sequence (its items), encapsulated
     // pixel data (their fragments) or an item (its elements), each of a
     // defined length (it ends at `end`) or an undefined one (a delimiter
@@ -175,7 +177,8 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
             // file (fuzz_scan_headers); the walk cannot follow its guesses.
             if (!transferSyntax.empty() && transferSyntax != "1.2.840.10008.1.2" && transferSyntax.rfind("1.2.840.10008.1.2.", 0) != 0 &&
                 transferSyntax != "1.2.840.113619.5.2")
-                return fmt::format("its transfer syntax '{}' is none DICOM defines", transferSyntax);
+                return fmt::format("its transfer syntax '{}' is none DICOM defines",
+                                   transferSyntax.size() > 64 ? transferSyntax.substr(0, 64) + "..." : transferSyntax);
         }
         const bool le = inMeta || !bigEndian;
         const uint16_t group = le ? uint16_t(h[0] | h[1] << 8) : u16(h), element = le ? uint16_t(h[2] | h[3] << 8) : u16(h + 2);
@@ -210,17 +213,32 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
                                                    "OL", "OV", "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC", "UI", "UL", "UN",
                                                    "UR", "US", "UT", "UV"};
         if (inMeta && !knownVr.count(vr)) return fmt::format("file meta element ({:04X},{:04X}) at byte {} has no valid VR", group, element, pos);
+        // Nor on one of VR SQ: the file meta group holds no sequence, and
+        // GDCM asserts on one there (ReadExplicitDataElement,
+        // gdcmFileMetaInformation.cxx; a (0002,0001) SQ of length 0 after
+        // the DICM prefix: found by fuzz_scan_headers).
+        if (inMeta && std::strcmp(vr, "SQ") == 0)
+            return fmt::format("file meta element ({:04X},{:04X}) at byte {} is a sequence (VR SQ), which the file meta group never holds", group, element, pos);
         // An implicit transfer syntax is read as implicit (as GDCM does).
-        // Under an explicit one, a data set whose first element's VR bytes
-        // are no VR is read as implicit (a writer that declared the wrong
-        // syntax), and any later element without a VR is refused: GDCM
+        // Under an explicit one, an element without a VR is refused: GDCM
         // guesses how to read such an element, and a 462-byte file whose
         // guessed length GDCM allocated took 1.7 GB (found by
-        // fuzz_scan_headers; the walk had read it as implicit).
+        // fuzz_scan_headers; the walk had read it as implicit). Only a data
+        // set without a file meta group to declare its syntax, whose first
+        // element's VR bytes are no VR, is read as implicit, as GDCM guesses
+        // it. Under a syntax the file meta group declares explicit, GDCM
+        // reads such a first element and those after it with a 2-byte
+        // length after the 2 bytes where the VR belongs
+        // (VR16ExplicitDataElement), not as implicit, and asserted when the
+        // file ended after such a tag and VR (a 506-byte RLE file the walk
+        // had read as implicit: found by fuzz_scan_headers).
         if (!inMeta && !declaredImplicit) {
             const bool known = knownVr.count(vr) > 0;
-            if (!datasetStarted && !known) declaredImplicit = true, explicitVr = false;
-            else if (!known) return fmt::format("element ({:04X},{:04X}) at byte {} has no valid VR under an explicit transfer syntax", group, element, pos);
+            if (!datasetStarted && !known && !declaredSyntax) declaredImplicit = true, explicitVr = false;
+            else if (!known)
+                return declaredSyntax ? fmt::format("element ({:04X},{:04X}) at byte {} has no valid VR under the explicit transfer syntax {} its file meta group declares",
+                                                    group, element, pos, transferSyntax)
+                                      : fmt::format("element ({:04X},{:04X}) at byte {} has no valid VR under an explicit transfer syntax", group, element, pos);
             else explicitVr = true;
         }
         if (!inMeta) datasetStarted = true;
@@ -268,11 +286,22 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
             if (pixelLength && group == kPixelGroup && element == 0x0010) *pixelLength = length;
             return fmt::format("element ({:04X},{:04X}) at byte {} claims {} bytes, but only {} follow", group, element, pos, length, size - pos - header);
         }
-        if (inMeta && element == 0x0010 && length < 256) {
-            std::string uid(length, '\0');
-            readAt(pos + header, uid.data(), length);
-            while (!uid.empty() && (uid.back() == '\0' || uid.back() == ' ')) uid.pop_back();
+        // The transfer syntax as GDCM reads it: the first (0002,0010), its
+        // value up to its first NUL, less trailing spaces, however long the
+        // element (the walk had skipped one of 276 bytes, "1.2.840.10008.1.2.5"
+        // and a NUL before other bytes, that GDCM read as RLE: found by
+        // fuzz_scan_headers).
+        if (inMeta && element == 0x0010 && !declaredSyntax) {
+            constexpr uint64_t kMaxUid = 64 * 1024;
+            std::string uid(std::min(length, kMaxUid), '\0');
+            if (!readAt(pos + header, uid.data(), uid.size())) return fmt::format("element (0002,0010) at byte {} is cut off", pos);
+            const size_t nul = uid.find('\0');
+            if (nul == std::string::npos && length > kMaxUid)
+                return fmt::format("its transfer syntax (0002,0010) at byte {} is {} bytes long", pos, length);
+            if (nul != std::string::npos) uid.resize(nul);
+            while (!uid.empty() && uid.back() == ' ') uid.pop_back();
             transferSyntax = uid;
+            declaredSyntax = true;
         }
         // An explicit SQ of defined length: GDCM reads its items, so the walk does.
         if ((inMeta || explicitVr) && std::string(vr) == "SQ" && length > 0) {

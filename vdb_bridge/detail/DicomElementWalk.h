@@ -4,8 +4,9 @@
 // below reads the element headers only (tag, VR, length; into sequences and
 // items of undefined length, keeping their nesting) and refuses a length past
 // the end of the file, a delimiter outside any sequence, an item tag DICOM
-// does not define, a file meta group cut short or with a VR DICOM does not
-// define, an element without a VR under an explicit transfer syntax, a file
+// does not define, a file meta group cut short, with a VR DICOM does not
+// define or with a sequence, an element without a VR under an explicit transfer
+// syntax (the first too, when the file meta group declares it), a file
 // that ends inside an element, a sequence or an item, a file without
 // preamble whose first group is neither 0002 nor 0008, and a DICM prefix
 // without the file meta group after it (GDCM guesses how to read those). It also finds the top-level Pixel Data element, so native pixel
