@@ -107,7 +107,10 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                          {"dicom_guessed_big_endian_oom", "its first element (0028,0103) is of neither"},
                                                          {"dicom_no_meta_group_oom", "no file meta group after the DICM prefix: its first element is (FFFF,FFFF)"},
                                                          // walks, but is refused when its header is read
-                                                         {"dicom_recognition_code_abort", "its Recognition Code (0008,0010) '1.2.3.4.5.6.7' is none"}};
+                                                         {"dicom_recognition_code_abort", "its Recognition Code (0008,0010) '1.2.3.4.5.6.7' is none"},
+                                                         {"dicom_meta_explicit_without_vr_abort",
+                                                          "has no valid VR under the explicit transfer syntax 1.2.840.10008.1.2.5 its file meta group declares"},
+                                                         {"dicom_meta_sequence_abort", "is a sequence (VR SQ)"}};
     for (const auto& [name, why] : cases) {
         std::ifstream in(dir / name, std::ios::binary);
         const std::string input((std::istreambuf_iterator<char>(in)), {});
