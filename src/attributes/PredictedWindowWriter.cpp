@@ -114,13 +114,13 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         if (floats->lattice)
             if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *floats->lattice)) {
                 const uint64_t latticeSize = integers->size();
-                consider(std::move(*integers), latticeSize, detail::kFittedRescaledFloatCoding);
+                consider(std::move(*integers), latticeSize, detail::kWideRescaledFloatCoding);
             }
     } else if (vs == 4) {
         const bool placed = !places.empty();
         std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel));
         const uint64_t size = numeric.size();
-        consider(std::move(numeric), size, placed ? detail::kFittedContextCoding : detail::kContextCoding);
+        consider(std::move(numeric), size, placed ? detail::kWideContextCoding : detail::kContextCoding);
         labelsLike = placed && looksLikeLabels(values);
         if (labelsLike) {
             std::vector<uint8_t> labels = encodeContextChannel(values, layout, places, true);

@@ -102,9 +102,9 @@ struct CompactRecord {
     }
 };
 
-// Generation 2 (kReach Wide) also finds the far neighbours, with the raster
-// walk's substitutes (IntVolumeCoder.cpp) where a neighbour's brick is not
-// visited yet.
+// Generation 2 (kReach Wide) also finds the far neighbours, generation 3
+// (Widest) five more, with the raster walk's substitutes (IntVolumeCoder.cpp)
+// where a neighbour's brick is not visited yet.
 template <Reach kReach, typename Step>
 void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
                 Models& models, Step&& step) {
@@ -138,12 +138,18 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             } else {
                 n.P = med(n.W, n.N, n.NW), n.PW = n.W, n.PN = n.N, n.PNW = n.NW;
             }
-            if constexpr (kReach == Reach::Wide) {
+            if constexpr (kReach >= Reach::Wide) {
                 const auto o = [&](Nb::Which k, int64_t substitute) { return nb.has(k) ? v(k) : substitute; };
                 n.far[kWW] = o(Nb::WW, n.W), n.far[kNN] = o(Nb::NN, n.N), n.far[kPP] = o(Nb::PP, n.P);
                 n.far[kPE] = o(Nb::PE, n.P), n.far[kPS] = o(Nb::PS, n.P), n.far[kPNE] = o(Nb::PNE, n.PN), n.far[kPSW] = o(Nb::PSW, n.PW);
                 n.far[kPSE] = o(Nb::PSE, n.far[kPS]), n.far[kNWW] = o(Nb::NWW, n.NW), n.far[kNNE] = o(Nb::NNE, n.far[kNN]);
                 n.far[kNNW] = o(Nb::NNW, n.far[kNN]), n.far[kNEE] = o(Nb::NEE, n.NE);
+                if constexpr (kReach == Reach::Widest) {
+                    n.far[kWWW] = o(Nb::WWW, n.far[kWW]), n.far[kWWWW] = o(Nb::WWWW, n.far[kWWW]), n.far[kNWWW] = o(Nb::NWWW, n.far[kNWW]);
+                    n.far[kNEEE] = o(Nb::NEEE, n.far[kNEE]), n.far[kNNN] = o(Nb::NNN, n.far[kNN]);
+                    for (const Nb::Which k : {Nb::WW, Nb::NN, Nb::NEE})
+                        if (nb.has(k)) n.residualsFar += nb.rec(k).residual;
+                }
             } else {
                 n.far.fill(n.W);
             }
@@ -157,7 +163,7 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             const auto add = [&](Nb::Which k, unsigned times) {
                 if (!nb.has(k)) return;
                 const CompactRecord& r = nb.rec(k);
-                if constexpr (kReach != Reach::Wide)  // generation 2 has no blend to weigh
+                if constexpr (kReach < Reach::Wide)  // generations 2 and 3 have no blend to weigh
                     for (size_t j = 0; j < size_t(kPredictors); ++j) n.errorsAbove[j] += times * uint64_t(r.err[j]);
                 n.residualsAbove += times * uint64_t(r.residual);
             };
@@ -176,7 +182,8 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
 template <typename Step>
 void walkPlacedAny(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
                    Models& models, Step&& step) {
-    if (options.model >= 2) walkPlaced<Reach::Wide>(layout, places, entries, order, options, models, step);
+    if (options.model >= 3) walkPlaced<Reach::Widest>(layout, places, entries, order, options, models, step);
+    else if (options.model == 2) walkPlaced<Reach::Wide>(layout, places, entries, order, options, models, step);
     else walkPlaced<Reach::Near>(layout, places, entries, order, options, models, step);
 }
 

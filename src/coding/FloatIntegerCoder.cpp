@@ -10,12 +10,14 @@
 namespace vdbdag::coding {
 namespace {
 
-constexpr uint8_t kGeneration = 0;
+// The header's generation: 0, the integers coded by model generation 2
+// (written 2026-12-05 to 2026-12-06); 1, by generation 3 (what is written).
+constexpr uint8_t kGeneration = 1;
 constexpr size_t kHeaderBytes = 10;  // generation, shift, min, max
 
-IntCoderOptions optionsFor(int32_t lo, int32_t hi) {
+IntCoderOptions optionsFor(int32_t lo, int32_t hi, uint8_t generation) {
     IntCoderOptions o;
-    o.minValue = lo, o.maxValue = hi, o.model = 2;
+    o.minValue = lo, o.maxValue = hi, o.model = generation == 0 ? 2 : 3;
     return o;
 }
 
@@ -45,7 +47,7 @@ std::vector<uint8_t> encodePlacedFloatIntegers(std::span<const uint32_t> bits, s
     std::vector<uint8_t> out{kGeneration, uint8_t(shift)};
     putI32(out, lo);
     putI32(out, hi);
-    const std::vector<uint8_t> stream = encodePlacedBrickValues(ints, layout, places, BrickOrder::Raster, optionsFor(lo, hi));
+    const std::vector<uint8_t> stream = encodePlacedBrickValues(ints, layout, places, BrickOrder::Raster, optionsFor(lo, hi, kGeneration));
     out.insert(out.end(), stream.begin(), stream.end());
     return out;
 }
@@ -53,7 +55,7 @@ std::vector<uint8_t> encodePlacedFloatIntegers(std::span<const uint32_t> bits, s
 void decodePlacedFloatIntegers(std::span<const uint8_t> payload, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
                                std::span<uint32_t> out, const std::string& what) {
     if (payload.size() < kHeaderBytes) throw Error(what + ": float integers: " + std::to_string(payload.size()) + " bytes, shorter than their header");
-    if (payload[0] != kGeneration) throw Error(what + ": float integers of generation " + std::to_string(payload[0]) + " (this reader knows 0)");
+    if (payload[0] > kGeneration) throw Error(what + ": float integers of generation " + std::to_string(payload[0]) + " (this reader knows 0 and 1)");
     const unsigned shift = payload[1];
     const int32_t lo = getI32(payload.data() + 2), hi = getI32(payload.data() + 6);
     if (shift > 31) throw Error(what + ": float integers shifted by " + std::to_string(shift) + " bits (at most 31)");
@@ -63,7 +65,7 @@ void decodePlacedFloatIntegers(std::span<const uint8_t> payload, std::span<const
         throw Error(what + ": float integers in " + std::to_string(lo) + ".." + std::to_string(hi) + ", beyond what " + std::to_string(31 - shift) +
                     "-bit magnitudes give");
     std::vector<int32_t> ints(out.size());
-    decodePlacedBrickValues(payload.subspan(kHeaderBytes), layout, places, BrickOrder::Raster, optionsFor(lo, hi), ints, what);
+    decodePlacedBrickValues(payload.subspan(kHeaderBytes), layout, places, BrickOrder::Raster, optionsFor(lo, hi, payload[0]), ints, what);
     for (size_t i = 0; i < ints.size(); ++i) {
         const int32_t v = ints[i];
         out[i] = v < 0 ? 0x80000000u | (uint32_t(-1 - v) << shift) : uint32_t(v) << shift;

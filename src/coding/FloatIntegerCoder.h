@@ -17,10 +17,11 @@
 // and a negative one is -1 - M: monotonic in the floats' order (-0 < +0,
 // NaNs at the ends) and one-to-one, so every bit pattern comes back. They
 // are coded by encodePlacedBrickValues in raster brick order under model
-// generation 2, within [min, max] of the window's integers.
+// generation 3 (the header's generation 1; generation 0, still read: model
+// generation 2), within [min, max] of the window's integers.
 //
-// Payload: u8 generation (0), u8 s (0..31), i32 min, i32 max (little-
-// endian), the integer coder's stream.
+// Payload: u8 generation (1; 0 still read), u8 s (0..31), i32 min, i32 max
+// (little-endian), the integer coder's stream.
 #pragma once
 #include <cstdint>
 #include <span>

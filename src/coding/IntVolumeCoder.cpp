@@ -20,8 +20,8 @@ namespace {
 
 using namespace detail;
 
-// Generation 2's far neighbours (LeastSquaresPredictor.h) of sample i at
-// (x, y, z), each with the nearest near neighbour where the volume ends.
+// Generations 2's and 3's far neighbours (LeastSquaresPredictor.h) of sample
+// i at (x, y, z), each with the nearest near neighbour where the volume ends.
 inline void farNeighbours(Neighbourhood& n, int64_t x, int64_t y, int64_t z, int64_t nx, int64_t ny, size_t i, const std::vector<int64_t>& cur,
                           const std::vector<int64_t>& prev, const std::vector<int64_t>& prev2) {
     const size_t row = size_t(nx);
@@ -38,6 +38,11 @@ inline void farNeighbours(Neighbourhood& n, int64_t x, int64_t y, int64_t z, int
     n.far[kNNE] = y > 1 && hE ? cur[i - 2 * row + 1] : n.far[kNN];
     n.far[kNNW] = y > 1 && hx ? cur[i - 2 * row - 1] : n.far[kNN];
     n.far[kNEE] = x + 2 < nx && hy ? cur[i - row + 2] : n.NE;
+    n.far[kWWW] = x > 2 ? cur[i - 3] : n.far[kWW];
+    n.far[kWWWW] = x > 3 ? cur[i - 4] : n.far[kWWW];
+    n.far[kNWWW] = x > 2 && hy ? cur[i - row - 3] : n.far[kNWW];
+    n.far[kNEEE] = x + 3 < nx && hy ? cur[i - row + 3] : n.far[kNEE];
+    n.far[kNNN] = y > 2 ? cur[i - 3 * row] : n.far[kNN];
 }
 
 // The raster walk shared by both directions. `step(prediction, sample
@@ -94,6 +99,9 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
                 n.rP = hz ? &prevRec[i] : nullptr;
                 std::copy_n(&rowErrors[size_t(x) * kPredictors], kPredictors, n.errorsAbove.begin());
                 n.residualsAbove = rowResiduals[size_t(x)];
+                if (models.farActivity)
+                    n.residualsFar = uint64_t(x > 1 ? curRec[i - 2].residual : 0) + (y > 1 ? curRec[i - 2 * size_t(nx)].residual : 0) +
+                                     (hy && x + 2 < nx ? curRec[i - size_t(nx) + 2].residual : 0);
                 const Prediction pr = predict(n, options.minValue, options.maxValue, models);
                 const int64_t value = step(pr, size_t(z) * plane + i);
                 learn(pr, value, curRec[i]);

@@ -45,7 +45,7 @@ struct IntVolumeShape {
 };
 
 // The newest model generation (SamplePredictor.h), what a writer writes.
-inline constexpr int kLatestIntModel = 2;
+inline constexpr int kLatestIntModel = 3;
 
 struct IntCoderOptions {
     // Every sample and every reconstruction lies in [minValue, maxValue]
@@ -56,7 +56,10 @@ struct IntCoderOptions {
     // The model's generation (SamplePredictor.h): 0, bias correction per
     // activity context (window codings 2-4 of files written before 2026-12-05);
     // 1, per activity context and texture (codings 5 and 6); 2, the least-
-    // squares fit and the floor flag (codings 10 and 11, and this coder).
+    // squares fit and the floor flag (codings 10 and 11, written
+    // 2026-12-05 to 2026-12-06); 3, the fit over 24 neighbours, solved every
+    // 64 samples, and the activity over WW, NN, NEE too (codings 13 and 14,
+    // coding 12's generation 1, and this coder).
     int model = kLatestIntModel;
 };
 

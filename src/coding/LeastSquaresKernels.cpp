@@ -17,11 +17,12 @@ namespace vdbdag::coding::detail {
 #if defined(__x86_64__) && (!defined(__clang__) || __clang_major__ >= 14)
 __attribute__((target_clones("avx2", "default")))
 #endif
-void addProducts(float* pa, float* pb, const float* x, float y) {
-    for (int i = 0; i < kLsTaps; ++i) {
+void addProducts(float* pa, float* pb, const float* x, float y, int taps) {
+    for (int i = 0; i < taps; ++i) {
         const float xi = x[i];
         float* row = pa + i * kLsStride;
-        for (int j = 0; j < kLsStride; ++j) row[j] += xi * x[j];
+        const int end = (i / 8 + 1) * 8;  // the lower triangle, to whole vectors (at most kLsStride)
+        for (int j = 0; j < end; ++j) row[j] += xi * x[j];
         pb[i] += xi * y;
     }
 }
@@ -34,16 +35,16 @@ void addProducts(float* pa, float* pb, const float* x, float y) {
 #if defined(__x86_64__) && (!defined(__clang__) || __clang_major__ >= 14)
 __attribute__((target_clones("avx2", "default")))
 #endif
-void solveFit(const double* a, const double* b, double* c) {
-    constexpr size_t T = kLsTaps;
+void solveFit(const double* a, const double* b, double* c, int taps) {
+    const size_t T = size_t(taps);
     double trace = 0;
-    for (size_t i = 0; i < T; ++i) trace += a[i * T + i];
-    const double ridge = kLsRidge * trace / kLsTaps + 1e-6;
-    std::array<double, T * T> col{};
-    std::array<double, T> inv{};  // 1 / L's diagonal
+    for (size_t i = 0; i < T; ++i) trace += a[i * kLsStride + i];
+    const double ridge = kLsRidge * trace / double(taps) + 1e-6;
+    std::array<double, kLsMaxTaps * kLsMaxTaps> col{};
+    std::array<double, kLsMaxTaps> inv{};  // 1 / L's diagonal
     for (size_t k = 0; k < T; ++k)
-        for (size_t i = k; i < T; ++i) col[k * T + i] = a[i * T + k] + (i == k ? ridge : 0.0);
-    std::array<double, T> z;
+        for (size_t i = k; i < T; ++i) col[k * T + i] = a[i * kLsStride + k] + (i == k ? ridge : 0.0);
+    std::array<double, kLsMaxTaps> z;
     for (size_t i = 0; i < T; ++i) z[i] = b[i];
     for (size_t j = 0; j < T; ++j) {
         double* cj = &col[j * T];
@@ -59,13 +60,14 @@ void solveFit(const double* a, const double* b, double* c) {
         z[j] *= inv[j];
         for (size_t i = j + 1; i < T; ++i) z[i] -= cj[i] * z[j];
     }
-    std::array<double, T> w{};
+    std::array<double, kLsMaxTaps> w{};
     for (size_t i = T; i-- > 0;) {
         double s = z[i];
         for (size_t k = i + 1; k < T; ++k) s -= col[i * T + k] * w[k];
         w[i] = s * inv[i];
     }
-    for (double& v : w) {
+    for (size_t i = 0; i < T; ++i) {
+        double& v = w[i];
         if (!std::isfinite(v)) return;
         if (std::abs(v) < kLsTiny) v = 0;
     }

@@ -8,7 +8,8 @@
 //                   W  *                         PW  P
 // (and, for a walk that asks for them, WW, NN and PP two voxels back along
 // x, y and z, Reach::Far; and also the rest of the slice below, PE, PS,
-// PNE, PSW, PSE, and NWW, NNE, NNW, NEE, Reach::Wide) wherever they were
+// PNE, PSW, PSE, and NWW, NNE, NNW, NEE, Reach::Wide; and also WWW, WWWW,
+// NWWW, NEEE, NNN, Reach::Widest) wherever they were
 // visited before in the same walk (in this brick or in any brick before it),
 // and its entry: the rank of its stored bit (dag_access.h dagStoredBit). A
 // tile (mask 0) is one entry without place.
@@ -41,11 +42,11 @@ struct PlacedBrick {
     Rec rec[64];
 };
 
-enum class Reach { Near, Far, Wide };
+enum class Reach { Near, Far, Wide, Widest };
 
 template <typename Rec>
 struct PlacedNeighbours {
-    enum Which { W, N, NW, NE, P, PW, PN, PNW, WW, NN, PP, PE, PS, PNE, PSW, PSE, NWW, NNE, NNW, NEE, kCount };
+    enum Which { W, N, NW, NE, P, PW, PN, PNW, WW, NN, PP, PE, PS, PNE, PSW, PSE, NWW, NNE, NNW, NEE, WWW, WWWW, NWWW, NEEE, NNN, kCount };
     const PlacedBrick<Rec>* brick[kCount];
     int bit[kCount];
     bool has(Which k) const { return brick[k] != nullptr; }
@@ -157,10 +158,10 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
         bricks.emplace_back();
         PlacedBrick<Rec>& self = bricks.back();
         // The bricks around that hold causal neighbours: dx in -1..1, dy in
-        // -1..0 (-1..1 for Reach::Wide, whose PS lies a row ahead), dz in -1..0.
+        // -1..0 (-1..1 for Reach::Wide and Widest, whose PS lies a row ahead), dz in -1..0.
         const PlacedBrick<Rec>* around[3][3][2];
         for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= (kReach == Reach::Wide ? 1 : 0); ++dy)
+            for (int dy = -1; dy <= (kReach >= Reach::Wide ? 1 : 0); ++dy)
                 for (int dz = -1; dz <= 0; ++dz) {
                     const auto it = slots.find(BrickKey{bx + dx, by + dy, bz + dz});
                     around[dx + 1][dy + 1][dz + 1] = (dx == 0 && dy == 0 && dz == 0) ? &self : it == slots.end() ? nullptr : &bricks[it->second];
@@ -169,7 +170,7 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
         PlacedNeighbours<Rec> n;
         // A neighbour's brick and bit, or null when it is not visited yet.
         const auto at = [&](typename PlacedNeighbours<Rec>::Which k, int x, int y, int z) {
-            const int ox = x < 0 ? -1 : x > 3 ? 1 : 0, oy = y < 0 ? -1 : y > 3 ? 1 : 0, oz = z < 0 ? -1 : 0;  // x, y, z in -2..5
+            const int ox = x < 0 ? -1 : x > 3 ? 1 : 0, oy = y < 0 ? -1 : y > 3 ? 1 : 0, oz = z < 0 ? -1 : 0;  // x in -4..6, y in -3..4, z in -2..3
             const PlacedBrick<Rec>* t = around[ox + 1][oy + 1][oz + 1];
             n.bit[k] = (x & 3) + 4 * (y & 3) + 16 * (z & 3);
             n.brick[k] = t && (t->done >> n.bit[k] & 1) ? t : nullptr;
@@ -180,11 +181,13 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
             at(Nb::W, x - 1, y, z), at(Nb::N, x, y - 1, z), at(Nb::NW, x - 1, y - 1, z), at(Nb::NE, x + 1, y - 1, z);
             at(Nb::P, x, y, z - 1), at(Nb::PW, x - 1, y, z - 1), at(Nb::PN, x, y - 1, z - 1), at(Nb::PNW, x - 1, y - 1, z - 1);
             if constexpr (kReach != Reach::Near) at(Nb::WW, x - 2, y, z), at(Nb::NN, x, y - 2, z), at(Nb::PP, x, y, z - 2);
-            if constexpr (kReach == Reach::Wide) {
+            if constexpr (kReach >= Reach::Wide) {
                 at(Nb::PE, x + 1, y, z - 1), at(Nb::PS, x, y + 1, z - 1), at(Nb::PNE, x + 1, y - 1, z - 1), at(Nb::PSW, x - 1, y + 1, z - 1);
                 at(Nb::PSE, x + 1, y + 1, z - 1), at(Nb::NWW, x - 2, y - 1, z), at(Nb::NNE, x + 1, y - 2, z), at(Nb::NNW, x - 1, y - 2, z);
                 at(Nb::NEE, x + 2, y - 1, z);
             }
+            if constexpr (kReach == Reach::Widest)
+                at(Nb::WWW, x - 3, y, z), at(Nb::WWWW, x - 4, y, z), at(Nb::NWWW, x - 3, y - 1, z), at(Nb::NEEE, x + 3, y - 1, z), at(Nb::NNN, x, y - 3, z);
             const unsigned stored = access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), place.mirror);
             voxel(n, e + uint64_t(std::popcount(mask & ((uint64_t(1) << stored) - 1))), self.value[p], self.rec[p]);
             self.done |= uint64_t(1) << p;

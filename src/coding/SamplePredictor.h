@@ -1,10 +1,10 @@
 // The per-sample model of the integer value coders (docs/CODING.md): six
 // predictions from a causal 3-D neighbourhood blended by their local errors
-// (generations 0 and 1) or a least-squares fit over 19 neighbours
-// (generation 2, LeastSquaresPredictor.h), an activity context, bias
+// (generations 0 and 1) or a least-squares fit over 19 or 24 neighbours
+// (generations 2 and 3, LeastSquaresPredictor.h), an activity context, bias
 // correction (per activity context, generation 0, or per activity context
-// and texture, generations 1 and 2), and the residual's binary coding.
-// Generation 2 also codes "the sample is the range's minimum" first where a
+// and texture, generations 1 to 3), and the residual's binary coding.
+// Generations 2 and 3 also code "the sample is the range's minimum" first where a
 // neighbour holds it (a scan's background at a tissue's edge).
 // IntVolumeCoder walks a raster box with it, BrickValueCoder the 4^3 bricks
 // of a DAG's attribute order; both hand it the same neighbourhood
@@ -58,9 +58,14 @@ struct ContextModels {
 inline constexpr int kLatestModel = kLatestIntModel;
 
 struct Models {
-    explicit Models(int generation) : textureBias(generation >= 1), leastSquares(generation >= 2) {}
-    bool textureBias;   // generations 1, 2: the bias corrections below, not the contexts' own
-    bool leastSquares;  // generation 2: the fits below predict, and the floor flags
+    explicit Models(int generation) : textureBias(generation >= 1), leastSquares(generation >= 2), farActivity(generation >= 3) {
+        for (LeastSquaresFit& f : fit) f.shape = generation >= 3 ? kLsGeneration3 : kLsGeneration2;
+    }
+    bool textureBias;   // generations 1-3: the bias corrections below, not the contexts' own
+    bool leastSquares;  // generations 2, 3: the fits below predict, and the floor flags
+    // Generation 3: the activity also counts the residuals at WW, NN and NEE
+    // (Neighbourhood::residualsFar; 0.1-0.3 % smaller on the shared scans).
+    bool farActivity;
     std::array<ContextModels, kContexts> ctx;
     std::array<std::array<BitModel, kMaxLength + 1>, kMaxLength + 1> low;  // [length][bit]: the remaining bits
     // Generation 1's bias corrections, per activity context and texture:
@@ -70,13 +75,13 @@ struct Models {
     // per context cannot see which side. On the shared scans 1-2.4 % smaller
     // (tooth the most: 637,721 -> 622,454 bytes in raster order).
     std::array<BiasCell, size_t(kContexts) * kTextures> bias;
-    // Generation 2's fits, one per kContextsPerFit activity contexts: four
+    // Generation 2's and 3's fits, one per kContextsPerFit activity contexts: four
     // (two bit lengths of the activity) beat one per context on every scan
     // (cthead 1.3 %, tooth 0.1 %: more samples per fit), and beat eight
     // (tooth 0.5 %) and one for all (cthead 1.5 %).
     static constexpr int kContextsPerFit = 4;
     std::array<LeastSquaresFit, (kContexts + kContextsPerFit - 1) / kContextsPerFit> fit;
-    // Generation 2's "the sample is the minimum" flag, coded before the
+    // Generation 2's (and 3's) "the sample is the minimum" flag, coded before the
     // residual where 1-7 of W, N, NW, NE, P, PW, PN hold the minimum and the
     // prediction does not: by how many (the edge of a skull-stripped MR's
     // zero background: FLAIR 2.2 % smaller) and the activity (8 buckets).
@@ -85,7 +90,15 @@ struct Models {
 
 inline uint32_t saturate(int64_t v) { return v > int64_t(UINT32_MAX) ? UINT32_MAX : uint32_t(v); }
 
-inline int64_t divRound(int64_t a, int64_t b) { return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b); }
+// a / b rounded half away from zero (b > 0); in 32 bits where both fit (the
+// same quotient: a 64-bit division was a tenth of the coder's time).
+inline int64_t divRound(int64_t a, int64_t b) {
+    if (a > -(int64_t(1) << 30) && a < (int64_t(1) << 30) && b < (int64_t(1) << 30)) {
+        const int32_t a32 = int32_t(a), b32 = int32_t(b);
+        return a32 >= 0 ? (a32 + b32 / 2) / b32 : -((-a32 + b32 / 2) / b32);
+    }
+    return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b);
+}
 
 inline int64_t med(int64_t w, int64_t n, int64_t nw) {
     if (nw >= std::max(w, n)) return std::min(w, n);
@@ -111,7 +124,7 @@ inline int64_t weightOf(uint64_t errors) { return kWeights[errors < kWeightCap ?
 // the placed walk's time).
 struct Neighbourhood {
     int64_t W, N, NW, NE, P, PW, PN, PNW;
-    std::array<int64_t, kFarNeighbours> far;  // generation 2 (LeastSquaresPredictor.h): set by every walk
+    std::array<int64_t, kFarNeighbours> far;  // generations 2, 3 (LeastSquaresPredictor.h): set by every walk
     const SampleRecord* rW = nullptr;
     const SampleRecord* rN = nullptr;
     const SampleRecord* rP = nullptr;
@@ -119,18 +132,21 @@ struct Neighbourhood {
     // errors and the residual magnitudes. W's part is added by predict().
     std::array<uint64_t, kPredictors> errorsAbove{};
     uint64_t residualsAbove = 0;
+    uint64_t residualsFar = 0;  // generation 3: the residual magnitudes at WW, NN and NEE (once each)
 };
 
 // One sample's prediction, and what it needs to learn from the sample.
+// The arrays are left uninitialised (each generation sets what it reads):
+// zeroing them per sample was a fifth of predict()'s time.
 struct Prediction {
-    std::array<int64_t, kPredictors> p{};  // generations 0 and 1
+    std::array<int64_t, kPredictors> p;  // generations 0 and 1
     int64_t blend = 0, value = 0;  // value: the final prediction
     ContextModels* ctx = nullptr;
     BiasCell* bias = nullptr;
     unsigned signs = 0;
     int floor = -1;  // generation 2: the floor flag's model, or -1 when no flag is coded
     LeastSquaresFit* fit = nullptr;
-    std::array<double, kLsTaps> x{};  // generation 2: the fit's neighbours, relative to W
+    std::array<double, kLsMaxTaps> x;  // generations 2, 3: the fit's neighbours, relative to W
     int64_t W = 0;
 };
 
@@ -153,10 +169,12 @@ inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxV
         }
         out.blend = std::clamp(divRound(weighted, weightSum), std::min({n.W, n.N, n.NE, n.P}), std::max({n.W, n.N, n.NE, n.P}));
     }
-    // The activity: the residuals around (W, N, P twice) and the gradients;
-    // generation 2 weighs the gradients twice as much (0.3-0.5 % smaller).
+    // The activity: the residuals around (W, N, P twice; generation 3 also
+    // WW, NN, NEE once) and the gradients; generations 2 and 3 weigh the
+    // gradients twice as much (0.3-0.5 % smaller).
     const uint64_t gradient = uint64_t(std::abs(n.W - n.NW) + std::abs(n.N - n.NW) + std::abs(n.NE - n.N) + std::abs(n.P - med(n.PW, n.PN, n.PNW)));
-    const uint64_t activity = (n.residualsAbove + 2 * uint64_t(rW.residual)) / 2 + (models.leastSquares ? gradient : gradient / 2);
+    const uint64_t around = n.residualsAbove + 2 * uint64_t(rW.residual) + (models.farActivity ? n.residualsFar : 0);
+    const uint64_t activity = around / 2 + (models.leastSquares ? gradient : gradient / 2);
     const int length = 64 - std::countl_zero(activity);
     const int context = std::min(kContexts - 1, 2 * length + (length >= 2 ? int(activity >> (length - 2)) & 1 : 0));
     out.ctx = &models.ctx[size_t(context)];
@@ -165,7 +183,8 @@ inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxV
         out.W = n.W;
         const int64_t nearSeven[] = {n.N, n.NW, n.NE, n.P, n.PW, n.PN, n.PNW};
         for (size_t k = 0; k < 7; ++k) out.x[k] = double(nearSeven[k] - n.W);
-        for (size_t k = 0; k < size_t(kFarNeighbours); ++k) out.x[7 + k] = double(n.far[k] - n.W);
+        const size_t far = size_t(out.fit->shape.taps - 7);
+        for (size_t k = 0; k < far; ++k) out.x[7 + k] = double(n.far[k] - n.W);
         out.blend = std::clamp(int64_t(std::nearbyint(out.fit->predict(out.x, double(n.W)))), minValue, maxValue);
     }
     if (models.textureBias) {

@@ -4,7 +4,7 @@
 // samples of a scan as vdbdag reads them (DICOM, NIfTI, NRRD, MetaImage,
 // raw), in one run:
 //
-//   vdbdag_int_coder_bench SCAN [--near N] [--repeats R] [--series N] [--volume N]
+//   vdbdag_int_coder_bench SCAN [--near N] [--repeats R] [--series N] [--volume N] [--dump RAW]
 //
 // `ours_model1_bytes`: the same volume coded with the previous model
 // generation (the blend of six, SamplePredictor.h), once, for the table's
@@ -154,9 +154,10 @@ size_t jpeg2000Slice(const int32_t* slice, uint32_t nx, uint32_t ny, int bits, b
 
 int main(int argc, char** argv) {
     try {
-        if (argc < 2) throw vdbdag::Error("usage: vdbdag_int_coder_bench SCAN [--near N] [--repeats R] [--series N] [--volume N]");
+        if (argc < 2) throw vdbdag::Error("usage: vdbdag_int_coder_bench SCAN [--near N] [--repeats R] [--series N] [--volume N] [--dump RAW]");
         const std::string path = argv[1];
         int near = 0, repeats = 3;
+        std::string dump;  // --dump PATH: the stored samples as raw int32 (x fastest), then stop
         vdbdag::bridge::DenseImportOptions options;
         options.showProgress = false;
         for (int i = 2; i + 1 < argc; i += 2) {
@@ -165,6 +166,7 @@ int main(int argc, char** argv) {
             else if (flag == "--repeats") repeats = std::max(1, std::stoi(value));
             else if (flag == "--series") options.series = value;
             else if (flag == "--volume") options.volume = std::stoll(value);
+            else if (flag == "--dump") dump = value;
             else throw vdbdag::Error("unknown option " + flag);
         }
         const vdbdag::bridge::DenseVolume v = vdbdag::bridge::describeDense(path, options);
@@ -175,6 +177,13 @@ int main(int argc, char** argv) {
         while ((int64_t(1) << bits) - 1 < int64_t(maxValue) - minValue) ++bits;
         if (bits > 16) throw vdbdag::Error(path + ": a " + std::to_string(bits) + "-bit range; JPEG-LS takes at most 16 bits");
         const int64_t nx = v.dims[0], ny = v.dims[1], nz = v.dims[2];
+        if (!dump.empty()) {
+            std::FILE* f = std::fopen(dump.c_str(), "wb");
+            if (!f || std::fwrite(samples.data(), sizeof(int32_t), samples.size(), f) != samples.size() || std::fclose(f) != 0)
+                throw vdbdag::Error(dump + ": cannot write the samples");
+            std::printf("{\"dims\": [%lld, %lld, %lld], \"min\": %d, \"max\": %d}\n", (long long)nx, (long long)ny, (long long)nz, minValue, maxValue);
+            return 0;
+        }
         const size_t plane = size_t(nx * ny);
 
         vdbdag::coding::IntCoderOptions o;

@@ -69,7 +69,7 @@ TEST(RescaledFloats, LatticeValuesComeBackBitForBitAsTheirIntegers) {
     for (const ValueRescale r : {kPet, ValueRescale{0.5, -1024.0}, ValueRescale{-3.25e-3, 7.5}}) {
         const std::vector<uint8_t> bytes = bytesOf(floatsOf(c, r));
         const std::vector<uint8_t> windows = encodePredictedWindows(bytes, 4, c.layout, c.places, FloatChannel{r});
-        EXPECT_EQ(codingOf(windows, c.layout), detail::kFittedRescaledFloatCoding) << r.slope;
+        EXPECT_EQ(codingOf(windows, c.layout), detail::kWideRescaledFloatCoding) << r.slope;
         EXPECT_EQ(decodePredictedWindows(windows, 4, c.layout, "test", c.places), bytes) << r.slope;
         EXPECT_LT(windows.size(), encodePredictedWindows(bytes, 4, c.layout, c.places).size() * 3 / 4) << "the integers beat the palettes";
     }
@@ -88,7 +88,7 @@ TEST(RescaledFloats, ValuesOffTheLatticeAreExceptionsKeptBitForBit) {
     for (const auto& [i, x] : odd) v[i] = x;
     const std::vector<uint8_t> bytes = bytesOf(v);
     const std::vector<uint8_t> windows = encodePredictedWindows(bytes, 4, c.layout, c.places, FloatChannel{kPet});
-    EXPECT_EQ(codingOf(windows, c.layout), detail::kFittedRescaledFloatCoding);
+    EXPECT_EQ(codingOf(windows, c.layout), detail::kWideRescaledFloatCoding);
     EXPECT_EQ(decodePredictedWindows(windows, 4, c.layout, "test", c.places), bytes);
     const auto payload = encodeRescaledFloats(bytes, c.layout, c.places, kPet);
     ASSERT_TRUE(payload);
@@ -115,24 +115,24 @@ TEST(RescaledFloats, CorruptPayloadsAreRefused) {
     const std::vector<uint8_t> bytes = bytesOf(v);
     const std::vector<uint8_t> good = *encodeRescaledFloats(bytes, c.layout, c.places, kPet);
     const uint64_t n = c.entries.size();
-    EXPECT_EQ(decodeRescaledFloats(good, c.layout, n, "good", c.places, 2), bytes);
+    EXPECT_EQ(decodeRescaledFloats(good, c.layout, n, "good", c.places, coding::kLatestIntModel), bytes);
     auto zeroSlope = good;
     std::memset(zeroSlope.data(), 0, 8);
-    EXPECT_THROW(decodeRescaledFloats(zeroSlope, c.layout, n, "slope", c.places, 2), Error);
+    EXPECT_THROW(decodeRescaledFloats(zeroSlope, c.layout, n, "slope", c.places, coding::kLatestIntModel), Error);
     auto nanIntercept = good;
     const uint64_t nanBits = 0x7FF8000000000000ull;
     std::memcpy(nanIntercept.data() + 8, &nanBits, 8);
-    EXPECT_THROW(decodeRescaledFloats(nanIntercept, c.layout, n, "intercept", c.places, 2), Error);
+    EXPECT_THROW(decodeRescaledFloats(nanIntercept, c.layout, n, "intercept", c.places, coding::kLatestIntModel), Error);
     auto swapped = good;  // exceptions out of order: 20 then 10
     std::memcpy(swapped.data() + 20, good.data() + 28, 8);
     std::memcpy(swapped.data() + 28, good.data() + 20, 8);
-    EXPECT_THROW(decodeRescaledFloats(swapped, c.layout, n, "order", c.places, 2), Error);
+    EXPECT_THROW(decodeRescaledFloats(swapped, c.layout, n, "order", c.places, coding::kLatestIntModel), Error);
     auto many = good;
     const uint32_t huge = 0xFFFFFFFFu;
     std::memcpy(many.data() + 16, &huge, 4);
-    EXPECT_THROW(decodeRescaledFloats(many, c.layout, n, "count", c.places, 2), Error);
-    EXPECT_THROW(decodeRescaledFloats(std::span(good).first(30), c.layout, n, "short", c.places, 2), Error);
-    EXPECT_THROW(decodeRescaledFloats(good, c.layout, n + 1, "entries", c.places, 2), Error);
+    EXPECT_THROW(decodeRescaledFloats(many, c.layout, n, "count", c.places, coding::kLatestIntModel), Error);
+    EXPECT_THROW(decodeRescaledFloats(std::span(good).first(30), c.layout, n, "short", c.places, coding::kLatestIntModel), Error);
+    EXPECT_THROW(decodeRescaledFloats(good, c.layout, n + 1, "entries", c.places, coding::kLatestIntModel), Error);
 }
 
 // A float grid through the codec and the file: with the hint its one window
@@ -162,7 +162,7 @@ TEST(RescaledFloats, AFloatGridWithALatticeStoresItsIntegers) {
         const ValueWindowsPayload& w = scene.grids[0].valueWindows;
         EXPECT_TRUE(w.predicted);
         const uint8_t coding = codingOf(w.bytes, encoding::attributeLayout(scene.grids[0].dag));
-        if (hint) EXPECT_EQ(coding, detail::kFittedRescaledFloatCoding);
+        if (hint) EXPECT_EQ(coding, detail::kWideRescaledFloatCoding);
         else EXPECT_TRUE(coding == detail::kPaletteCoding || coding == detail::kFloatCoding) << int(coding);
         const format::SsvdagScene back = format::readScene(format::writeScene(scene), "mem");
         const GridRecord decoded = pipeline::decodeGrid(back.grids[0]);
