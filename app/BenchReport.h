@@ -17,6 +17,7 @@ struct BenchRun {
     int repeats = 1, renderWidth = 0, renderHeight = 0;
     double budgetSeconds = 0;  // no repeat after a measurement took this long
     double seconds = 0;
+    size_t gridCount = 0;  // grids measured
     std::vector<bench::BenchPoint> points;
 };
 

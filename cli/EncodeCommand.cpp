@@ -4,14 +4,13 @@
 // NAME.ssvdag makes one sequence file of every frame; several other inputs
 // make one file each.
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
-#include <optional>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "app/EncodeFile.h"
+#include "app/EncodeSequence.h"
 #include "cli/ByteSize.h"
 #include "cli/Commands.h"
 #include "cli/DenseInputOptions.h"
@@ -20,13 +19,10 @@
 #include "cli/JsonReport.h"
 #include "cli/RunContext.h"
 #include "app/SceneReport.h"
-#include "src/format/FrameSequence.h"
-#include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 #include "src/util/FramePattern.h"
 #include "src/util/OutputPath.h"
 #include "src/util/Progress.h"
-#include "src/util/TemporaryFiles.h"
 #include "vdb_bridge/DenseImport.h"
 
 namespace vdbdag::cli {
@@ -54,7 +50,7 @@ std::string defaultOutputFor(const std::string& input) {
 void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::vector<std::string> inputs;
-        std::string input, output;
+        std::string output;
         std::vector<std::string> grids;
         bool force = false, noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
         bool svdagStats = false;
@@ -67,10 +63,6 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         std::vector<std::string> colourGrids;
         std::string normalGrid;
         DenseInputOptions dense;
-        // While a sequence is encoded: its progress (each frame 1000 units)
-        // and the frame being encoded; the frames print no line of their own.
-        Progress* sequenceProgress = nullptr;
-        size_t frameIndex = 0;
     };
     auto opt = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("encode", "Encode the grids of a .vdb or NanoVDB .nvdb file (or a dense .raw/.nrrd/.nhdr/.mhd/.mha/.nii scan, or one DICOM series) into an .ssvdag file");
@@ -111,57 +103,46 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
-    // One input (opt->input) to one output (opt->output); the report goes
-    // to `batch` when given, else is printed.
-    const auto encodeOne = [opt, &exitCode](nlohmann::json* batch) {
-        setActivity(opt->input, "encoding");
-        const bool dense = bridge::denseFormatOf(opt->input) != bridge::DenseFormat::None;
+    // One input to one output; the report goes to `batch` when given, else
+    // is printed. A sequence's frame (onProgress set) prints nothing.
+    const auto encodeOne = [opt](const std::string& input, const std::string& output, nlohmann::json* batch,
+                                 const std::function<void(double)>& onProgress, pipeline::CubeTeam& team) {
+        setActivity(input, "encoding");
+        const bool dense = bridge::denseFormatOf(input) != bridge::DenseFormat::None;
         if (!dense) {
-            if (!opt->dense.series.empty()) throw Error(opt->input + ": --series applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
+            if (!opt->dense.series.empty()) throw Error(input + ": --series applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
             if (!opt->dense.dims.empty() || !opt->dense.type.empty() || !opt->dense.endian.empty() || !opt->dense.spacing.empty() ||
                 !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
-                throw Error(opt->input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
-                                         "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
+                throw Error(input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
+                                    "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
         }
         app::EncodeRequest request;
-        request.input = opt->input, request.output = opt->output, request.force = opt->force;
-        request.inputFiles = denseInputFiles(opt->input, opt->dense);
+        request.input = input, request.output = output, request.force = opt->force;
+        request.inputFiles = denseInputFiles(input, opt->dense);
         request.grids = opt->grids, request.skipUnsupported = opt->skipUnsupported, request.topologyOnly = opt->topologyOnly;
-        if (dense) request.dense = opt->dense.resolve(opt->input);
+        if (dense) request.dense = opt->dense.resolve(input);
         request.noSymmetry = opt->noSymmetry, request.noCompress = opt->noCompress, request.noPredict = opt->noPredict, request.svdagStats = opt->svdagStats;
         request.placementTrials = opt->placementTrials, request.absError = opt->absError, request.relError = opt->relError;
         request.colourBits = opt->colourBits, request.normalBits = opt->normalBits, request.colourGrids = opt->colourGrids, request.normalGrid = opt->normalGrid;
         request.memoryLimit = opt->memoryLimit, request.scratch = opt->scratch, request.threads = opt->threads;
         app::EncodeHooks hooks;
-        hooks.team = &cubeTeam();
+        hooks.team = &team;
         hooks.warning = [](const std::string& w) { fmt::print(stderr, "vdbdag: warning: {}\n", w); };
-        // In a sequence the frame's share of the whole moves instead (this
-        // frame's own line stays silent: setQuiet while it runs), and the
-        // frames make no notes.
-        if (opt->sequenceProgress)
-            hooks.onProgress = [opt](double done) { opt->sequenceProgress->set(opt->frameIndex * 1000 + uint64_t(done * 1000)); };
-        else hooks.note = [](const std::string& n) { note(n); };
+        hooks.onProgress = onProgress;  // a sequence's frame: its share of the whole, and no notes
+        if (!onProgress) hooks.note = [](const std::string& n) { note(n); };
         const app::EncodeResult result = app::encodeFile(request, hooks);
-        if (!result.written) {  // another process of the team writes and reports
-            exitCode = 0;
-            return;
-        }
+        if (!result.written) return nlohmann::json();  // another process of the team writes and reports
         const nlohmann::json& report = result.report;
-        const auto voxels = report["active_voxels"].get<uint64_t>();
-        const auto fileBytes = report["bytes"].get<uint64_t>();
-        const auto seconds = report["seconds"].get<double>();
-        const size_t gridCount = report["grid_count"].get<size_t>();
+        const std::string line = fmt::format("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", output,
+                                             report["grid_count"].get<size_t>(), report["active_voxels"].get<uint64_t>(), report["bytes"].get<uint64_t>(),
+                                             report["bits_per_active_voxel"].get<double>(), report["seconds"].get<double>());
         if (batch) {
             batch->push_back(report);
-            if (!opt->json && !opt->sequenceProgress)
-                fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output, gridCount,
-                           voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);
+            if (!opt->json && !onProgress) fmt::print("{}", line);
         } else if (opt->json) {
             printJson(report);
         } else {
-            fmt::print("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", opt->output,
-                       gridCount, voxels, fileBytes, report["bits_per_active_voxel"].get<double>(), seconds);
-            fmt::print("{}", thresholdText(result.threshold));
+            fmt::print("{}{}", line, thresholdText(result.threshold));
             for (const auto& l : report["grids_lossy"])
                 fmt::print("  grid '{}' {}: {} of {} values changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
                            l["name"].get<std::string>(), l["tolerance"].get<std::string>(), l["changed"].get<uint64_t>(), l["entries"].get<uint64_t>(),
@@ -169,112 +150,28 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
             for (const auto& c : report["grids_colour"]) fmt::print("  {}\n", app::formatColour(c));
             for (const auto& n : report["grids_normals"]) fmt::print("  {}\n", app::formatNormals(n));
         }
-        exitCode = 0;
+        return report;
     };
-    // Frames of a cache into one sequence file: each frame encoded alone
-    // (every option applies, the same bytes as its own file) into a
-    // temporary folder beside the output (or in --scratch), then the frame
-    // files gathered into the output section by section
-    // (format/FrameSequence.h), and the folder removed.
-    const auto encodeSequence = [opt, &exitCode, encodeOne](const std::vector<FrameFile>& frames, const std::string& described) {
-        const auto start = std::chrono::steady_clock::now();
-        const std::string output = opt->output;
-        std::vector<std::string> inputs;
-        for (const FrameFile& f : frames) inputs.push_back(f.path);
-        checkOutputPath(output, inputs, {{".ssvdag"}, "encode", opt->force});
-        const std::filesystem::path near = opt->scratch.empty() ? std::filesystem::path(output) : std::filesystem::path(opt->scratch) / std::filesystem::path(output).filename();
-        // Under mpirun the frames are spread over the processes, each frame
-        // encoded by one process alone (the same bytes), into process 0's
-        // folder (the output's folder: a shared file system, as for the
-        // input); process 0 then gathers them.
-        pipeline::CubeTeam& team = cubeTeam();
-        std::string folder = team.isRoot() ? temporaryNameFor(near.string()) : std::string();
-        std::optional<TemporaryGuard> guard;
-        struct Removed {
-            std::string path;
-            ~Removed() {
-                std::error_code ignored;
-                if (!path.empty()) std::filesystem::remove_all(path, ignored);
-            }
-        } removed;
-        if (team.isRoot()) {
-            guard.emplace(folder, /*folder=*/true);
-            removed.path = folder;
-            std::error_code ec;
-            if (!std::filesystem::create_directory(folder, ec) || ec)
-                throw Error(folder + ": cannot make the folder for the frames being encoded (" + (ec ? ec.message() : "it exists") + ")");
-        }
-        if (team.size() > 1) {  // (after process 0 made it)
-            const std::vector<uint8_t> name = team.broadcast(std::vector<uint8_t>(folder.begin(), folder.end()));
-            folder.assign(name.begin(), name.end());
-        }
-        Progress progress("encode " + std::filesystem::path(output).filename().string(), frames.size() * 1000);
-        const bool wasQuiet = isQuiet();
-        setQuiet(true);  // the frames' own progress lines
-        struct Restore {
-            bool quiet;
-            Options& o;
-            pipeline::CubeTeam& team;
-            ~Restore() {
-                setQuiet(quiet);
-                o.sequenceProgress = nullptr;
-                setCubeTeam(team);
-            }
-        } restore{wasQuiet, *opt, team};
-        opt->sequenceProgress = &progress;
-        std::vector<format::FramePart> parts;
-        nlohmann::json reports = nlohmann::json::array();
-        for (size_t i = 0; i < frames.size(); ++i) {
-            parts.push_back({frames[i].number, (std::filesystem::path(folder) / fmt::format("frame{:06}.ssvdag", i)).string()});
-            if (i % team.size() != team.rank()) continue;
-            progress.setLabel(fmt::format("encode frame {} ({} of {})", frames[i].number, i + 1, frames.size()));
-            opt->frameIndex = i;
-            opt->input = frames[i].path;
-            opt->output = parts.back().path;
-            setCubeTeam(pipeline::soloTeam());
-            encodeOne(&reports);
-            setCubeTeam(team);
-            reports.back()["frame_index"] = i;
-        }
-        opt->output = output;
-        if (team.size() > 1) {  // every process's reports on process 0, once its frames are written
-            const std::string mine = reports.dump();
-            reports = nlohmann::json::array();
-            for (const std::vector<uint8_t>& theirs : team.gather(std::vector<uint8_t>(mine.begin(), mine.end())))
-                for (auto& r : nlohmann::json::parse(theirs.begin(), theirs.end())) reports.push_back(std::move(r));
-            std::sort(reports.begin(), reports.end(), [](const nlohmann::json& a, const nlohmann::json& b) { return a["frame_index"] < b["frame_index"]; });
-        }
-        if (!team.isRoot()) {
-            exitCode = 0;
-            return;
-        }
-        progress.setLabel("encode: writing " + output);
-        uint64_t bytes = 0;
-        writeStreamAtomically(output, [&](std::ostream& out) { bytes = format::writeSequence(parts, out); });
-        progress.finish();
-        uint64_t frameBytes = 0, voxels = 0;
-        for (const auto& r : reports) {
-            frameBytes += r["bytes"].get<uint64_t>();
-            voxels += r["active_voxels"].get<uint64_t>();
-        }
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        nlohmann::json report{{"input", described}, {"output", output}, {"bytes", bytes}, {"ssvdag_bytes", bytes}, {"frames", frames.size()},
-                              {"first_frame", frames.front().number}, {"last_frame", frames.back().number}, {"frame_files_bytes", frameBytes},
-                              {"active_voxels", voxels}, {"seconds", seconds}, {"bits_per_active_voxel", voxels ? 8.0 * double(bytes) / double(voxels) : 0.0}};
-        for (size_t i = 0; i < reports.size(); ++i) {
-            reports[i]["frame"] = frames[i].number;
-            reports[i]["output"] = output;
-            reports[i].erase("frame_index");
-        }
-        report["per_frame"] = reports;
-        if (opt->json) printJson(report);
+    // Frames of a cache into one sequence file (app/EncodeSequence.h), each
+    // frame by encodeOne on this process alone.
+    const auto encodeSequence = [opt, encodeOne](const std::vector<FrameFile>& frames, const std::string& described) {
+        app::SequenceRequest request{frames, opt->output, described, opt->scratch, opt->force};
+        const auto frame = [&](size_t, const std::string& input, const std::string& output, const std::function<void(double)>& onProgress) {
+            nlohmann::json reports = nlohmann::json::array();
+            encodeOne(input, output, &reports, onProgress, pipeline::soloTeam());
+            return reports.at(0);
+        };
+        const app::SequenceResult result = app::encodeSequence(request, cubeTeam(), frame);
+        if (!result.written) return;
+        const nlohmann::json& r = result.report;
+        if (opt->json) printJson(r);
         else
-            fmt::print("{}: {} frames ({} to {}), {} active voxels -> {} bytes ({:.3f} bits/active voxel; the frames alone {} bytes) in {:.2f} s\n", output,
-                       frames.size(), frames.front().number, frames.back().number, voxels, bytes, report["bits_per_active_voxel"].get<double>(), frameBytes,
-                       seconds);
-        exitCode = 0;
+            fmt::print("{}: {} frames ({} to {}), {} active voxels -> {} bytes ({:.3f} bits/active voxel; the frames alone {} bytes) in {:.2f} s\n",
+                       opt->output, frames.size(), frames.front().number, frames.back().number, r["active_voxels"].get<uint64_t>(), r["bytes"].get<uint64_t>(),
+                       r["bits_per_active_voxel"].get<double>(), r["frame_files_bytes"].get<uint64_t>(), r["seconds"].get<double>());
     };
     cmd->callback([opt, &exitCode, encodeOne, encodeSequence] {
+        exitCode = 0;
         // A sequence: a frame pattern (smoke.####.vdb, %04d, $F4), or
         // several inputs that are not DICOM with -o NAME.ssvdag.
         // A folder of .vdb or .nvdb files (frames of a cache, no DICOM among
@@ -311,9 +208,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                                  return bridge::denseFormatOf(in) == bridge::DenseFormat::Dicom;
                              });
         if (!several) {
-            opt->input = opt->dense.takeInputs(opt->inputs);
-            if (opt->output.empty()) opt->output = defaultOutputFor(opt->input);
-            encodeOne(nullptr);
+            const std::string input = opt->dense.takeInputs(opt->inputs);
+            encodeOne(input, opt->output.empty() ? defaultOutputFor(input) : opt->output, nullptr, nullptr, cubeTeam());
             return;
         }
         if (lowerExtension(opt->output) == ".ssvdag" && !std::filesystem::is_directory(opt->output)) {
@@ -336,13 +232,8 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                 throw Error(in + ": another input is also written to " + outputs.back() + " (inputs of the same name from different folders)");
         }
         nlohmann::json reports = nlohmann::json::array();
-        for (size_t i = 0; i < opt->inputs.size(); ++i) {
-            opt->input = opt->inputs[i];
-            opt->output = outputs[i];
-            encodeOne(&reports);
-        }
+        for (size_t i = 0; i < opt->inputs.size(); ++i) encodeOne(opt->inputs[i], outputs[i], &reports, nullptr, cubeTeam());
         if (opt->json) printJson(reports);
-        exitCode = 0;
     });
 }
 
