@@ -5,11 +5,13 @@
 // make one file each.
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "app/EncodeFile.h"
+#include "app/EncodeOutputs.h"
 #include "app/EncodeSequence.h"
 #include "cli/ByteSize.h"
 #include "cli/Commands.h"
@@ -26,27 +28,6 @@
 #include "vdb_bridge/DenseImport.h"
 
 namespace vdbdag::cli {
-namespace {
-
-// IN.ssvdag beside the input: its name without its extension (.nii.gz,
-// .raw.gz and the like count as one), a folder's name for a folder.
-std::string defaultOutputFor(const std::string& input) {
-    std::filesystem::path p(input);
-    if (!p.has_filename()) p = p.parent_path();  // "dir/"
-    std::string name = p.filename().string();
-    std::error_code ec;
-    if (!std::filesystem::is_directory(p, ec)) {
-        std::string lower = name;
-        std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-        if (lower.size() > 3 && lower.ends_with(".gz")) name.resize(name.size() - 3);
-        if (const size_t dot = name.rfind('.'); dot != std::string::npos && dot > 0) name.resize(dot);
-    }
-    if (name.empty() || name == "." || name == "..") throw Error(input + ": no name to make the output's from; give -o OUT.ssvdag");
-    return (p.parent_path() / (name + ".ssvdag")).string();
-}
-
-} // namespace
-
 void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::vector<std::string> inputs;
@@ -176,27 +157,16 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         // several inputs that are not DICOM with -o NAME.ssvdag.
         // A folder of .vdb or .nvdb files (frames of a cache, no DICOM among
         // them): its files as a sequence, numbered by their names.
-        if (opt->inputs.size() == 1 && std::filesystem::is_directory(opt->inputs[0])) {
-            std::vector<std::string> files;
-            bool other = false;
-            std::error_code ec;
-            for (const auto& e : std::filesystem::directory_iterator(opt->inputs[0], ec)) {
-                if (!e.is_regular_file(ec)) continue;
-                const std::string ext = lowerExtension(e.path().string());
-                if (ext == ".vdb" || ext == ".nvdb") files.push_back(e.path().string());
-                else if (e.path().filename().string()[0] != '.') other = true;
-            }
-            if (!files.empty() && !other) {
-                std::sort(files.begin(), files.end());
-                if (opt->output.empty()) opt->output = defaultOutputFor(opt->inputs[0]);
-                encodeSequence(framesOfList(files), opt->inputs[0]);
+        if (opt->inputs.size() == 1)
+            if (const std::optional<std::vector<std::string>> files = app::cacheFrameFiles(opt->inputs[0])) {
+                if (opt->output.empty()) opt->output = app::defaultOutputFor(opt->inputs[0]);
+                encodeSequence(framesOfList(*files), opt->inputs[0]);
                 return;
             }
-        }
         if (opt->inputs.size() == 1 && isFramePattern(opt->inputs[0]) && !std::filesystem::exists(opt->inputs[0])) {
             const std::vector<FrameFile> frames = expandFramePattern(opt->inputs[0]);
             if (frames.empty()) throw Error(opt->inputs[0] + ": no file matches this frame pattern");
-            if (opt->output.empty()) opt->output = defaultOutputFor(withoutFrameToken(opt->inputs[0]));
+            if (opt->output.empty()) opt->output = app::defaultOutputFor(withoutFrameToken(opt->inputs[0]));
             encodeSequence(frames, opt->inputs[0]);
             return;
         }
@@ -209,28 +179,14 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                              });
         if (!several) {
             const std::string input = opt->dense.takeInputs(opt->inputs);
-            encodeOne(input, opt->output.empty() ? defaultOutputFor(input) : opt->output, nullptr, nullptr, cubeTeam());
+            encodeOne(input, opt->output.empty() ? app::defaultOutputFor(input) : opt->output, nullptr, nullptr, cubeTeam());
             return;
         }
         if (lowerExtension(opt->output) == ".ssvdag" && !std::filesystem::is_directory(opt->output)) {
             encodeSequence(framesOfList(opt->inputs), std::to_string(opt->inputs.size()) + " files");
             return;
         }
-        const std::string folder = opt->output;
-        if (!folder.empty()) {
-            std::error_code ec;
-            const bool fileName = std::filesystem::path(folder).extension() == ".ssvdag";
-            if ((std::filesystem::exists(folder, ec) && !std::filesystem::is_directory(folder, ec)) || (fileName && !std::filesystem::is_directory(folder, ec)))
-                throw Error(folder + ": " + std::to_string(opt->inputs.size()) + " inputs are encoded one file each: -o names a folder, not a file");
-            std::filesystem::create_directories(folder, ec);
-            if (ec) throw Error(folder + ": cannot make the output folder (" + ec.message() + ")");
-        }
-        std::vector<std::string> outputs;
-        for (const std::string& in : opt->inputs) {
-            outputs.push_back(folder.empty() ? defaultOutputFor(in) : (std::filesystem::path(folder) / std::filesystem::path(defaultOutputFor(in)).filename()).string());
-            if (std::count(outputs.begin(), outputs.end(), outputs.back()) > 1)
-                throw Error(in + ": another input is also written to " + outputs.back() + " (inputs of the same name from different folders)");
-        }
+        const std::vector<std::string> outputs = app::outputsForEach(opt->inputs, opt->output);
         nlohmann::json reports = nlohmann::json::array();
         for (size_t i = 0; i < opt->inputs.size(); ++i) encodeOne(opt->inputs[i], outputs[i], &reports, nullptr, cubeTeam());
         if (opt->json) printJson(reports);
