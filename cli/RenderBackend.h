@@ -4,20 +4,11 @@
 #include <memory>
 #include <string>
 
-#include "src/trace/Camera.h"
-#include "src/trace/CpuRenderer.h"
+#include "app/RenderFile.h"
 
 namespace vdbdag::cli {
 
-class RenderBackend {
-public:
-    virtual ~RenderBackend() = default;
-    virtual std::string name() const = 0;
-    // What ran the frames: the Vulkan device's name, or the CPU's thread count.
-    virtual std::string device() const = 0;
-    virtual trace::Image render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
-                                trace::RenderStats& stats) = 0;
-};
+using RenderBackend = app::RenderBackend;  // the interface (app/RenderFile.h)
 
 // "cpu", "vulkan", or "auto" (a Vulkan GPU when one exists, else the CPU
 // tracer with a one-line note on stderr: a software Vulkan device is used
