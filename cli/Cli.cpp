@@ -73,8 +73,15 @@ int runVdbdag(int argc, char** argv, pipeline::CubeTeam& team) {
         const std::string name(entry.first);
         for (CLI::App* sub : app.get_subcommands([&](CLI::App* s) { return s->get_name() == name; })) sub->footer(std::string("Example:\n  ") + entry.second);
     }
+    // The environment variables anything of ours reads, on the help of the
+    // commands they affect and of vdbdag itself (none changes a file's bytes).
+    const std::string environment =
+        "Environment: VDBDAG_VULKAN_VALIDATION=1 turns on the Khronos validation layer (its messages on stderr); VK_ICD_FILENAMES or "
+        "VK_DRIVER_FILES choose the Vulkan drivers the loader sees (e.g. lavapipe's lvp_icd.x86_64.json).";
+    for (CLI::App* sub : app.get_subcommands([](CLI::App* s) { return s->get_name() == "render" || s->get_name() == "devices"; }))
+        sub->footer(sub->get_footer() + "\n" + environment);
     app.footer("Exit status: 0 done (diff: the same), 1 failed (diff: they differ), 2 a mistake in the command line (diff: failed).\n"
-               "vdbdag help COMMAND, or vdbdag COMMAND --help, describes a command.");
+               "vdbdag help COMMAND, or vdbdag COMMAND --help, describes a command.\n" + environment);
     if (const std::optional<int> helped = answerHelpCommand(app, argc, argv)) return *helped;
     try {
         app.parse(argc, argv);

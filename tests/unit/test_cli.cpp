@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 
 #include <nlohmann/json.hpp>
 #include <openvdb/openvdb.h>
@@ -573,6 +574,25 @@ TEST(Cli, EveryCommandsHelpShowsAnExampleAndItsDefaults) {
     const CommandResult render = runCli("render --help");
     EXPECT_NE(render.out.find("--width INT:INT in [1 - 16384]=1024"), std::string::npos) << render.out;
     EXPECT_NE(render.out.find("--view TEXT:{iso,front,back,side,top}=iso"), std::string::npos) << render.out;
+}
+
+// Every environment variable the product's sources read (std::getenv in
+// src/, app/, vdb_bridge/, gpu/, cli/, found by reading them) is named in
+// `vdbdag --help`: no behaviour hides behind one (issue 41 #2).
+TEST(Cli, EveryEnvironmentVariableReadIsInTheHelp) {
+    const CommandResult help = runCli("--help");
+    ASSERT_EQ(help.exitCode, 0);
+    const std::regex read(R"re(getenv\(\s*"([A-Z0-9_]+)"\s*\))re");
+    size_t names = 0;
+    for (const char* folder : {"src", "app", "vdb_bridge", "gpu", "cli"})
+        for (const auto& e : fs::recursive_directory_iterator(fs::path(VDBDAG_SOURCE_DIR) / folder)) {
+            if (!e.is_regular_file() || e.path().string().find("selftest") != std::string::npos) continue;
+            const std::string text = fileBytes(e.path());
+            for (auto m = std::sregex_iterator(text.begin(), text.end(), read); m != std::sregex_iterator(); ++m, ++names)
+                EXPECT_NE(help.out.find((*m)[1].str()), std::string::npos) << (*m)[1].str() << " (read in " << e.path() << ") is not in vdbdag --help";
+        }
+    EXPECT_GE(names, 1u) << "the search found no getenv at all: the pattern is wrong";
+    EXPECT_NE(runCli("render --help").out.find("VDBDAG_VULKAN_VALIDATION"), std::string::npos);
 }
 
 // Without -o, encode writes IN.ssvdag beside the input (the name without its
