@@ -65,6 +65,92 @@ std::string checkNativeLength(const std::string& path, uint32_t length, bool big
 
 namespace {
 
+// The elements GDCM's image reader (ImageReader::ReadImage,
+// PixmapReader::ReadImageInternal and ReadACRNEMAImage, the ImageHelper
+// functions they call: spacing, origin, direction cosines, rescale,
+// dimensions; the icon image, overlays and curves) reads through
+// gdcm::Attribute<>, or checks against its dictionary VR by hand, as GDCM
+// 3.0's dictionary types them. Attribute<>::SetFromDataElement asserts
+// (aborts) that an element's VR is Compatible() with the attribute's:
+// the same VR, or UN, or none (implicit VR); GetSpacingValue asserts the
+// same of the spacing tag its media storage names, and that the Z spacing
+// tag's VR is its dictionary VR. So under an explicit VR any other VR for
+// one of these, at any depth (GDCM reads several from functional group,
+// ultrasound region, icon image and detector items), is refused before
+// GDCM reads the file: an Image Orientation (Patient) of VR AS in an RLE
+// file aborted in GetDirectionCosinesFromDataSet (found by
+// fuzz_scan_headers). Not here: what the reader takes as bytes
+// (Photometric Interpretation, the palette descriptors through Element<>,
+// which checks no VR) or not at all (Slice Thickness, Real World Value
+// Intercept/Slope: code GDCM 3.0.21 compiles out). `group` matches under
+// `groupMask`: the even overlay (60xx) and curve (50xx) groups GDCM reads
+// as one.
+struct ReaderVr {
+    uint16_t group, groupMask, element;
+    const char* vrs;   // the VRs GDCM takes (UN always passes too)
+    const char* name;
+};
+constexpr ReaderVr kReaderVrs[] = {
+    {0x0018, 0xFFFF, 0x0088, "DS", "Spacing Between Slices"},
+    {0x0018, 0xFFFF, 0x1063, "DS", "Frame Time"},
+    {0x0018, 0xFFFF, 0x1164, "DS", "Imager Pixel Spacing"},
+    {0x0018, 0xFFFF, 0x2010, "DS", "Nominal Scanned Pixel Spacing"},
+    {0x0018, 0xFFFF, 0x602C, "FD", "Physical Delta X"},
+    {0x0018, 0xFFFF, 0x602E, "FD", "Physical Delta Y"},
+    {0x0020, 0xFFFF, 0x0030, "DS", "Image Position (retired)"},
+    {0x0020, 0xFFFF, 0x0032, "DS", "Image Position (Patient)"},
+    {0x0020, 0xFFFF, 0x0035, "DS", "Image Orientation (retired)"},
+    {0x0020, 0xFFFF, 0x0037, "DS", "Image Orientation (Patient)"},
+    {0x0028, 0xFFFF, 0x0002, "US", "Samples per Pixel"},
+    {0x0028, 0xFFFF, 0x0005, "US SS", "Image Dimensions"},  // ReadACRNEMAImage reads SS apart
+    {0x0028, 0xFFFF, 0x0006, "US", "Planar Configuration"},
+    {0x0028, 0xFFFF, 0x0008, "IS", "Number of Frames"},
+    {0x0028, 0xFFFF, 0x0009, "AT", "Frame Increment Pointer"},
+    {0x0028, 0xFFFF, 0x0010, "US", "Rows"},
+    {0x0028, 0xFFFF, 0x0011, "US", "Columns"},
+    {0x0028, 0xFFFF, 0x0012, "US", "Planes"},
+    {0x0028, 0xFFFF, 0x0030, "DS", "Pixel Spacing"},
+    {0x0028, 0xFFFF, 0x0034, "IS", "Pixel Aspect Ratio"},
+    {0x0028, 0xFFFF, 0x0100, "US", "Bits Allocated"},
+    {0x0028, 0xFFFF, 0x0101, "US", "Bits Stored"},
+    {0x0028, 0xFFFF, 0x0102, "US", "High Bit"},
+    {0x0028, 0xFFFF, 0x0103, "US", "Pixel Representation"},
+    {0x0028, 0xFFFF, 0x1052, "DS", "Rescale Intercept"},
+    {0x0028, 0xFFFF, 0x1053, "DS", "Rescale Slope"},
+    {0x0028, 0xFFFF, 0x2110, "CS", "Lossy Image Compression"},
+    {0x3002, 0xFFFF, 0x0011, "DS", "Image Plane Pixel Spacing"},
+    {0x3004, 0xFFFF, 0x000C, "DS", "Grid Frame Offset Vector"},
+    {0x3004, 0xFFFF, 0x000E, "DS", "Dose Grid Scaling"},
+    {0x5000, 0xFF01, 0x0005, "US", "Curve Dimensions"},
+    {0x5000, 0xFF01, 0x0010, "US", "Number of Points"},
+    {0x5000, 0xFF01, 0x0103, "US", "Data Value Representation"},
+    {0x5000, 0xFF01, 0x0110, "US", "Curve Data Descriptor"},
+    {0x5000, 0xFF01, 0x0112, "US", "Coordinate Start Value"},
+    {0x5000, 0xFF01, 0x0114, "US", "Coordinate Step Value"},
+    {0x6000, 0xFF01, 0x0010, "US", "Overlay Rows"},
+    {0x6000, 0xFF01, 0x0011, "US", "Overlay Columns"},
+    {0x6000, 0xFF01, 0x0015, "IS", "Number of Frames in Overlay"},
+    {0x6000, 0xFF01, 0x0050, "SS", "Overlay Origin"},
+    {0x6000, 0xFF01, 0x0051, "US", "Image Frame Origin"},
+    {0x6000, 0xFF01, 0x0100, "US", "Overlay Bits Allocated"},
+    {0x6000, 0xFF01, 0x0102, "US", "Overlay Bit Position"},
+    {0x6000, 0xFF01, 0x0200, "US", "Overlay Location"},
+};
+
+// "" when GDCM's image reader takes an element of this tag and explicit VR,
+// else why not.
+std::string readerVrProblem(uint16_t group, uint16_t element, const char* vr, uint64_t pos) {
+    for (const ReaderVr& r : kReaderVrs) {
+        if ((group & r.groupMask) != r.group || element != r.element) continue;
+        if (std::strcmp(vr, "UN") == 0) return "";
+        for (const char* v = r.vrs; *v; v += v[2] ? 3 : 2)
+            if (v[0] == vr[0] && v[1] == vr[1]) return "";
+        return fmt::format("element ({:04X},{:04X}) {} at byte {} has VR {}, which GDCM's image reader aborts on (it takes {} or UN only)", group,
+                           element, r.name, pos, vr, r.vrs[2] ? "US, SS" : r.vrs);
+    }
+    return "";
+}
+
 // GDCM allocates each element's declared length before it reads the bytes,
 // so a 1 KB file that declares a 3 GB element makes it allocate (and touch)
 // 3 GB. This walk reads only the element headers (tag, VR, length; into
@@ -242,6 +328,10 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
             else explicitVr = true;
         }
         if (!inMeta) datasetStarted = true;
+        // An element GDCM's image reader reads with another VR than its own
+        // (kReaderVrs): GDCM asserts on it.
+        if (!inMeta && explicitVr)
+            if (const std::string bad = readerVrProblem(group, element, vr, pos); !bad.empty()) return bad;
         if (inMeta || explicitVr) {
             static const std::set<std::string> longVr{"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
             if (longVr.count(vr)) {

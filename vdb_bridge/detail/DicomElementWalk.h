@@ -6,7 +6,9 @@
 // the end of the file, a delimiter outside any sequence, an item tag DICOM
 // does not define, a file meta group cut short, with a VR DICOM does not
 // define or with a sequence, an element without a VR under an explicit transfer
-// syntax (the first too, when the file meta group declares it), a file
+// syntax (the first too, when the file meta group declares it), an element
+// GDCM's image reader reads through gdcm::Attribute<> with an explicit VR
+// other than its own (it asserts on one; DicomElementWalk.cpp's kReaderVrs), a file
 // that ends inside an element, a sequence or an item, a file without
 // preamble whose first group is neither 0002 nor 0008, and a DICM prefix
 // without the file meta group after it (GDCM guesses how to read those). It also finds the top-level Pixel Data element, so native pixel
