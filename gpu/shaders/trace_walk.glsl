@@ -507,25 +507,13 @@ bool findVoxel(i64vec3 voxel, out uint64_t entry) {
     }
     uint64_t pos = 0ul, base = 0ul;
     uint mirror = gRootReflection;
+    const uint64_t x = uint64_t(v[0]), y = uint64_t(v[1]), z = uint64_t(v[2]);
     for (uint depth = 0u; depth < kMaxInnerLevels; ++depth) {
         const uint header = innerWord(pos);
         if (header == 0u) { entry = base; return true; }
-        const uint halfLog2 = gLog2Size - depth - 1u;
-        const uint p = uint((v[0] >> halfLog2) & 1l) | (uint((v[1] >> halfLog2) & 1l) << 1) | (uint((v[2] >> halfLog2) & 1l) << 2);
-        const uint j = p ^ mirror;
-        if (((header >> (2u * j)) & 3u) == 0u) return false;
-        uint64_t offset, attributeOffset;
-        uint reflection;
-        dagChildPointer(0u, pos, header, j, offsetWordsAt(depth), offset, reflection, attributeOffset);
-        mirror ^= reflection;
-        base += attributeOffset;
-        if (depth + 1u == gInnerLevels) {
-            const uint64_t mask = leafMask(offset);
-            const uint bit = dagStoredBit(uint(v[0] & 3l), uint(v[1] & 3l), uint(v[2] & 3l), mirror);
-            if (((mask >> bit) & 1ul) == 0ul) return false;
-            entry = base + uint64_t(dagLeafRank(mask, bit));
-            return true;
-        }
+        uint64_t offset;
+        if (!dagDescend(0u, pos, header, x, y, z, gLog2Size - depth - 1u, offsetWordsAt(depth), mirror, base, offset)) return false;
+        if (depth + 1u == gInnerLevels) return dagLeafEntry(leafMask(offset), x, y, z, mirror, base, entry);
         pos = P.levelStart[depth + 1u] + offset;
     }
     return false;

@@ -3,7 +3,8 @@
 // decodes the inner words and 4^3 leaves of a .ssvdag DAG (docs/FORMAT.md
 // §5) lives here: child tags, tagged pointers with their reflection and
 // attribute offset, a node's word count, the stored bit of a voxel in a
-// mirrored leaf and its popcount rank, and the reflection of a leaf mask;
+// mirrored leaf and its popcount rank, the two steps of a point lookup
+// (dagDescend, dagLeafEntry), and the reflection of a leaf mask;
 // and what writes the pointers (dagPointerTag, dagPointerWord0/1). The
 // public reader (src/reader/Accessor.cpp), the writer and its checks
 // (src/encoding/CompactDag.cpp), the CPU tracer (src/trace/DagWalk.h) and
@@ -73,6 +74,28 @@ VDBDAG_FN void dagChildPointer(VDBDAG_INNER_BUF buf, uint64_t pos, uint header, 
     }
 }
 
+// One step of a point lookup, the walk every reader of a voxel takes (the
+// public reader's Accessor, DagTracer::find, the shaders' findVoxel): in the
+// node whose nonzero header is at word `pos`, the child whose cube holds the
+// voxel (x, y, z) (relative to the root's corner; children of size
+// 2^childLog2).
+// False where that child is empty. Else its offset (in the next level's
+// words, or among the leaf masks below the last inner level), and `mirror`
+// and `base` (the entry of the cube's first stored voxel) become the child's.
+VDBDAG_FN bool dagDescend(VDBDAG_INNER_BUF buf, uint64_t pos, uint header, uint64_t x, uint64_t y, uint64_t z, uint childLog2, uint offsetWords,
+                          VDBDAG_INOUT(uint) mirror, VDBDAG_INOUT(uint64_t) base, VDBDAG_OUT(uint64_t) offset) {
+    const uint spatial = uint((x >> childLog2) & 1ul) | (uint((y >> childLog2) & 1ul) << 1u) | (uint((z >> childLog2) & 1ul) << 2u);
+    const uint slot = spatial ^ mirror;
+    offset = 0ul;
+    if (dagChildTag(header, slot) == 0u) return false;
+    uint reflection;
+    uint64_t attributeOffset;
+    dagChildPointer(buf, pos, header, slot, offsetWords, offset, reflection, attributeOffset);
+    mirror ^= reflection;
+    base += attributeOffset;
+    return true;
+}
+
 // Words of the node whose header is `header` (nonzero: a solid node is its
 // header alone): the header, each stored child's pointer (one word for
 // tag 01, two for 1x) and, for every child but the first, `offsetWords`
@@ -116,6 +139,15 @@ VDBDAG_PURE uint dagPopcount64(uint64_t x) {
 
 // The entry rank of stored bit `bit` among the leaf's set bits below it.
 VDBDAG_PURE uint dagLeafRank(uint64_t mask, uint bit) { return dagPopcount64(mask & ((uint64_t(1) << bit) - 1ul)); }
+
+// The last step of a point lookup: the voxel (x, y, z) (its low two bits)
+// of the 4^3 leaf `mask` stored under `mirror`, whose first entry is `base`.
+// False where the voxel is not stored (inactive); else its entry.
+VDBDAG_FN bool dagLeafEntry(uint64_t mask, uint64_t x, uint64_t y, uint64_t z, uint mirror, uint64_t base, VDBDAG_OUT(uint64_t) entry) {
+    const uint bit = dagStoredBit(uint(x & 3ul), uint(y & 3ul), uint(z & 3ul), mirror);
+    entry = base + uint64_t(dagLeafRank(mask, bit));
+    return ((mask >> bit) & 1ul) != 0ul;
+}
 
 // A 4^3 leaf mask reflected by m (x: reverse every row's 4 bits; y: the 4
 // rows of every 16-bit slice; z: the 4 slices).

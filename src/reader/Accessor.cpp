@@ -43,10 +43,7 @@ bool Layer::find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t
         if (diff < 4 && path.leaf.valid) {  // the same 4^3 brick: no walk
             const Accessor::Path::Leaf& leaf = path.leaf;
             path.key = {int64_t(rel[0]), int64_t(rel[1]), int64_t(rel[2])};
-            const unsigned bit = access::dagStoredBit(unsigned(rel[0] & 3u), unsigned(rel[1] & 3u), unsigned(rel[2] & 3u), leaf.mirror);
-            if (((leaf.stored >> bit) & 1u) == 0) return false;
-            entry = leaf.base + access::dagLeafRank(leaf.stored, bit);
-            return true;
+            return access::dagLeafEntry(leaf.stored, rel[0], rel[1], rel[2], leaf.mirror, leaf.base, entry);
         }
         if (path.uniform.log2 < 64 && (diff >> path.uniform.log2) == 0) {  // the same solid or empty cube
             path.key = {int64_t(rel[0]), int64_t(rel[1]), int64_t(rel[2])};
@@ -69,24 +66,16 @@ bool Layer::find(int64_t i, int64_t j, int64_t k, Accessor::Path& path, uint64_t
             return true;
         }
         const unsigned half = d.log2Size - t - 1;  // log2 of a child's size
-        const unsigned spatial = unsigned((rel[0] >> half) & 1u) | unsigned((rel[1] >> half) & 1u) << 1 | unsigned((rel[2] >> half) & 1u) << 2;
-        const unsigned slot = spatial ^ n.mirror;
-        if (((header >> (2 * slot)) & 3u) == 0) {  // an empty child: none of its cube
-            path.uniform = {half, false, 0};
+        unsigned mirror = n.mirror;
+        uint64_t base = n.base, childOffset;
+        if (!access::dagDescend(d.inner.data(), n.pos, header, rel[0], rel[1], rel[2], half, d.offsetWords[t], mirror, base, childOffset)) {
+            path.uniform = {half, false, 0};  // an empty child: none of its cube
             return false;
         }
-        uint64_t childOffset, attributeOffset;
-        unsigned reflection;
-        access::dagChildPointer(d.inner.data(), n.pos, header, slot, d.offsetWords[t], childOffset, reflection, attributeOffset);
-        const unsigned mirror = n.mirror ^ reflection;
-        const uint64_t base = n.base + attributeOffset;
         if (t + 1 == d.innerLevelCount()) {  // the child is a 4^3 leaf
             const uint64_t stored = d.leaves[childOffset];
             path.leaf = {stored, base, mirror, true};
-            const unsigned bit = access::dagStoredBit(unsigned(rel[0] & 3u), unsigned(rel[1] & 3u), unsigned(rel[2] & 3u), mirror);
-            if (((stored >> bit) & 1u) == 0) return false;
-            entry = base + access::dagLeafRank(stored, bit);
-            return true;
+            return access::dagLeafEntry(stored, rel[0], rel[1], rel[2], mirror, base, entry);
         }
         if (t + 1 >= Accessor::Path::kMaxDepth) throw Error(what + ": the DAG is deeper than " + std::to_string(Accessor::Path::kMaxDepth) + " levels");
         path.nodes[t + 1] = {d.levelStart[t + 1] + childOffset, base, mirror};

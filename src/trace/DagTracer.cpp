@@ -64,23 +64,17 @@ std::optional<uint64_t> DagTracer::find(const std::array<int64_t, 3>& voxel) con
     uint64_t pos = 0, base = 0;
     unsigned mirror = dag.rootReflection;
     const unsigned innerLevels = unsigned(dag.innerLevelCount());
+    const uint64_t x = uint64_t(v[0]), y = uint64_t(v[1]), z = uint64_t(v[2]);
     for (unsigned depth = 0;; ++depth) {
         const uint16_t header = dag.inner[pos];
         if (header == 0) return base;
-        const unsigned half = dag.log2Size - depth - 1;
-        const unsigned p = unsigned((v[0] >> half) & 1) | unsigned((v[1] >> half) & 1) << 1 | unsigned((v[2] >> half) & 1) << 2;
-        const unsigned j = p ^ mirror;
-        if (((header >> (2 * j)) & 3u) == 0) return std::nullopt;
-        uint64_t offset, attributeOffset;
-        unsigned reflection;
-        access::dagChildPointer(dag.inner.data(), pos, header, j, dag.offsetWords[depth], offset, reflection, attributeOffset);
-        mirror ^= reflection;
-        base += attributeOffset;
+        uint64_t offset;
+        if (!access::dagDescend(dag.inner.data(), pos, header, x, y, z, dag.log2Size - depth - 1, dag.offsetWords[depth], mirror, base, offset))
+            return std::nullopt;
         if (depth + 1 == innerLevels) {
-            const uint64_t mask = dag.leaves[offset];
-            const unsigned bit = access::dagStoredBit(unsigned(v[0] & 3), unsigned(v[1] & 3), unsigned(v[2] & 3), mirror);
-            if (!((mask >> bit) & 1u)) return std::nullopt;
-            return base + access::dagLeafRank(mask, bit);
+            uint64_t entry;
+            if (!access::dagLeafEntry(dag.leaves[offset], x, y, z, mirror, base, entry)) return std::nullopt;
+            return entry;
         }
         pos = dag.levelStart[depth + 1] + offset;
     }
