@@ -101,6 +101,7 @@ bool modelMayBeatLabels(std::span<const uint8_t> values, std::span<const uint64_
     std::vector<uint64_t> first(layout.size() + 1, 0);  // entries before each brick
     for (size_t b = 0; b < layout.size(); ++b) first[b + 1] = first[b] + coding::layoutEntryCount(layout.subspan(b, 1));
     const uint64_t total = first.back(), run = std::max<uint64_t>(total / 64, uint64_t(1) << 11);
+    if (total <= kRuns * run) return true;  // the sample would be the whole window: code it both ways once
     std::vector<uint8_t> sample;
     std::vector<uint64_t> sampleLayout;
     std::vector<coding::BrickPlace> samplePlaces;

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cctype>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 
@@ -12,6 +13,7 @@
 
 #include <gdcmDataSet.h>
 #include <gdcmMediaStorage.h>
+#include <gdcmPhotometricInterpretation.h>
 #include <gdcmReader.h>
 #include <gdcmSequenceOfItems.h>
 #include <gdcmStringFilter.h>
@@ -91,6 +93,192 @@ std::string nonImageClass(const std::string& sop) {
     if (sop == "1.2.840.10008.5.1.4.1.1.66" || startsWith(sop, "1.2.840.10008.5.1.4.1.1.66."))
         return "a non-image object (" + sopClassName(sop) + ")";
     if (sop == "1.2.840.10008.1.3.10") return "a DICOMDIR (media directory), not an image";
+    return "";
+}
+
+// What GDCM 3.0's image reader (PixmapReader::ReadImageInternal, which
+// vdbdag runs on a file whose pixel data it does not read itself: any but
+// native pixel data under a native transfer syntax) asserts (aborts) or
+// crashes on in the values of the overlay (60xx) and curve (50xx) groups
+// and of the Icon Image Sequence (0088,0200); "" when none. The element
+// walk has checked their VRs (kReaderVrs); these need their values, read
+// here as GDCM keeps them (raw bytes, little-endian: no big-endian data set
+// reaches that reader).
+uint16_t valueUs(const gdcm::ByteValue& bv, size_t index) {
+    const auto* p = reinterpret_cast<const uint8_t*>(bv.GetPointer()) + 2 * index;
+    return uint16_t(p[0] | p[1] << 8);
+}
+
+std::string tagName(uint16_t group, uint16_t element) { return fmt::format("({:04X},{:04X})", group, element); }
+
+// The overlay groups, as PixmapReader's GetNumberOfOverlaysInternal and
+// DoOverlays and Overlay::Update read them. `nativePixels`: the pixel data
+// is not encapsulated (GDCM then takes an overlay without Overlay Data from
+// its unused bits); `pixelBits`: its Bits Allocated.
+std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned pixelBits, unsigned samplesPerPixel) {
+    std::map<uint16_t, std::vector<const gdcm::DataElement*>> groups;  // the even (public) groups 6000-60FE
+    for (const gdcm::DataElement& de : ds.GetDES()) {
+        const uint16_t g = de.GetTag().GetGroup();
+        if (g > 0x60FF) break;
+        if (g >= 0x6000 && g % 2 == 0) groups[g].push_back(&de);
+    }
+    const auto present = [&](uint16_t g, uint16_t e) { return ds.FindDataElement(gdcm::Tag(g, e)) && !ds.GetDataElement(gdcm::Tag(g, e)).IsEmpty(); };
+    std::vector<uint16_t> overlays;  // what GDCM counts as one: Overlay Data, or Rows, Columns and Bit Position
+    for (const auto& [g, elements] : groups)
+        if (present(g, 0x3000) || (present(g, 0x0010) && present(g, 0x0011) && present(g, 0x0102))) overlays.push_back(g);
+    // GetNumberOfOverlaysInternal asserts that there are at most 16.
+    if (overlays.size() > 16)
+        return fmt::format("{} overlay groups (60xx), more than the 16 GDCM's image reader takes (it aborts on more)", overlays.size());
+    for (const uint16_t g : overlays) {
+        unsigned rows = 0, columns = 0;
+        bool data = false;
+        for (const gdcm::DataElement* de : groups[g]) {
+            const gdcm::ByteValue* bv = de->GetByteValue();
+            if (!bv || !bv->GetLength()) continue;  // Update skips an empty element (and a sequence)
+            const uint16_t e = de->GetTag().GetElement();
+            const std::string s(bv->GetPointer(), bv->GetLength());
+            static const std::set<uint16_t> known{0x0000, 0x0010, 0x0011, 0x0015, 0x0022, 0x0040, 0x0045, 0x0050, 0x0051, 0x0060,
+                                                  0x0100, 0x0102, 0x0110, 0x0200, 0x1301, 0x1302, 0x1303, 0x1500, 0x3000};
+            if (!known.count(e))
+                return fmt::format("overlay group {:04X} holds element {}, which GDCM's image reader aborts on (Overlay::Update takes only the {} overlay "
+                                   "elements it knows)",
+                                   g, tagName(g, e), known.size());
+            if (e == 0x0060 && s != "NONE")
+                return fmt::format("element {} Overlay Compression Code is '{}', which GDCM's image reader aborts on (it takes NONE only)", tagName(g, e), s);
+            if (e == 0x0110 && s != "RECT")
+                return fmt::format("element {} Overlay Format is '{}', which GDCM's image reader aborts on (it takes RECT only)", tagName(g, e), s);
+            // Attribute<0x6000,0x0050> (SS, VM 2) reads its two values and
+            // asserts when the first is cut short.
+            if (e == 0x0050 && bv->GetLength() < 2)
+                return fmt::format("element {} Overlay Origin holds {} byte, too few for the first of its 2 values: GDCM's image reader aborts on it",
+                                   tagName(g, e), bv->GetLength());
+            if (e == 0x0010) rows = bv->GetLength() >= 2 ? valueUs(*bv, 0) : uint8_t(s[0]);
+            if (e == 0x0011) columns = bv->GetLength() >= 2 ? valueUs(*bv, 0) : uint8_t(s[0]);
+            if (e == 0x3000) data = true;
+        }
+        // An overlay without Overlay Data (or of no pixels): GDCM takes it
+        // from the unused bits of native pixel data of 8 or 16 bits
+        // (Overlay::GrabOverlayFromPixelData), asserting that its pixels are
+        // a multiple of 8, and reading Rows x Columns pixels however short
+        // the pixel data.
+        const uint64_t pixels = uint64_t(rows) * columns;
+        if ((!data || pixels == 0) && nativePixels && samplesPerPixel == 1 && (pixelBits == 8 || pixelBits == 16) && pixels % 8 != 0)
+            return fmt::format("overlay group {:04X} of {}x{} pixels (not a multiple of 8) lies in the pixel data's unused bits, which GDCM's image reader "
+                               "aborts on",
+                               g, rows, columns);
+    }
+    return "";
+}
+
+// The curve groups, as PixmapReader's DoCurves and Curve::Update read them:
+// once one even 50xx group holds Curve Data, GDCM reads every even 50xx
+// group as a curve, asserting that each holds Curve Data too, and that
+// Update knows each element.
+std::string curveProblem(const gdcm::DataSet& ds) {
+    std::map<uint16_t, std::vector<const gdcm::DataElement*>> groups;
+    for (const gdcm::DataElement& de : ds.GetDES()) {
+        const uint16_t g = de.GetTag().GetGroup();
+        if (g > 0x50FF) break;
+        if (g >= 0x5000 && g % 2 == 0) groups[g].push_back(&de);
+    }
+    const auto withData = [&](uint16_t g) { return ds.FindDataElement(gdcm::Tag(g, 0x3000)) && !ds.GetDataElement(gdcm::Tag(g, 0x3000)).IsEmpty(); };
+    if (std::none_of(groups.begin(), groups.end(), [&](const auto& kv) { return withData(kv.first); })) return "";
+    for (const auto& [g, elements] : groups) {
+        if (!withData(g))
+            return fmt::format("curve group {:04X} has no Curve Data ({:04X},3000) while another curve group has, which GDCM's image reader aborts on", g,
+                               g);
+        for (const gdcm::DataElement* de : elements) {
+            const gdcm::ByteValue* bv = de->GetByteValue();
+            if (!bv || !bv->GetLength()) continue;
+            const uint16_t e = de->GetTag().GetElement();
+            static const std::set<uint16_t> known{0x0000, 0x0005, 0x0010, 0x0020, 0x0022, 0x0030, 0x0040, 0x0103, 0x0104,
+                                                  0x0105, 0x0106, 0x0110, 0x0112, 0x0114, 0x2500, 0x2600, 0x2610, 0x3000};
+            if (!known.count(e))
+                return fmt::format("curve group {:04X} holds element {}, which GDCM's image reader aborts on (Curve::Update takes only the {} curve elements "
+                                   "it knows)",
+                                   g, tagName(g, e), known.size());
+        }
+    }
+    return "";
+}
+
+// The first item of the Icon Image Sequence, as PixmapReader's DoIconImage
+// reads it: its Photometric Interpretation, and for PALETTE COLOR its
+// palette (gdcm::LookupTable::Allocate, InitializeLUT and SetLUT, and the
+// reader's own check of each table's length), emulated here.
+std::string iconProblem(const gdcm::DataSet& ds) {
+    gdcm::SmartPointer<gdcm::SequenceOfItems> keep;
+    const gdcm::DataSet* icon = firstItem(ds, 0x0088, 0x0200, keep);
+    if (!icon) return "";
+    const std::string where = "its Icon Image Sequence (0088,0200)";
+    gdcm::PhotometricInterpretation::PIType pi = gdcm::PhotometricInterpretation::MONOCHROME2;
+    if (icon->FindDataElement(gdcm::Tag(0x0028, 0x0004))) {
+        const gdcm::ByteValue* bv = icon->GetDataElement(gdcm::Tag(0x0028, 0x0004)).GetByteValue();
+        // DoIconImage reads the value without asking whether there is one.
+        if (!bv) return where + " has an empty Photometric Interpretation (0028,0004), which GDCM's image reader crashes on";
+        pi = gdcm::PhotometricInterpretation::GetPIType(std::string(bv->GetPointer(), bv->GetLength()).c_str());
+    }
+    if (pi != gdcm::PhotometricInterpretation::PALETTE_COLOR) return "";
+    if (icon->FindDataElement(gdcm::Tag(0x0028, 0x1221)))
+        return where + " holds a segmented palette (0028,1221), which GDCM's image reader aborts on";
+    unsigned bits = 0;  // Attribute<0x0028,0x0100> = {0}
+    if (icon->FindDataElement(gdcm::Tag(0x0028, 0x0100)))
+        if (const gdcm::ByteValue* bv = icon->GetDataElement(gdcm::Tag(0x0028, 0x0100)).GetByteValue(); bv && bv->GetLength())
+            bits = bv->GetLength() >= 2 ? valueUs(*bv, 0) : uint8_t(bv->GetPointer()[0]);
+    if (bits != 8 && bits != 16)
+        return fmt::format("{} is PALETTE COLOR with Bits Allocated {}, which GDCM's image reader aborts on (its palettes take 8 or 16)", where, bits);
+    const size_t rgbSize = bits == 8 ? 256 * 3 : 65536 * 2 * 3;
+    uint32_t lutLength[3] = {0, 0, 0};
+    unsigned lutBits[3] = {0, 0, 0};
+    bool incomplete = false;
+    static const char* const colour[3] = {"Red", "Green", "Blue"};
+    for (unsigned i = 0; i < 3; ++i) {
+        const uint16_t descriptor = uint16_t(0x1101 + i), data = uint16_t(0x1201 + i), segmented = uint16_t(0x1221 + i);
+        const std::string name = fmt::format("{} Palette Color Lookup Table Descriptor {}", colour[i], tagName(0x0028, descriptor));
+        // Element<VR::US,VM::VM3>: left undefined without a value, asserts
+        // on fewer than 2 values, leaves the third undefined without it.
+        const gdcm::ByteValue* d = icon->FindDataElement(gdcm::Tag(0x0028, descriptor)) ? icon->GetDataElement(gdcm::Tag(0x0028, descriptor)).GetByteValue()
+                                                                                         : nullptr;
+        if (!d || d->GetLength() < 6)
+            return fmt::format("{} has a {} of {} bytes, fewer than its 3 values: GDCM's image reader aborts on it or reads undefined ones", where, name,
+                               d ? d->GetLength() : 0);
+        const unsigned entries = valueUs(*d, 0), first = valueUs(*d, 1), entryBits = valueUs(*d, 2);
+        if (entryBits == 8 || entryBits == 16) {  // LookupTable::InitializeLUT
+            if (first != 0)
+                return fmt::format("{} has a {} whose first mapped value is {}, which GDCM's image reader aborts on (it takes 0 only)", where, name, first);
+            lutLength[i] = entries ? entries : 65536;
+            lutBits[i] = entryBits;
+            if (entries && entries != 256) incomplete = true;
+        }
+        const bool plain = icon->FindDataElement(gdcm::Tag(0x0028, data));
+        if (!plain && !icon->FindDataElement(gdcm::Tag(0x0028, segmented))) return "";  // GDCM gives the icon up
+        const uint16_t table = plain ? data : segmented;
+        const gdcm::ByteValue* t = icon->GetDataElement(gdcm::Tag(0x0028, table)).GetByteValue();
+        const std::string tableName = fmt::format("{} Palette Color Lookup Table Data {}", colour[i], tagName(0x0028, table));
+        if (!t) return fmt::format("{} has an empty {}, which GDCM's image reader aborts on", where, tableName);
+        const uint64_t length = t->GetLength();
+        // LookupTable::SetLUT's asserts.
+        bool fits = true;
+        if (const uint64_t n = lutLength[i]) {
+            if (!incomplete && rgbSize != 3 * n * (bits / 8)) fits = false;
+            else if (bits == 8) {
+                const uint64_t mult = lutBits[i] / 8, mult2 = length / n;
+                if (n * mult2 != length || n > 256) fits = false;
+                else if (n * mult == length || n * mult + 1 == length) fits = mult2 == 1 || mult2 == 2;
+                else fits = mult2 == 2;
+            } else {
+                fits = n * 2 == length;
+            }
+        }
+        // DoIconImage's check of a (not segmented) table's length.
+        if (plain) {
+            const uint64_t check = uint64_t(entries ? entries : 65536) * entryBits / 8;
+            if (check != length && 2 * check != length && check + 1 != length) fits = false;
+        }
+        if (!fits)
+            return fmt::format("{} has a {} of {} bytes, which its descriptor ({}, {}, {}) and Bits Allocated {} do not fit: GDCM's image reader aborts on it",
+                               where, tableName, length, entries, first, entryBits, bits);
+    }
     return "";
 }
 
