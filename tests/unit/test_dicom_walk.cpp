@@ -96,8 +96,9 @@ TEST(DicomWalk, AnElementWithoutAVrUnderAnExplicitSyntaxIsRefused) {
 // like no DICOM (no preamble and a first group neither 0002 nor 0008, or a
 // DICM prefix without the file meta group after it), which GDCM parses by
 // guessing its byte order and VRs: the walk refuses them before GDCM sees
-// them. The last is refused when its header is read, before GDCM's image
-// reader sees its Recognition Code. `vdbdag info` of each file and of its
+// them. Others walk and are refused when their header is read, before
+// GDCM's image reader sees their Recognition Code, overlay or curve groups
+// or icon; the walk refuses the rest. `vdbdag info` of each file and of its
 // folder, under a 1.5 GB address-space cap, lists it as skipped.
 TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
     const fs::path dir = fs::path(VDBDAG_SOURCE_DIR) / "tests/fuzz/regressions/scan_headers";
@@ -112,7 +113,19 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                           "has no valid VR under the explicit transfer syntax 1.2.840.10008.1.2.5 its file meta group declares"},
                                                          {"dicom_meta_sequence_abort", "is a sequence (VR SQ)"},
                                                          {"dicom_orientation_vr_abort",
-                                                          "element (0020,0037) Image Orientation (Patient) at byte 250 has VR AS, which GDCM's image reader aborts on"}};
+                                                          "element (0020,0037) Image Orientation (Patient) at byte 250 has VR AS, which GDCM's image reader aborts on"},
+                                                         // walk, but are refused when their header is read (RLE: GDCM's image reader would decode them)
+                                                         {"dicom_overlay_element_abort", "overlay group 6000 holds element (6000,1001), which GDCM's image reader aborts on"},
+                                                         {"dicom_overlay_groups_abort", "17 overlay groups (60xx), more than the 16 GDCM's image reader takes"},
+                                                         {"dicom_overlay_origin_short_abort", "element (6000,0050) Overlay Origin holds 1 byte, too few for the first of its 2 values"},
+                                                         {"dicom_icon_palette_subscript_abort",
+                                                          "Red Palette Color Lookup Table Descriptor (0028,1101) whose first mapped value is 16, which GDCM's image reader aborts on"},
+                                                         {"dicom_icon_descriptor_short_abort", "Red Palette Color Lookup Table Descriptor (0028,1101) of 2 bytes, fewer than its 3 values"},
+                                                         {"dicom_icon_empty_photometric_crash", "its Icon Image Sequence (0088,0200) has an empty Photometric Interpretation (0028,0004)"},
+                                                         {"dicom_curve_element_abort", "curve group 5000 holds element (5000,0050), which GDCM's image reader aborts on"},
+                                                         // refused by the walk
+                                                         {"dicom_odd_item_length_abort",
+                                                          "the item at byte 316 holds elements of odd total length (its element (0008,1150) at byte 324 is 25 bytes long)"}};
     for (const auto& [name, why] : cases) {
         std::ifstream in(dir / name, std::ios::binary);
         const std::string input((std::istreambuf_iterator<char>(in)), {});

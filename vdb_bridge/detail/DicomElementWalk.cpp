@@ -227,20 +227,48 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
     // ends it). GDCM asserts on an item where an element belongs and on an
     // element where an item belongs, so neither passes.
     enum class Kind { DataSet, Sequence, Fragments, Item };
+    // GDCM sums the lengths of an item's elements (Item::GetLength) for
+    // each item of a sequence of defined length, and for each item of a
+    // sequence of undefined length inside such an item or an item of defined
+    // length (DataSet::ReadWithLength sums its elements' lengths), and
+    // asserts that the sum is even: `checked` marks those sequences and items, `odd` the
+    // parity of an item's element lengths so far, `oddAt` its last element
+    // of odd length (a 4x4 RLE file whose icon item held elements of 1, 1
+    // and 257 bytes aborted in gdcm::Reader).
+    struct OddElement {
+        uint16_t group = 0, element = 0;
+        uint64_t pos = 0, length = 0;
+    };
     struct Frame {
         Kind kind;
         uint64_t end;  // 0: undefined length
+        uint64_t start = 0;
+        bool checked = false, odd = false;
+        OddElement oddAt{};
     };
     std::vector<Frame> frames{{Kind::DataSet, 0}};
     const auto enter = [&](Kind kind, uint64_t at, uint64_t length) -> std::string {
         if (frames.size() >= 64) return fmt::format("sequences nested more than 64 deep at byte {}", at);
-        frames.push_back({kind, length == 0xFFFFFFFFu ? 0 : at + length});
+        const Frame& parent = frames.back();
+        const bool checked = kind == Kind::Item ? parent.checked
+                                                : kind == Kind::Sequence && (length != 0xFFFFFFFFu || (parent.kind == Kind::Item && (parent.checked || parent.end)));
+        frames.push_back({kind, length == 0xFFFFFFFFu ? 0 : at + length, at, checked, false, {}});
+        return "";
+    };
+    // Leaving a frame: an item GDCM sums is refused when its sum is odd.
+    const auto leave = [&]() -> std::string {
+        const Frame f = frames.back();
+        frames.pop_back();
+        if (f.kind == Kind::Item && f.checked && f.odd)
+            return fmt::format("the item at byte {} holds elements of odd total length (its element ({:04X},{:04X}) at byte {} is {} bytes long), which GDCM "
+                               "asserts on in a sequence of defined length",
+                               f.start - 8, f.oddAt.group, f.oddAt.element, f.oddAt.pos, f.oddAt.length);
         return "";
     };
     for (unsigned steps = 0; steps < 10'000'000; ++steps) {
         while (frames.size() > 1 && frames.back().end && pos >= frames.back().end) {
             if (pos > frames.back().end) return fmt::format("an element at byte {} runs past the end of its sequence or item", pos);
-            frames.pop_back();
+            if (const std::string bad = leave(); !bad.empty()) return bad;
         }
         // GDCM asserts on an element cut off after its tag, whatever the
         // file starts with (a 291-byte file whose first group is 0000 and
@@ -287,7 +315,7 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
             if (element != 0xE00D && element != 0xE0DD) return fmt::format("unknown item tag (FFFE,{:04X}) at byte {}", element, pos);
             if ((!endsItem && !endsSequence) || frames.back().end)
                 return fmt::format("a delimiter (FFFE,{:04X}) at byte {} outside a sequence or item of undefined length it could end", element, pos);
-            frames.pop_back();
+            if (const std::string bad = leave(); !bad.empty()) return bad;
             pos += header;
             continue;
         }
@@ -365,6 +393,10 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
             pixels->length = pixels->encapsulated ? 0 : length;
             pixels->bigEndian = bigEndian;
             pixels->transferSyntax = transferSyntax;
+        }
+        if (where == Kind::Item && length != 0xFFFFFFFFu && length % 2) {
+            frames.back().odd = !frames.back().odd;
+            frames.back().oddAt = {group, element, pos, length};
         }
         if (length == 0xFFFFFFFFu) {  // a sequence or encapsulated pixel data: walk into it
             pos += header;

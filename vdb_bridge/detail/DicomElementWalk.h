@@ -8,7 +8,9 @@
 // define or with a sequence, an element without a VR under an explicit transfer
 // syntax (the first too, when the file meta group declares it), an element
 // GDCM's image reader reads through gdcm::Attribute<> with an explicit VR
-// other than its own (it asserts on one; DicomElementWalk.cpp's kReaderVrs), a file
+// other than its own (it asserts on one; DicomElementWalk.cpp's kReaderVrs), an item
+// whose elements' lengths sum to an odd number where GDCM sums them (in a
+// sequence of defined length; it asserts on one), a file
 // that ends inside an element, a sequence or an item, a file without
 // preamble whose first group is neither 0002 nor 0008, and a DICM prefix
 // without the file meta group after it (GDCM guesses how to read those). It also finds the top-level Pixel Data element, so native pixel

@@ -113,8 +113,8 @@ std::string tagName(uint16_t group, uint16_t element) { return fmt::format("({:0
 
 // The overlay groups, as PixmapReader's GetNumberOfOverlaysInternal and
 // DoOverlays and Overlay::Update read them. `nativePixels`: the pixel data
-// is not encapsulated (GDCM then takes an overlay without Overlay Data from
-// its unused bits); `pixelBits`: its Bits Allocated.
+// are not encapsulated; `pixelBits`, `samplesPerPixel`: the image's Bits
+// Allocated and Samples per Pixel.
 std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned pixelBits, unsigned samplesPerPixel) {
     std::map<uint16_t, std::vector<const gdcm::DataElement*>> groups;  // the even (public) groups 6000-60FE
     for (const gdcm::DataElement& de : ds.GetDES()) {
@@ -123,9 +123,12 @@ std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned 
         if (g >= 0x6000 && g % 2 == 0) groups[g].push_back(&de);
     }
     const auto present = [&](uint16_t g, uint16_t e) { return ds.FindDataElement(gdcm::Tag(g, e)) && !ds.GetDataElement(gdcm::Tag(g, e)).IsEmpty(); };
-    std::vector<uint16_t> overlays;  // what GDCM counts as one: Overlay Data, or Rows, Columns and Bit Position
+    // What GDCM counts as an overlay: a group with Overlay Data, not empty;
+    // or without it, with Rows, Columns and Bit Position, none empty.
+    std::vector<uint16_t> overlays;
     for (const auto& [g, elements] : groups)
-        if (present(g, 0x3000) || (present(g, 0x0010) && present(g, 0x0011) && present(g, 0x0102))) overlays.push_back(g);
+        if (ds.FindDataElement(gdcm::Tag(g, 0x3000)) ? present(g, 0x3000) : present(g, 0x0010) && present(g, 0x0011) && present(g, 0x0102))
+            overlays.push_back(g);
     // GetNumberOfOverlaysInternal asserts that there are at most 16.
     if (overlays.size() > 16)
         return fmt::format("{} overlay groups (60xx), more than the 16 GDCM's image reader takes (it aborts on more)", overlays.size());
@@ -151,16 +154,15 @@ std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned 
             // asserts when the first is cut short.
             if (e == 0x0050 && bv->GetLength() < 2)
                 return fmt::format("element {} Overlay Origin holds {} byte, too few for the first of its 2 values: GDCM's image reader aborts on it",
-                                   tagName(g, e), bv->GetLength());
+                                   tagName(g, e), uint32_t(bv->GetLength()));
             if (e == 0x0010) rows = bv->GetLength() >= 2 ? valueUs(*bv, 0) : uint8_t(s[0]);
             if (e == 0x0011) columns = bv->GetLength() >= 2 ? valueUs(*bv, 0) : uint8_t(s[0]);
             if (e == 0x3000) data = true;
         }
         // An overlay without Overlay Data (or of no pixels): GDCM takes it
-        // from the unused bits of native pixel data of 8 or 16 bits
-        // (Overlay::GrabOverlayFromPixelData), asserting that its pixels are
-        // a multiple of 8, and reading Rows x Columns pixels however short
-        // the pixel data.
+        // from the unused bits of native pixel data of 8 or 16 bits of one
+        // sample (Overlay::GrabOverlayFromPixelData), asserting that its
+        // pixels are a multiple of 8.
         const uint64_t pixels = uint64_t(rows) * columns;
         if ((!data || pixels == 0) && nativePixels && samplesPerPixel == 1 && (pixelBits == 8 || pixelBits == 16) && pixels % 8 != 0)
             return fmt::format("overlay group {:04X} of {}x{} pixels (not a multiple of 8) lies in the pixel data's unused bits, which GDCM's image reader "
@@ -241,7 +243,7 @@ std::string iconProblem(const gdcm::DataSet& ds) {
                                                                                          : nullptr;
         if (!d || d->GetLength() < 6)
             return fmt::format("{} has a {} of {} bytes, fewer than its 3 values: GDCM's image reader aborts on it or reads undefined ones", where, name,
-                               d ? d->GetLength() : 0);
+                               d ? uint32_t(d->GetLength()) : 0u);
         const unsigned entries = valueUs(*d, 0), first = valueUs(*d, 1), entryBits = valueUs(*d, 2);
         if (entryBits == 8 || entryBits == 16) {  // LookupTable::InitializeLUT
             if (first != 0)
@@ -256,7 +258,7 @@ std::string iconProblem(const gdcm::DataSet& ds) {
         const gdcm::ByteValue* t = icon->GetDataElement(gdcm::Tag(0x0028, table)).GetByteValue();
         const std::string tableName = fmt::format("{} Palette Color Lookup Table Data {}", colour[i], tagName(0x0028, table));
         if (!t) return fmt::format("{} has an empty {}, which GDCM's image reader aborts on", where, tableName);
-        const uint64_t length = t->GetLength();
+        const uint64_t length = uint32_t(t->GetLength());
         // LookupTable::SetLUT's asserts.
         bool fits = true;
         if (const uint64_t n = lutLength[i]) {
@@ -316,6 +318,7 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
 
     // The pixel data element itself (the header read stops before it).
     uint64_t nativePixelBytes = 0;  // the length of native (not encapsulated) pixel data, else 0
+    DicomPixelData px;              // where the element walk found the pixel data
     {
         gdcm::Reader pixels;
         pixels.SetFileName(path.c_str());
@@ -326,7 +329,7 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
         // GDCM would allocate a declared pixel length past the file's end
         // before reading it: such a file is damaged without asking GDCM.
         uint64_t declaredPixels = 0;
-        const std::string bad = elementLengthProblem(path, false, &declaredPixels);
+        const std::string bad = elementLengthProblem(path, false, &declaredPixels, &px);
         if (!bad.empty()) {
             const bool bigEndian = file.GetHeader().GetDataSetTransferSyntax() == gdcm::TransferSyntax::ExplicitVRBigEndian;
             if (declaredPixels) info.damaged = checkNativeLength(path, uint32_t(declaredPixels), bigEndian);
@@ -348,6 +351,22 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
             if (!vl.IsUndefined() && uint32_t(vl) > 0) info.damaged = checkNativeLength(path, uint32_t(vl), bigEndian);
             if (!vl.IsUndefined()) nativePixelBytes = uint32_t(vl);
         }
+    }
+    // GDCM's image reader decodes what vdbdag does not read itself (any but
+    // native pixel data under a native transfer syntax, DicomSeries.cpp),
+    // and asserts (aborts) on overlay, curve and icon values the walk cannot
+    // see: such a file is refused here, before its pixel data are decoded.
+    const std::string& syntax = px.transferSyntax;
+    const bool nativeSyntax = syntax.empty() || syntax == "1.2.840.10008.1.2" || syntax == "1.2.840.10008.1.2.1" || syntax == "1.2.840.10008.1.2.2";
+    if (info.damaged.empty() && !(px.found && !px.encapsulated && nativeSyntax)) {
+        const auto spp = f.numbers(ds, 0x0028, 0x0002);
+        const auto bits = f.numbers(ds, 0x0028, 0x0100);
+        // (Deflated data sets are not walked: their pixel data are native.)
+        std::string why = overlayProblem(ds, !px.encapsulated, bits && bits->size() == 1 ? unsigned((*bits)[0]) : 0,
+                                         spp && spp->size() == 1 ? unsigned((*spp)[0]) : 1);
+        if (why.empty()) why = curveProblem(ds);
+        if (why.empty()) why = iconProblem(ds);
+        if (!why.empty()) return "corrupt DICOM: " + why;
     }
 
     info.file = path;
