@@ -349,7 +349,12 @@ ScanState scan(const std::vector<std::string>& paths) {
         }
         auto info = std::make_unique<FileInfo>();
         std::vector<Frame> frames;
-        const std::string why = readFile(file, *info, frames);
+        std::string why;
+        try {
+            why = readFile(file, *info, frames);
+        } catch (const Error& e) {  // a header GDCM's text reading would abort on (detail::Fields::text)
+            why = std::string("corrupt DICOM: ") + e.what();
+        }
         if (!why.empty()) {
             st.scan.skipped.push_back(file + ": " + why);
             continue;

@@ -100,6 +100,34 @@ TEST(DicomWalk, AnElementWithoutAVrUnderAnExplicitSyntaxIsRefused) {
 // GDCM's image reader sees their Recognition Code, overlay or curve groups
 // or icon; the walk refuses the rest. `vdbdag info` of each file and of its
 // folder, under a 1.5 GB address-space cap, lists it as skipped.
+// GE's private transfer syntax 1.2.840.113619.5.2 ("implicit VR big
+// endian": GDCM reads its data set as implicit VR, only its pixels are
+// big-endian) is walked as implicit, not refused as an explicit data set
+// without VRs (a regression of ee789f3 found by review).
+TEST(DicomWalk, GesPrivateImplicitSyntaxIsWalkedAsImplicit) {
+    const auto implicitElement = [](uint16_t group, uint16_t elem, const std::string& value) {
+        std::string e;
+        e += char(group & 0xFF), e += char(group >> 8), e += char(elem & 0xFF), e += char(elem >> 8);
+        for (int b = 0; b < 4; ++b) e += char((value.size() >> (8 * b)) & 0xFF);
+        return e + value;
+    };
+    // A preamble, DICM, the meta group (its length, the transfer syntax),
+    // then two implicit-VR elements.
+    const auto file = [&](const std::string& syntax) {
+        const std::string meta = element(0x0002, 0x0010, "UI", syntax);
+        const uint32_t n = uint32_t(meta.size());
+        const std::string length{char(n & 0xFF), char(n >> 8 & 0xFF), char(n >> 16 & 0xFF), char(n >> 24)};
+        return std::string(128, '\0') + "DICM" + element(0x0002, 0x0000, "UL", length) + meta +
+               implicitElement(0x0008, 0x0016, std::string("1.2.840.10008.5.1.4.1.1.2\0", 26)) + implicitElement(0x0008, 0x0060, "MR");
+    };
+    const fs::path ge = write("ge.dcm", file(std::string("1.2.840.113619.5.2", 18)));
+    EXPECT_EQ(detail::elementLengthProblem(ge.string(), true), "");
+    // The same elements under explicit VR little endian: no VR where one belongs.
+    const std::string refused = detail::elementLengthProblem(write("explicit.dcm", file(std::string("1.2.840.10008.1.2.1\0", 20))).string(), true);
+    EXPECT_NE(refused.find("has no valid VR under the explicit transfer syntax 1.2.840.10008.1.2.1"), std::string::npos) << refused;
+    fs::remove_all(ge.parent_path());
+}
+
 TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
     const fs::path dir = fs::path(VDBDAG_SOURCE_DIR) / "tests/fuzz/regressions/scan_headers";
     const std::pair<const char*, const char*> cases[] = {{"dicom_cut_after_tag_abort", "its first element (0000,0000) is of neither"},
@@ -112,6 +140,7 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                          {"dicom_meta_explicit_without_vr_abort",
                                                           "has no valid VR under the explicit transfer syntax 1.2.840.10008.1.2.5 its file meta group declares"},
                                                          {"dicom_meta_sequence_abort", "is a sequence (VR SQ)"},
+                                                         {"dicom_text_vr_abort", "element (0008,0016) has VR OV, which has no text (GDCM's StringFilter aborts on it)"},
                                                          {"dicom_orientation_vr_abort",
                                                           "element (0020,0037) Image Orientation (Patient) at byte 250 has VR AS, which GDCM's image reader aborts on"},
                                                          // walk, but are refused when their header is read (RLE: GDCM's image reader would decode them)

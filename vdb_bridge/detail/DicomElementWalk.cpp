@@ -283,7 +283,9 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         const bool inMeta = metaGroup && (h[0] | h[1] << 8) == 0x0002;
         if (metaGroup && !inMeta) {  // the meta group ends: the dataset's encoding from its transfer syntax
             metaGroup = false;
-            if (transferSyntax == "1.2.840.10008.1.2") explicitVr = false, declaredImplicit = true;
+            // Implicit VR: DICOM's, and GE's private "implicit VR big endian"
+            // (only its pixels are big-endian; GDCM reads it as implicit).
+            if (transferSyntax == "1.2.840.10008.1.2" || transferSyntax == "1.2.840.113619.5.2") explicitVr = false, declaredImplicit = true;
             else if (transferSyntax == "1.2.840.10008.1.2.2") bigEndian = true;
             else if (transferSyntax == "1.2.840.10008.1.2.1.99") return "";  // deflated: GDCM inflates and checks
             // A transfer syntax DICOM does not define: GDCM then guesses the

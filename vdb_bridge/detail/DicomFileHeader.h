@@ -15,6 +15,9 @@
 #include <gdcmFile.h>
 #include <gdcmStringFilter.h>
 
+#include <fmt/core.h>
+
+#include "src/util/Error.h"
 #include "vdb_bridge/DenseVolume.h"
 
 namespace vdbdag::bridge::detail {
@@ -41,11 +44,17 @@ std::optional<std::vector<double>> parseNumbers(const std::string& text);
 class Fields {
 public:
     explicit Fields(const gdcm::File& file) { filter_.SetFile(file); }
+    // Throws vdbdag::Error for an element of a binary VR GDCM's
+    // StringFilter has no text for (OD, OL, OV, SV, UV: it asserts,
+    // gdcmStringFilter.cxx:471).
     std::string text(const gdcm::DataSet& ds, uint16_t group, uint16_t element) const {
         const gdcm::Tag tag(group, element);
         if (!ds.FindDataElement(tag)) return "";
         const gdcm::DataElement& de = ds.GetDataElement(tag);
         if (de.IsEmpty()) return "";
+        if (!stringFilterReads(de.GetVR()))
+            throw Error(fmt::format("element ({:04X},{:04X}) has VR {}, which has no text (GDCM's StringFilter aborts on it)", group, element,
+                                    gdcm::VR::GetVRString(de.GetVR())));
         return trim(filter_.ToString(de));
     }
     // Empty when absent; nullopt when present but not numbers.
@@ -54,6 +63,16 @@ public:
     }
 
 private:
+    // The VRs StringFilter::ToStringPairInternal turns into text: none read
+    // (implicit: the dictionary's), UN (the dictionary's), the text VRs, and
+    // the binary ones it has a case for.
+    static bool stringFilterReads(gdcm::VR vr) {
+        using V = gdcm::VR;
+        if (vr == V::INVALID || vr == V::UN || gdcm::VR::IsASCII(vr)) return true;
+        for (const V::VRType known : {V::AT, V::FL, V::FD, V::OF, V::SL, V::SS, V::UL, V::US, V::UT, V::OB, V::OW, V::OB_OW, V::SQ})
+            if (vr == known) return true;
+        return false;
+    }
     gdcm::StringFilter filter_;
 };
 
