@@ -39,6 +39,7 @@
 #include "vdb_bridge/DicomTags.h"
 #include "vdb_bridge/detail/DicomElementWalk.h"
 #include "vdb_bridge/detail/DicomFileHeader.h"
+#include "vdb_bridge/detail/DicomRle.h"
 
 namespace vdbdag::bridge {
 namespace {
@@ -533,7 +534,7 @@ private:
             if (const std::string bad = elementLengthProblem(slice.file, false, nullptr, &px); !bad.empty())
                 throw Error(where + ": corrupt DICOM: " + bad);
             cachedFrames_ = px.found && !px.encapsulated && nativeSyntax(px.transferSyntax) ? decodeNative(slice.file, where, px, sliceBytes)
-                                                                                           : decodeWithGdcm(slice.file, where, sliceBytes);
+                                                                                           : decodeWithGdcm(slice.file, px.transferSyntax, where, sliceBytes);
             cachedFile_ = slice.file;
         }
         if (slice.frame >= cachedFrames_) throw Error(fmt::format("{}: frame {} is missing", slice.file, slice.frame + 1));
@@ -604,12 +605,16 @@ private:
 
     // Compressed pixel data: GDCM's image reader and codecs, after the
     // fields its reader asserts on are checked. Returns the frame count.
-    uint64_t decodeWithGdcm(const std::string& file, const std::string& where, size_t sliceBytes) {
+    uint64_t decodeWithGdcm(const std::string& file, const std::string& transferSyntax, const std::string& where, size_t sliceBytes) {
         {
+            // RLE: GDCM's image reader decodes the pixel data as it reads
+            // the file, so they are read (not decoded) and checked first.
+            const bool rle = transferSyntax == detail::kRleSyntax;
             gdcm::Reader header;
             header.SetFileName(file.c_str());
-            if (!header.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008), {gdcm::Tag(kPixelGroup, 0x0010)}))
+            if (!(rle ? header.Read() : header.ReadUpToTag(gdcm::Tag(kPixelGroup, 0x0008), {gdcm::Tag(kPixelGroup, 0x0010)})))
                 throw Error(where + ": GDCM cannot read its header (truncated or corrupt?)");
+            if (const std::string bad = rle ? detail::rleProblem(header.GetFile()) : ""; !bad.empty()) throw Error(where + ": " + bad);
             const Fields f(header.GetFile());
             const std::string photometric = f.text(header.GetFile().GetDataSet(), 0x0028, 0x0004);
             if (photometric != "MONOCHROME1" && photometric != "MONOCHROME2")

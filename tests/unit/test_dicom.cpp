@@ -413,6 +413,13 @@ TEST(DicomSeries, MultiFrameFilesGiveTheSameSamples) {
             for (int c = 0; c < 3; ++c) EXPECT_NEAR(v.axes[size_t(a)][size_t(c)], original.axes[size_t(a)][size_t(c)], 1e-6);
         EXPECT_EQ(v.rescaleSlope, original.rescaleSlope);
         EXPECT_EQ(readSamples(v), samples);
+        // The same frames in RLE, one fragment per frame (each checked
+        // before GDCM decodes it: detail/DicomRle.h).
+        if (runShell("gdcmconv --version >/dev/null").exitCode != 0) continue;
+        const fs::path rle = dir / "frames_rle.dcm";
+        const auto c = runShell("gdcmconv --rle " + quote(file) + " " + quote(rle));
+        ASSERT_EQ(c.exitCode, 0) << c.err;
+        EXPECT_EQ(readSamples(describeDicomSeries(rle.string(), "")), samples);
     }
 }
 

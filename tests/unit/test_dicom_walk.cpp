@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -14,6 +15,7 @@
 
 #include "src/util/Error.h"
 #include "tests/unit/CliRunner.h"
+#include "vdb_bridge/DenseVolume.h"
 #include "vdb_bridge/DicomSeries.h"
 #include "vdb_bridge/detail/DicomElementWalk.h"
 
@@ -181,4 +183,73 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
         }
         fs::remove_all(file.parent_path());
     }
+}
+
+// RLE Lossless pixel data (PS3.5 annex G) that GDCM's RLECodec would decode
+// unchecked (vdb_bridge/detail/DicomRle.h). The base is the fuzz finding
+// tests/fuzz/regressions/scan_headers/dicom_rle_segment_count_crash: a 4x4
+// 16-bit RLE file whose header declares 0x02000002 segments, so GDCM read
+// its 15 segment offsets far out of bounds (SIGSEGV while encoding). With the
+// count set to 2 it is a valid file: segment 1 holds the high bytes, segment
+// 2 the low ones, each 16 literal bytes after a control byte 15 (at bytes 64
+// and 82 of the 100-byte fragment), so pixel i is hi[i] << 8 | lo[i], read
+// off the bytes by hand. Every forged variant is refused with an
+// vdbdag::Error naming the problem, in-process (a crash ends the test).
+TEST(DicomRle, ForgedRleHeadersAreRefusedAndAValidOneDecodesByHand) {
+    std::ifstream in(fs::path(VDBDAG_SOURCE_DIR) / "tests/fuzz/regressions/scan_headers/dicom_rle_segment_count_crash", std::ios::binary);
+    const std::string input((std::istreambuf_iterator<char>(in)), {});
+    ASSERT_EQ(input.size(), 700u);
+    const std::string base = input.substr(1);
+    const size_t fragment = base.find(std::string("\xFE\xFF\x00\xE0\x64\x00\x00\x00", 8)) + 8;  // the 100-byte fragment's first byte
+    ASSERT_LT(fragment, base.size());
+    const auto patch = [&](const std::string& from, size_t at, const std::string& bytes) {
+        std::string s = from;
+        s.replace(fragment + at, bytes.size(), bytes);
+        return s;
+    };
+    const auto le32 = [](uint32_t v) { return std::string{char(v & 0xFF), char(v >> 8 & 0xFF), char(v >> 16 & 0xFF), char(v >> 24)}; };
+    const std::string valid = patch(base, 0, le32(2));
+    const auto patched = [&](size_t at, const std::string& bytes) { return patch(valid, at, bytes); };
+    const auto read = [&](const std::string& bytes) {
+        const fs::path file = write("rle.dcm", bytes);
+        const DenseVolume v = describeDicomSeries(file.string(), "");
+        std::vector<uint8_t> out;
+        openSliceReader(v)->readSlices(v.dims[2], out);
+        return out;
+    };
+    // Valid: the values by hand.
+    const std::vector<uint8_t> samples = read(valid);
+    ASSERT_EQ(samples.size(), 32u);
+    const uint8_t hi[16] = {0, 0, 0, 1, 1, 1, 2, 2, 3, 3, 3, 4, 4, 5, 5, 5};
+    const uint8_t lo[16] = {0x00, 0x64, 0xc8, 0x2c, 0x90, 0xf4, 0x58, 0xbc, 0x20, 0x84, 0xe8, 0x4c, 0xb0, 0x14, 0x78, 0xdc};
+    for (size_t i = 0; i < 16; ++i) EXPECT_EQ(samples[2 * i] | samples[2 * i + 1] << 8, hi[i] << 8 | lo[i]) << i;
+    const std::pair<std::string, std::string> forged[] = {
+        {base, "an RLE header of 33554434 segments where its pixels need 2"},
+        {patched(0, le32(0)), "an RLE header of 0 segments where its pixels need 2"},
+        {patched(0, le32(16)), "an RLE header of 16 segments where its pixels need 2"},
+        {patched(0, le32(2) + le32(65)), "RLE segment 1 starts at byte 65 of a 100-byte frame (the first must start at byte 64)"},
+        {patched(0, le32(2) + le32(64) + le32(100)), "RLE segment 2 starts at byte 100 of a 100-byte frame (not inside the frame after"},
+        {patched(0, le32(2) + le32(64) + le32(64)), "RLE segment 2 starts at byte 64 of a 100-byte frame (not inside the frame after"},
+        {patched(64, "\x10"), "RLE segment 1 decodes to 17 bytes, not the 16 of its share of the frame"},
+        {patched(82, "\x7f"), "RLE segment 2 runs past the end of its frame after 0 of its 16 bytes"},
+        {patched(64, "\x0e"), "RLE segment 1 decodes to 21 bytes"},  // 15 literal bytes, then the 16th (5) read as a control byte: 6 more
+    };
+    for (const auto& [bytes, why] : forged) {
+        try {
+            read(bytes);
+            ADD_FAILURE() << "not refused: " << why;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+        }
+    }
+    // The finding itself through the command line: one line naming the
+    // file and the problem, a non-zero exit, nothing written.
+    const fs::path file = write("finding.dcm", base);
+    const fs::path out = file.parent_path() / "finding.ssvdag";
+    const auto r = vdbdag::testing::runShell(std::string(VDBDAG_BINARY) + " encode " + quote(file) + " -o " + quote(out));
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find(file.string() + ": slice file of "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("an RLE header of 33554434 segments"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    fs::remove_all(file.parent_path());
 }
