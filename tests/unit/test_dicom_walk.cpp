@@ -155,6 +155,8 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                          {"dicom_icon_empty_photometric_crash", "its Icon Image Sequence (0088,0200) has an empty Photometric Interpretation (0028,0004)"},
                                                          {"dicom_curve_element_abort", "curve group 5000 holds element (5000,0050), which GDCM's image reader aborts on"},
                                                          // refused by the walk
+                                                         {"dicom_pixel_data_od_undefined_abort",
+                                                          "element (7FE0,0010) at byte 936 has an undefined length under VR OD (GDCM takes it for OB, OW or UN pixel data only)"},
                                                          {"dicom_odd_item_length_abort",
                                                           "the item at byte 316 holds elements of odd total length (its element (0008,1150) at byte 324 is 25 bytes long)"}};
     for (const auto& [name, why] : cases) {
@@ -252,4 +254,27 @@ TEST(DicomRle, ForgedRleHeadersAreRefusedAndAValidOneDecodesByHand) {
     EXPECT_NE(r.err.find("an RLE header of 33554434 segments"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
     fs::remove_all(file.parent_path());
+}
+
+// An element of undefined length under an explicit VR GDCM reads it by:
+// SQ or UN (a sequence), Pixel Data of OB, OW or UN (fragments). Any other
+// VR asserted in ExplicitDataElement::ReadValue (the fuzz finding
+// dicom_pixel_data_od_undefined_abort: Pixel Data of VR OD). The finding
+// with its VR made OB walks; the same bytes under another tag, an OB
+// element of undefined length that is no pixel data, are refused.
+TEST(DicomWalk, UndefinedLengthsOnlyUnderTheVrsGdcmReadsThemBy) {
+    std::ifstream in(fs::path(VDBDAG_SOURCE_DIR) / "tests/fuzz/regressions/scan_headers/dicom_pixel_data_od_undefined_abort", std::ios::binary);
+    const std::string base = std::string((std::istreambuf_iterator<char>(in)), {}).substr(1);
+    const size_t at = base.find(std::string("\xE0\x7F\x10\x00OD", 6));
+    ASSERT_NE(at, std::string::npos);
+    std::string ob = base;
+    ob[at + 4] = 'O', ob[at + 5] = 'B';
+    EXPECT_EQ(detail::elementLengthProblem(write("ob.dcm", ob).string()), "");
+    std::string other = ob;
+    other[at] = '\x09', other[at + 1] = '\x00';  // (0009,0010): a private element, not pixel data
+    const std::string refused = detail::elementLengthProblem(write("other.dcm", other).string());
+    EXPECT_NE(refused.find("element (0009,0010) at byte 936 has an undefined length under VR OB (GDCM takes it for a sequence of VR SQ or UN only)"),
+              std::string::npos)
+        << refused;
+    fs::remove_all(fs::temp_directory_path() / ("vdbdag_dicom_walk_" + std::to_string(::getpid())));
 }

@@ -381,6 +381,18 @@ std::string walkElementLengths(const std::string& path, bool beforePixels, uint6
         }
         if (inMeta && length == 0xFFFFFFFFu)  // GDCM asserts on it too
             return fmt::format("file meta element ({:04X},{:04X}) at byte {} has an undefined length", group, element, pos);
+        // GDCM reads an element of undefined length as a sequence when its
+        // explicit VR is SQ or UN, as fragments when it is Pixel Data of VR
+        // OB, OW or UN, and asserts on any other VR
+        // (ExplicitDataElement::ReadValue, gdcmExplicitDataElement.txx:203
+        // and :210: an "OD" of undefined length, found by fuzz_scan_headers).
+        if (!inMeta && explicitVr && length == 0xFFFFFFFFu) {
+            const bool pixels = group == kPixelGroup && element == 0x0010;
+            const bool readable = std::strcmp(vr, "UN") == 0 || (pixels ? std::strcmp(vr, "OB") == 0 || std::strcmp(vr, "OW") == 0 : std::strcmp(vr, "SQ") == 0);
+            if (!readable)
+                return fmt::format("element ({:04X},{:04X}) at byte {} has an undefined length under VR {} (GDCM takes it for {} only)", group, element, pos,
+                                   vr, pixels ? "OB, OW or UN pixel data" : "a sequence of VR SQ or UN");
+        }
         const bool pixelData = group == kPixelGroup && element == 0x0010 && frames.size() == 1;
         // Under an explicit transfer syntax GDCM reads the pixel data's own
         // VR even when it stops there, and asserts on one it cannot read as
