@@ -153,6 +153,8 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                           "Red Palette Color Lookup Table Descriptor (0028,1101) whose first mapped value is 16, which GDCM's image reader aborts on"},
                                                          {"dicom_icon_descriptor_short_abort", "Red Palette Color Lookup Table Descriptor (0028,1101) of 2 bytes, fewer than its 3 values"},
                                                          {"dicom_icon_empty_photometric_crash", "its Icon Image Sequence (0088,0200) has an empty Photometric Interpretation (0028,0004)"},
+                                                         {"dicom_icon_samples_per_pixel_abort",
+                                                          "its Icon Image Sequence (0088,0200) has Samples per Pixel (0028,0002) 79, which GDCM's image reader aborts on"},
                                                          {"dicom_curve_element_abort", "curve group 5000 holds element (5000,0050), which GDCM's image reader aborts on"},
                                                          // refused by the walk
                                                          {"dicom_pixel_data_od_undefined_abort",

@@ -213,6 +213,15 @@ std::string iconProblem(const gdcm::DataSet& ds) {
     const gdcm::DataSet* icon = firstItem(ds, 0x0088, 0x0200, keep);
     if (!icon) return "";
     const std::string where = "its Icon Image Sequence (0088,0200)";
+    // DoIconImage gives the icon's Samples per Pixel to
+    // PixelFormat::SetSamplesPerPixel, which asserts on any but 1, 3 and 4
+    // (79: found by fuzz_scan_headers).
+    if (icon->FindDataElement(gdcm::Tag(0x0028, 0x0002)))
+        if (const gdcm::ByteValue* bv = icon->GetDataElement(gdcm::Tag(0x0028, 0x0002)).GetByteValue(); bv && bv->GetLength()) {
+            const unsigned spp = bv->GetLength() >= 2 ? valueUs(*bv, 0) : uint8_t(bv->GetPointer()[0]);
+            if (spp != 1 && spp != 3 && spp != 4)
+                return fmt::format("{} has Samples per Pixel (0028,0002) {}, which GDCM's image reader aborts on (it takes 1, 3 or 4)", where, spp);
+        }
     gdcm::PhotometricInterpretation::PIType pi = gdcm::PhotometricInterpretation::MONOCHROME2;
     if (icon->FindDataElement(gdcm::Tag(0x0028, 0x0004))) {
         const gdcm::ByteValue* bv = icon->GetDataElement(gdcm::Tag(0x0028, 0x0004)).GetByteValue();
@@ -364,6 +373,9 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
         // (Deflated data sets are not walked: their pixel data are native.)
         std::string why = overlayProblem(ds, !px.encapsulated, bits && bits->size() == 1 ? unsigned((*bits)[0]) : 0,
                                          spp && spp->size() == 1 ? unsigned((*spp)[0]) : 1);
+        // PixelFormat::SetSamplesPerPixel asserts on any but 1, 3 and 4.
+        if (why.empty() && spp && spp->size() == 1 && (*spp)[0] != 1 && (*spp)[0] != 3 && (*spp)[0] != 4)
+            why = fmt::format("Samples per Pixel (0028,0002) {}, which GDCM's image reader aborts on (it takes 1, 3 or 4)", (*spp)[0]);
         if (why.empty()) why = curveProblem(ds);
         if (why.empty()) why = iconProblem(ds);
         if (!why.empty()) return "corrupt DICOM: " + why;
