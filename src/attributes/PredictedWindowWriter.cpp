@@ -157,7 +157,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         if (floats->lattice)
             if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *floats->lattice)) {
                 const uint64_t latticeSize = integers->size();
-                consider(std::move(*integers), latticeSize, detail::kWideRescaledFloatCoding);
+                consider(std::move(*integers), latticeSize, detail::kBandedRescaledFloatCoding);
             }
     } else if (vs == 4) {
         const bool placed = !places.empty();
@@ -170,7 +170,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         if (!labelsLike || modelMayBeatLabels(values, layout, places)) {
             std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel));
             const uint64_t size = numeric.size();
-            consider(std::move(numeric), size, placed ? detail::kWideContextCoding : detail::kContextCoding);
+            consider(std::move(numeric), size, placed ? detail::kBandedContextCoding : detail::kContextCoding);
         }
     } else {
         std::vector<uint8_t> predicted = encodePredicted(values, vs, layout);

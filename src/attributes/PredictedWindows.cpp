@@ -38,7 +38,7 @@ const char* predictedCodingName(uint8_t coding) {
     static const char* const names[] = {"palettes", "brick residuals", "context-coded", "placed context-coded", "placed labels",
                                         "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors",
                                         "fitted context-coded", "fitted rescaled floats", "float integers", "wide fitted context-coded",
-                                        "wide fitted rescaled floats"};
+                                        "wide fitted rescaled floats", "banded context-coded", "banded rescaled floats"};
     static_assert(std::size(names) == detail::kCodingCount);
     return coding < std::size(names) ? names[coding] : "unknown";
 }
@@ -124,21 +124,25 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
     if (raw[0] == detail::kPredictedCoding) return decodePredicted(body, dir.valueSize, bricks, where);
     const uint8_t c = raw[0];
     if (c == detail::kContextCoding || c == detail::kPlacedContextCoding || c == detail::kPlacedLabelCoding || c == detail::kSpatialContextCoding ||
-        c == detail::kSpatialLabelCoding || c == detail::kFittedContextCoding || c == detail::kWideContextCoding) {
+        c == detail::kSpatialLabelCoding || c == detail::kFittedContextCoding || c == detail::kWideContextCoding || c == detail::kBandedContextCoding) {
         if (dir.valueSize != 4) throw Error(where + ": a context-coded window of " + std::to_string(dir.valueSize) + "-byte values (int32 only)");
         if (c == detail::kContextCoding) return decodeContextChannel(body, bricks, e.entries, where);
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
-        const int model = c == detail::kWideContextCoding ? 3 : c == detail::kFittedContextCoding ? 2 : 1;
+        const int model = c == detail::kBandedContextCoding ? 4 : c == detail::kWideContextCoding ? 3 : c == detail::kFittedContextCoding ? 2 : 1;
         const bool spatial = c == detail::kSpatialContextCoding || c == detail::kSpatialLabelCoding || model >= 2;
         return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
                                     c == detail::kPlacedLabelCoding || c == detail::kSpatialLabelCoding,
                                     spatial ? coding::spatialOrderOf(model) : coding::BrickOrder::Attribute, model);
     }
-    if (raw[0] == detail::kRescaledFloatCoding || raw[0] == detail::kFittedRescaledFloatCoding || raw[0] == detail::kWideRescaledFloatCoding) {
+    if (raw[0] == detail::kRescaledFloatCoding || raw[0] == detail::kFittedRescaledFloatCoding || raw[0] == detail::kWideRescaledFloatCoding ||
+        raw[0] == detail::kBandedRescaledFloatCoding) {
         if (dir.valueSize != 4) throw Error(where + ": rescaled floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
         return decodeRescaledFloats(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
-                                    raw[0] == detail::kWideRescaledFloatCoding ? 3 : raw[0] == detail::kFittedRescaledFloatCoding ? 2 : 1);
+                                    raw[0] == detail::kBandedRescaledFloatCoding   ? 4
+                                    : raw[0] == detail::kWideRescaledFloatCoding   ? 3
+                                    : raw[0] == detail::kFittedRescaledFloatCoding ? 2
+                                                                                   : 1);
     }
     if (raw[0] == detail::kFloatCoding || raw[0] == detail::kFloatIntegerCoding) {  // float32 bits predicted, or their order's integers
         const bool integers = raw[0] == detail::kFloatIntegerCoding;

@@ -63,7 +63,7 @@ inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
 inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3, kPlacedLabelCoding = 4,
                          kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7, kFloatCoding = 8, kFloatVectorCoding = 9,
                          kFittedContextCoding = 10, kFittedRescaledFloatCoding = 11, kFloatIntegerCoding = 12, kWideContextCoding = 13,
-                         kWideRescaledFloatCoding = 14, kCodingCount = 15;
+                         kWideRescaledFloatCoding = 14, kBandedContextCoding = 15, kBandedRescaledFloatCoding = 16, kCodingCount = 17;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail

@@ -41,7 +41,7 @@ inline float rescaledFloat(int64_t k, const ValueRescale& r) {
 // Entries (little-endian float32) over `layout`/`places` as coding 5, or
 // nothing when more than a sixteenth of them lie off the lattice or the
 // integers leave int32.
-// `model`: the integers' model generation, 3 (coding 14), 2 (coding 11) or 1 (coding 5).
+// `model`: the integers' model generation, 4 (coding 16), 3 (coding 14), 2 (coding 11) or 1 (coding 5).
 std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                                          std::span<const coding::BrickPlace> places, const ValueRescale& rescale,
                                                          int model = coding::kLatestIntModel);

@@ -47,7 +47,7 @@ std::vector<uint8_t> encodeSamples(std::span<const int32_t> samples, const IntCo
         const int64_t prediction = pr.value;
         const int64_t e = s - prediction;
         const int64_t q = options.near == 0 ? wrap(e, options.minValue, options.maxValue) : (e >= 0 ? (e + options.near) / step : -((options.near - e) / step));
-        putResidual(rc, *models, *pr.ctx, pr.signs, q);
+        putResidual(rc, *models, *pr.ctx, *pr.high, pr.signs, q);
         const int64_t v = reconstruct(prediction, q, step, options.minValue, options.maxValue);
         if (reconstructed) (*reconstructed)[at] = int32_t(v);
         return v;
@@ -70,7 +70,7 @@ void decodeSamples(std::span<const uint8_t> bytes, const IntCoderOptions& option
                 out[at] = int32_t(options.minValue);
                 return options.minValue;
             }
-            const int64_t v = reconstruct(pr.value, getResidual(rc, *models, *pr.ctx, pr.signs), step, options.minValue, options.maxValue);
+            const int64_t v = reconstruct(pr.value, getResidual(rc, *models, *pr.ctx, *pr.high, pr.signs), step, options.minValue, options.maxValue);
             out[at] = int32_t(v);
             return v;
         });

@@ -11,13 +11,14 @@ namespace vdbdag::coding {
 namespace {
 
 // The header's generation: 0, the integers coded by model generation 2
-// (written 2026-12-05 to 2026-12-06); 1, by generation 3 (what is written).
-constexpr uint8_t kGeneration = 1;
+// (written 2026-12-05 to 2026-12-06); 1, by generation 3 (written on
+// 2026-12-06); 2, by generation 4 (what is written).
+constexpr uint8_t kGeneration = 2;
 constexpr size_t kHeaderBytes = 10;  // generation, shift, min, max
 
 IntCoderOptions optionsFor(int32_t lo, int32_t hi, uint8_t generation) {
     IntCoderOptions o;
-    o.minValue = lo, o.maxValue = hi, o.model = generation == 0 ? 2 : 3;
+    o.minValue = lo, o.maxValue = hi, o.model = generation + 2;
     return o;
 }
 
@@ -55,7 +56,7 @@ std::vector<uint8_t> encodePlacedFloatIntegers(std::span<const uint32_t> bits, s
 void decodePlacedFloatIntegers(std::span<const uint8_t> payload, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
                                std::span<uint32_t> out, const std::string& what) {
     if (payload.size() < kHeaderBytes) throw Error(what + ": float integers: " + std::to_string(payload.size()) + " bytes, shorter than their header");
-    if (payload[0] > kGeneration) throw Error(what + ": float integers of generation " + std::to_string(payload[0]) + " (this reader knows 0 and 1)");
+    if (payload[0] > kGeneration) throw Error(what + ": float integers of generation " + std::to_string(payload[0]) + " (this reader knows 0 to 2)");
     const unsigned shift = payload[1];
     const int32_t lo = getI32(payload.data() + 2), hi = getI32(payload.data() + 6);
     if (shift > 31) throw Error(what + ": float integers shifted by " + std::to_string(shift) + " bits (at most 31)");

@@ -17,10 +17,10 @@
 // and a negative one is -1 - M: monotonic in the floats' order (-0 < +0,
 // NaNs at the ends) and one-to-one, so every bit pattern comes back. They
 // are coded by encodePlacedBrickValues in raster brick order under model
-// generation 3 (the header's generation 1; generation 0, still read: model
-// generation 2), within [min, max] of the window's integers.
+// generation 4 (the header's generation 2; generations 0 and 1, still read:
+// model generations 2 and 3), within [min, max] of the window's integers.
 //
-// Payload: u8 generation (1; 0 still read), u8 s (0..31), i32 min, i32 max
+// Payload: u8 generation (2; 0 and 1 still read), u8 s (0..31), i32 min, i32 max
 // (little-endian), the integer coder's stream.
 #pragma once
 #include <cstdint>

@@ -45,7 +45,7 @@ struct IntVolumeShape {
 };
 
 // The newest model generation (SamplePredictor.h), what a writer writes.
-inline constexpr int kLatestIntModel = 3;
+inline constexpr int kLatestIntModel = 4;
 
 struct IntCoderOptions {
     // Every sample and every reconstruction lies in [minValue, maxValue]
@@ -59,7 +59,9 @@ struct IntCoderOptions {
     // squares fit and the floor flag (codings 10 and 11, written
     // 2026-12-05 to 2026-12-06); 3, the fit over 24 neighbours, solved every
     // 64 samples, and the activity over WW, NN, NEE too (codings 13 and 14,
-    // coding 12's generation 1, and this coder).
+    // coding 12's generation 1, written on 2026-12-06); 4, the residual's
+    // models and the bias corrections also by the prediction's intensity
+    // band (codings 15 and 16, coding 12's generation 2, and this coder).
     int model = kLatestIntModel;
 };
 

@@ -3,15 +3,17 @@
 // model the value coders build on.
 //
 // A bit is coded under a model that holds the probability of a 0 as two
-// 16-bit estimates adapting at different speeds (1/16 and 1/128 per bit),
+// 16-bit estimates adapting at different speeds (1/32 and 1/128 per bit),
 // averaged: the fast one follows local changes, the slow one keeps the
 // long-run rate. Both stay inside [15, 65521], so the coded interval never
-// collapses.
+// collapses (a warmed-up model, BitModel::warmUp, takes larger steps over
+// its first 31 bits only, from 1/2, and so ends them well inside).
 //
 // The decoder reads past the end of its bytes as zeros and counts how far
 // it went: a corrupt or truncated stream decodes to garbage in bounded time,
 // never reads out of bounds, and `overrun()` tells the caller to refuse it.
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -20,14 +22,30 @@ namespace vdbdag::coding {
 
 struct BitModel {
     uint16_t fast = 32768, slow = 32768;  // P(bit == 0) in 1/65536
+    // Updates seen while warming up (warmUp(): from 0 to 31); 255, a model
+    // that adapts at 1/32 and 1/128 from the start.
+    uint8_t seen = 255;
     uint32_t p0() const { return (uint32_t(fast) + uint32_t(slow)) >> 1; }
+    // A model that learns its first bits fast: its n-th update (from 0)
+    // moves both estimates by 2^-(1 + bit_width(n + 1)) (1/4, 1/8, 1/8,
+    // 1/16 x4, 1/32 x8 (the fast one's own rate), 1/64 x16 for the slow
+    // one) until both adapt at their own rates (after 31). What many sparse
+    // contexts need: a fresh model at 1/2 pays for its first dozens of
+    // bits at 1/32 (integer model generation 4, SamplePredictor.h).
+    void warmUp() { seen = 0; }
     void update(unsigned bit) {
+        unsigned fs = 5, ss = 7;
+        if (seen < 31) {
+            const unsigned w = 1 + unsigned(std::bit_width(unsigned(seen) + 1u));
+            fs = w < 5 ? w : 5, ss = w < 7 ? w : 7;
+            ++seen;
+        }
         if (bit) {
-            fast = uint16_t(fast - (fast >> 5));
-            slow = uint16_t(slow - (slow >> 7));
+            fast = uint16_t(fast - (fast >> fs));
+            slow = uint16_t(slow - (slow >> ss));
         } else {
-            fast = uint16_t(fast + ((65536u - fast) >> 5));
-            slow = uint16_t(slow + ((65536u - slow) >> 7));
+            fast = uint16_t(fast + ((65536u - fast) >> fs));
+            slow = uint16_t(slow + ((65536u - slow) >> ss));
         }
     }
 };

@@ -32,7 +32,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     o.minValue = data[4] & 1 ? -(int64_t(1) << (bits - 1)) : 0;
     o.maxValue = std::min<int64_t>(INT32_MAX, o.minValue + (int64_t(1) << bits) - 1);
     o.near = data[5] % 4 == 0 ? data[6] % 5 : 0;
-    o.model = ((data[5] >> 7) & 1) + ((data[6] >> 7) & 1) + ((data[4] >> 1) & 1);  // bytes 5's and 6's top bits, byte 4's bit 1: the model generation, 0-3
+    o.model = ((data[5] >> 7) & 1) + ((data[6] >> 7) & 1) + ((data[4] >> 1) & 1) + ((data[4] >> 2) & 1);  // bytes 5's and 6's top bits, byte 4's bits 1-2: the model generation, 0-4
     const std::span<const uint8_t> rest(data + 8, size - 8);
     const bool bricks = data[7] & 1;
     std::vector<uint64_t> layout;

@@ -193,7 +193,7 @@ int main(int argc, char** argv) {
         model1.model = 1;
         const size_t model1Bytes = vdbdag::coding::encodeIntVolume(samples, {nx, ny, nz}, model1).size();
         vdbdag::coding::IntCoderOptions model2 = o;  // the generation before ours, timed in the same loop
-        model2.model = 2;
+        model2.model = vdbdag::coding::kLatestIntModel - 1;
         std::vector<double> oursEncode, oursDecode, jlsEncode, jlsDecode, model2Encode, model2Decode;
         size_t oursBytes = 0, jlsBytes = 0, oursWrong = 0, jlsWrong = 0, model2Bytes = 0;
         for (int r = 0; r < repeats; ++r) {
@@ -301,6 +301,7 @@ int main(int argc, char** argv) {
                                     {"near", near},
                                     {"ours_bytes", oursBytes},
                                     {"ours_model1_bytes", model1Bytes},
+                                    {"previous_model", model2.model},
                                     {"ours_model2_bytes", model2Bytes},
                                     {"ours_model2_encode_mb_s", mb / median(model2Encode)},
                                     {"ours_model2_decode_mb_s", mb / median(model2Decode)},

@@ -546,7 +546,7 @@ TEST(PredictedChannel, SurvivesTheFileWithMirroredBricksAndTiles) {
         ASSERT_TRUE(w.predicted);
         const auto dir = attributes::readPredictedWindowDirectory(w.bytes, 4, encoding::attributeLayout(scene.grids[0].dag), "test");
         ASSERT_EQ(dir.windows.size(), 1u);
-        EXPECT_EQ(attributes::windowRawBytes(w.bytes, dir.windows[0], "test").at(0), attributes::detail::kWideContextCoding)
+        EXPECT_EQ(attributes::windowRawBytes(w.bytes, dir.windows[0], "test").at(0), attributes::detail::kBandedContextCoding)
             << "the predictor should win on this channel";
     }
     EXPECT_LT(scene.grids[0].dag.leaves.size(), 16u) << "32 distinct masks, pairs of mirror images: reflected instances must exist";

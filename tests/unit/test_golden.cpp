@@ -87,10 +87,12 @@ TEST(Golden, ScanSourcedFileDecodesToTheSameSamples) {
     // labels (coding 7) and scan_coding10 (a 24x24x16 crop of
     // ../shared/data/dense/headsq, its int16 CT samples in coding 10, the
     // least-squares fit, as written on 2026-12-05); scan_coding13, the same
-    // crop in coding 13 (model generation 3, as written since 2026-12-06).
+    // crop in coding 13 (model generation 3, as written on 2026-12-06);
+    // scan_coding15, in coding 15 (model generation 4, written since).
     for (const auto& [name, raw, bytes] : {std::tuple{"labels", "labels_24x20x10_int16le.raw", 24u * 20 * 10 * 2},
                                            {"scan_coding10", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2},
-                                           {"scan_coding13", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2}}) {
+                                           {"scan_coding13", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2},
+                                           {"scan_coding15", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2}}) {
         const fs::path dir = testFolder(std::string("golden_scan_") + name);
         const fs::path back = dir / raw;
         const CommandResult r = runCli("decode " + (kGolden / (std::string(name) + ".ssvdag")).string() + " -o " + back.string() + " -q");
@@ -103,4 +105,6 @@ TEST(Golden, ScanSourcedFileDecodesToTheSameSamples) {
     EXPECT_NE(info.out.find("windows: 1 fitted context-coded"), std::string::npos) << info.out;
     const CommandResult info13 = runCli("info " + (kGolden / "scan_coding13.ssvdag").string());
     EXPECT_NE(info13.out.find("windows: 1 wide fitted context-coded"), std::string::npos) << info13.out;
+    const CommandResult info15 = runCli("info " + (kGolden / "scan_coding15.ssvdag").string());
+    EXPECT_NE(info15.out.find("windows: 1 banded context-coded"), std::string::npos) << info15.out;
 }

@@ -69,7 +69,7 @@ TEST(RescaledFloats, LatticeValuesComeBackBitForBitAsTheirIntegers) {
     for (const ValueRescale r : {kPet, ValueRescale{0.5, -1024.0}, ValueRescale{-3.25e-3, 7.5}}) {
         const std::vector<uint8_t> bytes = bytesOf(floatsOf(c, r));
         const std::vector<uint8_t> windows = encodePredictedWindows(bytes, 4, c.layout, c.places, FloatChannel{r});
-        EXPECT_EQ(codingOf(windows, c.layout), detail::kWideRescaledFloatCoding) << r.slope;
+        EXPECT_EQ(codingOf(windows, c.layout), detail::kBandedRescaledFloatCoding) << r.slope;
         EXPECT_EQ(decodePredictedWindows(windows, 4, c.layout, "test", c.places), bytes) << r.slope;
         EXPECT_LT(windows.size(), encodePredictedWindows(bytes, 4, c.layout, c.places).size() * 3 / 4) << "the integers beat the palettes";
     }
@@ -88,7 +88,7 @@ TEST(RescaledFloats, ValuesOffTheLatticeAreExceptionsKeptBitForBit) {
     for (const auto& [i, x] : odd) v[i] = x;
     const std::vector<uint8_t> bytes = bytesOf(v);
     const std::vector<uint8_t> windows = encodePredictedWindows(bytes, 4, c.layout, c.places, FloatChannel{kPet});
-    EXPECT_EQ(codingOf(windows, c.layout), detail::kWideRescaledFloatCoding);
+    EXPECT_EQ(codingOf(windows, c.layout), detail::kBandedRescaledFloatCoding);
     EXPECT_EQ(decodePredictedWindows(windows, 4, c.layout, "test", c.places), bytes);
     const auto payload = encodeRescaledFloats(bytes, c.layout, c.places, kPet);
     ASSERT_TRUE(payload);
@@ -162,7 +162,7 @@ TEST(RescaledFloats, AFloatGridWithALatticeStoresItsIntegers) {
         const ValueWindowsPayload& w = scene.grids[0].valueWindows;
         EXPECT_TRUE(w.predicted);
         const uint8_t coding = codingOf(w.bytes, encoding::attributeLayout(scene.grids[0].dag));
-        if (hint) EXPECT_EQ(coding, detail::kWideRescaledFloatCoding);
+        if (hint) EXPECT_EQ(coding, detail::kBandedRescaledFloatCoding);
         else EXPECT_TRUE(coding == detail::kPaletteCoding || coding == detail::kFloatCoding) << int(coding);
         const format::SsvdagScene back = format::readScene(format::writeScene(scene), "mem");
         const GridRecord decoded = pipeline::decodeGrid(back.grids[0]);
