@@ -89,7 +89,7 @@ struct Models {
     // (BitModel::warmUp): 16 times the models learn 16 times as often from
     // 1/2. With both, 0.1-2.9 % smaller than generation 3 on the shared
     // scans (cthead 2.9 %, ch2 2.4 %, adi_brain 0.8-1.0 %; the tooth, whose
-    // noise does not follow its intensity, 0.1 %), as fast
+    // noise does not follow its intensity, 0.1 %), 1-4 % slower
     // (docs/CODING.md "Generation 4"). Linear bands (8 or 16 of the range)
     // gained 0.1 %.
     bool intensityBands;
