@@ -10,16 +10,37 @@
 namespace vdbdag::attributes {
 
 WindowCursor::WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what,
-                           std::span<const coding::BrickPlace> places)
-    : payload_(payload), predicted_(predicted), layout_(layout), places_(places), what_(std::move(what)) {
+                           std::span<const coding::BrickPlace> places, unsigned ahead)
+    : payload_(payload), predicted_(predicted), layout_(layout), places_(places), what_(std::move(what)), ahead_(ahead) {
     dir_ = predicted ? readPredictedWindowDirectory(payload, valueSize, layout, what_) : readValueWindowDirectory(payload, what_);
     if (dir_.valueSize != valueSize)
         throw Error(what_ + ": holds " + std::to_string(dir_.valueSize) + "-byte values, expected " + std::to_string(valueSize));
 }
 
+// The windows decoding ahead finish before the cursor's spans may go.
+WindowCursor::~WindowCursor() {
+    for (std::future<std::vector<uint8_t>>& f : pending_)
+        if (f.valid()) f.wait();
+}
+
+std::vector<uint8_t> WindowCursor::decode(size_t k) const {
+    return predicted_ ? decodePredictedWindow(payload_, dir_, k, layout_, what_, places_) : decodeValueWindow(payload_, dir_, k, what_).decodeAll();
+}
+
+// Windows are read in order (0, 1, ...): window k is the first pending one.
 void WindowCursor::load(size_t k) {
     values_.clear();
-    values_ = predicted_ ? decodePredictedWindow(payload_, dir_, k, layout_, what_, places_) : decodeValueWindow(payload_, dir_, k, what_).decodeAll();
+    if (ahead_ == 0) {
+        values_ = decode(k);
+    } else {
+        while (launched_ < dir_.windows.size() && launched_ <= k + ahead_) {
+            pending_.push_back(std::async(std::launch::async, [this, j = launched_] { return decode(j); }));
+            ++launched_;
+        }
+        std::future<std::vector<uint8_t>> next = std::move(pending_.front());
+        pending_.pop_front();
+        values_ = next.get();  // rethrows the window's error
+    }
     window_ = k;
     loaded_ = true;
     at_ = 0;

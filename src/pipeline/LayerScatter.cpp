@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <optional>
 
+#include <tbb/global_control.h>
+
 #include "src/attributes/WindowCursor.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/util/Error.h"
@@ -25,7 +27,11 @@ void scatterLayerByCubes(const format::EncodedGrid& grid, bool inactive, unsigne
     if (vs && attributes.empty()) {
         if (windows.empty()) throw Error("grid '" + grid.record.name + "': its " + (inactive ? "inactive" : "active") + " values were not read");
         if (windows.predicted) layout = encoding::attributeLayout(dag), places = encoding::attributePlaces(dag, vs);
-        cursor.emplace(windows.bytes, windows.predicted, vs, layout, "grid '" + grid.record.name + "' value windows", places);
+        // Windows ahead on the other threads --threads allows (at most 7
+        // ahead: each holds up to a window's decoded entries, 16 MB).
+        const size_t threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+        cursor.emplace(windows.bytes, windows.predicted, vs, layout, "grid '" + grid.record.name + "' value windows", places,
+                       unsigned(std::clamp<size_t>(threads, 1, 8) - 1));
         if (cursor->entries() != entries) throw Error("grid '" + grid.record.name + "': its value windows do not match its DAG");
     } else if (vs && attributes.size() != entries * vs) {
         throw Error("grid '" + grid.record.name + "': its values do not match its DAG");

@@ -10,6 +10,7 @@
 #include <tbb/global_control.h>
 
 #include "src/attributes/ValueWindows.h"
+#include "src/attributes/WindowCursor.h"
 #include "src/util/Error.h"
 
 using namespace vdbdag;
@@ -135,5 +136,53 @@ TEST(ValueWindows, SharesPutTogetherGiveTheSingleWritersBytes) {
             root.addShare(attributes::ShareWindows::deserialize(share.finishShare().serialize()));
         }
         EXPECT_TRUE(root.finish().bytes == whole) << "shares cut at " << ::testing::PrintToString(cuts);
+    }
+}
+
+// A cursor reads the windows in order, one decoded at a time or with
+// windows decoding ahead on other threads (WindowCursor.h): every entry
+// back, against the input, in uneven reads that cross windows, whatever
+// the read-ahead; and a damaged window is refused the same way.
+TEST(ValueWindows, ACursorGivesBackEveryEntryWhateverItsReadAhead) {
+    const uint64_t n = kValueWindowEntries * 3 + 4321;  // four windows
+    const std::vector<uint8_t> values = mixedFloats(n, 7);
+    const std::vector<uint8_t> payload = attributes::encodeValueWindows(values, 4);
+    for (const unsigned ahead : {0u, 1u, 3u, 7u}) {
+        attributes::WindowCursor cursor(payload, false, 4, {}, "test", {}, ahead);
+        ASSERT_EQ(cursor.entries(), n);
+        std::vector<uint8_t> back(values.size());
+        uint64_t at = 0;
+        for (uint64_t step = 1; at < n; step = step * 3 + 1) {  // 1, 4, 13, ... entries a read
+            const uint64_t take = std::min(step % (kValueWindowEntries + 7), n - at);
+            cursor.read(take, back.data() + at * 4);
+            at += take;
+        }
+        EXPECT_TRUE(back == values) << "ahead " << ahead;
+        EXPECT_THROW(cursor.read(1, back.data()), Error) << "ahead " << ahead;
+    }
+    // The third window's bytes damaged: the same refusal, read ahead or not.
+    std::vector<uint8_t> damaged = payload;
+    std::string first;
+    for (size_t at = payload.size() / 2; at < payload.size() / 2 + 64 && first.empty(); ++at) {
+        damaged = payload;
+        damaged[at] ^= 0x5A;
+        try {
+            attributes::decodeValueWindows(damaged, "test");
+        } catch (const Error& e) {
+            first = e.what();
+        }
+    }
+    ASSERT_FALSE(first.empty()) << "no byte in the middle of the payload is checked";
+    for (const unsigned ahead : {0u, 3u}) {
+        std::string got;
+        try {
+            attributes::WindowCursor cursor(damaged, false, 4, {}, "test", {}, ahead);
+            std::vector<uint8_t> back(values.size());
+            cursor.read(n, back.data());
+        } catch (const Error& e) {
+            got = e.what();
+        }
+        EXPECT_FALSE(got.empty()) << "ahead " << ahead;
+        EXPECT_EQ(got.rfind("test", 0), 0u) << got;
     }
 }
