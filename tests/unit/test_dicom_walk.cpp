@@ -271,6 +271,9 @@ TEST(DicomWalk, UndefinedLengthsOnlyUnderTheVrsGdcmReadsThemBy) {
     ASSERT_NE(at, std::string::npos);
     std::string ob = base;
     ob[at + 4] = 'O', ob[at + 5] = 'B';
+    const size_t end = ob.rfind(std::string("\xFE\xFF\xDD\xE0", 4));  // its delimiter's length (60,160) made 0, as DICOM has it
+    ASSERT_NE(end, std::string::npos);
+    ob.replace(end + 4, 4, std::string(4, '\0'));
     EXPECT_EQ(detail::elementLengthProblem(write("ob.dcm", ob).string()), "");
     std::string other = ob;
     other[at] = '\x09', other[at + 1] = '\x00';  // (0009,0010): a private element, not pixel data
@@ -279,4 +282,28 @@ TEST(DicomWalk, UndefinedLengthsOnlyUnderTheVrsGdcmReadsThemBy) {
               std::string::npos)
         << refused;
     fs::remove_all(fs::temp_directory_path() / ("vdbdag_dicom_walk_" + std::to_string(::getpid())));
+}
+
+// The delimiter that ends encapsulated pixel data with a length: GDCM reads
+// it as one more fragment and allocated its 3 GB before reading
+// (Fragment::ReadValue; the fuzz finding dicom_fragments_delimiter_length_oom,
+// 1,600 bytes). The walk refuses it, so `info` lists the series as not
+// convertible and `encode` stops naming the file; with the length 0 that
+// DICOM gives every delimiter the file walks.
+TEST(DicomWalk, ADelimiterWithALengthAfterPixelFragmentsIsRefused) {
+    std::ifstream in(fs::path(VDBDAG_SOURCE_DIR) / "tests/fuzz/regressions/scan_headers/dicom_fragments_delimiter_length_oom", std::ios::binary);
+    const std::string bytes = std::string((std::istreambuf_iterator<char>(in)), {}).substr(1);
+    const std::string why = "the delimiter (FFFE,E0DD) at byte 1094 that ends encapsulated pixel data claims 3137339392 bytes (DICOM gives it 0)";
+    const fs::path file = write("delimiter.dcm", bytes);
+    EXPECT_NE(detail::elementLengthProblem(file.string()).find(why), std::string::npos) << detail::elementLengthProblem(file.string());
+    const fs::path out = file.parent_path() / "delimiter.ssvdag";
+    const auto r = vdbdag::testing::runShell("ulimit -v 1500000; " + std::string(VDBDAG_BINARY) + " encode " + quote(file) + " -o " + quote(out));
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find(file.string() + " is corrupt: " + why), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    std::string zero = bytes;
+    ASSERT_EQ(zero.substr(1094, 4), std::string("\xFE\xFF\xDD\xE0", 4));
+    zero.replace(1098, 4, std::string(4, '\0'));
+    EXPECT_EQ(detail::elementLengthProblem(write("zero.dcm", zero).string()), "");
+    fs::remove_all(file.parent_path());
 }
