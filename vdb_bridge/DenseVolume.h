@@ -151,6 +151,7 @@ public:
 private:
     void readBytes(uint8_t* out, size_t n);
     std::string where() const;  // "HEADER: data file DATA", or the file itself
+    void positionAt(uint64_t fileSize, uint64_t need);  // the constructor's checks and seek, once the file is open
     void skipDecoded(uint64_t n);
     DenseVolume volume_;
     std::FILE* file_ = nullptr;
