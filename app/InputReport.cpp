@@ -9,6 +9,7 @@
 
 #include "app/ReportVersions.h"
 #include "app/SceneReport.h"
+#include "src/attributes/PredictedWindows.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
 #include "src/util/ParallelFor.h"
@@ -22,6 +23,55 @@
 
 namespace vdbdag::app {
 namespace {
+
+// `info` of an .ssvdag file reads what it prints: where every grid has a
+// Summary section (docs/FORMAT.md 10.1), the section table, the grids'
+// headers, DagLevels and statistics, and of each PredictedWindows section
+// its directory and each window's first byte; the DAGs and the values stay
+// in the file. A file without (written before Summary sections) or with
+// normals, whose report needs their channel, gets nullopt: it is read whole.
+std::optional<std::pair<format::SsvdagScene, nlohmann::json>> reportFromHeaders(const InfoRequest& opt, const std::string& input) {
+    using format::SectionKind;
+    const std::vector<format::Section> stored = format::storedSectionsOf(input);
+    for (const format::Section& s : stored)
+        if (s.kind == SectionKind::Normals) return std::nullopt;
+    const auto small = [](SectionKind kind, uint32_t) {
+        switch (kind) {
+        case SectionKind::DagInner: case SectionKind::DagLeaves: case SectionKind::InactiveInner: case SectionKind::InactiveLeaves:
+        case SectionKind::Values: case SectionKind::InactiveValues: case SectionKind::ValueWindows: case SectionKind::InactiveValueWindows:
+        case SectionKind::PredictedWindows: case SectionKind::InactivePredictedWindows: case SectionKind::PredictedValues:
+        case SectionKind::InactivePredictedValues: case SectionKind::Normals: return false;
+        default: return true;
+        }
+    };
+    format::ReadOptions readOptions;
+    readOptions.limits = opt.limits;
+    readOptions.headersOnly = true;
+    format::SsvdagScene scene = format::sectionsToScene(format::readContainerFile(input, false, opt.limits, small), input, readOptions);
+    for (const format::EncodedGrid& grid : scene.grids)
+        if (!grid.summary) return std::nullopt;
+    StoredScene file;
+    file.bytes = std::filesystem::file_size(input);
+    for (const format::Section& s : stored) file.sections.push_back({s.kind, s.grid, s.stored->zstd, s.stored->storedBytes, s.stored->rawBytes});
+    file.codings = [&](uint32_t g, bool inactive) -> std::vector<uint64_t> {
+        const SectionKind kind = inactive ? SectionKind::InactivePredictedWindows : SectionKind::PredictedWindows;
+        const std::string what = input + ": grid " + std::to_string(g) + (inactive ? " inactive" : "") + " predicted windows";
+        const unsigned vs = valueSize(scene.grids[g].record.valueType);
+        for (const format::Section& s : stored) {
+            if (s.kind != kind || s.grid != g) continue;
+            if (s.stored->zstd) {  // another writer's: the section whole
+                const auto whole = format::readContainerFile(input, false, opt.limits, [&](SectionKind k, uint32_t grid) { return k == kind && grid == g; });
+                return attributes::predictedWindowCodings(
+                    whole.at(0).data.size(), [&](uint64_t at, uint64_t n) { return std::vector<uint8_t>(whole[0].data.begin() + long(at), whole[0].data.begin() + long(at + n)); }, vs, what);
+            }
+            const format::StoredPayloadReader reader(*s.stored);
+            return attributes::predictedWindowCodings(reader.size(), [&](uint64_t at, uint64_t n) { return reader.read(at, n); }, vs, what);
+        }
+        return {};
+    };
+    nlohmann::json report = sceneReport(scene, file, input, false);
+    return std::make_pair(std::move(scene), std::move(report));
+}
 
 nlohmann::json dicomReport(const std::string& input, const bridge::DicomScan& scan) {
     nlohmann::json series = nlohmann::json::array();
@@ -139,18 +189,25 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoRequest& opt, con
                           false);
         }
     } else if (kind != bridge::InputKind::Vdb) {
-        const std::vector<uint8_t> bytes = format::readFileBytes(input);
-        // Nothing decoded but what is printed: value windows stay as
-        // they are in the file (their range is read window by window)
-        // unless --values asks for the channels' statistics.
-        format::ReadOptions readOptions;
-        readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
-        readOptions.limits = opt.limits;
-        readOptions.keepValueWindows = !opt.values;
-        const format::SsvdagScene scene = format::readScene(bytes, input, readOptions);
-        report = sceneReport(scene, bytes, input, opt.values);
+        std::optional<std::pair<format::SsvdagScene, nlohmann::json>> headers = opt.values ? std::nullopt : reportFromHeaders(opt, input);
+        format::SsvdagScene scene;
+        if (headers) {
+            scene = std::move(headers->first);
+            report = std::move(headers->second);
+        } else {
+            const std::vector<uint8_t> bytes = format::readFileBytes(input);
+            // Nothing decoded but what is printed: value windows stay as
+            // they are in the file (their range is read window by window)
+            // unless --values asks for the channels' statistics.
+            format::ReadOptions readOptions;
+            readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
+            readOptions.limits = opt.limits;
+            readOptions.keepValueWindows = !opt.values;
+            scene = format::readScene(bytes, input, readOptions);
+            report = sceneReport(scene, bytes, input, opt.values);
+        }
         report["format"] = "ssvdag";
-        report["input_bytes"] = bytes.size();
+        report["input_bytes"] = report["ssvdag_bytes"];
         for (size_t g = 0; g < scene.grids.size(); ++g) {
             const format::EncodedGrid& grid = scene.grids[g];
             const std::string what = input + " grid " + std::to_string(g);

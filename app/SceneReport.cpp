@@ -130,10 +130,22 @@ std::string formatGridHeader(const nlohmann::json& g) {
 }
 
 nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> fileBytes, const std::string& name, bool valueStats) {
+    StoredScene file{format::summarizeContainer(fileBytes, name), fileBytes.size(), [&](uint32_t g, bool inactive) -> std::vector<uint64_t> {
+                         const format::EncodedGrid& grid = scene.grids[g];
+                         const attributes::ValueWindowsPayload& w = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+                         if (!w.predicted || w.empty()) return {};
+                         return attributes::predictedWindowCodings(w.load(), valueSize(grid.record.valueType),
+                                                                   encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
+                                                                   "grid '" + grid.record.name + "' predicted windows");
+                     }};
+    return sceneReport(scene, file, name, valueStats);
+}
+
+nlohmann::json sceneReport(const format::SsvdagScene& scene, const StoredScene& file, const std::string& name, bool valueStats) {
     using nlohmann::json;
-    const auto sections = format::summarizeContainer(fileBytes, name);
-    json report{{"input", name}, {"ssvdag_bytes", fileBytes.size()}, {"grid_count", scene.grids.size()}, {"grids", json::array()}};
-    uint64_t fileLevelBytes = fileBytes.size();
+    const auto& sections = file.sections;
+    json report{{"input", name}, {"ssvdag_bytes", file.bytes}, {"grid_count", scene.grids.size()}, {"grids", json::array()}};
+    uint64_t fileLevelBytes = file.bytes;
     for (size_t g = 0; g < scene.grids.size(); ++g) {
         const format::EncodedGrid& grid = scene.grids[g];
         json j{{"index", g},
@@ -158,12 +170,8 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
             json section{{"kind", format::sectionKindName(s.kind)}, {"stored_bytes", s.storedBytes}, {"raw_bytes", s.rawBytes}, {"compressed", s.compressed}};
             // Predicted windows: how many windows each coding holds.
             if (s.kind == format::SectionKind::PredictedWindows || s.kind == format::SectionKind::InactivePredictedWindows) {
-                const bool inactive = s.kind == format::SectionKind::InactivePredictedWindows;
-                const attributes::ValueWindowsPayload& w = inactive ? grid.inactiveValueWindows : grid.valueWindows;
-                if (w.predicted && !w.empty()) {
-                    const std::vector<uint64_t> counts = attributes::predictedWindowCodings(
-                        w.load(), valueSize(grid.record.valueType), encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
-                        "grid '" + grid.record.name + "' predicted windows");
+                const std::vector<uint64_t> counts = file.codings(uint32_t(g), s.kind == format::SectionKind::InactivePredictedWindows);
+                if (!counts.empty()) {
                     json codings = json::object();
                     for (size_t c = 0; c < counts.size(); ++c) {
                         const char* name = attributes::predictedCodingName(uint8_t(c));  // two codings share a name
@@ -221,7 +229,7 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uin
     uint64_t voxels = 0;
     for (const format::EncodedGrid& grid : scene.grids) voxels += grid.activeVoxels;
     report["active_voxels"] = voxels;
-    report["bits_per_active_voxel"] = voxels ? 8.0 * double(fileBytes.size()) / double(voxels) : 0.0;
+    report["bits_per_active_voxel"] = voxels ? 8.0 * double(file.bytes) / double(voxels) : 0.0;
     return report;
 }
 

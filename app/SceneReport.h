@@ -4,6 +4,7 @@
 // on .ssvdag files and on .vdb files (which are encoded in memory first).
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 
@@ -20,6 +21,15 @@ namespace vdbdag::app {
 // Table 1) and the traceable size, which decode every value and rebuild the
 // palettes; without, nothing is decoded but the value windows' range.
 nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> encodedBytes, const std::string& name, bool valueStats);
+// The same of a file read in part (ReadOptions::headersOnly): its section
+// table, its size, and how many windows of each coding a grid's
+// PredictedWindows (or InactivePredictedWindows) section holds.
+struct StoredScene {
+    std::vector<format::SectionSummary> sections;
+    uint64_t bytes = 0;
+    std::function<std::vector<uint64_t>(uint32_t grid, bool inactive)> codings;
+};
+nlohmann::json sceneReport(const format::SsvdagScene& scene, const StoredScene& file, const std::string& name, bool valueStats);
 std::string formatSceneReport(const nlohmann::json& report);
 
 // What `vdb_print -l -m` shows of a grid (see vdb_bridge/VdbSummary.h), as

@@ -220,6 +220,7 @@ void PredictedWindowWriter::beginShare(uint64_t firstEntry, bool endsLayer) {
 }
 
 void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
+    if (rangeType_) range_.add(*rangeType_, values);
     if (!layout.empty()) {
         if (!places.empty() && places.size() != layout.size()) throw Error("internal error: a layout and its places differ in length");
         if (placed_ && *placed_ != !places.empty()) throw Error("internal error: brick places given in some calls only");
@@ -302,11 +303,13 @@ ShareWindows PredictedWindowWriter::finishShare() {
     for (const Directory& d : directory_) out.directory.push_back({d.stored, d.raw, d.entries});
     out.coded = std::move(payload_);
     out.head = std::move(head_);
+    if (rangeType_) out.range = range_;
     directory_.clear();
     return out;
 }
 
 void PredictedWindowWriter::addShare(const ShareWindows& share) {
+    if (rangeType_ && share.range) range_.merge(*rangeType_, *share.range);
     add(share.head.values, share.head.layout, share.head.places);
     uint64_t at = 0;
     for (size_t j = 0; j < share.directory.size(); ++j) {
@@ -344,6 +347,7 @@ ValueWindowsPayload PredictedWindowWriter::finish() {
     directory_.clear();
     ValueWindowsPayload out = sealWindows(std::move(payload_), std::move(spill_), head.bytes(), dir.bytes());
     out.predicted = true;
+    if (rangeType_) out.range = range_;
     return out;
 }
 

@@ -34,6 +34,34 @@ std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, u
     return counts;
 }
 
+std::vector<uint64_t> predictedWindowCodings(uint64_t payloadBytes, const PayloadPart& read, uint32_t valueSize, const std::string& what) {
+    constexpr uint64_t kHead = 4 + 8 + 8 + 8;
+    if (payloadBytes < kHead) throw Error(what + ": truncated");
+    const std::vector<uint8_t> head = read(0, kHead);
+    format::ByteReader r(head, what);
+    if (const uint32_t vs = r.get<uint32_t>(); vs != valueSize) r.fail("holds " + std::to_string(vs) + "-byte values, expected " + std::to_string(valueSize));
+    r.get<uint64_t>();  // entries
+    r.get<uint64_t>();  // entries per window
+    const uint64_t windows = r.get<uint64_t>();
+    if (windows > (payloadBytes - kHead) / detail::kPredictedDirectoryEntryBytes) r.fail("window directory runs past the end");
+    const uint64_t directoryBegin = payloadBytes - windows * detail::kPredictedDirectoryEntryBytes;
+    const std::vector<uint8_t> directory = read(directoryBegin, windows * detail::kPredictedDirectoryEntryBytes);
+    format::ByteReader d(directory, what + " window directory");
+    std::vector<uint64_t> counts(static_cast<size_t>(detail::kCodingCount));
+    uint64_t at = kHead;
+    for (uint64_t k = 0; k < windows; ++k) {
+        const uint64_t stored = d.get<uint64_t>(), raw = d.get<uint64_t>();
+        d.get<uint64_t>();  // entries
+        if (stored == 0 || stored > directoryBegin - at || raw < stored || !format::zstdCanProduce(stored, raw)) r.fail("window sizes are implausible");
+        const std::string window = what + " window " + std::to_string(k);
+        const std::vector<uint8_t> first = stored == raw ? read(at, 1) : format::zstdFirstBytes(read(at, stored), 1, window);
+        if (first.empty() || first[0] >= counts.size()) throw Error(window + ": unknown coding");
+        ++counts[first[0]];
+        at += stored;
+    }
+    return counts;
+}
+
 const char* predictedCodingName(uint8_t coding) {
     static const char* const names[] = {"palettes", "brick residuals", "context-coded", "placed context-coded", "placed labels",
                                         "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors",

@@ -45,6 +45,7 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -88,6 +89,8 @@ public:
     // then coded with neighbours across bricks (coding 3). Give them in
     // every call or in none.
     void add(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places = {});
+    // As ValueWindowWriter's.
+    void trackRange(ValueType type) { rangeType_ = type; }
     ValueWindowsPayload finish();  // its `predicted` is set
     uint64_t entries() const { return entries_; }
     // Share mode and assembly, as ValueWindowWriter's (the loose parts
@@ -119,6 +122,8 @@ private:
     std::optional<bool> placed_;  // whether the calls so far gave places
     uint64_t headEnd_ = 0;
     ShareWindows::Loose head_;
+    std::optional<ValueType> rangeType_;
+    ValueRange range_;
 };
 
 // How many windows use each coding (index: the coding byte, 0..9), read
@@ -127,6 +132,13 @@ private:
 // what each coding is, in a few words (a report's names).
 std::vector<uint64_t> predictedWindowCodings(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
                                              const std::string& what);
+// The same from a payload of `payloadBytes` read in parts (`read(offset,
+// n)`: its header, its directory and each window's first byte; a
+// compressed window whole), without the DAG: the directory is checked
+// against the payload's size, not the layout (what `info` reads of a file
+// whose Summary section tells the rest).
+using PayloadPart = std::function<std::vector<uint8_t>(uint64_t offset, uint64_t n)>;
+std::vector<uint64_t> predictedWindowCodings(uint64_t payloadBytes, const PayloadPart& read, uint32_t valueSize, const std::string& what);
 const char* predictedCodingName(uint8_t coding);
 
 // Coding 9's payload: vec3s entries (12 bytes each) over `layout`/`places`,

@@ -58,6 +58,7 @@ void ValueWindowWriter::beginShare(uint64_t firstEntry, bool endsLayer) {
 
 void ValueWindowWriter::add(std::span<const uint8_t> values) {
     if (values.size() % valueSize_) throw Error("internal error: values are not whole entries");
+    if (rangeType_) range_.add(*rangeType_, values);
     if (share_ && entries_ < headEnd_ && !values.empty()) {  // the window this share starts inside
         const size_t take = size_t(std::min<uint64_t>(headEnd_ - entries_, values.size() / valueSize_) * valueSize_);
         head_.values.insert(head_.values.end(), values.begin(), values.begin() + long(take));
@@ -120,7 +121,9 @@ ValueWindowsPayload ValueWindowWriter::finish() {
     }
     estimate_ += kHeaderBytes + dir.bytes().size();
     directory_.clear();
-    return sealWindows(std::move(payload_), std::move(spill_), head.bytes(), dir.bytes());
+    ValueWindowsPayload out = sealWindows(std::move(payload_), std::move(spill_), head.bytes(), dir.bytes());
+    if (rangeType_) out.range = range_;
+    return out;
 }
 
 void appendWindow(std::vector<uint8_t>& payload, ScratchFile* spill, std::span<const uint8_t> bytes) {
@@ -159,11 +162,13 @@ ShareWindows ValueWindowWriter::finishShare() {
     for (size_t i = 0; i < directory_.size(); ++i) out.directory.push_back({directory_[i].first, directory_[i].second, codedEntries_[i]});
     out.coded = std::move(payload_);
     out.head = std::move(head_);
+    if (rangeType_) out.range = range_;
     directory_.clear();
     return out;
 }
 
 void ValueWindowWriter::addShare(const ShareWindows& share) {
+    if (rangeType_ && share.range) range_.merge(*rangeType_, *share.range);
     add(share.head.values);
     uint64_t at = 0;
     for (size_t j = 0; j < share.directory.size(); ++j) {
@@ -206,6 +211,12 @@ std::vector<uint8_t> ShareWindows::serialize() const {
         w.put<uint64_t>(l->places.size());
         for (const coding::BrickPlace& p : l->places) w.put(p);
     }
+    w.put<uint8_t>(range ? 1 : 0);
+    if (range) {
+        w.put<uint64_t>(range->min.size());
+        w.putBytes(range->min);
+        w.putBytes(range->max);
+    }
     return w.take();
 }
 
@@ -227,6 +238,13 @@ ShareWindows ShareWindows::deserialize(std::span<const uint8_t> bytes) {
         l->values = r.getArray<uint8_t>(r.get<uint64_t>());
         l->layout = r.getArray<uint64_t>(r.get<uint64_t>());
         l->places = r.getArray<coding::BrickPlace>(r.get<uint64_t>());
+    }
+    if (r.get<uint8_t>()) {
+        ValueRange range;
+        const uint64_t n = r.get<uint64_t>();
+        range.min = r.getArray<uint8_t>(n);
+        range.max = r.getArray<uint8_t>(n);
+        s.range = std::move(range);
     }
     r.expectEnd();
     return s;

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -31,6 +32,7 @@
 #include "src/coding/BrickValueCoder.h"
 
 #include "src/attributes/PaletteChannel.h"
+#include "src/attributes/ValueRange.h"
 #include "src/util/ScratchFile.h"
 
 namespace vdbdag::attributes {
@@ -47,6 +49,9 @@ inline constexpr uint64_t kValueWindowEntries = uint64_t(1) << 22;
 // a scratch file.
 struct ValueWindowsPayload {
     std::vector<uint8_t> bytes;
+    // The range of the values coded, when the writer was asked to keep it
+    // (trackRange): an encoder's Summary section (docs/FORMAT.md 10.1).
+    std::optional<ValueRange> range;
     std::shared_ptr<const ScratchFile> file;
     // An integer channel's PredictedWindows payload (PredictedWindows.h),
     // not a ValueWindows one.
@@ -76,6 +81,7 @@ struct ShareWindows {
         bool empty() const { return values.empty(); }
     };
     Loose head, tail;
+    std::optional<ValueRange> range;  // of every value this share was given (trackRange)
     std::vector<uint8_t> serialize() const;
     static ShareWindows deserialize(std::span<const uint8_t> bytes);
 };
@@ -94,6 +100,9 @@ public:
     explicit ValueWindowWriter(uint32_t valueSize, uint64_t expectedEntries = 0, unsigned parallel = 0, const std::string& spillNear = "",
                                uint64_t spillInMemory = 0);
     void add(std::span<const uint8_t> values);
+    // Keep the range of the values added (and of the shares added) as
+    // values of `type`: finish() and finishShare() return it.
+    void trackRange(ValueType type) { rangeType_ = type; }
     // The section payload. The writer is spent afterwards.
     ValueWindowsPayload finish();
     // Share mode (before the first add): the entries start at `firstEntry`
@@ -125,6 +134,8 @@ private:
     uint64_t headEnd_ = 0;  // share mode: the first window boundary at or after the first entry
     ShareWindows::Loose head_;
     std::vector<uint64_t> codedEntries_;  // entries per coded window
+    std::optional<ValueType> rangeType_;
+    ValueRange range_;
 };
 
 // For the window writers (this one and PredictedWindows.h): a coded window

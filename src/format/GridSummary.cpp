@@ -13,70 +13,25 @@
 #include "src/volume/ValueBytes.h"
 
 namespace vdbdag::format {
-namespace {
-
-
-template <typename T>
-int compareScalar(const uint8_t* a, const uint8_t* b) {
-    T x, y;
-    std::memcpy(&x, a, sizeof(T));
-    std::memcpy(&y, b, sizeof(T));
-    return x < y ? -1 : (y < x ? 1 : 0);
-}
-
-// OpenVDB's `<` for one value: scalars as themselves, vectors
-// lexicographically (math::Tuple::operator<).
-int compareValues(ValueType type, const uint8_t* a, const uint8_t* b) {
-    switch (type) {
-    case ValueType::Float: return compareScalar<float>(a, b);
-    case ValueType::Double: return compareScalar<double>(a, b);
-    case ValueType::Int32: return compareScalar<int32_t>(a, b);
-    case ValueType::Int64: return compareScalar<int64_t>(a, b);
-    case ValueType::Bool: return compareScalar<uint8_t>(a, b);
-    case ValueType::Mask: return 0;
-    case ValueType::Vec3S:
-    case ValueType::Vec3D:
-    case ValueType::Vec3I: {
-        const unsigned c = valueSize(type) / 3;
-        for (unsigned i = 0; i < 3; ++i) {
-            const int r = type == ValueType::Vec3S   ? compareScalar<float>(a + i * c, b + i * c)
-                          : type == ValueType::Vec3D ? compareScalar<double>(a + i * c, b + i * c)
-                                                     : compareScalar<int32_t>(a + i * c, b + i * c);
-            if (r) return r;
-        }
-        return 0;
-    }
-    }
-    return 0;
-}
-
-
-} // namespace
-
-
-void ValueRange::add(ValueType type, std::span<const uint8_t> values) {
-    const unsigned vs = valueSize(type);
-    if (!vs) return;
-    for (size_t at = 0; at + vs <= values.size(); at += vs) {
-        const uint8_t* v = values.data() + at;
-        if (min.empty()) {
-            min.assign(v, v + vs);
-            max.assign(v, v + vs);
-            continue;
-        }
-        if (compareValues(type, v, min.data()) < 0) std::memcpy(min.data(), v, vs);
-        if (compareValues(type, max.data(), v) < 0) std::memcpy(max.data(), v, vs);
-    }
-}
 
 GridSummary summarizeGrid(const EncodedGrid& grid) {
     GridSummary s;
     s.activeVoxels = grid.activeVoxels;
+    if (grid.summary) {
+        s.solidNodes = grid.summary->solidNodes;
+        s.indexBox = grid.summary->indexBox;
+        s.activeRange = grid.summary->activeRange;
+        return s;
+    }
     s.solidNodes = encoding::decodedSize(grid.dag).emittedTiles;
     s.indexBox = dagBounds(grid.dag);
     const ValueType type = grid.record.valueType;
     const unsigned vs = valueSize(type);
     if (!vs || grid.dag.empty()) return s;
+    if (grid.valueWindows.range) {  // kept by the encoder's value writer
+        s.activeRange = *grid.valueWindows.range;
+        return s;
+    }
     if (!grid.attributes.empty()) {
         s.activeRange.add(type, grid.attributes);
         return s;
@@ -113,6 +68,12 @@ GridSummary summarizeGrid(const EncodedGrid& grid) {
         done += n;
     }
     return s;
+}
+
+StoredSummary summaryToStore(const EncodedGrid& grid) {
+    if (grid.summary) return *grid.summary;
+    const GridSummary s = summarizeGrid(grid);
+    return {s.indexBox, s.solidNodes, s.activeRange};
 }
 
 std::vector<double> valueNumbers(ValueType type, std::span<const uint8_t> value) {

@@ -20,12 +20,9 @@
 namespace vdbdag::format {
 
 
-// Minimum and maximum of raw values as OpenVDB's tools::minMax finds them:
-// by the value type's `<` (vectors lexicographically, as math::Tuple).
-struct ValueRange {
-    std::vector<uint8_t> min, max;  // valueSize bytes each; empty when there are no values
-    void add(ValueType type, std::span<const uint8_t> values);
-};
+// Minimum and maximum of raw values as OpenVDB's tools::minMax finds them,
+// by the value type's `<` made total (attributes/ValueRange.h).
+using ValueRange = attributes::ValueRange;
 
 struct GridSummary {
     uint64_t activeVoxels = 0;
@@ -33,8 +30,13 @@ struct GridSummary {
     std::optional<IndexBox> indexBox;  // active voxels
     ValueRange activeRange;            // active values (tiles once each)
 };
-// `grid` as read with ReadOptions::keepValueWindows (or fully).
+// `grid` as read with ReadOptions::keepValueWindows (or fully): from its
+// Summary section when the file has one, else from its DAG and values.
 GridSummary summarizeGrid(const EncodedGrid& grid);
+// What an encoder stores in `grid`'s Summary section, once the grid is
+// whole: the one read, or the grid's summary (its value range the value
+// writer's where it kept one: no value is decoded).
+StoredSummary summaryToStore(const EncodedGrid& grid);
 
 // A value as OpenVDB's operator<< prints it (6 significant digits, vectors
 // as "[x, y, z]"), and as JSON-ready doubles (one, or three for vectors).

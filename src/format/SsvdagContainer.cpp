@@ -235,6 +235,7 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::Frames: return "Frames";
         case SectionKind::FrameMetadata: return "FrameMetadata";
         case SectionKind::SameAs: return "SameAs";
+        case SectionKind::Summary: return "Summary";
         case SectionKind::GridInfo: return "GridInfo";
         case SectionKind::VdbDescriptor: return "VdbDescriptor";
         case SectionKind::DagLevels: return "DagLevels";
@@ -524,6 +525,23 @@ std::vector<Section> storedSectionsOf(const std::string& path) {
         sections.push_back(std::move(s));
     }
     return sections;
+}
+
+struct StoredPayloadReader::Open {
+    InputFile file;
+};
+
+StoredPayloadReader::StoredPayloadReader(const StoredPayload& payload) : payload_(payload), file_(new Open{InputFile(payload.path)}) {
+    if (payload.zstd) throw Error(payload.path + ": internal error: a compressed section is read only whole");
+}
+StoredPayloadReader::~StoredPayloadReader() = default;
+
+std::vector<uint8_t> StoredPayloadReader::read(uint64_t offset, uint64_t n) const {
+    if (offset > payload_.storedBytes || n > payload_.storedBytes - offset)
+        throw Error(payload_.path + ": corrupt (a read of " + num(n) + " bytes at " + num(offset) + " of a " + num(payload_.storedBytes) + "-byte section)");
+    std::vector<uint8_t> bytes = file_->file.read(payload_.offset + offset, n, payload_.path);
+    if (bytes.size() != n) throw Error(payload_.path + ": truncated (the file ends inside a section)");
+    return bytes;
 }
 
 std::vector<uint8_t> readFileBytes(const std::string& path) {

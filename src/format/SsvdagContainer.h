@@ -50,6 +50,7 @@ enum class SectionKind : uint32_t {
     Frames = 23,         // file-level, sequence files only: each frame's number and grid count (FrameSequence.h)
     FrameMetadata = 24,  // sequence files: a frame's .vdb file metadata (as FileMetadata); grid = the frame's first grid
     SameAs = 25,         // sequence files: this grid's section of a kind holds the bytes of an earlier grid's (a grid that does not change between frames)
+    Summary = 26,        // per grid: what `info` prints that the DAG and values would otherwise give (index box, solid nodes, value range)
 };
 const char* sectionKindName(SectionKind kind);  // "unknown" for a kind this build does not know
 bool isKnownKind(SectionKind kind);
@@ -121,6 +122,25 @@ std::vector<SectionSummary> summarizeContainer(std::span<const uint8_t> bytes, c
 // table checked as readContainer checks them; the payloads are checked when
 // written): for a writer that copies them into another file unchanged.
 std::vector<Section> storedSectionsOf(const std::string& path);
+
+// Parts of a section's payload as its file stores it (codec raw: the
+// payload's own bytes), read where they lie, never the whole section: what
+// `info` reads of a large section (attributes::predictedWindowCodings).
+// Not checked against the section's checksum (that covers the whole).
+class StoredPayloadReader {
+public:
+    explicit StoredPayloadReader(const StoredPayload& payload);
+    ~StoredPayloadReader();
+    uint64_t size() const { return payload_.storedBytes; }
+    // `n` bytes from `offset` of the payload; throws Error naming the file
+    // when they lie outside it or the file ends before them.
+    std::vector<uint8_t> read(uint64_t offset, uint64_t n) const;
+
+private:
+    StoredPayload payload_;
+    struct Open;
+    std::unique_ptr<Open> file_;
+};
 
 // Reads a whole file into memory (throws Error naming the file if missing or
 // unreadable).

@@ -94,6 +94,50 @@ std::vector<uint8_t> serializeDagLevels(const encoding::CompactDag& dag) {
     return levels.take();
 }
 
+// Summary (docs/FORMAT.md 10.1): u8 flags (1: an index box, 2: a value
+// range), [i64 min[3], i64 max[3]], u64 solid nodes, [min, max: the value's
+// bytes each].
+std::vector<uint8_t> serializeSummary(const StoredSummary& s, unsigned valueSize) {
+    const bool range = valueSize && !s.activeRange.empty();
+    if (range && (s.activeRange.min.size() != valueSize || s.activeRange.max.size() != valueSize))
+        throw Error("internal error: a value range of the wrong size");
+    ByteWriter w;
+    w.put<uint8_t>(uint8_t((s.indexBox ? 1 : 0) | (range ? 2 : 0)));
+    if (s.indexBox) {
+        for (int64_t v : s.indexBox->min) w.put<int64_t>(v);
+        for (int64_t v : s.indexBox->max) w.put<int64_t>(v);
+    }
+    w.put<uint64_t>(s.solidNodes);
+    if (range) {
+        w.putBytes(s.activeRange.min);
+        w.putBytes(s.activeRange.max);
+    }
+    return w.take();
+}
+
+StoredSummary parseSummary(std::span<const uint8_t> bytes, unsigned valueSize, const std::string& what) {
+    ByteReader r(bytes, what);
+    StoredSummary s;
+    const uint8_t flags = r.get<uint8_t>();
+    if (flags > 3) r.fail("unknown flags " + std::to_string(flags));
+    if ((flags & 2) && !valueSize) r.fail("a value range for a grid without values");
+    if (flags & 1) {
+        IndexBox box;
+        for (int64_t& v : box.min) v = r.get<int64_t>();
+        for (int64_t& v : box.max) v = r.get<int64_t>();
+        for (int a = 0; a < 3; ++a)
+            if (box.min[size_t(a)] > box.max[size_t(a)]) r.fail("an index box whose minimum lies past its maximum");
+        s.indexBox = box;
+    }
+    s.solidNodes = r.get<uint64_t>();
+    if (flags & 2) {
+        s.activeRange.min = r.getArray<uint8_t>(valueSize);
+        s.activeRange.max = r.getArray<uint8_t>(valueSize);
+    }
+    r.expectEnd();
+    return s;
+}
+
 std::vector<uint8_t> serializeDagStats(const DagStats& st) {
     ByteWriter stats;
     stats.put<uint32_t>(uint32_t(st.svoNodes.size()));
@@ -202,6 +246,7 @@ std::vector<Section> toSections(SsvdagScene& scene, bool take) {
         }
         if (grid.normals) sections.push_back({SectionKind::Normals, g, attributes::serializeNormals(*grid.normals)});
         sections.push_back({SectionKind::DagStats, g, serializeDagStats(grid.stats)});
+        if (grid.summary) sections.push_back({SectionKind::Summary, g, serializeSummary(*grid.summary, vs)});
     }
     return sections;
 }
@@ -237,7 +282,7 @@ void resolveSameAs(std::vector<Section>& sections, const std::string& sourceName
             const auto it = real.find({e.grid, e.kind});
             if (it == real.end()) {
                 // Reading one frame, only its own grids need their sections.
-                if (options.frame) continue;
+                if (options.frame || options.headersOnly) continue;
                 throw Error(sourceName + ": grid " + std::to_string(grid) + " takes its " + sectionKindName(e.kind) + " from grid " +
                             std::to_string(e.grid) + ", which has none");
             }
@@ -364,6 +409,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 leafCount = r.get<uint64_t>();
                 r.expectEnd();
             }
+            if (options.headersOnly) return encoding::DecodedSize{};
             Section* inner = find(g, kinds.inner, dag.log2Size != 0);
             Section* leaves = find(g, kinds.leaves, false);
             if (inner) dag.inner = fromRawBytes<uint16_t>(inner->data, innerWords, what + " " + layer + " inner nodes");
@@ -453,8 +499,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         const bool inactiveLayer = grid.inactiveVoxels || find(g, kInactive.levels, false);
         const encoding::DecodedSize inactiveSize = inactiveLayer ? readLayerDag(kInactive, grid.inactiveDag, grid.inactiveVoxels, "inactive")
                                                                  : encoding::DecodedSize{};
-        readLayerValues(kActive, grid.dag, activeSize, grid.attributes, grid.values, grid.predictedValues, grid.valueWindows, "active");
-        if (inactiveLayer)
+        if (!options.headersOnly) readLayerValues(kActive, grid.dag, activeSize, grid.attributes, grid.values, grid.predictedValues, grid.valueWindows, "active");
+        if (inactiveLayer && !options.headersOnly)
             readLayerValues(kInactive, grid.inactiveDag, inactiveSize, grid.inactiveAttributes, grid.inactiveValues, grid.inactivePredictedValues,
                             grid.inactiveValueWindows, "inactive");
         if (Section* e = find(g, SectionKind::ValueErrors, false)) {
@@ -491,7 +537,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             if (c.distinctAfter > (uint64_t(1) << c.bits) && c.distinctAfter != c.distinctBefore) r.fail("more colours than the bits allow");
             grid.colour = c;
         }
-        if (Section* n = find(g, SectionKind::Normals, false)) {
+        if (Section* n = options.headersOnly ? nullptr : find(g, SectionKind::Normals, false)) {
             if (grid.dag.empty()) throw Error(what + ": normals for an empty grid");
             grid.normals = attributes::deserializeNormals(n->data, encoding::decodedSize(grid.dag).attributeEntries, what + " Normals");
         }
@@ -507,6 +553,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             }
             r.expectEnd();
         }
+        if (Section* s = find(g, SectionKind::Summary, false)) grid.summary = parseSummary(s->data, vs, what + " Summary");
     }
     for (const auto& [key, section] : byGrid)
         if (key.first >= gridCount) throw Error(sourceName + ": section for grid " + std::to_string(key.first) + " but the file has " + std::to_string(gridCount) + " grids");

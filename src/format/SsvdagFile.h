@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -13,8 +14,10 @@
 #include "src/attributes/NormalChannel.h"
 #include "src/attributes/PaletteChannel.h"
 #include "src/attributes/ScalarTolerance.h"
+#include "src/attributes/ValueRange.h"
 #include "src/attributes/ValueWindows.h"
 #include "src/encoding/CompactDag.h"
+#include "src/format/DagBounds.h"
 #include "src/format/SsvdagContainer.h"
 #include "src/volume/GridRecord.h"
 
@@ -25,6 +28,14 @@ namespace vdbdag::format {
 struct DagStats {
     std::vector<uint64_t> svoNodes, svdagNodes, storedNodes;
     bool hasSvdag = false;
+};
+
+// What a grid's Summary section stores (docs/FORMAT.md 10.1): the facts
+// `info` prints that would otherwise take the whole DAG and every value.
+struct StoredSummary {
+    std::optional<IndexBox> indexBox;  // of the active voxels; none when the active layer is empty
+    uint64_t solidNodes = 0;           // DAG nodes that are whole active cubes (a .vdb's active tiles)
+    attributes::ValueRange activeRange;
 };
 
 struct EncodedGrid {
@@ -50,6 +61,9 @@ struct EncodedGrid {
     // decode entry i with normals->decode(i)). Absent unless asked for.
     std::optional<attributes::NormalChannel> normals;
     DagStats stats;
+    // Its Summary section: as read (none in files written before it), or as
+    // an encoder sets it (format::summaryToStore); written when present.
+    std::optional<StoredSummary> summary;
     // Inactive voxels/tiles whose value differs from the background.
     uint64_t inactiveVoxels = 0;
     encoding::CompactDag inactiveDag;
@@ -84,6 +98,10 @@ std::vector<Section> sceneToSections(const SsvdagScene& scene);
 // a grid's DagStats section, as the writer stores them (docs/FORMAT.md).
 std::vector<uint8_t> serializeDagLevels(const encoding::CompactDag& dag);
 std::vector<uint8_t> serializeDagStats(const DagStats& stats);
+// The Summary section's payload (docs/FORMAT.md 10.1), and its parse
+// (throws Error naming `what`).
+std::vector<uint8_t> serializeSummary(const StoredSummary& summary, unsigned valueSize);
+StoredSummary parseSummary(std::span<const uint8_t> bytes, unsigned valueSize, const std::string& what);
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName);
 // What a reader builds beyond the values themselves.
 struct ReadOptions {
@@ -103,6 +121,10 @@ struct ReadOptions {
     // Read one frame of a sequence file (an index into its frames; a file
     // of one volume has frame 0 only): only its sections are read.
     std::optional<uint32_t> frame;
+    // The grids' headers only (`info` of a file with Summary sections): each
+    // layer's DagLevels (origin, size, levels; no inner words or leaves),
+    // no values, no normals. The sections given may lack the rest.
+    bool headersOnly = false;
 };
 SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& sourceName, const ReadOptions& options);
 

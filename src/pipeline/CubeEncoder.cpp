@@ -16,6 +16,7 @@
 #include "src/dag/ReducedDagBytes.h"
 #include "src/dag/SubDagMerge.h"
 #include "src/encoding/CompactDag.h"
+#include "src/format/GridSummary.h"
 #include "src/pipeline/AttributeOrder.h"
 #include "src/pipeline/GridCodecParts.h"
 #include "src/util/Error.h"
@@ -355,6 +356,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
         ValueStream stream;
         stream.quantizer = quantizer;
         auto run = [&](auto& writer) -> attributes::ValueWindowsPayload {
+            if (!inactive) writer.trackRange(source.header().valueType);  // the file's Summary section
             const LayerSummary summary = source.summary(layer);
             if constexpr (std::is_same_v<std::decay_t<decltype(writer)>, attributes::ValueWindowWriter>) {
                 if (team.size() == 1 && summary.uniform() && summary.uniformValue.size() == vs && !stream.quantizer) {
@@ -390,6 +392,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
                     whole.emplace(vs, inFlight, budget.spillNear, budget.spillInMemory, floatChannelOf(source.header(), options, inactive));
                 else
                     whole.emplace(vs, expected, inFlight, budget.spillNear, budget.spillInMemory);
+                if (!inactive) whole->trackRange(source.header().valueType);
             }
             team.gatherEach(writer.finishShare().serialize(), [&](std::vector<uint8_t>&& bytes) {
                 const attributes::ShareWindows share = attributes::ShareWindows::deserialize(bytes);
@@ -457,6 +460,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
         out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, team, codeInactive, keep);
         storeInactiveValues(out, std::move(kept));
     }
+    if (team.isRoot()) out.summary = format::summaryToStore(out);  // the file's Summary section
     return out;
 }
 

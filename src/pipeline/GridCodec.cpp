@@ -2,6 +2,7 @@
 // root-placement search and the statistics `info` reports.
 #include "src/pipeline/GridCodec.h"
 
+#include "src/format/GridSummary.h"
 #include "src/format/SsvdagContainer.h"
 #include "src/format/TraceableValues.h"
 
@@ -288,6 +289,7 @@ format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& 
         storeInactiveValues(out, std::move(kept));
     }
     if (release) *release = GridRecord{};  // everything the scene needs is copied
+    out.summary = format::summaryToStore(out);
     return out;
 }
 

@@ -282,7 +282,9 @@ TEST(Cli, RenderWithOnvNormalsOnVulkanAndCpuGivesTheSamePng) {
 // --max-voxels and --max-memory on every command that expands a file: a
 // one-line error naming the file and the limit, exit 1, nothing written.
 // The ball's entries (active voxels, a closed form of OpenVDB's count here)
-// are the threshold: one less is refused, the count itself passes.
+// are the threshold: one less is refused, the count itself passes. (`info`
+// without --values expands nothing of a file with Summary sections: it
+// reads the headers, test_summary_section.cpp.)
 TEST(Cli, ReadLimitsRefuseAFileBeforeExpandingIt) {
     const fs::path encoded = workDir() / "limits_ball.ssvdag";
     ASSERT_EQ(runCli("encode " + sphereFile().string() + " -o " + encoded.string()).exitCode, 0);
@@ -295,7 +297,7 @@ TEST(Cli, ReadLimitsRefuseAFileBeforeExpandingIt) {
     const std::string in = encoded.string();
     const std::vector<std::string> commands{"decode " + in + " -o " + (dir / "o.vdb").string(), "export " + in + " -o " + (dir / "o.vtu").string(),
                                             "render " + in + " -o " + (dir / "o.png").string() + " --backend cpu --width 8 --height 8",
-                                            "info " + in, "verify " + sphereFile().string() + " --encoded " + in,
+                                            "info " + in + " --values", "verify " + sphereFile().string() + " --encoded " + in,
                                             "diff " + in + " " + sphereFile().string()};
     for (const std::string& c : commands) {
         for (const std::string& limit : {"--max-voxels " + std::to_string(active - 1), std::string("--max-memory 2K")}) {
