@@ -35,19 +35,10 @@ std::optional<std::pair<format::SsvdagScene, nlohmann::json>> reportFromHeaders(
     const std::vector<format::Section> stored = format::storedSectionsOf(input);
     for (const format::Section& s : stored)
         if (s.kind == SectionKind::Normals) return std::nullopt;
-    const auto small = [](SectionKind kind, uint32_t) {
-        switch (kind) {
-        case SectionKind::DagInner: case SectionKind::DagLeaves: case SectionKind::InactiveInner: case SectionKind::InactiveLeaves:
-        case SectionKind::Values: case SectionKind::InactiveValues: case SectionKind::ValueWindows: case SectionKind::InactiveValueWindows:
-        case SectionKind::PredictedWindows: case SectionKind::InactivePredictedWindows: case SectionKind::PredictedValues:
-        case SectionKind::InactivePredictedValues: case SectionKind::Normals: return false;
-        default: return true;
-        }
-    };
     format::ReadOptions readOptions;
     readOptions.limits = opt.limits;
     readOptions.headersOnly = true;
-    format::SsvdagScene scene = format::sectionsToScene(format::readContainerFile(input, false, opt.limits, small), input, readOptions);
+    format::SsvdagScene scene = format::readSceneFile(input, readOptions);
     for (const format::EncodedGrid& grid : scene.grids)
         if (!grid.summary) return std::nullopt;
     StoredScene file;

@@ -6,8 +6,13 @@
 //   vdbdag::Accessor a = g.accessor();                         // one per thread
 //   if (a.isActive(i, j, k)) float v = a.value<float>(i, j, k);
 //
-// A file is memory-mapped on open; its DAGs are inflated then, and each
-// value channel is decoded the first time a value of it is asked for. A
+// Opening a file reads its section table and its grids' headers; a grid's
+// DAGs and value payloads are read the first time the grid is walked (an
+// Accessor, forEachActive, a sample), and each value channel is decoded the
+// first time a value of it is asked for. (A file written before Summary
+// sections, docs/FORMAT.md 10.1, is read whole on open.) The limits a file
+// is opened with are weighed on open against what its table and headers
+// claim, and again as each grid is read. A
 // File, its Grids and their Accessors are used from any number of threads
 // (an Accessor from one at a time); Grids and Accessors refer to the File
 // they came from, which must outlive them.

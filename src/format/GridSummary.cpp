@@ -73,7 +73,8 @@ GridSummary summarizeGrid(const EncodedGrid& grid) {
 StoredSummary summaryToStore(const EncodedGrid& grid) {
     if (grid.summary) return *grid.summary;
     const GridSummary s = summarizeGrid(grid);
-    return {s.indexBox, s.solidNodes, s.activeRange};
+    return {s.indexBox, s.solidNodes, encoding::decodedSize(grid.dag).attributeEntries, encoding::decodedSize(grid.inactiveDag).attributeEntries,
+            s.activeRange};
 }
 
 std::vector<double> valueNumbers(ValueType type, std::span<const uint8_t> value) {

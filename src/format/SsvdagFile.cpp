@@ -95,8 +95,8 @@ std::vector<uint8_t> serializeDagLevels(const encoding::CompactDag& dag) {
 }
 
 // Summary (docs/FORMAT.md 10.1): u8 flags (1: an index box, 2: a value
-// range), [i64 min[3], i64 max[3]], u64 solid nodes, [min, max: the value's
-// bytes each].
+// range), [i64 min[3], i64 max[3]], u64 solid nodes, u64 active entries,
+// u64 inactive entries, [min, max: the value's bytes each].
 std::vector<uint8_t> serializeSummary(const StoredSummary& s, unsigned valueSize) {
     const bool range = valueSize && !s.activeRange.empty();
     if (range && (s.activeRange.min.size() != valueSize || s.activeRange.max.size() != valueSize))
@@ -108,6 +108,8 @@ std::vector<uint8_t> serializeSummary(const StoredSummary& s, unsigned valueSize
         for (int64_t v : s.indexBox->max) w.put<int64_t>(v);
     }
     w.put<uint64_t>(s.solidNodes);
+    w.put<uint64_t>(s.activeEntries);
+    w.put<uint64_t>(s.inactiveEntries);
     if (range) {
         w.putBytes(s.activeRange.min);
         w.putBytes(s.activeRange.max);
@@ -130,6 +132,8 @@ StoredSummary parseSummary(std::span<const uint8_t> bytes, unsigned valueSize, c
         s.indexBox = box;
     }
     s.solidNodes = r.get<uint64_t>();
+    s.activeEntries = r.get<uint64_t>();
+    s.inactiveEntries = r.get<uint64_t>();
     if (flags & 2) {
         s.activeRange.min = r.getArray<uint8_t>(valueSize);
         s.activeRange.max = r.getArray<uint8_t>(valueSize);
@@ -282,7 +286,7 @@ void resolveSameAs(std::vector<Section>& sections, const std::string& sourceName
             const auto it = real.find({e.grid, e.kind});
             if (it == real.end()) {
                 // Reading one frame, only its own grids need their sections.
-                if (options.frame || options.headersOnly) continue;
+                if (options.frame || options.grid || options.headersOnly) continue;
                 throw Error(sourceName + ": grid " + std::to_string(grid) + " takes its " + sectionKindName(e.kind) + " from grid " +
                             std::to_string(e.grid) + ", which has none");
             }
@@ -338,7 +342,11 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     if (framesSection) frames = parseFrames(framesSection->data, gridCount, sourceName + ": Frames");
     if (framesSection && fileMetadata) throw Error(sourceName + ": a sequence file keeps each frame's metadata in FrameMetadata, not FileMetadata");
     if (!framesSection && !frameMetadata.empty()) throw Error(sourceName + ": FrameMetadata in a file without frames");
-    const GridRange range = options.frame ? frameGrids(frames, gridCount, *options.frame, sourceName) : GridRange{0, gridCount};
+    if (options.grid && *options.grid >= gridCount)
+        throw Error(sourceName + ": has " + std::to_string(gridCount) + " grid(s); grid " + std::to_string(*options.grid) + " asked for");
+    const GridRange range = options.frame ? frameGrids(frames, gridCount, *options.frame, sourceName)
+                            : options.grid ? GridRange{*options.grid, *options.grid + 1}
+                                           : GridRange{0, gridCount};
     const uint32_t first = range.first, end = range.end;
     if (end - first > sections.size()) throw Error(sourceName + ": FileInfo claims " + std::to_string(gridCount) + " grids, more than its sections can hold");
 
@@ -572,11 +580,35 @@ SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceN
 
 SsvdagScene readSceneFile(const std::string& path) { return readSceneFile(path, ReadOptions{}); }
 
+bool isHeaderSection(SectionKind kind) {
+    switch (kind) {
+        case SectionKind::DagInner:
+        case SectionKind::DagLeaves:
+        case SectionKind::InactiveInner:
+        case SectionKind::InactiveLeaves:
+        case SectionKind::Values:
+        case SectionKind::InactiveValues:
+        case SectionKind::ValueWindows:
+        case SectionKind::InactiveValueWindows:
+        case SectionKind::PredictedWindows:
+        case SectionKind::InactivePredictedWindows:
+        case SectionKind::PredictedValues:
+        case SectionKind::InactivePredictedValues:
+        case SectionKind::Normals: return false;
+        default: return true;
+    }
+}
+
 SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
-    if (!options.frame) return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false, options.limits), path, options);
-    // One frame: its sections only (and the file's FileInfo and Frames).
+    if (options.headersOnly && !options.frame && !options.grid)
+        return sectionsToScene(readContainerFile(path, false, options.limits, [](SectionKind kind, uint32_t) { return isHeaderSection(kind); }), path, options);
+    if (!options.frame && !options.grid) return sectionsToScene(readContainerFile(path, /*unknownKinds=*/false, options.limits), path, options);
+    if (options.frame && options.grid) throw Error("internal error: a frame and a grid asked for at once");
+    // One frame or grid: its sections only (and the file's FileInfo and Frames).
     const FrameList list = readFrameList(path);
-    const GridRange range = frameGrids(list.frames, list.gridCount, *options.frame, path);
+    if (options.grid && *options.grid >= list.gridCount)
+        throw Error(path + ": has " + std::to_string(list.gridCount) + " grid(s); grid " + std::to_string(*options.grid) + " asked for");
+    const GridRange range = options.frame ? frameGrids(list.frames, list.gridCount, *options.frame, path) : GridRange{*options.grid, *options.grid + 1};
     const uint32_t first = range.first, end = range.end;  // (named, for the lambdas)
     const auto keep = [first, end](SectionKind kind, uint32_t grid) {
         switch (kind) {

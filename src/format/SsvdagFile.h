@@ -35,6 +35,9 @@ struct DagStats {
 struct StoredSummary {
     std::optional<IndexBox> indexBox;  // of the active voxels; none when the active layer is empty
     uint64_t solidNodes = 0;           // DAG nodes that are whole active cubes (a .vdb's active tiles)
+    // Each layer's attribute entries (each voxel of a brick, each solid node
+    // once): what a reader weighs against its limits before it reads the DAG.
+    uint64_t activeEntries = 0, inactiveEntries = 0;
     attributes::ValueRange activeRange;
 };
 
@@ -121,6 +124,10 @@ struct ReadOptions {
     // Read one frame of a sequence file (an index into its frames; a file
     // of one volume has frame 0 only): only its sections are read.
     std::optional<uint32_t> frame;
+    // Read one grid (its index in the file) and only its sections: the
+    // scene's grids are that one (the reader library's first use of a grid).
+    // Not with `frame`.
+    std::optional<uint32_t> grid;
     // The grids' headers only (`info` of a file with Summary sections): each
     // layer's DagLevels (origin, size, levels; no inner words or leaves),
     // no values, no normals. The sections given may lack the rest.
@@ -136,6 +143,9 @@ std::vector<uint8_t> writeScene(const SsvdagScene& scene, const ContainerOptions
 uint64_t writeSceneReleasing(SsvdagScene& scene, std::ostream& out, const ContainerOptions& options = {});
 SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName);
 SsvdagScene readScene(std::span<const uint8_t> bytes, const std::string& sourceName, const ReadOptions& options);
+// The sections a ReadOptions::headersOnly read of a file reads: all but
+// the DAGs' inner words and leaves, the values and the normals.
+bool isHeaderSection(SectionKind kind);
 SsvdagScene readSceneFile(const std::string& path);
 SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options);
 

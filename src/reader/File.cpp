@@ -19,6 +19,36 @@ int readableFormatVersion() { return int(format::kFormatVersion); }
 
 namespace detail {
 
+void GridData::load() const {
+    if (!lazy) return;
+    std::call_once(loaded_, [&] {
+        format::ReadOptions options;
+        options.keepValueWindows = true;
+        options.limits = limits;
+        options.grid = index;
+        format::SsvdagScene scene = format::readSceneFile(path, options);
+        if (scene.grids.size() != 1) throw Error(path + ": grid " + std::to_string(index) + " could not be read alone");
+        format::EncodedGrid& from = scene.grids[0];
+        // What no reader touched before now (the once flag orders it before
+        // every walk); the header, the counts and the summary stay as read.
+        auto& to = const_cast<format::EncodedGrid&>(grid);
+        to.dag = std::move(from.dag);
+        to.inactiveDag = std::move(from.inactiveDag);
+        to.attributes = std::move(from.attributes);
+        to.values = std::move(from.values);
+        to.valueWindows = std::move(from.valueWindows);
+        to.predictedValues = std::move(from.predictedValues);
+        to.inactiveAttributes = std::move(from.inactiveAttributes);
+        to.inactiveValues = std::move(from.inactiveValues);
+        to.inactiveValueWindows = std::move(from.inactiveValueWindows);
+        to.inactivePredictedValues = std::move(from.inactivePredictedValues);
+        to.lossy = from.lossy;
+        to.colour = std::move(from.colour);
+        to.normals = std::move(from.normals);
+        to.stats = std::move(from.stats);
+    });
+}
+
 void Layer::load() const {
     std::call_once(loaded_, [&] {
         const unsigned vs = valueSize(grid->record.valueType);
@@ -90,7 +120,28 @@ std::shared_ptr<FileData> FileData::read(const std::string& path, const OpenLimi
     options.keepValueWindows = true;  // decoded when first asked for
     options.limits.maxVoxels = limits.maxVoxels;
     options.limits.maxMemory = limits.maxMemory ? limits.maxMemory : format::defaultReadMemory();
-    format::SsvdagScene scene = format::readSceneFile(path, options);
+    // The headers first; with a Summary for every grid the rest waits for
+    // each grid's first use (GridData::load), and what the whole file
+    // would take is weighed now, as a whole read weighs it, so that a file
+    // beyond the limits is still refused on open.
+    format::ReadOptions headers;
+    headers.headersOnly = true;
+    headers.limits = options.limits;
+    format::SsvdagScene scene = format::readSceneFile(path, headers);
+    const bool lazy = std::all_of(scene.grids.begin(), scene.grids.end(), [](const format::EncodedGrid& g) { return g.summary.has_value(); });
+    if (lazy) {
+        uint64_t bytes = 0;
+        for (const format::Section& s : format::storedSectionsOf(path))
+            if (format::isKnownKind(s.kind)) bytes = format::saturatingAdd(bytes, s.stored->rawBytes);
+        for (const format::EncodedGrid& g : scene.grids) {
+            const std::string what = path + ": grid '" + g.record.name + "'";
+            format::checkVoxels(options.limits, g.summary->activeEntries, what + " active layer");
+            format::checkVoxels(options.limits, g.summary->inactiveEntries, what + " inactive layer");
+        }
+        format::checkMemory(options.limits, bytes, path, "its sections");
+    } else {
+        scene = format::readSceneFile(path, options);
+    }
     auto file = std::make_shared<FileData>();
     file->path = path;
     file->sequence = !scene.frames.empty();
@@ -112,6 +163,10 @@ std::shared_ptr<FileData> FileData::read(const std::string& path, const OpenLimi
         data->inactive.grid = &data->grid;
         data->inactive.inactive = true;
         data->inactive.what = what + " inactive values";
+        data->lazy = lazy;
+        data->path = path;
+        data->index = uint32_t(file->grids.size());
+        data->limits = options.limits;
         file->grids.push_back(Grid(data.get()));
         file->data.push_back(std::move(data));
     }
@@ -163,6 +218,11 @@ std::array<double, 16> Grid::indexToWorld() const { return data_->grid.record.in
 
 IndexBBox Grid::indexBBox() const {
     IndexBBox box;
+    if (data_->grid.summary) {  // the DAG's own bounds, stored
+        if (const auto& b = data_->grid.summary->indexBox) box.min = b->min, box.max = b->max;
+        return box;
+    }
+    data_->load();
     if (const auto b = format::dagBounds(data_->grid.dag)) {
         box.min = b->min;
         box.max = b->max;

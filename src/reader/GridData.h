@@ -1,6 +1,7 @@
 // What a vdbdag::File (include/vdbdag/vdbdag.h) holds behind its public
-// classes: each grid as read (DAGs inflated, value windows kept as stored)
-// and each layer's value channel, decoded on first use.
+// classes: each grid's header as read on open, its DAGs and value payloads
+// read when the grid is first used (GridData::load), and each layer's value
+// channel, decoded on first use.
 #pragma once
 #include <memory>
 #include <mutex>
@@ -72,6 +73,19 @@ struct GridData {
     format::EncodedGrid grid;
     Layer active, inactive;
     unsigned valueSize = 0;
+    // A file whose grids all have Summary sections (docs/FORMAT.md 10.1) is
+    // opened by its headers: `grid` holds the record, the counts and the
+    // summary, and load() reads the rest of grid `index` (its DAGs, values,
+    // normals and reports) the first time the grid is walked, under the
+    // limits the file was opened with. Otherwise everything is read on open.
+    bool lazy = false;
+    std::string path;
+    uint32_t index = 0;
+    format::ReadLimits limits;
+    void load() const;  // any thread; a failed load throws again next time
+
+private:
+    mutable std::once_flag loaded_;
 };
 
 struct FileData {

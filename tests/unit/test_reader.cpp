@@ -20,6 +20,7 @@
 
 #include <unistd.h>
 
+#include "src/format/SsvdagContainer.h"
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/selftest/SyntheticGrid.h"
@@ -116,7 +117,10 @@ std::vector<Case> everyType(std::mt19937& rng) {
     return cases;
 }
 
-std::filesystem::path writeFile(const std::vector<std::pair<Case*, bool>>& grids, const pipeline::EncodeOptions& options, const std::string& stem) {
+// `summaries` false: the grids without their Summary sections, as a file
+// written before them (read whole on open).
+std::filesystem::path writeFile(const std::vector<std::pair<Case*, bool>>& grids, const pipeline::EncodeOptions& options, const std::string& stem,
+                                bool summaries = true) {
     format::SsvdagScene scene;
     for (const auto& [c, withInactive] : grids) {
         GridRecord record = selftest::toRecord(c->active, c->name);
@@ -127,6 +131,7 @@ std::filesystem::path writeFile(const std::vector<std::pair<Case*, bool>>& grids
         }
         record.indexToWorld = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 1.25, -2, 3, 1};
         scene.grids.push_back(pipeline::encodeGrid(record, options));
+        if (!summaries) scene.grids.back().summary.reset();
     }
     const auto path = std::filesystem::temp_directory_path() / (stem + "_" + std::to_string(::getpid()) + ".ssvdag");
     const std::vector<uint8_t> bytes = format::writeScene(scene);
@@ -186,6 +191,51 @@ TEST(Reader, AccessorAnswersAsTheGridsThatMadeTheFile) {
         }
         std::filesystem::remove(path);
     }
+}
+
+// Opening reads the headers; a grid's DAG and values are read when it is
+// first walked: with the second grid's DAG and values corrupted, the file
+// opens, both grids' facts are the brute-force ones, the first grid answers
+// every lookup as its case, and the second refuses its first walk with one
+// error naming the file (each time it is asked). A file without Summary
+// sections is read whole on open and answers the same.
+TEST(Reader, AGridIsReadWhenFirstWalked) {
+    std::mt19937 rng(12);
+    std::vector<Case> cases = everyType(rng);
+    ASSERT_GE(cases.size(), 2u);
+    std::vector<std::pair<Case*, bool>> grids{{&cases[0], true}, {&cases[1], true}};
+    const auto good = writeFile(grids, {}, "reader_lazy_good");
+    std::vector<uint8_t> bytes = format::readFileBytes(good.string());
+    for (const format::Section& s : format::storedSectionsOf(good.string()))
+        if (s.grid == 1 && s.kind != format::SectionKind::GridInfo && s.kind != format::SectionKind::DagLevels && s.kind != format::SectionKind::Summary &&
+            s.kind != format::SectionKind::VdbDescriptor && s.kind != format::SectionKind::DagStats && s.kind != format::SectionKind::InactiveLevels &&
+            s.stored->storedBytes > 0)
+            bytes[size_t(s.stored->offset + s.stored->storedBytes / 2)] ^= 0x24;
+    const auto bad = std::filesystem::temp_directory_path() / ("reader_lazy_bad_" + std::to_string(::getpid()) + ".ssvdag");
+    std::ofstream(bad, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    const File file = File::open(bad.string());
+    ASSERT_EQ(file.gridCount(), 2u);
+    for (size_t g = 0; g < 2; ++g) {
+        EXPECT_EQ(file.grid(g).name(), cases[g].name);
+        EXPECT_EQ(file.grid(g).activeVoxelCount(), cases[g].active.voxels.size() + [&] {
+            uint64_t n = 0;
+            for (const Tile& t : cases[g].active.tiles) n += uint64_t(1) << (3 * t.log2Size);
+            return n;
+        }());
+    }
+    expectSameAnswers(file.grid(0), cases[0], true, rng);
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        try {
+            (void)file.grid(1).accessor();
+            ADD_FAILURE() << "the corrupted grid was walked";
+        } catch (const Error& e) {
+            EXPECT_EQ(std::string(e.what()).rfind(bad.string(), 0), 0u) << e.what();
+        }
+    }
+    const auto whole = writeFile(grids, {}, "reader_lazy_whole", /*summaries=*/false);
+    const File old = File::open(whole.string());
+    for (size_t g = 0; g < 2; ++g) expectSameAnswers(old.grid(g), cases[g], true, rng);
+    for (const auto& p : {good, bad, whole}) std::filesystem::remove(p);
 }
 
 namespace {
