@@ -60,7 +60,8 @@ inline constexpr int kLatestModel = kLatestIntModel;
 
 struct Models {
     explicit Models(int generation)
-        : textureBias(generation >= 1), leastSquares(generation >= 2), farActivity(generation >= 3), intensityBands(generation >= 4) {
+        : textureBias(generation >= 1), leastSquares(generation >= 2), farActivity(generation >= 3), intensityBands(generation >= 4),
+          bands(intensityBands ? kBands : 1), ctx(size_t(kContexts) * bands), bias(size_t(kContexts) * kTextures * bands) {
         for (LeastSquaresFit& f : fit) f.shape = generation >= 3 ? kLsGeneration3 : kLsGeneration2;
         if (intensityBands) {  // 16 times the residual models: each learns its first bits fast (BitModel::warmUp)
             for (ContextModels& c : ctx) {
@@ -93,7 +94,11 @@ struct Models {
     // (docs/CODING.md "Generation 4"). Linear bands (8 or 16 of the range)
     // gained 0.1 %.
     bool intensityBands;
-    std::array<ContextModels, size_t(kContexts) * kBands> ctx;  // [context][band]; band 0 only before generation 4
+    // The bands the models below are kept for: kBands in generation 4, else
+    // 1 (the arrays are sized by it: 115 KB of models before generation 4,
+    // 1.9 MB in it, built for every window).
+    size_t bands;
+    std::vector<ContextModels> ctx;  // [context][band]
     std::array<std::array<BitModel, kMaxLength + 1>, kMaxLength + 1> low;  // [length][bit]: the remaining bits
     // Generation 1's bias corrections, per activity context and texture:
     // which of W, N, P, NW, NE, PN lie above the blend (CALIC's texture
@@ -101,7 +106,7 @@ struct Models {
     // neighbours lie, and by an amount the activity scales; one correction
     // per context cannot see which side. On the shared scans 1-2.4 % smaller
     // (tooth the most: 637,721 -> 622,454 bytes in raster order).
-    std::array<BiasCell, size_t(kContexts) * kTextures * kBands> bias;  // [context][texture][band]; band 0 only before generation 4
+    std::vector<BiasCell> bias;  // [context][texture][band]
     // Generation 2's and 3's fits, one per kContextsPerFit activity contexts: four
     // (two bit lengths of the activity) beat one per context on every scan
     // (cthead 1.3 %, tooth 0.1 %: more samples per fit), and beat eight
@@ -230,14 +235,14 @@ inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxV
         const unsigned texture = unsigned(n.W > b) | unsigned(n.N > b) << 1 | unsigned(n.P > b) << 2 | unsigned(n.NW > b) << 3 | unsigned(n.NE > b) << 4 |
                                  unsigned(n.PN > b) << 5;
         const int band = models.intensityBands ? intensityBand(b - minValue, false) : 0;
-        out.bias = &models.bias[(size_t(context) * kTextures + texture) * kBands + size_t(band)];
+        out.bias = &models.bias[(size_t(context) * kTextures + texture) * models.bands + size_t(band)];
     } else {
-        out.bias = &models.ctx[size_t(context) * kBands].bias;
+        out.bias = &models.ctx[size_t(context) * models.bands].bias;
     }
     const int64_t bias = out.bias->count ? divRound(out.bias->sum, out.bias->count) : 0;
     out.value = std::clamp(out.blend + bias, minValue, maxValue);
-    out.ctx = &models.ctx[size_t(context) * kBands + size_t(models.intensityBands ? intensityBand(out.value - minValue, true) : 0)];
-    out.high = &models.ctx[size_t(context) * kBands];
+    out.ctx = &models.ctx[size_t(context) * models.bands + size_t(models.intensityBands ? intensityBand(out.value - minValue, true) : 0)];
+    out.high = &models.ctx[size_t(context) * models.bands];
     out.signs = unsigned(9 * (rP.sign + 1) + 3 * (rW.sign + 1) + (rN.sign + 1));
     if (models.leastSquares && out.value != minValue) {
         const int k = (n.W == minValue) + (n.N == minValue) + (n.NW == minValue) + (n.NE == minValue) + (n.P == minValue) + (n.PW == minValue) +
