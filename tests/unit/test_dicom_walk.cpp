@@ -18,6 +18,7 @@
 #include "vdb_bridge/DenseVolume.h"
 #include "vdb_bridge/DicomSeries.h"
 #include "vdb_bridge/detail/DicomElementWalk.h"
+#include "vdb_bridge/detail/DicomSequence.h"
 
 namespace fs = std::filesystem;
 using namespace vdbdag;
@@ -159,6 +160,10 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                          // refused by the walk
                                                          {"dicom_pixel_data_od_undefined_abort",
                                                           "element (7FE0,0010) at byte 936 has an undefined length under VR OD (GDCM takes it for OB, OW or UN pixel data only)"},
+                                                         // refused when its header is read (DicomSequence.h)
+                                                         {"dicom_un_icon_sequence_oom",
+                                                          "its Icon Image Sequence (0088,0200) is a sequence stored as 962 bytes (UN) that, read as explicit VR, "
+                                                          "declares 4211080960 bytes at its byte 150: GDCM would allocate them"},
                                                          {"dicom_odd_item_length_abort",
                                                           "the item at byte 316 holds elements of odd total length (its element (0008,1150) at byte 324 is 25 bytes long)"}};
     for (const auto& [name, why] : cases) {
@@ -307,3 +312,47 @@ TEST(DicomWalk, ADelimiterWithALengthAfterPixelFragmentsIsRefused) {
     EXPECT_EQ(detail::elementLengthProblem(write("zero.dcm", zero).string()), "");
     fs::remove_all(file.parent_path());
 }
+
+// A sequence GDCM keeps as bytes (stored as UN, or of defined length in an
+// implicit-VR file) is parsed (DataElement::GetValueAsSQ) only where no
+// attempt GDCM makes would allocate more than kMaxUnheldBytes past its bytes
+// (vdb_bridge/detail/DicomSequence.h; the fuzz finding
+// dicom_un_icon_sequence_oom allocated 4.2 GB). GDCM itself is the
+// reference for the sequences let through: it reads their one item and its
+// two elements.
+TEST(DicomSequence, ASequenceKeptAsBytesIsParsedOnlyWhereGdcmHoldsWhatItAllocates) {
+    const auto le16 = [](uint16_t v) { return std::string{char(v & 0xFF), char(v >> 8)}; };
+    const auto le32 = [&](uint32_t v) { return le16(uint16_t(v)) + le16(uint16_t(v >> 16)); };
+    const auto implicitElement = [&](uint16_t g, uint16_t e, const std::string& value) { return le16(g) + le16(e) + le32(uint32_t(value.size())) + value; };
+    const auto item = [&](const std::string& elements) { return le16(0xFFFE) + le16(0xE000) + le32(uint32_t(elements.size())) + elements; };
+    const std::string samples = std::string("\x01\x00", 2), photometric = "MONOCHROME2 ";
+    // An OW element with a 4-byte length: the explicit form of palette data.
+    const auto ow = [&](uint32_t declared, const std::string& value) { return le16(0x0028) + le16(0x1201) + "OW" + std::string(2, '\0') + le32(declared) + value; };
+    const std::string explicitItem = item(element(0x0028, 0x0002, "US", samples) + element(0x0028, 0x0004, "CS", photometric) + ow(4, "abcd"));
+    const std::string implicitItem = item(implicitElement(0x0028, 0x0002, samples) + implicitElement(0x0028, 0x0004, photometric) + implicitElement(0x0028, 0x1201, "abcd"));
+    const auto elementOf = [](gdcm::VR vr, const std::string& bytes) {
+        gdcm::DataElement de(gdcm::Tag(0x0088, 0x0200));
+        de.SetVR(vr);
+        de.SetByteValue(bytes.data(), gdcm::VL(uint32_t(bytes.size())));
+        return de;
+    };
+    for (const auto& [vr, bytes] : {std::pair{gdcm::VR(gdcm::VR::UN), explicitItem}, std::pair{gdcm::VR(gdcm::VR::UN), implicitItem},
+                                    std::pair{gdcm::VR(gdcm::VR::INVALID), implicitItem}}) {
+        const gdcm::DataElement de = elementOf(vr, bytes);
+        std::string problem;
+        const gdcm::SmartPointer<gdcm::SequenceOfItems> sq = detail::valueAsSequence(de, problem);
+        EXPECT_EQ(problem, "");
+        ASSERT_TRUE(sq);
+        ASSERT_EQ(sq->GetNumberOfItems(), 1u);
+        EXPECT_EQ(sq->GetItem(1).GetNestedDataSet().Size(), 3u);
+    }
+    // The palette data's length forged: 0xFB000000 bytes past 4 is refused (every
+    // attempt GDCM makes at a UN sequence reaches it); 16 bytes past is not
+    // (GDCM allocates 20 bytes, fails and gives up).
+    const std::string forged = item(element(0x0028, 0x0002, "US", samples) + element(0x0028, 0x0004, "CS", photometric) + ow(0xFB000000u, "abcd"));
+    const std::string problem = detail::sequenceProblem(elementOf(gdcm::VR::UN, forged));
+    EXPECT_NE(problem.find("that, read as explicit VR, declares 4211081216 bytes at its byte 46: GDCM would allocate them"), std::string::npos) << problem;
+    const std::string shortForged = item(element(0x0028, 0x0002, "US", samples) + element(0x0028, 0x0004, "CS", photometric) + ow(20, "abcd"));
+    EXPECT_EQ(detail::sequenceProblem(elementOf(gdcm::VR::UN, shortForged)), "");
+}
+

@@ -23,6 +23,7 @@
 #include "src/util/Error.h"
 #include "vdb_bridge/DicomTags.h"
 #include "vdb_bridge/detail/DicomElementWalk.h"
+#include "vdb_bridge/detail/DicomSequence.h"
 
 namespace vdbdag::bridge::detail {
 
@@ -65,11 +66,14 @@ std::optional<std::vector<double>> parseNumbers(const std::string& text) {
 
 namespace {
 
-// The first item of sequence (group, element) in `ds`, or null.
-const gdcm::DataSet* firstItem(const gdcm::DataSet& ds, uint16_t group, uint16_t element, gdcm::SmartPointer<gdcm::SequenceOfItems>& keep) {
+// The first item of sequence (group, element) in `ds`, or null; null with
+// `problem` set where GDCM must not parse the sequence's bytes
+// (DicomSequence.h).
+const gdcm::DataSet* firstItem(const gdcm::DataSet& ds, uint16_t group, uint16_t element, gdcm::SmartPointer<gdcm::SequenceOfItems>& keep,
+                               std::string& problem) {
     const gdcm::Tag tag(group, element);
     if (!ds.FindDataElement(tag)) return nullptr;
-    keep = ds.GetDataElement(tag).GetValueAsSQ();
+    keep = valueAsSequence(ds.GetDataElement(tag), problem);
     if (!keep || keep->GetNumberOfItems() < 1) return nullptr;
     return &keep->GetItem(1).GetNestedDataSet();
 }
@@ -210,9 +214,11 @@ std::string curveProblem(const gdcm::DataSet& ds) {
 // reader's own check of each table's length), emulated here.
 std::string iconProblem(const gdcm::DataSet& ds) {
     gdcm::SmartPointer<gdcm::SequenceOfItems> keep;
-    const gdcm::DataSet* icon = firstItem(ds, 0x0088, 0x0200, keep);
-    if (!icon) return "";
     const std::string where = "its Icon Image Sequence (0088,0200)";
+    std::string problem;
+    const gdcm::DataSet* icon = firstItem(ds, 0x0088, 0x0200, keep, problem);
+    if (!problem.empty()) return where + " is " + problem;
+    if (!icon) return "";
     // DoIconImage gives the icon's Samples per Pixel to
     // PixelFormat::SetSamplesPerPixel, which asserts on any but 1, 3 and 4
     // (79: found by fuzz_scan_headers).
@@ -449,8 +455,11 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
                                        need, frameCount, info.columns, info.rows);
     }
     gdcm::SmartPointer<gdcm::SequenceOfItems> sharedSq, perFrameSq;
-    const gdcm::DataSet* shared = firstItem(ds, 0x5200, 0x9229, sharedSq);
-    if (ds.FindDataElement(gdcm::Tag(0x5200, 0x9230))) perFrameSq = ds.GetDataElement(gdcm::Tag(0x5200, 0x9230)).GetValueAsSQ();
+    std::string problem;
+    const gdcm::DataSet* shared = firstItem(ds, 0x5200, 0x9229, sharedSq, problem);
+    if (!problem.empty()) return "corrupt DICOM: its Shared Functional Groups Sequence (5200,9229) is " + problem;
+    if (ds.FindDataElement(gdcm::Tag(0x5200, 0x9230))) perFrameSq = valueAsSequence(ds.GetDataElement(gdcm::Tag(0x5200, 0x9230)), problem);
+    if (!problem.empty()) return "corrupt DICOM: its Per-frame Functional Groups Sequence (5200,9230) is " + problem;
 
     if (perFrameSq && perFrameSq->GetNumberOfItems() > 0) {
         // Enhanced multi-frame: each frame's plane from its functional
@@ -464,14 +473,17 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
             fr.multiFrame = true;
             bool havePos = basePos, haveOri = baseOri;
             std::vector<gdcm::SmartPointer<gdcm::SequenceOfItems>> keep(8);
+            std::string sequence;  // a functional group GDCM must not parse (DicomSequence.h)
             const auto group = [&](uint16_t g, uint16_t e, size_t slot) -> const gdcm::DataSet* {
-                if (const gdcm::DataSet* d = firstItem(item, g, e, keep[slot])) return d;
-                return shared ? firstItem(*shared, g, e, keep[slot + 4]) : nullptr;
+                if (const gdcm::DataSet* d = firstItem(item, g, e, keep[slot], sequence)) return d;
+                if (!sequence.empty()) return nullptr;
+                return shared ? firstItem(*shared, g, e, keep[slot + 4], sequence) : nullptr;
             };
             const gdcm::DataSet* pos = group(0x0020, 0x9113, 0);
-            const gdcm::DataSet* ori = group(0x0020, 0x9116, 1);
-            const gdcm::DataSet* pix = group(0x0028, 0x9110, 2);
-            const gdcm::DataSet* res = group(0x0028, 0x9145, 3);
+            const gdcm::DataSet* ori = sequence.empty() ? group(0x0020, 0x9116, 1) : nullptr;
+            const gdcm::DataSet* pix = sequence.empty() ? group(0x0028, 0x9110, 2) : nullptr;
+            const gdcm::DataSet* res = sequence.empty() ? group(0x0028, 0x9145, 3) : nullptr;
+            if (!sequence.empty()) return fmt::format("corrupt DICOM: frame {}'s functional groups hold {}", k + 1, sequence);
             if (std::string why = readPlane(pos, ori, pix, res, fr, havePos, haveOri); !why.empty()) return fmt::format("frame {}: {}", k + 1, why);
             if (!havePos || !haveOri) return fmt::format("multi-frame file: frame {} has no Plane Position/Orientation", k + 1);
             frames.push_back(fr);
@@ -520,7 +532,9 @@ std::vector<std::string> dicomdirFiles(const std::string& path, std::vector<std:
     const Fields f(file);
     const gdcm::Tag records(0x0004, 0x1220);
     if (!ds.FindDataElement(records)) throw Error(path + ": a DICOMDIR without a Directory Record Sequence");
-    const gdcm::SmartPointer<gdcm::SequenceOfItems> sq = ds.GetDataElement(records).GetValueAsSQ();
+    std::string problem;
+    const gdcm::SmartPointer<gdcm::SequenceOfItems> sq = valueAsSequence(ds.GetDataElement(records), problem);
+    if (!problem.empty()) throw Error(path + ": its Directory Record Sequence (0004,1220) is " + problem);
     const fs::path folder = fs::path(path).parent_path();
     std::vector<std::string> out;
     std::set<std::string> seen;
