@@ -24,6 +24,35 @@
 namespace vdbdag::app {
 namespace {
 
+// `info --values` reads every value: the Summary sections (docs/FORMAT.md
+// 10.1) are checked against what the grids' DAGs and values give, as
+// NanoVDB's validator recomputes its grid's bounding boxes. A Summary that
+// says otherwise is refused naming the file (it would mislead `info` and
+// the reader library).
+void checkSummaries(const format::SsvdagScene& scene, const std::string& input) {
+    for (size_t g = 0; g < scene.grids.size(); ++g) {
+        const format::EncodedGrid& grid = scene.grids[g];
+        if (!grid.summary) continue;
+        const format::StoredSummary want = format::recomputedSummary(grid);
+        const format::StoredSummary& have = *grid.summary;
+        const auto box = [](const std::optional<format::IndexBox>& b) {
+            return b ? fmt::format("[{}, {}, {}] -> [{}, {}, {}]", b->min[0], b->min[1], b->min[2], b->max[0], b->max[1], b->max[2]) : std::string("none");
+        };
+        const ValueType type = grid.record.valueType;
+        const auto range = [&](const attributes::ValueRange& r) {
+            return r.empty() ? std::string("none") : format::formatValue(type, r.min) + " to " + format::formatValue(type, r.max);
+        };
+        std::string why;
+        if (box(have.indexBox) != box(want.indexBox)) why = "an index box " + box(have.indexBox) + ", its DAG " + box(want.indexBox);
+        else if (have.solidNodes != want.solidNodes) why = fmt::format("{} solid nodes, its DAG {}", have.solidNodes, want.solidNodes);
+        else if (have.activeEntries != want.activeEntries || have.inactiveEntries != want.inactiveEntries)
+            why = fmt::format("{} and {} entries, its DAGs {} and {}", have.activeEntries, have.inactiveEntries, want.activeEntries, want.inactiveEntries);
+        else if (have.activeRange.min != want.activeRange.min || have.activeRange.max != want.activeRange.max)
+            why = "active values from " + range(have.activeRange) + ", its values " + range(want.activeRange);
+        if (!why.empty()) throw Error(fmt::format("{}: grid {} '{}': its Summary section says {}; the file is corrupted", input, g, grid.record.name, why));
+    }
+}
+
 // `info` of an .ssvdag file reads what it prints: where every grid has a
 // Summary section (docs/FORMAT.md 10.1), the section table, the grids'
 // headers, DagLevels and statistics, and of each PredictedWindows section
@@ -195,6 +224,7 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoRequest& opt, con
             readOptions.limits = opt.limits;
             readOptions.keepValueWindows = !opt.values;
             scene = format::readScene(bytes, input, readOptions);
+            if (opt.values) checkSummaries(scene, input);
             report = sceneReport(scene, bytes, input, opt.values);
         }
         report["format"] = "ssvdag";

@@ -14,15 +14,12 @@
 
 namespace vdbdag::format {
 
-GridSummary summarizeGrid(const EncodedGrid& grid) {
+namespace {
+
+// The summary of `grid` from its DAG and values, whatever its Summary section says.
+GridSummary computedSummary(const EncodedGrid& grid) {
     GridSummary s;
     s.activeVoxels = grid.activeVoxels;
-    if (grid.summary) {
-        s.solidNodes = grid.summary->solidNodes;
-        s.indexBox = grid.summary->indexBox;
-        s.activeRange = grid.summary->activeRange;
-        return s;
-    }
     s.solidNodes = encoding::decodedSize(grid.dag).emittedTiles;
     s.indexBox = dagBounds(grid.dag);
     const ValueType type = grid.record.valueType;
@@ -70,12 +67,25 @@ GridSummary summarizeGrid(const EncodedGrid& grid) {
     return s;
 }
 
-StoredSummary summaryToStore(const EncodedGrid& grid) {
-    if (grid.summary) return *grid.summary;
-    const GridSummary s = summarizeGrid(grid);
+} // namespace
+
+GridSummary summarizeGrid(const EncodedGrid& grid) {
+    if (!grid.summary) return computedSummary(grid);
+    GridSummary s;
+    s.activeVoxels = grid.activeVoxels;
+    s.solidNodes = grid.summary->solidNodes;
+    s.indexBox = grid.summary->indexBox;
+    s.activeRange = grid.summary->activeRange;
+    return s;
+}
+
+StoredSummary recomputedSummary(const EncodedGrid& grid) {
+    const GridSummary s = computedSummary(grid);
     return {s.indexBox, s.solidNodes, encoding::decodedSize(grid.dag).attributeEntries, encoding::decodedSize(grid.inactiveDag).attributeEntries,
             s.activeRange};
 }
+
+StoredSummary summaryToStore(const EncodedGrid& grid) { return grid.summary ? *grid.summary : recomputedSummary(grid); }
 
 std::vector<double> valueNumbers(ValueType type, std::span<const uint8_t> value) {
     if (value.size() < valueSize(type)) throw Error("internal error: value too short");

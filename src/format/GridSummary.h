@@ -37,6 +37,9 @@ GridSummary summarizeGrid(const EncodedGrid& grid);
 // whole: the one read, or the grid's summary (its value range the value
 // writer's where it kept one: no value is decoded).
 StoredSummary summaryToStore(const EncodedGrid& grid);
+// The same from the grid's DAG and values, whatever its Summary says (the
+// check of `info --values`).
+StoredSummary recomputedSummary(const EncodedGrid& grid);
 
 // A value as OpenVDB's operator<< prints it (6 significant digits, vectors
 // as "[x, y, z]"), and as JSON-ready doubles (one, or three for vectors).

@@ -183,3 +183,28 @@ TEST(SummarySection, InfoReadsNeitherTheDagNorTheValues) {
         EXPECT_NE(r.err.find(bad.string()), std::string::npos) << reads << ": " << r.err;
     }
 }
+
+// A Summary that says otherwise than its grid: `info` prints what it says
+// (it reads no more), `info --values`, which reads every value, checks it
+// against the DAG and values and refuses the file naming it.
+TEST(SummarySection, InfoValuesRefusesASummaryItsGridContradicts) {
+    const fs::path vdb = sphereWithTiles();
+    const fs::path good = folder() / "lying_good.ssvdag", bad = folder() / "lying.ssvdag";
+    ASSERT_EQ(vdbdag::testing::runCli("encode " + vdb.string() + " -o " + good.string() + " --force").exitCode, 0);
+    for (const int forge : {0, 1, 2}) {
+        format::SsvdagScene scene = format::readSceneFile(good.string());
+        ASSERT_TRUE(scene.grids.at(0).summary);
+        format::StoredSummary& s = *scene.grids[0].summary;
+        if (forge == 0) s.solidNodes += 1;
+        if (forge == 1) s.indexBox->max[2] += 4;
+        if (forge == 2) std::swap(s.activeRange.min, s.activeRange.max);
+        const std::vector<uint8_t> bytes = format::writeScene(scene);
+        std::ofstream(bad, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        EXPECT_EQ(vdbdag::testing::runCli("info " + bad.string()).exitCode, 0) << forge;
+        const auto r = vdbdag::testing::runCli("info " + bad.string() + " --values");
+        EXPECT_EQ(r.exitCode, 1) << forge;
+        EXPECT_NE(r.err.find(bad.string() + ": grid 0 'ball': its Summary section says"), std::string::npos) << forge << ": " << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    }
+    EXPECT_EQ(vdbdag::testing::runCli("info " + good.string() + " --values").exitCode, 0);
+}
