@@ -5,6 +5,10 @@
 //   2. the same bytes with every checksum the table makes reachable patched
 //      to match, so mutations of the table and payloads get past the xxh3
 //      checks and reach the bounds, overlap, raw-size and zstd checks.
+//   3. a file that reads as a scene is also read from a file as `info` and
+//      the reader library read it: its headers alone (ReadOptions::
+//      headersOnly), then vdbdag::File::open and each grid's first walk
+//      (its DAGs and values read then, GridData::load) and one lookup.
 // Any input must end in success or vdbdag::Error; anything else (a crash, a
 // sanitizer report, another exception, a timeout or an out-of-memory) is a
 // bug, and so is summarizeContainer disagreeing with readContainer.
@@ -13,9 +17,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <span>
+#include <string>
 #include <vector>
 
+#include <unistd.h>
+#include <vdbdag/vdbdag.h>
 #include <xxhash.h>
 
 #include "src/encoding/CompactDag.h"
@@ -50,6 +58,33 @@ void patchChecksums(std::vector<uint8_t>& b) {
     }
     const uint64_t sum = XXH3_64bits(b.data(), tableEnd);
     std::memcpy(&b[tableEnd], &sum, 8);
+}
+
+// 3. above, for bytes that read as a scene: written to a file in /dev/shm.
+void readAsFile(std::span<const uint8_t> bytes, const format::ReadLimits& limits) {
+    static const std::string path = "/dev/shm/fuzz_ssvdag_reader_" + std::to_string(::getpid()) + ".ssvdag";
+    std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    try {
+        format::ReadOptions headers;
+        headers.limits = limits;
+        headers.headersOnly = true;
+        (void)format::readSceneFile(path, headers);
+    } catch (const Error&) {
+    }
+    try {
+        const File file = File::open(path, OpenLimits{limits.maxVoxels, limits.maxMemory});
+        for (size_t g = 0; g < file.gridCount(); ++g) {
+            const Grid& grid = file.grid(g);
+            const IndexBBox box = grid.indexBBox();
+            try {
+                Accessor a = grid.accessor();
+                uint8_t value[32] = {};
+                if (!box.empty() && grid.valueSize() <= sizeof(value)) a.valueBytes(box.min[0], box.min[1], box.min[2], value);
+            } catch (const Error&) {
+            }
+        }
+    } catch (const Error&) {
+    }
 }
 
 void readAll(std::span<const uint8_t> bytes, bool deep) {
@@ -98,6 +133,7 @@ void readAll(std::span<const uint8_t> bytes, bool deep) {
             }
         }
         const format::SsvdagScene scene = format::sectionsToScene(std::move(sections), "fuzz", options);
+        readAsFile(bytes, options.limits);
         for (const auto& grid : scene.grids) {
             // An expansion bomb (a few KB that decode to 2^40 bricks) is a
             // valid file the readers bound by --max-voxels; the walk below is
