@@ -162,8 +162,11 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                           "element (7FE0,0010) at byte 936 has an undefined length under VR OD (GDCM takes it for OB, OW or UN pixel data only)"},
                                                          // refused when its header is read (DicomSequence.h)
                                                          {"dicom_un_icon_sequence_oom",
-                                                          "its Icon Image Sequence (0088,0200) is a sequence stored as 962 bytes (UN) that, read as explicit VR, "
-                                                          "declares 4211080960 bytes at its byte 150: GDCM would allocate them"},
+                                                          "its Icon Image Sequence (0088,0200) is a sequence stored as 962 bytes (UN) that does not read as implicit VR "
+                                                          "little endian (DICOM CP-246)"},
+                                                         {"dicom_un_icon_sequence_swapped_oom",
+                                                          "its Icon Image Sequence (0088,0200) is a sequence stored as 962 bytes (UN) that does not read as implicit VR "
+                                                          "little endian (DICOM CP-246)"},
                                                          {"dicom_odd_item_length_abort",
                                                           "the item at byte 316 holds elements of odd total length (its element (0008,1150) at byte 324 is 25 bytes long)"}};
     for (const auto& [name, why] : cases) {
@@ -314,31 +317,34 @@ TEST(DicomWalk, ADelimiterWithALengthAfterPixelFragmentsIsRefused) {
 }
 
 // A sequence GDCM keeps as bytes (stored as UN, or of defined length in an
-// implicit-VR file) is parsed (DataElement::GetValueAsSQ) only where no
-// attempt GDCM makes would allocate more than kMaxUnheldBytes past its bytes
-// (vdb_bridge/detail/DicomSequence.h; the fuzz finding
-// dicom_un_icon_sequence_oom allocated 4.2 GB). GDCM itself is the
+// implicit-VR file) is parsed (DataElement::GetValueAsSQ) only where GDCM's
+// first reading, implicit VR little endian, holds it: every declared value
+// length within kMaxUnheldBytes past its bytes (vdb_bridge/detail/
+// DicomSequence.h; the fuzz findings dicom_un_icon_sequence_oom and
+// dicom_un_icon_sequence_swapped_oom allocated 4.2 GB and 850 MB in the
+// other readings GDCM tries after it on a UN sequence). GDCM itself is the
 // reference for the sequences let through: it reads their one item and its
-// two elements.
+// three elements.
 TEST(DicomSequence, ASequenceKeptAsBytesIsParsedOnlyWhereGdcmHoldsWhatItAllocates) {
     const auto le16 = [](uint16_t v) { return std::string{char(v & 0xFF), char(v >> 8)}; };
     const auto le32 = [&](uint32_t v) { return le16(uint16_t(v)) + le16(uint16_t(v >> 16)); };
-    const auto implicitElement = [&](uint16_t g, uint16_t e, const std::string& value) { return le16(g) + le16(e) + le32(uint32_t(value.size())) + value; };
+    const auto implicitElement = [&](uint16_t g, uint16_t e, uint32_t declared, const std::string& value) { return le16(g) + le16(e) + le32(declared) + value; };
     const auto item = [&](const std::string& elements) { return le16(0xFFFE) + le16(0xE000) + le32(uint32_t(elements.size())) + elements; };
     const std::string samples = std::string("\x01\x00", 2), photometric = "MONOCHROME2 ";
     // An OW element with a 4-byte length: the explicit form of palette data.
     const auto ow = [&](uint32_t declared, const std::string& value) { return le16(0x0028) + le16(0x1201) + "OW" + std::string(2, '\0') + le32(declared) + value; };
     const std::string explicitItem = item(element(0x0028, 0x0002, "US", samples) + element(0x0028, 0x0004, "CS", photometric) + ow(4, "abcd"));
-    const std::string implicitItem = item(implicitElement(0x0028, 0x0002, samples) + implicitElement(0x0028, 0x0004, photometric) + implicitElement(0x0028, 0x1201, "abcd"));
+    const auto implicitItem = [&](uint32_t paletteLength) {
+        return item(implicitElement(0x0028, 0x0002, 2, samples) + implicitElement(0x0028, 0x0004, 12, photometric) + implicitElement(0x0028, 0x1201, paletteLength, "abcd"));
+    };
     const auto elementOf = [](gdcm::VR vr, const std::string& bytes) {
         gdcm::DataElement de(gdcm::Tag(0x0088, 0x0200));
         de.SetVR(vr);
         de.SetByteValue(bytes.data(), gdcm::VL(uint32_t(bytes.size())));
         return de;
     };
-    for (const auto& [vr, bytes] : {std::pair{gdcm::VR(gdcm::VR::UN), explicitItem}, std::pair{gdcm::VR(gdcm::VR::UN), implicitItem},
-                                    std::pair{gdcm::VR(gdcm::VR::INVALID), implicitItem}}) {
-        const gdcm::DataElement de = elementOf(vr, bytes);
+    for (const gdcm::VR vr : {gdcm::VR(gdcm::VR::UN), gdcm::VR(gdcm::VR::INVALID)}) {
+        const gdcm::DataElement de = elementOf(vr, implicitItem(4));
         std::string problem;
         const gdcm::SmartPointer<gdcm::SequenceOfItems> sq = detail::valueAsSequence(de, problem);
         EXPECT_EQ(problem, "");
@@ -346,13 +352,16 @@ TEST(DicomSequence, ASequenceKeptAsBytesIsParsedOnlyWhereGdcmHoldsWhatItAllocate
         ASSERT_EQ(sq->GetNumberOfItems(), 1u);
         EXPECT_EQ(sq->GetItem(1).GetNestedDataSet().Size(), 3u);
     }
-    // The palette data's length forged: 0xFB000000 bytes past 4 is refused (every
-    // attempt GDCM makes at a UN sequence reaches it); 16 bytes past is not
-    // (GDCM allocates 20 bytes, fails and gives up).
-    const std::string forged = item(element(0x0028, 0x0002, "US", samples) + element(0x0028, 0x0004, "CS", photometric) + ow(0xFB000000u, "abcd"));
-    const std::string problem = detail::sequenceProblem(elementOf(gdcm::VR::UN, forged));
-    EXPECT_NE(problem.find("that, read as explicit VR, declares 4211081216 bytes at its byte 46: GDCM would allocate them"), std::string::npos) << problem;
-    const std::string shortForged = item(element(0x0028, 0x0002, "US", samples) + element(0x0028, 0x0004, "CS", photometric) + ow(20, "abcd"));
-    EXPECT_EQ(detail::sequenceProblem(elementOf(gdcm::VR::UN, shortForged)), "");
+    // Explicit VR stored as UN (not CP-246's implicit VR): GDCM would go on
+    // to byte-swapped and explicit readings; refused.
+    std::string problem = detail::sequenceProblem(elementOf(gdcm::VR::UN, explicitItem));
+    EXPECT_NE(problem.find("a sequence stored as 54 bytes (UN) that does not read as implicit VR little endian (DICOM CP-246)"), std::string::npos) << problem;
+    // The palette data's length forged to 0xFB000000 bytes past its 4: refused.
+    problem = detail::sequenceProblem(elementOf(gdcm::VR::UN, implicitItem(0xFB000000u)));
+    EXPECT_NE(problem.find("that, read as implicit VR, declares 4211081216 bytes at its byte 42: GDCM would allocate them"), std::string::npos) << problem;
+    // 16 bytes past: GDCM allocates 20 bytes and fails; in an implicit file
+    // it then gives up on the bytes (let through), as UN it would try other
+    // readings (refused).
+    EXPECT_EQ(detail::sequenceProblem(elementOf(gdcm::VR::INVALID, implicitItem(20))), "");
+    EXPECT_NE(detail::sequenceProblem(elementOf(gdcm::VR::UN, implicitItem(20))).find("CP-246"), std::string::npos);
 }
-

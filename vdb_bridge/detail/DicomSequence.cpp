@@ -7,7 +7,10 @@
 // explicit one a tag, a VR and a 2-byte length, or 2 reserved bytes and a
 // 4-byte one for OB, OD, OF, OL, OV, OW, SQ, SV, UC, UN, UR, UT and UV; a
 // sequence's defined length holds its items. Byte-swapped, each tag number
-// and length is read big-endian.
+// and length is read big-endian. An item tag read as (FEFF,00E0) or
+// (FEFF,DDE0) takes GDCM's branch for Philips files of the other byte
+// order (its length and elements byte-swapped: a second fuzz finding, an
+// 800 MB allocation in the byte-swapped attempt at a little-endian item).
 #include "vdb_bridge/detail/DicomSequence.h"
 
 #include <fmt/core.h>
@@ -64,15 +67,50 @@ struct Attempt {
             const uint32_t len = u32(pos + 4);
             pos += 8;
             if (group == 0xFFFE && element == 0xE0DD) return pos;  // the sequence's end
+            if (group == 0xFEFF && (element == 0x00E0 || element == 0xDDE0)) {
+                // An item tag of the other byte order: GDCM's Philips branch
+                // (Item::Read) takes it for the item (or the sequence's end),
+                // reads its length byte-swapped whatever the attempt's order,
+                // and its elements byte-swapped (an undefined length: then,
+                // should that fail, as they are).
+                if (element == 0xDDE0) return pos;
+                uint32_t raw;
+                std::memcpy(&raw, bytes.data() + pos - 4, 4);
+                const uint32_t swapped = __builtin_bswap32(raw);
+                const bool order = swap;
+                swap = true;
+                std::optional<size_t> after;
+                if (swapped == kUndefined) {
+                    after = elements(pos, end, true, depth + 1);
+                    if (!after && !tooLong) {
+                        failed = false;
+                        swap = false;
+                        after = elements(pos, end, true, depth + 1);
+                    }
+                } else {
+                    const size_t itemEnd = swapped <= end - pos ? pos + swapped : end;
+                    if (elements(pos, itemEnd, false, depth + 1)) {
+                        if (itemEnd == pos + swapped) after = itemEnd;
+                        else fail();
+                    }
+                }
+                swap = order;
+                if (!after) return std::nullopt;
+                pos = *after;
+                continue;
+            }
             if (group != 0xFFFE || element != 0xE000) return fail(), std::nullopt;
             if (len == kUndefined) {
                 const std::optional<size_t> after = elements(pos, end, true, depth + 1);
                 if (!after) return std::nullopt;
                 pos = *after;
             } else {
-                if (!fits(len, end - pos, pos - 4)) return std::nullopt;
-                if (!elements(pos, pos + len, false, depth + 1)) return std::nullopt;
-                pos += len;
+                // An item's length is no allocation: GDCM reads its elements
+                // until the length or the bytes end (then fails).
+                const size_t itemEnd = len <= end - pos ? pos + len : end;
+                if (!elements(pos, itemEnd, false, depth + 1)) return std::nullopt;
+                if (itemEnd != pos + len) return fail(), std::nullopt;
+                pos = itemEnd;
             }
         }
         if (undefined) return fail(), std::nullopt;  // no delimiter
@@ -103,6 +141,18 @@ struct Attempt {
                 len = u32(pos + 4);
                 pos += 8;
                 sequence = len == kUndefined;
+                if (sequence && group == 0x7FE0 && element == 0x0010) {  // pixel data fragments: each item's length is allocated
+                    while (true) {
+                        if (end - pos < 8) return fail(), std::nullopt;
+                        const uint16_t g = u16(pos), e = u16(pos + 2);
+                        const uint32_t n = u32(pos + 4);
+                        pos += 8;
+                        if (g == 0xFFFE && e == 0xE0DD) break;
+                        if (g != 0xFFFE || e != 0xE000 || !fits(n, end - pos, pos - 4)) return fail(), std::nullopt;
+                        pos += n;
+                    }
+                    continue;
+                }
             } else {
                 const char vr[2] = {char(bytes[pos + 4]), char(bytes[pos + 5])};
                 if (vr[0] < 'A' || vr[0] > 'Z' || vr[1] < 'A' || vr[1] > 'Z') return fail(), std::nullopt;
@@ -118,10 +168,11 @@ struct Attempt {
                 if (len == kUndefined) {
                     if (!sq && !un) return fail(), std::nullopt;
                     sequence = true;
-                } else if (sq) {  // a sequence of defined length: its items
-                    if (!fits(len, end - pos, pos - 4)) return std::nullopt;
-                    if (!items(pos, pos + len, false, depth + 1)) return std::nullopt;
-                    pos += len;
+                } else if (sq) {  // a sequence of defined length: its items (its length, like an item's, no allocation)
+                    const size_t sqEnd = len <= end - pos ? pos + len : end;
+                    if (!items(pos, sqEnd, false, depth + 1)) return std::nullopt;
+                    if (sqEnd != pos + len) return fail(), std::nullopt;
+                    pos = sqEnd;
                     continue;
                 }
             }
@@ -151,24 +202,26 @@ std::string sequenceProblem(const gdcm::DataElement& de) {
         bool explicitVr, swap;
         const char* name;
     };
-    std::vector<Way> ways;
     const gdcm::VR vr = de.GetVR();
-    if (vr == gdcm::VR::INVALID) {
-        ways.push_back({false, false, "implicit VR"});
-        if (bytes.size() >= 4 && bytes[0] == 0xFF && bytes[1] == 0xFE && bytes[2] == 0xE0 && bytes[3] == 0x00)  // (FEFF,00E0) as read
-            ways.push_back({true, true, "explicit VR byte-swapped"});
-    } else if (vr == gdcm::VR::UN) {
-        ways = {{false, false, "implicit VR"}, {true, true, "explicit VR byte-swapped"}, {true, false, "explicit VR"}};
-    } else if (vr & gdcm::VR::OB_OW) {
-        ways.push_back({false, false, "implicit VR"});
-    }
-    for (const Way& w : ways) {
-        Attempt a{bytes, w.explicitVr, w.swap};
-        if (a.items(0, bytes.size(), false, 0)) return "";  // GDCM reads it this way and stops
-        if (a.tooLong)
-            return fmt::format("a sequence stored as {} bytes ({}) that, read as {}, declares {} bytes at its byte {}: GDCM would allocate them", bytes.size(),
-                               vr == gdcm::VR::INVALID ? "implicit VR" : gdcm::VR::GetVRString(vr), w.name, a.tooLong, a.tooLongAt);
-    }
+    const bool un = vr == gdcm::VR::UN;
+    if (vr != gdcm::VR::INVALID && !un && !(vr & gdcm::VR::OB_OW)) return "";  // GDCM does not parse it
+    const std::string stored = fmt::format("a sequence stored as {} bytes ({})", bytes.size(), un ? "UN" : vr == gdcm::VR::INVALID ? "implicit VR" : gdcm::VR::GetVRString(vr));
+    // GDCM's first attempt, implicit VR little endian (what DICOM CP-246
+    // asks of a sequence stored as UN): walked, bounded by the bytes.
+    Attempt a{bytes, false, false};
+    if (a.items(0, bytes.size(), false, 0)) return "";  // GDCM reads it so and stops
+    if (a.tooLong)
+        return fmt::format("{} that, read as implicit VR, declares {} bytes at its byte {}: GDCM would allocate them", stored, a.tooLong, a.tooLongAt);
+    // Where that fails GDCM tries explicit VR, byte-swapped and as is (UN),
+    // or byte-swapped (an implicit file's sequence whose first tag reads
+    // (FEFF,00E0)), falling back on yet other readings inside (another
+    // byte order for an item, implicit VR after a VR it does not know): a
+    // walk of those cannot promise to follow it. Such a sequence is
+    // refused; otherwise GDCM gives up on the bytes (no sequence).
+    const bool philips = bytes.size() >= 4 && bytes[0] == 0xFF && bytes[1] == 0xFE && bytes[2] == 0xE0 && bytes[3] == 0x00;
+    if (un || (vr == gdcm::VR::INVALID && philips))
+        return stored + " that does not read as implicit VR little endian (DICOM CP-246): GDCM would read it in other byte orders and VRs, allocating "
+                        "what they declare";
     return "";
 }
 

@@ -14,14 +14,18 @@
 // dicom_un_icon_sequence_oom). GDCM's image reader parses the icon the same
 // way (PixmapReader::DoIconImage).
 //
-// sequenceProblem walks each attempt GDCM would make, in its order, over the
-// bytes and bounded by them, up to the first that reads to the end; it names
-// the first declared length past the bytes left that is larger than
-// kMaxUnheldBytes (GDCM would allocate it, then fail and try the next
-// encoding). A smaller one is allowed: GDCM's first, implicit attempt at a
-// valid explicit-VR sequence stored as UN reads each element's VR and short
-// length as one 4-byte length (US and 2 bytes: 152,405), allocates that and
-// fails; only a value of 4 KB or more would make it exceed the bound.
+// sequenceProblem walks GDCM's first attempt, implicit VR little endian
+// (what DICOM CP-246 asks of a sequence stored as UN), over the bytes and
+// bounded by them. It names a declared value length past the bytes larger
+// than kMaxUnheldBytes. Where that attempt does not read the bytes to their
+// end, GDCM goes on (UN; or an implicit file's sequence whose first tag
+// reads (FEFF,00E0)) to byte-swapped and explicit readings with fallbacks
+// of their own (another byte order for an item that looks swapped, implicit
+// VR after a VR it does not know), which no walk here promises to follow: a
+// second finding (dicom_un_icon_sequence_swapped_oom) allocated 850 MB in
+// the byte-swapped reading of a little-endian item. Such a sequence is
+// refused; otherwise GDCM gives up on the bytes (no sequence), as it is let.
+// A smaller overrun is allowed: GDCM allocates it, fails and gives up.
 #pragma once
 #include <gdcmDataElement.h>
 #include <gdcmSequenceOfItems.h>
