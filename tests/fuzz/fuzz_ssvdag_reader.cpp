@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <span>
@@ -85,6 +86,7 @@ void readAsFile(std::span<const uint8_t> bytes, const format::ReadLimits& limits
         }
     } catch (const Error&) {
     }
+    std::remove(path.c_str());  // nothing left in /dev/shm
 }
 
 void readAll(std::span<const uint8_t> bytes, bool deep) {
