@@ -16,11 +16,12 @@ namespace vdbdag::format {
 
 namespace {
 
-// The summary of `grid` from its DAG and values, whatever its Summary section says.
-GridSummary computedSummary(const EncodedGrid& grid) {
+// The summary of `grid` from its DAG (`size`: encoding::decodedSize of it)
+// and values, whatever its Summary section says.
+GridSummary computedSummary(const EncodedGrid& grid, const encoding::DecodedSize& size) {
     GridSummary s;
     s.activeVoxels = grid.activeVoxels;
-    s.solidNodes = encoding::decodedSize(grid.dag).emittedTiles;
+    s.solidNodes = size.emittedTiles;
     s.indexBox = dagBounds(grid.dag);
     const ValueType type = grid.record.valueType;
     const unsigned vs = valueSize(type);
@@ -70,7 +71,7 @@ GridSummary computedSummary(const EncodedGrid& grid) {
 } // namespace
 
 GridSummary summarizeGrid(const EncodedGrid& grid) {
-    if (!grid.summary) return computedSummary(grid);
+    if (!grid.summary) return computedSummary(grid, encoding::decodedSize(grid.dag));
     GridSummary s;
     s.activeVoxels = grid.activeVoxels;
     s.solidNodes = grid.summary->solidNodes;
@@ -80,9 +81,9 @@ GridSummary summarizeGrid(const EncodedGrid& grid) {
 }
 
 StoredSummary recomputedSummary(const EncodedGrid& grid) {
-    const GridSummary s = computedSummary(grid);
-    return {s.indexBox, s.solidNodes, encoding::decodedSize(grid.dag).attributeEntries, encoding::decodedSize(grid.inactiveDag).attributeEntries,
-            s.activeRange};
+    const encoding::DecodedSize active = encoding::decodedSize(grid.dag);
+    const GridSummary s = computedSummary(grid, active);
+    return {s.indexBox, s.solidNodes, active.attributeEntries, encoding::decodedSize(grid.inactiveDag).attributeEntries, s.activeRange};
 }
 
 StoredSummary summaryToStore(const EncodedGrid& grid) { return grid.summary ? *grid.summary : recomputedSummary(grid); }

@@ -1,16 +1,13 @@
-// See DicomSequence.h. The walk follows GDCM 3.0's readers
+// See DicomSequence.h. The walk follows GDCM 3.0's implicit VR readers
 // (SequenceOfItems::Read, Item::Read, DataSet::Read/ReadWithLength,
-// ImplicitDataElement and ExplicitDataElement::ReadPreValue/ReadValue) as
-// far as lengths go: an item is (FFFE,E000) and a 4-byte length, undefined
-// (it ends at (FFFE,E00D)) or the bytes of its elements; an implicit
-// element is a tag and a 4-byte length, undefined for a sequence; an
-// explicit one a tag, a VR and a 2-byte length, or 2 reserved bytes and a
-// 4-byte one for OB, OD, OF, OL, OV, OW, SQ, SV, UC, UN, UR, UT and UV; a
-// sequence's defined length holds its items. Byte-swapped, each tag number
-// and length is read big-endian. An item tag read as (FEFF,00E0) or
-// (FEFF,DDE0) takes GDCM's branch for Philips files of the other byte
-// order (its length and elements byte-swapped: a second fuzz finding, an
-// 800 MB allocation in the byte-swapped attempt at a little-endian item).
+// ImplicitDataElement::ReadPreValue/ReadValue) as far as lengths go: an
+// item is (FFFE,E000) and a 4-byte length, undefined (it ends at
+// (FFFE,E00D)) or the bytes of its elements; an element is a tag and a
+// 4-byte length, undefined for a sequence (for Pixel Data, fragments whose
+// lengths are allocated). An item tag read as (FEFF,00E0) or (FEFF,DDE0)
+// takes GDCM's branch for Philips files of the other byte order: its length
+// and elements are read byte-swapped (each tag number and length
+// big-endian).
 #include "vdb_bridge/detail/DicomSequence.h"
 
 #include <fmt/core.h>
@@ -25,13 +22,12 @@ namespace {
 
 constexpr uint32_t kUndefined = 0xFFFFFFFFu;
 
-// One of GDCM's attempts at the bytes.
+// GDCM's implicit VR reading of the bytes.
 struct Attempt {
     std::span<const uint8_t> bytes;
-    bool explicitVr = false, swap = false;
+    bool swap = false;  // inside a Philips item of the other byte order
     // What stopped it: a length past the bytes larger than kMaxUnheldBytes
-    // (GDCM allocates it), or anything else GDCM throws on (it then tries
-    // the next encoding).
+    // (GDCM allocates it), or anything else GDCM throws on.
     uint64_t tooLong = 0;
     size_t tooLongAt = 0;
     bool failed = false;
@@ -117,13 +113,6 @@ struct Attempt {
         return pos;
     }
 
-    static bool longVr(const char* vr) {
-        static const char* const kLong[] = {"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN", "UR", "UT", "UV"};
-        for (const char* l : kLong)
-            if (vr[0] == l[0] && vr[1] == l[1]) return true;
-        return false;
-    }
-
     // An item's elements from `pos` to `end`, or with `undefined` up to and
     // past the item delimiter (FFFE,E00D).
     std::optional<size_t> elements(size_t pos, size_t end, bool undefined, int depth) {
@@ -135,48 +124,21 @@ struct Attempt {
                 if (undefined) return pos;
                 continue;
             }
-            uint32_t len = 0;
-            bool sequence = false;
-            if (!explicitVr) {
-                len = u32(pos + 4);
-                pos += 8;
-                sequence = len == kUndefined;
-                if (sequence && group == 0x7FE0 && element == 0x0010) {  // pixel data fragments: each item's length is allocated
-                    while (true) {
-                        if (end - pos < 8) return fail(), std::nullopt;
-                        const uint16_t g = u16(pos), e = u16(pos + 2);
-                        const uint32_t n = u32(pos + 4);
-                        pos += 8;
-                        if (g == 0xFFFE && e == 0xE0DD) break;
-                        if (g != 0xFFFE || e != 0xE000 || !fits(n, end - pos, pos - 4)) return fail(), std::nullopt;
-                        pos += n;
-                    }
-                    continue;
-                }
-            } else {
-                const char vr[2] = {char(bytes[pos + 4]), char(bytes[pos + 5])};
-                if (vr[0] < 'A' || vr[0] > 'Z' || vr[1] < 'A' || vr[1] > 'Z') return fail(), std::nullopt;
-                if (longVr(vr)) {
-                    if (end - pos < 12) return fail(), std::nullopt;
-                    len = u32(pos + 8);
-                    pos += 12;
-                } else {
-                    len = u16(pos + 6);
+            const uint32_t len = u32(pos + 4);
+            pos += 8;
+            if (len == kUndefined && group == 0x7FE0 && element == 0x0010) {  // pixel data fragments: each item's length is allocated
+                while (true) {
+                    if (end - pos < 8) return fail(), std::nullopt;
+                    const uint16_t g = u16(pos), e = u16(pos + 2);
+                    const uint32_t n = u32(pos + 4);
                     pos += 8;
+                    if (g == 0xFFFE && e == 0xE0DD) break;
+                    if (g != 0xFFFE || e != 0xE000 || !fits(n, end - pos, pos - 4)) return fail(), std::nullopt;
+                    pos += n;
                 }
-                const bool sq = vr[0] == 'S' && vr[1] == 'Q', un = vr[0] == 'U' && vr[1] == 'N';
-                if (len == kUndefined) {
-                    if (!sq && !un) return fail(), std::nullopt;
-                    sequence = true;
-                } else if (sq) {  // a sequence of defined length: its items (its length, like an item's, no allocation)
-                    const size_t sqEnd = len <= end - pos ? pos + len : end;
-                    if (!items(pos, sqEnd, false, depth + 1)) return std::nullopt;
-                    if (sqEnd != pos + len) return fail(), std::nullopt;
-                    pos = sqEnd;
-                    continue;
-                }
+                continue;
             }
-            if (sequence) {
+            if (len == kUndefined) {  // a sequence
                 const std::optional<size_t> after = items(pos, end, true, depth + 1);
                 if (!after) return std::nullopt;
                 pos = *after;
@@ -197,18 +159,13 @@ std::string sequenceProblem(const gdcm::DataElement& de) {
     const gdcm::ByteValue* bv = de.GetByteValue();
     if (!bv || !bv->GetPointer()) return "";
     const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(bv->GetPointer()), bv->GetLength());
-    // GDCM's attempts for this VR, in its order (DataElement::GetValueAsSQ).
-    struct Way {
-        bool explicitVr, swap;
-        const char* name;
-    };
     const gdcm::VR vr = de.GetVR();
     const bool un = vr == gdcm::VR::UN;
     if (vr != gdcm::VR::INVALID && !un && !(vr & gdcm::VR::OB_OW)) return "";  // GDCM does not parse it
     const std::string stored = fmt::format("a sequence stored as {} bytes ({})", bytes.size(), un ? "UN" : vr == gdcm::VR::INVALID ? "implicit VR" : gdcm::VR::GetVRString(vr));
     // GDCM's first attempt, implicit VR little endian (what DICOM CP-246
     // asks of a sequence stored as UN): walked, bounded by the bytes.
-    Attempt a{bytes, false, false};
+    Attempt a{bytes};
     if (a.items(0, bytes.size(), false, 0)) return "";  // GDCM reads it so and stops
     if (a.tooLong)
         return fmt::format("{} that, read as implicit VR, declares {} bytes at its byte {}: GDCM would allocate them", stored, a.tooLong, a.tooLongAt);
