@@ -6,6 +6,8 @@
 #include <chrono>
 #include <filesystem>
 
+#include "app/FrameJobs.h"
+#include "src/format/FrameSequence.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/pipeline/LayerScatter.h"
 #include "src/util/Error.h"
@@ -151,5 +153,30 @@ DecodeResult decodeFile(const DecodeRequest& request) {
     return result();
 }
 
+
+nlohmann::json decodeFiles(const DecodeRequest& request, const std::string& frames,
+                           const std::function<void(const std::string& output, const DecodeResult&)>& onFile) {
+    const std::vector<FrameJob> jobs = frameJobs({request.input, request.output, frames, "--frames", "file",
+                                                  "write them with a frame token in -o (out.####.vdb, out.%04d.vdb) or pick one with --frames N"},
+                                                 format::readFrameList(request.input));
+    const auto decodeJob = [&](const FrameJob& job) {
+        DecodeRequest one = request;
+        one.output = job.output, one.frame = job.index;
+        DecodeResult result = decodeFile(one);
+        if (job.index) result.report["frame"] = job.number;
+        if (onFile) onFile(job.output, result);
+        return std::move(result.report);
+    };
+    if (jobs.size() == 1 && jobs.front().output == request.output) {  // one output: a file of one volume, or one frame to the output itself
+        nlohmann::json report = decodeJob(jobs.front());
+        if (jobs.front().index) report.erase("frame");
+        return report;
+    }
+    for (const FrameJob& job : jobs)
+        checkOutputPath(job.output, {request.input}, {{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", request.force});
+    nlohmann::json reports = nlohmann::json::array();
+    for (const FrameJob& job : jobs) reports.push_back(decodeJob(job));
+    return reports;
+}
 
 } // namespace vdbdag::app

@@ -7,6 +7,7 @@
 // into a DecodeRequest and prints the result.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,5 +34,16 @@ struct DecodeResult {
 
 // Throws vdbdag::Error naming the file on a refusal; nothing is written then.
 DecodeResult decodeFile(const DecodeRequest& request);
+
+// `vdbdag decode IN -o OUT [--frames SEL]` whole: a file of one volume to
+// the output; a sequence file's frames (`frames`: "12", "10-20",
+// "1,5,9-12"; empty: all) each to the output with its number in the frame
+// token (out.####.vdb), or the one chosen to the output itself
+// (FrameJobs.h). request.frame is ignored. Every output is checked before
+// any is written; `onFile` sees each one's result as it is written (the
+// report of a sequence's frame carries "frame": its number). Returns the
+// report: one volume's object, or an array of the frames' reports.
+nlohmann::json decodeFiles(const DecodeRequest& request, const std::string& frames,
+                           const std::function<void(const std::string& output, const DecodeResult&)>& onFile = {});
 
 } // namespace vdbdag::app

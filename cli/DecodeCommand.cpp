@@ -9,7 +9,6 @@
 
 #include "app/DecodeFile.h"
 #include "cli/Commands.h"
-#include "cli/FrameJobs.h"
 #include "cli/JsonReport.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
@@ -26,26 +25,10 @@ struct DecodeOptions {
     ReadLimitOptions limits;
 };
 
-// One volume of the input (the whole file, or frame `frame` of a sequence)
-// to `output`; its report goes to `batch` when given, else is printed.
-// One volume of the input (the whole file, or frame `frame` of a sequence)
-// to `output` (app::decodeFile); its report goes to `batch` when given,
-// else is printed.
-void decodeOne(const DecodeOptions& opt, const std::string& output, std::optional<uint32_t> frame, nlohmann::json* batch) {
-    setActivity(opt.input, "decoding");
-    app::DecodeRequest request;
-    request.input = opt.input, request.output = output, request.grid = opt.grid, request.frame = frame;
-    request.force = opt.force, request.storedValues = opt.storedValues;
-    request.limits = opt.limits.limits(0);
-    const app::DecodeResult result = app::decodeFile(request);
-    // What changed on the way out, one line each (not silenced by -q: a value written otherwise than stored).
-    for (const std::string& n : result.notes) fmt::print(stderr, "{}: note: {}\n", output, n);
-    const nlohmann::json& report = result.report;
-    if (batch) batch->push_back(report);
-    else if (opt.json) printJson(report);
-    if (!opt.json)
-        fmt::print("{} -> {}: {} grid(s), {} active voxels, {} bytes in {:.2f} s\n", opt.input, output, report["grids"].get<size_t>(),
-                   report["active_voxels"].get<uint64_t>(), report["output_bytes"].get<uint64_t>(), report["seconds"].get<double>());
+// "IN -> OUT: N grid(s), V active voxels, B bytes in S s", one output's report.
+std::string fileLine(const DecodeOptions& opt, const std::string& output, const nlohmann::json& report) {
+    return fmt::format("{} -> {}: {} grid(s), {} active voxels, {} bytes in {:.2f} s\n", opt.input, output, report["grids"].get<size_t>(),
+                       report["active_voxels"].get<uint64_t>(), report["output_bytes"].get<uint64_t>(), report["seconds"].get<double>());
 }
 
 } // namespace
@@ -65,22 +48,17 @@ void addDecodeCommand(CLI::App& app, int& exitCode) {
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
         if (opt->json) setQuiet(true);
-        const std::vector<FrameJob> jobs = frameJobs({opt->input, opt->output, opt->frames, "--frames", "file",
-                                                      "write them with a frame token in -o (out.####.vdb, out.%04d.vdb) or pick one with --frames N"},
-                                                     format::readFrameList(opt->input));
-        if (jobs.size() == 1 && jobs.front().output == opt->output) {  // one output: a file of one volume, or one frame to -o itself
-            decodeOne(*opt, jobs.front().output, jobs.front().index, nullptr);
-            exitCode = 0;
-            return;
-        }
-        // Every output checked before any is written.
-        for (const FrameJob& job : jobs) checkOutputPath(job.output, {opt->input}, {{".vdb", ".nvdb", ".nrrd", ".nhdr", ".mha", ".mhd", ".nii", ".gz", ".raw"}, "decode", opt->force});
-        nlohmann::json reports = nlohmann::json::array();
-        for (const FrameJob& job : jobs) {
-            decodeOne(*opt, job.output, job.index, &reports);
-            reports.back()["frame"] = job.number;
-        }
-        if (opt->json) printJson(reports);
+        setActivity(opt->input, "decoding");
+        app::DecodeRequest request;
+        request.input = opt->input, request.output = opt->output, request.grid = opt->grid;
+        request.force = opt->force, request.storedValues = opt->storedValues;
+        request.limits = opt->limits.limits(0);
+        const nlohmann::json report = app::decodeFiles(request, opt->frames, [&](const std::string& output, const app::DecodeResult& result) {
+            // What changed on the way out, one line each (not silenced by -q: a value written otherwise than stored).
+            for (const std::string& n : result.notes) fmt::print(stderr, "{}: note: {}\n", output, n);
+            if (!opt->json) fmt::print("{}", fileLine(*opt, output, result.report));
+        });
+        if (opt->json) printJson(report);
         exitCode = 0;
     });
 }

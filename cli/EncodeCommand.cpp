@@ -10,9 +10,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include "app/EncodeFile.h"
-#include "app/EncodeOutputs.h"
-#include "app/EncodeSequence.h"
+#include "app/EncodeInputs.h"
 #include "cli/ByteSize.h"
 #include "cli/Commands.h"
 #include "cli/DenseInputOptions.h"
@@ -28,6 +26,15 @@
 #include "vdb_bridge/DenseImport.h"
 
 namespace vdbdag::cli {
+namespace {
+// "OUT: N grid(s), V active voxels -> B bytes (...) in S s", one file's report.
+std::string fileLine(const nlohmann::json& report) {
+    return fmt::format("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", report["output"].get<std::string>(),
+                       report["grid_count"].get<size_t>(), report["active_voxels"].get<uint64_t>(), report["bytes"].get<uint64_t>(),
+                       report["bits_per_active_voxel"].get<double>(), report["seconds"].get<double>());
+}
+} // namespace
+
 void addEncodeCommand(CLI::App& app, int& exitCode) {
     struct Options {
         std::vector<std::string> inputs;
@@ -84,112 +91,43 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));
     cmd->add_flag("--json", opt->json, "print the summary as JSON");
     opt->dense.addTo(*cmd);
-    // One input to one output; the report goes to `batch` when given, else
-    // is printed. A sequence's frame (onProgress set) prints nothing.
-    const auto encodeOne = [opt](const std::string& input, const std::string& output, nlohmann::json* batch,
-                                 const std::function<void(double)>& onProgress, pipeline::CubeTeam& team) {
-        setActivity(input, "encoding");
-        const bool dense = bridge::denseFormatOf(input) != bridge::DenseFormat::None;
-        if (!dense) {
-            if (!opt->dense.series.empty()) throw Error(input + ": --series applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
-            if (!opt->dense.dims.empty() || !opt->dense.type.empty() || !opt->dense.endian.empty() || !opt->dense.spacing.empty() ||
-                !opt->dense.origin.empty() || opt->dense.belowOption->count() || opt->dense.aboveOption->count())
-                throw Error(input + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above) "
-                                    "apply to .raw/.nrrd/.nhdr/.mhd/.mha inputs only");
-        }
-        app::EncodeRequest request;
-        request.input = input, request.output = output, request.force = opt->force;
-        request.inputFiles = denseInputFiles(input, opt->dense);
-        request.grids = opt->grids, request.skipUnsupported = opt->skipUnsupported, request.topologyOnly = opt->topologyOnly;
-        if (dense) request.dense = opt->dense.resolve(input);
-        request.noSymmetry = opt->noSymmetry, request.noCompress = opt->noCompress, request.noPredict = opt->noPredict, request.svdagStats = opt->svdagStats;
-        request.placementTrials = opt->placementTrials, request.absError = opt->absError, request.relError = opt->relError;
-        request.colourBits = opt->colourBits, request.normalBits = opt->normalBits, request.colourGrids = opt->colourGrids, request.normalGrid = opt->normalGrid;
-        request.memoryLimit = opt->memoryLimit, request.scratch = opt->scratch, request.threads = opt->threads;
-        app::EncodeHooks hooks;
-        hooks.team = &team;
-        hooks.warning = [](const std::string& w) { fmt::print(stderr, "vdbdag: warning: {}\n", w); };
-        hooks.onProgress = onProgress;  // a sequence's frame: its share of the whole, and no notes
-        if (!onProgress) hooks.note = [](const std::string& n) { note(n); };
-        const app::EncodeResult result = app::encodeFile(request, hooks);
-        if (!result.written) return nlohmann::json();  // another process of the team writes and reports
-        const nlohmann::json& report = result.report;
-        const std::string line = fmt::format("{}: {} grid(s), {} active voxels -> {} bytes ({:.3f} bits/active voxel) in {:.2f} s\n", output,
-                                             report["grid_count"].get<size_t>(), report["active_voxels"].get<uint64_t>(), report["bytes"].get<uint64_t>(),
-                                             report["bits_per_active_voxel"].get<double>(), report["seconds"].get<double>());
-        if (batch) {
-            batch->push_back(report);
-            if (!opt->json && !onProgress) fmt::print("{}", line);
-        } else if (opt->json) {
-            printJson(report);
-        } else {
-            fmt::print("{}{}", line, thresholdText(result.threshold));
-            for (const auto& l : report["grids_lossy"])
+    cmd->callback([opt, &exitCode] {
+        exitCode = 0;
+        app::EncodeInputsRequest request;
+        request.inputs = opt->inputs, request.output = opt->output, request.dense = opt->dense.inputs();
+        app::EncodeRequest& c = request.coding;
+        c.force = opt->force, c.grids = opt->grids, c.skipUnsupported = opt->skipUnsupported, c.topologyOnly = opt->topologyOnly;
+        c.noSymmetry = opt->noSymmetry, c.noCompress = opt->noCompress, c.noPredict = opt->noPredict, c.svdagStats = opt->svdagStats;
+        c.placementTrials = opt->placementTrials, c.absError = opt->absError, c.relError = opt->relError;
+        c.colourBits = opt->colourBits, c.normalBits = opt->normalBits, c.colourGrids = opt->colourGrids, c.normalGrid = opt->normalGrid;
+        c.memoryLimit = opt->memoryLimit, c.scratch = opt->scratch, c.threads = opt->threads;
+        app::EncodeInputsHooks hooks;
+        hooks.file.team = &cubeTeam();
+        hooks.file.warning = [](const std::string& w) { fmt::print(stderr, "vdbdag: warning: {}\n", w); };
+        hooks.file.note = [](const std::string& n) { note(n); };
+        hooks.onInput = [](const std::string& input) { setActivity(input, "encoding"); };
+        hooks.onFile = [opt](const nlohmann::json& report) {
+            if (!opt->json) fmt::print("{}", fileLine(report));
+        };
+        const app::EncodeInputsResult result = app::encodeInputs(request, hooks);
+        if (!result.written) return;  // another process of the team writes and reports
+        const nlohmann::json& r = result.report;
+        if (opt->json) {
+            printJson(r);
+        } else if (result.shape == app::EncodeShape::Sequence) {
+            const std::vector<FrameFile>& frames = result.frames;
+            fmt::print("{}: {} frames ({} to {}), {} active voxels -> {} bytes ({:.3f} bits/active voxel; the frames alone {} bytes) in {:.2f} s\n",
+                       result.output, frames.size(), frames.front().number, frames.back().number, r["active_voxels"].get<uint64_t>(),
+                       r["bytes"].get<uint64_t>(), r["bits_per_active_voxel"].get<double>(), r["frame_files_bytes"].get<uint64_t>(), r["seconds"].get<double>());
+        } else if (result.shape == app::EncodeShape::OneFile) {
+            fmt::print("{}{}", fileLine(r), thresholdText(result.threshold));
+            for (const auto& l : r["grids_lossy"])
                 fmt::print("  grid '{}' {}: {} of {} values changed, max error {:.3g}, mean {:.3g}, RMS {:.3g}, max relative {:.3g}\n",
                            l["name"].get<std::string>(), l["tolerance"].get<std::string>(), l["changed"].get<uint64_t>(), l["entries"].get<uint64_t>(),
                            l["max_abs_error"].get<double>(), l["mean_abs_error"].get<double>(), l["rms_error"].get<double>(), l["max_rel_error"].get<double>());
-            for (const auto& c : report["grids_colour"]) fmt::print("  {}\n", app::formatColour(c));
-            for (const auto& n : report["grids_normals"]) fmt::print("  {}\n", app::formatNormals(n));
+            for (const auto& colour : r["grids_colour"]) fmt::print("  {}\n", app::formatColour(colour));
+            for (const auto& n : r["grids_normals"]) fmt::print("  {}\n", app::formatNormals(n));
         }
-        return report;
-    };
-    // Frames of a cache into one sequence file (app/EncodeSequence.h), each
-    // frame by encodeOne on this process alone.
-    const auto encodeSequence = [opt, encodeOne](const std::vector<FrameFile>& frames, const std::string& described) {
-        app::SequenceRequest request{frames, opt->output, described, opt->scratch, opt->force};
-        const auto frame = [&](size_t, const std::string& input, const std::string& output, const std::function<void(double)>& onProgress) {
-            nlohmann::json reports = nlohmann::json::array();
-            encodeOne(input, output, &reports, onProgress, pipeline::soloTeam());
-            return reports.at(0);
-        };
-        const app::SequenceResult result = app::encodeSequence(request, cubeTeam(), frame);
-        if (!result.written) return;
-        const nlohmann::json& r = result.report;
-        if (opt->json) printJson(r);
-        else
-            fmt::print("{}: {} frames ({} to {}), {} active voxels -> {} bytes ({:.3f} bits/active voxel; the frames alone {} bytes) in {:.2f} s\n",
-                       opt->output, frames.size(), frames.front().number, frames.back().number, r["active_voxels"].get<uint64_t>(), r["bytes"].get<uint64_t>(),
-                       r["bits_per_active_voxel"].get<double>(), r["frame_files_bytes"].get<uint64_t>(), r["seconds"].get<double>());
-    };
-    cmd->callback([opt, &exitCode, encodeOne, encodeSequence] {
-        exitCode = 0;
-        // A sequence: a frame pattern (smoke.####.vdb, %04d, $F4), or
-        // several inputs that are not DICOM with -o NAME.ssvdag.
-        // A folder of .vdb or .nvdb files (frames of a cache, no DICOM among
-        // them): its files as a sequence, numbered by their names.
-        if (opt->inputs.size() == 1)
-            if (const std::optional<std::vector<std::string>> files = app::cacheFrameFiles(opt->inputs[0])) {
-                if (opt->output.empty()) opt->output = app::defaultOutputFor(opt->inputs[0]);
-                encodeSequence(framesOfList(*files), opt->inputs[0]);
-                return;
-            }
-        if (opt->inputs.size() == 1 && isFramePattern(opt->inputs[0]) && !std::filesystem::exists(opt->inputs[0])) {
-            const std::vector<FrameFile> frames = expandFramePattern(opt->inputs[0]);
-            if (frames.empty()) throw Error(opt->inputs[0] + ": no file matches this frame pattern");
-            if (opt->output.empty()) opt->output = app::defaultOutputFor(withoutFrameToken(opt->inputs[0]));
-            encodeSequence(frames, opt->inputs[0]);
-            return;
-        }
-        // Several inputs none of which is DICOM (frames of a cache, scans):
-        // each encoded alone, to the folder -o names (made when missing; a
-        // name ending in .ssvdag is refused) or beside itself, as
-        // IN.ssvdag; the same bytes as one by one.
-        const bool several = opt->inputs.size() > 1 && std::none_of(opt->inputs.begin(), opt->inputs.end(), [](const std::string& in) {
-                                 return bridge::denseFormatOf(in) == bridge::DenseFormat::Dicom;
-                             });
-        if (!several) {
-            const std::string input = opt->dense.takeInputs(opt->inputs);
-            encodeOne(input, opt->output.empty() ? app::defaultOutputFor(input) : opt->output, nullptr, nullptr, cubeTeam());
-            return;
-        }
-        if (lowerExtension(opt->output) == ".ssvdag" && !std::filesystem::is_directory(opt->output)) {
-            encodeSequence(framesOfList(opt->inputs), std::to_string(opt->inputs.size()) + " files");
-            return;
-        }
-        const std::vector<std::string> outputs = app::outputsForEach(opt->inputs, opt->output);
-        nlohmann::json reports = nlohmann::json::array();
-        for (size_t i = 0; i < opt->inputs.size(); ++i) encodeOne(opt->inputs[i], outputs[i], &reports, nullptr, cubeTeam());
-        if (opt->json) printJson(reports);
     });
 }
 

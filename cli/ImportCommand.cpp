@@ -37,13 +37,14 @@ void addImportCommand(CLI::App& app, int& exitCode) {
     opt->dense.addTo(*cmd);
     opt->limits.add(*cmd);
     cmd->callback([opt, &exitCode] {
-        opt->input = opt->dense.takeInputs(opt->inputs);
+        app::DenseInputs dense = opt->dense.inputs();
+        opt->input = dense.takeInputs(opt->inputs);
         setActivity(opt->input, "importing");
         const auto start = std::chrono::steady_clock::now();
         if (bridge::denseFormatOf(opt->input) == bridge::DenseFormat::None)
             throw Error(opt->input + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz, .hdr or DICOM)");
-        checkOutputPath(opt->output, denseInputFiles(opt->input, opt->dense), {{".vdb"}, "import", opt->force});
-        bridge::DenseImportOptions denseOptions = opt->dense.resolve(opt->input);
+        checkOutputPath(opt->output, app::denseInputFiles(opt->input, dense), {{".vdb"}, "import", opt->force});
+        bridge::DenseImportOptions denseOptions = dense.resolve(opt->input);
         denseOptions.limits = opt->limits.limits(1);  // the grid record, then the OpenVDB grid written
         const bridge::DenseImportResult imported = bridge::importDense(opt->input, denseOptions);
         {

@@ -5,7 +5,7 @@
 
 #include "app/InputReport.h"
 #include "cli/Commands.h"
-#include "cli/DenseInputOptions.h"
+#include "app/DenseInputs.h"
 #include "cli/JsonReport.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
@@ -33,7 +33,7 @@ void addInfoCommand(CLI::App& app, int& exitCode) {
     cmd->callback([opt, &exitCode] {
         exitCode = 0;
         if (bridge::denseFormatOf(opt->inputs.front()) == bridge::DenseFormat::Dicom) {
-            DenseInputOptions dicomInputs;
+            app::DenseInputs dicomInputs;
             const std::string input = dicomInputs.takeInputs(opt->inputs);  // several: one set of DICOM input
             setActivity(input, "reading");
             const auto [report, text] = app::describeDicom(opt->inputs);

@@ -1,5 +1,5 @@
 // `vdbdag render IN.ssvdag -o OUT.png|OUT.exr [...]`: parses the request,
-// picks the frames (cli/FrameJobs.h) and the backend (the CPU reference
+// picks the frames (app/FrameJobs.h) and the backend (the CPU reference
 // tracer or Vulkan, cli/RenderBackend.h), runs app::renderImages
 // (app/RenderFile.h) and prints rays/s and ms per frame.
 #include <fmt/core.h>
@@ -8,7 +8,7 @@
 #include "app/RenderFile.h"
 #include "cli/Commands.h"
 #include "cli/FiniteNumber.h"
-#include "cli/FrameJobs.h"
+#include "app/FrameJobs.h"
 #include "cli/GlobalOptions.h"
 #include "cli/JsonReport.h"
 #include "cli/ReadLimitOptions.h"
@@ -86,11 +86,11 @@ void addRenderCommand(CLI::App& app, int& exitCode) {
         setActivity(request.input, "rendering");
         // The frames of a sequence file rendered: (index, output); else the
         // input whole to -o.
-        const std::vector<FrameJob> jobs =
-            frameJobs({request.input, opt->output, opt->frame, "--frame", "image", "render one with --frame N, or each to its image with a frame token in -o (f.####.png)"},
+        const std::vector<app::FrameJob> jobs =
+            app::frameJobs({request.input, opt->output, opt->frame, "--frame", "image", "render one with --frame N, or each to its image with a frame token in -o (f.####.png)"},
                       bridge::inputKindOf(request.input) == bridge::InputKind::Ssvdag ? std::optional(format::readFrameList(request.input)) : std::nullopt);
         std::vector<app::RenderJob> renderJobs;
-        for (const FrameJob& job : jobs) {
+        for (const app::FrameJob& job : jobs) {
             checkOutputPath(job.output, {request.input}, {{".png", ".exr"}, "render", opt->force});
             renderJobs.push_back({job.index, job.number, job.output});
         }

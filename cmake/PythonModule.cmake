@@ -1,6 +1,6 @@
 # The Python package `vdbdag` (python/): the reader through pybind11
-# (vdbdag._vdbdag, linked to libvdbdag) and encode/decode through the
-# command. Built when pybind11 and Python's headers are found; usable from
+# (vdbdag._vdbdag, linked to libvdbdag) and encode/decode in-process
+# (vdbdag._codec, linked to the command's libraries). Built when pybind11 and Python's headers are found; usable from
 # the build tree with PYTHONPATH=build/python, installed under
 # lib/python3/dist-packages (Debian's layout).
 #
@@ -18,9 +18,15 @@ if(Python3_FOUND AND pybind11_FOUND)
   target_link_libraries(vdbdag_python PRIVATE vdbdag_lib)
   set_target_properties(vdbdag_python PROPERTIES OUTPUT_NAME _vdbdag LIBRARY_OUTPUT_DIRECTORY ${VDBDAG_PYTHON_DIR}
                         INSTALL_RPATH "$ORIGIN/../../..")
+  # vdbdag._codec: encode and decode in this process, through the library
+  # the command calls (app/); loaded on the first encode or decode, since it
+  # brings OpenVDB and GDCM.
+  pybind11_add_module(vdbdag_python_codec MODULE python/codec_module.cpp)
+  target_link_libraries(vdbdag_python_codec PRIVATE vdbdag_app vdbdag_bridge_dicom vdbdag_bridge vdbdag_core)
+  set_target_properties(vdbdag_python_codec PROPERTIES OUTPUT_NAME _codec LIBRARY_OUTPUT_DIRECTORY ${VDBDAG_PYTHON_DIR})
   configure_file(python/vdbdag/__init__.py ${VDBDAG_PYTHON_DIR}/__init__.py COPYONLY)
   set(VDBDAG_PYTHON_INSTALL_DIR ${CMAKE_INSTALL_LIBDIR}/python3/dist-packages/vdbdag)
-  install(TARGETS vdbdag_python LIBRARY DESTINATION ${VDBDAG_PYTHON_INSTALL_DIR})
+  install(TARGETS vdbdag_python vdbdag_python_codec LIBRARY DESTINATION ${VDBDAG_PYTHON_INSTALL_DIR})
   install(FILES python/vdbdag/__init__.py DESTINATION ${VDBDAG_PYTHON_INSTALL_DIR})
   set(VDBDAG_HAVE_PYTHON ON)
 else()

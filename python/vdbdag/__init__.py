@@ -8,78 +8,50 @@
     vdbdag.encode("in.vdb", "out.ssvdag", abs_error=0.01)
     vdbdag.decode("out.ssvdag", "back.vdb")
 
-encode and decode run the vdbdag command: $VDBDAG_EXECUTABLE, else the one
-installed beside this package's prefix, else vdbdag on the PATH. Each
-returns the command's report (its --json output) as a dict: bytes written,
-seconds, per-grid facts and, for a lossy encode, the errors measured.
+encode and decode run in this process, through the library the vdbdag
+command is built from (no executable is needed; the module that does it,
+vdbdag._codec, is loaded on the first call). Each returns the report the
+command prints with --json (a dict: bytes written, seconds, per-grid facts
+and, for a lossy encode, the errors measured; "warnings" and "notes" hold
+what the command would print on stderr) and raises vdbdag.Error with the
+command's one-line message for a refused input, output or option.
 """
-import json
-import os
-import shutil
-import subprocess
-
 from ._vdbdag import Error, File, Grid, format_version, open  # noqa: F401
 
 __all__ = ["Error", "File", "Grid", "format_version", "open", "encode", "decode"]
 
 
-def _executable():
-    env = os.environ.get("VDBDAG_EXECUTABLE")
-    if env:
-        return env
-    here = os.path.dirname(os.path.abspath(__file__))
-    # <prefix>/lib/python3/dist-packages/vdbdag -> <prefix>/bin/vdbdag
-    for up in (3, 4):
-        candidate = os.path.join(here, *([".."] * up), "bin", "vdbdag")
-        if os.access(candidate, os.X_OK):
-            return os.path.normpath(candidate)
-    found = shutil.which("vdbdag")
-    if not found:
-        raise Error("the vdbdag command was not found: set VDBDAG_EXECUTABLE or put vdbdag on the PATH")
-    return found
+def _coder():
+    from . import _codec as codec  # OpenVDB and GDCM load here, not on import
+
+    return codec
 
 
-def _run(arguments):
-    result = subprocess.run([_executable(), *arguments, "--quiet", "--json"], capture_output=True, text=True)
-    if result.returncode != 0:
-        message = (result.stderr.strip().splitlines() or ["vdbdag exited with status %d" % result.returncode])[-1]
-        raise Error(message)
-    try:
-        return json.loads(result.stdout)
-    except ValueError:
-        raise Error("vdbdag printed no report: " + result.stdout[:200])
+def encode(src, dst=None, **options):
+    """Encodes src (.vdb, .nvdb, a dense scan, a DICOM series, NIfTI, ...) into the .ssvdag dst.
 
-
-def _flags(options):
-    out = []
-    for key, value in options.items():
-        flag = "--" + key.replace("_", "-")
-        if value is True:
-            out.append(flag)
-        elif value is False or value is None:
-            continue
-        elif isinstance(value, (list, tuple)):
-            for item in value:
-                out += [flag, str(item)]
-        else:
-            out += [flag, str(value)]
-    return out
-
-
-def encode(src, dst, **options):
-    """Encodes src (.vdb, a dense scan, a DICOM series, NIfTI, ...) into the .ssvdag dst.
-
+    src is a path or a list of paths, as the command's inputs: several DICOM
+    files or folders are one series; a frame pattern ("smoke.####.vdb"), a
+    folder of .vdb frames, or a list with dst "NAME.ssvdag" make one
+    sequence file; other lists one file each, in the folder dst names.
+    dst None: the input's name with .ssvdag, beside it.
     Keyword options are the command's: abs_error=0.01 -> --abs-error 0.01,
-    force=True -> --force, grid=["a", "b"] -> --grid a --grid b.
+    force=True -> --force, grid=["a", "b"] -> --grid a --grid b,
+    memory_limit="512M" (or a number of bytes), dims=(256, 256, 99).
     Returns the report, as `vdbdag encode --json` prints it (a dict: "bytes",
-    "seconds", "grids", "grids_lossy" with each lossy grid's errors, ...).
+    "seconds", "grids", "grids_lossy" with each lossy grid's errors, ...;
+    a list of them for one file each).
     """
-    return _run(["encode", os.fspath(src), "-o", os.fspath(dst), *_flags(options)])
+    return _coder().encode(src, dst, **options)
 
 
 def decode(src, dst, **options):
-    """Decodes the .ssvdag src into dst (.vdb, or a dense format by its extension).
+    """Decodes the .ssvdag src into dst (.vdb, .nvdb, or a dense format by its extension).
 
-    Returns the report, as `vdbdag decode --json` prints it (a dict).
+    Options: force, grid (a scan output's grid), stored_values, frames ("12",
+    "10-20", "1,5,9-12": a sequence file's frames, each to dst with its
+    number in the frame token, out.####.vdb), max_voxels, max_memory.
+    Returns the report, as `vdbdag decode --json` prints it (a dict, or a
+    list of the frames' reports).
     """
-    return _run(["decode", os.fspath(src), "-o", os.fspath(dst), *_flags(options)])
+    return _coder().decode(src, dst, **options)

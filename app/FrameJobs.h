@@ -10,7 +10,7 @@
 
 #include "src/format/FrameSequence.h"
 
-namespace vdbdag::cli {
+namespace vdbdag::app {
 
 struct FrameJob {
     std::optional<uint32_t> index;  // into the file's frames; none: the file whole
@@ -31,4 +31,4 @@ struct FrameRequest {
 // a frame option or token for a file of one volume.
 std::vector<FrameJob> frameJobs(const FrameRequest& request, const std::optional<format::FrameList>& list);
 
-} // namespace vdbdag::cli
+} // namespace vdbdag::app

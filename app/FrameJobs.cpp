@@ -1,4 +1,4 @@
-#include "cli/FrameJobs.h"
+#include "app/FrameJobs.h"
 
 #include <filesystem>
 
@@ -7,7 +7,7 @@
 #include "src/util/Error.h"
 #include "src/util/FramePattern.h"
 
-namespace vdbdag::cli {
+namespace vdbdag::app {
 
 std::vector<FrameJob> frameJobs(const FrameRequest& r, const std::optional<format::FrameList>& list) {
     const bool pattern = isFramePattern(r.output) && !std::filesystem::exists(r.output);
@@ -28,4 +28,4 @@ std::vector<FrameJob> frameJobs(const FrameRequest& r, const std::optional<forma
     return jobs;
 }
 
-} // namespace vdbdag::cli
+} // namespace vdbdag::app
