@@ -149,7 +149,7 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
             }
             scene = pipeline::encodeSourcesByCubes(std::move(sources), imported.volume.fileMetadata, encodeOptions, budget, onGrid, team);
         } else {
-            scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, onGrid);
+            scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, onGrid, /*keepAttributes=*/false);
         }
     } catch (const Error& e) {
         throw Error(request.input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too

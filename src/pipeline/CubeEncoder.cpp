@@ -17,8 +17,9 @@
 #include "src/dag/SubDagMerge.h"
 #include "src/encoding/CompactDag.h"
 #include "src/format/GridSummary.h"
+#include "src/format/SsvdagContainer.h"
 #include "src/pipeline/AttributeOrder.h"
-#include "src/pipeline/GridCodecParts.h"
+#include "src/pipeline/LayerCoding.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::pipeline {
@@ -284,40 +285,83 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
 // stored bytes (on process 0; elsewhere anything).
 using PlanValues = std::function<uint64_t(const encoding::CompactDag& dag, const LayerPlan& plan)>;
 
-// Tries the placements like encodeLayer (GridCodec.cpp) and keeps the one
-// whose file is smallest, its values coded by `code` and kept by `keep`.
+// The level table, inner and leaf sections of `dag` as the file stores them.
+uint64_t storedGeometryBytes(const encoding::CompactDag& dag) {
+    const std::span<const uint8_t> inner(reinterpret_cast<const uint8_t*>(dag.inner.data()), dag.inner.size() * sizeof(uint16_t));
+    const std::span<const uint8_t> leaves(reinterpret_cast<const uint8_t*>(dag.leaves.data()), dag.leaves.size() * sizeof(uint64_t));
+    return format::storedSectionBytes(format::serializeDagLevels(dag)) + format::storedSectionBytes(inner) + format::storedSectionBytes(leaves);
+}
+
+// Builds the layer at each root placement candidate (placementCandidates)
+// and keeps the one whose file is smallest: its geometry as the writer
+// compresses it plus its values, coded by `code` in that candidate's
+// attribute order (the placement orders the values, so it changes their
+// coding too); `keep()` runs right after `code` for a candidate that is the
+// best so far, to keep what was just coded. With one candidate nothing is
+// measured. With `stats`, the kept DAG's node counts, and the plain SVDAG's
+// (the same placement without symmetry) when options.computeSvdagStats.
 encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const EncodeOptions& options, const CubeBudget& budget, bool withOffsets,
                                         format::DagStats* stats, CubeTeam& team, const PlanValues& code, const std::function<void()>& keep) {
     const LayerSummary summary = source.summary(layer);
+    const dag::ActiveBounds box = boxOf(summary);
     const int64_t alignment = int64_t(1) << std::max(2u, summary.largestTileLog2);
     const unsigned vs = valueSize(source.header().valueType);
-    std::optional<std::pair<std::array<int64_t, 3>, LayerPlan>> last;  // the SVDAG statistics rebuild the kept placement
-    auto planAt = [&](const std::array<int64_t, 3>& origin) -> const LayerPlan& {
-        if (!last || last->first != origin) {
-            dag::BuildOptions build;
-            build.origin = origin;
-            last.emplace(origin, planLayer(source, layer, dag::placeRoot(boxOf(summary), alignment, build), budget, vs));
-        }
-        return last->second;
+    const auto planAt = [&](const std::array<int64_t, 3>& origin) {
+        dag::BuildOptions build;
+        build.origin = origin;
+        return planLayer(source, layer, dag::placeRoot(box, alignment, build), budget, vs);
     };
-    const CandidateValues values{[&](const encoding::CompactDag& dag, const std::array<int64_t, 3>& origin) {
-                                     const uint64_t stored = code(dag, planAt(origin));
-                                     if (team.size() == 1) return stored;
-                                     // Every process keeps the same candidate: process 0's figure decides.
-                                     std::vector<uint8_t> bytes(sizeof stored);
-                                     std::memcpy(bytes.data(), &stored, sizeof stored);
-                                     bytes = team.broadcast(bytes);
-                                     uint64_t agreed = 0;
-                                     std::memcpy(&agreed, bytes.data(), sizeof agreed);
-                                     return agreed;
-                                 },
-                                 keep};
-    return encodeAtBestPlacement(
-        boxOf(summary), alignment, options, withOffsets, stats,
-        [&](const std::array<int64_t, 3>& origin, bool symmetry) {
-            return buildLayer(source, layer, planAt(origin), symmetry, budget, team, options.onStepProgress);
-        },
-        &values);
+    // The plain SVDAG's node counts at a placement, beside `candidate`'s.
+    const auto addSvdagStats = [&](format::DagStats& candidate, const LayerPlan& plan) {
+        if (!options.symmetry) {
+            candidate.svdagNodes = candidate.storedNodes;
+        } else {
+            const dag::ReducedDag plain = buildLayer(source, layer, plan, false, budget, team, options.onStepProgress);
+            for (unsigned s = 2; s <= plain.log2Size; ++s) candidate.svdagNodes.push_back(plain.uniqueNodeCount(s));
+        }
+        candidate.hasSvdag = true;
+    };
+    // Every process keeps the same candidate: process 0's figure decides.
+    const auto agreed = [&](uint64_t stored) {
+        if (team.size() == 1) return stored;
+        std::vector<uint8_t> bytes(sizeof stored);
+        std::memcpy(bytes.data(), &stored, sizeof stored);
+        bytes = team.broadcast(bytes);
+        uint64_t figure = 0;
+        std::memcpy(&figure, bytes.data(), sizeof figure);
+        return figure;
+    };
+    const auto candidates = placementCandidates(box, alignment, std::max(1, options.placementTrials));
+    const bool several = candidates.size() > 1;
+    std::optional<LayerPlan> keptPlan;
+    encoding::CompactDag best;
+    uint64_t bestStored = 0;
+    for (const auto& origin : candidates) {
+        LayerPlan plan = planAt(origin);
+        const dag::ReducedDag reduced = buildLayer(source, layer, plan, options.symmetry, budget, team, options.onStepProgress);
+        encoding::CompactDag compact = encoding::encodeCompact(reduced, withOffsets, options.compactPointers);
+        // With several candidates, every section the placement changes, as
+        // the writer stores it (the uncompressed sizes can rank them the
+        // other way).
+        format::DagStats candidateStats;
+        if (stats) candidateStats = statsOf(reduced);
+        uint64_t stored = 0;
+        if (several) {
+            stored = storedGeometryBytes(compact);
+            if (stats && options.computeSvdagStats) addSvdagStats(candidateStats, plan);
+            if (stats) stored += format::storedSectionBytes(format::serializeDagStats(candidateStats));
+        }
+        stored += agreed(code(compact, plan));
+        if (!keptPlan || stored < bestStored || (stored == bestStored && compact.byteSize() < best.byteSize())) {
+            bestStored = stored;
+            best = std::move(compact);
+            if (stats) *stats = std::move(candidateStats);
+            keptPlan = std::move(plan);
+            keep();
+        }
+    }
+    if (stats && options.computeSvdagStats && !several) addSvdagStats(*stats, *keptPlan);
+    return best;
 }
 
 } // namespace
@@ -332,7 +376,9 @@ unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize) {
 }
 
 format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget, CubeTeam& team) {
-    if (options.normalBits) throw Error("--normals needs the whole grid in memory (the gradient reads across cubes): use it without --memory-limit");
+    const std::optional<NormalSource> normals = options.normalBits ? source.normals() : std::nullopt;
+    if (options.normalBits && !normals)
+        throw Error("--normals needs the whole grid in memory (the gradient reads across cubes): use it without --memory-limit");
     format::EncodedGrid out = encodedHeader(source.header(), options);
     const unsigned vs = valueSize(source.header().valueType);
     auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };
@@ -419,6 +465,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     // placement orders them); the smallest file's are kept.
     CodedValues kept, trial;
     auto keep = [&] { kept = std::move(trial); };
+    const bool withNormals = normals && normals->cubes;
     if (!active.empty()) {
         const PlanValues codeActive = [&](const encoding::CompactDag& dag, const LayerPlan& layerPlan) -> uint64_t {
             trial = {};
@@ -434,9 +481,20 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
                 step("palette compression");
                 if (team.isRoot()) codeActiveValues(dag, trial, source.header(), options);
             }
+            if (withNormals) {  // the normals in the same attribute order, from their own source
+                const std::vector<uint8_t> raw = gatherLayer(*normals->cubes, Layer::Active, layerPlan, dag, sizeof(std::array<float, 3>), budget, team,
+                                                             options.onStepProgress);
+                std::vector<std::array<float, 3>> exact(raw.size() / sizeof(std::array<float, 3>));
+                if (!raw.empty()) std::memcpy(exact.data(), raw.data(), raw.size());
+                if (team.isRoot())
+                    trial.normals = attributes::encodeNormals(exact, options.normalBits,
+                                                              normals->fromNormalGrid ? attributes::NormalReport::Source::NormalGrid
+                                                                                      : attributes::NormalReport::Source::Gradient,
+                                                              normals->oneSided);
+            }
             return trial.storedBytes();
         };
-        out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0, &out.stats, team, codeActive, keep);
+        out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0 || withNormals, &out.stats, team, codeActive, keep);
         storeActiveValues(out, std::move(kept));
     } else {
         step(streamValues ? "coding the last value windows" : "palette compression");

@@ -2,9 +2,9 @@
 // from a CubeSource. Per layer: the cubes' sub-DAGs are built several at a
 // time (TBB) and merged in Morton order (dag/SubDagMerge.h); the values are
 // then gathered cube by cube in the final DAG's attribute order. The result
-// is the EncodedGrid encodeGrid gives for the whole grid in memory, so the
-// file is byte-identical whatever the cube size, the budget and the thread
-// count.
+// is the same EncodedGrid whatever the cube size, the budget and the thread
+// count, so the file is byte-identical. It is the one encoder: a grid in
+// memory (encodeGrid) is encoded through it too.
 //
 // Bounded: the cubes in flight (at most `workers`, each within its share of
 // the budget), the value windows being coded (one per core, ValueWindows.h,
@@ -40,8 +40,9 @@ uint64_t cubeBytesPerBrick(unsigned valueSize);
 // Value windows coded at once within the budget (at least 1, at most the workers).
 unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize);
 
-// Throws vdbdag::Error for --normals (which needs the whole grid: the
-// gradient reads neighbours across cubes).
+// --normals: the normals come from source.normals() (a grid in memory
+// has them); a source that cannot give them is refused with a
+// vdbdag::Error (the gradient reads neighbours across cubes).
 // With a team of several processes (CubeTeam.h), every process must call
 // this with the same input and options; only process 0's result holds the
 // coded values (the others' are headers and DAGs).

@@ -44,16 +44,21 @@ inline constexpr int kEncodeSteps = 4;
 // Whether `grid` is quantised as colours under `options`.
 bool isColourGrid(const GridRecord& grid, const EncodeOptions& options);
 
+// A grid in memory: the cube-by-cube encoder (CubeEncoder.h, the one
+// encoder) over the grid sliced into cubes (recordCubes), normals included.
 format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options = {});
 GridRecord decodeGrid(const format::EncodedGrid& grid);
 
 // Whole volumes; `onGrid(index, count)` is called before each grid (progress).
 using GridProgress = std::function<void(size_t index, size_t count)>;
 format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
-// The same, releasing each grid's voxels as soon as they are in attribute
-// order (a dense 512x512x999 scan then never holds its values twice); the
-// grids keep their headers, their voxels are gone afterwards.
-format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
+// The same, releasing each grid (voxels and header) as soon as it is
+// encoded: the grids are empty afterwards. With
+// `keepAttributes` false the encoded grids hold their values only as the
+// file stores them (value windows), not in attribute order as well: what
+// a caller that only writes the file needs (an in-memory grid's lossless
+// values would be gathered once more for nothing).
+format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {}, bool keepAttributes = true);
 Volume decodeScene(const format::SsvdagScene& scene, const GridProgress& onGrid = {});
 
 } // namespace vdbdag::pipeline

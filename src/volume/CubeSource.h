@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -62,9 +63,27 @@ struct CubeLoad {
     uint64_t bricks = 0;  // bricks in the cube (tiles no larger than the cube count as one brick)
 };
 
+class CubeSource;
+
+// The exact normals of a grid's active voxels (`encode --normals`), as a
+// source of their own: the same cubes as the grid's, each active voxel's
+// value its unit normal (3 x float; zero: no direction); and how they were
+// made (GridNormals).
+struct NormalSource {
+    CubeSource* cubes = nullptr;
+    bool fromNormalGrid = false;  // false: the level set's gradient
+    uint64_t oneSided = 0;        // gradient entries where a band edge forced a one-sided difference
+};
+
 class CubeSource {
 public:
     virtual ~CubeSource() = default;
+    // The grid's normals (`encode --normals`): a grid in memory gives its
+    // own (GridRecord::normals; cubes null when it has none, which the
+    // encoder then stores none of); none at all from a source that cannot
+    // give them (a file read region by region: the gradient reads across
+    // cubes), which the encoder refuses for --normals.
+    virtual std::optional<NormalSource> normals() { return std::nullopt; }
     // Name, class, type, transform, descriptor, background; no voxels.
     virtual const GridRecord& header() const = 0;
     virtual LayerSummary summary(Layer layer) = 0;

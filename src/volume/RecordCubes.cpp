@@ -4,6 +4,8 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <memory>
+#include <optional>
 #include <string>
 
 #include "src/util/Error.h"
@@ -18,8 +20,27 @@ struct CellLess {
 
 class RecordCubes final : public CubeSource {
 public:
-    explicit RecordCubes(const GridRecord& grid) : grid_(grid), header_(headerOf(grid)) {}
+    explicit RecordCubes(const GridRecord& grid)
+        : header_(headerOf(grid)), active_(grid.topology), inactive_(grid.inactiveTopology), activeValues_(grid.values),
+          inactiveValues_(grid.inactiveValues), valueSize_(valueSize(grid.valueType)) {
+        if (grid.normals) normals_ = std::make_unique<Normals>(grid);
+    }
+    // The normal channel of `grid` (which has normals): its active voxels,
+    // each with its exact normal as a vec3s value; no inactive layer.
+    struct NormalsOf {
+        const GridRecord& grid;
+    };
+    explicit RecordCubes(NormalsOf n)
+        : header_(headerOf(n.grid)), active_(n.grid.topology), inactive_(empty_), activeValues_(n.grid.normals->vectors), inactiveValues_(noValues_),
+          valueSize_(sizeof(std::array<float, 3>)) {
+        header_.valueType = ValueType::Vec3S;
+        header_.background.assign(valueSize_, 0);
+    }
     const GridRecord& header() const override { return header_; }
+    std::optional<NormalSource> normals() override {
+        if (!normals_) return NormalSource{};  // a grid in memory without normals: none to store
+        return NormalSource{normals_->cubes.get(), normals_->fromNormalGrid, normals_->oneSided};
+    }
 
     LayerSummary summary(Layer layer) override {
         const GridTopology& t = topology(layer);
@@ -47,7 +68,7 @@ public:
     }
 
     void largeTiles(Layer layer, unsigned log2, GridTopology& tiles, LayerValues& values) override {
-        selectLargeTiles(topology(layer), layerValues(layer), valueSize(grid_.valueType), log2, tiles, values);
+        selectLargeTiles(topology(layer), layerValues(layer), valueSize_, log2, tiles, values);
     }
 
     void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {
@@ -72,7 +93,7 @@ public:
         if (it == index_.end()) return;
         const GridTopology& t = this->topology(layer_);
         const LayerValues& v = layerValues(layer_);
-        const unsigned vs = withValues_ ? valueSize(grid_.valueType) : 0;
+        const unsigned vs = withValues_ ? valueSize_ : 0;
         for (const auto& [brick, firstValue] : it->second.bricks) {
             topology.bricks.push_back(t.bricks[brick]);
             if (vs) {
@@ -92,15 +113,29 @@ private:
     static CubeCell cellOf(const std::array<int64_t, 3>& origin, unsigned log2, int64_t x, int64_t y, int64_t z) {
         return {uint32_t(uint64_t(x - origin[0]) >> log2), uint32_t(uint64_t(y - origin[1]) >> log2), uint32_t(uint64_t(z - origin[2]) >> log2)};
     }
-    const GridTopology& topology(Layer layer) const { return layer == Layer::Active ? grid_.topology : grid_.inactiveTopology; }
-    const LayerValues& layerValues(Layer layer) const { return layer == Layer::Active ? grid_.values : grid_.inactiveValues; }
+    const GridTopology& topology(Layer layer) const { return layer == Layer::Active ? active_ : inactive_; }
+    const LayerValues& layerValues(Layer layer) const { return layer == Layer::Active ? activeValues_ : inactiveValues_; }
 
     struct CubeIndex {
         std::vector<std::pair<size_t, uint64_t>> bricks;  // (brick, its first value)
         std::vector<size_t> tiles;
     };
-    const GridRecord& grid_;
+    struct Normals {
+        explicit Normals(const GridRecord& grid)
+            : cubes(std::make_unique<RecordCubes>(NormalsOf{grid})), fromNormalGrid(grid.normals->fromNormalGrid), oneSided(grid.normals->oneSided) {}
+        std::unique_ptr<RecordCubes> cubes;
+        bool fromNormalGrid;
+        uint64_t oneSided;
+    };
     GridRecord header_;
+    const GridTopology empty_;
+    const LayerValues noValues_;
+    const GridTopology& active_;
+    const GridTopology& inactive_;
+    const LayerValues& activeValues_;
+    const LayerValues& inactiveValues_;
+    const unsigned valueSize_;
+    std::unique_ptr<Normals> normals_;
     Layer layer_ = Layer::Active;
     bool withValues_ = false;
     std::map<CubeCell, CubeIndex, CellLess> index_;

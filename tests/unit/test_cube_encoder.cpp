@@ -136,12 +136,53 @@ TEST(CubeEncoder, ChoosesSmallerCubesForASmallerBudget) {
     EXPECT_EQ(fileOf(pipeline::encodeGridByCubes(*source, {}, roomy)), fileOf(pipeline::encodeGrid(grid)));
 }
 
-TEST(CubeEncoder, RefusesNormals) {
+// A source that cannot give normals (as a .vdb read region by region).
+class WithoutNormals final : public CubeSource {
+public:
+    explicit WithoutNormals(CubeSource& inner) : inner_(inner) {}
+    const GridRecord& header() const override { return inner_.header(); }
+    LayerSummary summary(Layer layer) override { return inner_.summary(layer); }
+    std::vector<CubeLoad> cubes(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2) override { return inner_.cubes(layer, origin, log2); }
+    void largeTiles(Layer layer, unsigned log2, GridTopology& tiles, LayerValues& values) override { inner_.largeTiles(layer, log2, tiles, values); }
+    void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {
+        inner_.beginPass(layer, origin, log2, withValues);
+    }
+    void read(const CubeCell& cell, GridTopology& topology, LayerValues& values) override { inner_.read(cell, topology, values); }
+    void endPass() override { inner_.endPass(); }
+
+private:
+    CubeSource& inner_;
+};
+
+// --normals through the one encoder: a grid in memory gives its normals as
+// a channel of its own, gathered in the values' attribute order at every
+// cube size and worker count (the same file); a source without normals is
+// refused. (test_normals checks the stored normals against closed forms.)
+TEST(CubeEncoder, NormalsAreAChannelOfTheSource) {
     std::mt19937 rng(1);
-    const GridRecord grid = shellGrid(rng);
+    GridRecord grid = shellGrid(rng);
+    const uint64_t entries = grid.values.bricks.size() / 4 + grid.values.tiles.size() / 4;
+    GridNormals normals;
+    std::normal_distribution<float> n(0.0f, 1.0f);
+    for (uint64_t i = 0; i < entries; ++i) {
+        std::array<float, 3> v{n(rng), n(rng), n(rng)};
+        const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        for (float& c : v) c /= len;
+        auto& out = i < grid.values.bricks.size() / 4 ? normals.vectors.bricks : normals.vectors.tiles;
+        out.insert(out.end(), reinterpret_cast<const uint8_t*>(v.data()), reinterpret_cast<const uint8_t*>(v.data()) + sizeof v);
+    }
+    grid.normals = normals;
     pipeline::EncodeOptions options;
-    options.normalBits = 12;
-    EXPECT_THROW(pipeline::encodeGridByCubes(*recordCubes(grid), options, {}), Error);
+    options.normalBits = 16;
+    const format::EncodedGrid encoded = pipeline::encodeGrid(grid, options);
+    ASSERT_TRUE(encoded.normals.has_value());
+    EXPECT_EQ(encoded.normals->report.entries, entries);
+    expectSameFileForAllCubeSizes(grid, options, "shell with normals");
+    const auto source = recordCubes(grid);
+    WithoutNormals refusing(*source);
+    EXPECT_THROW(pipeline::encodeGridByCubes(refusing, options, {}), Error);
+    options.normalBits = 0;
+    EXPECT_EQ(fileOf(pipeline::encodeGridByCubes(refusing, options, {})), fileOf(pipeline::encodeGrid(grid, options)));
 }
 
 TEST(CubeTeam, SplitByWeightGivesContiguousBalancedShares) {

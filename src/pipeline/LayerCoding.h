@@ -1,6 +1,7 @@
-// The steps of encodeGrid that the cube-by-cube encoder (CubeEncoder.h)
-// shares, so both give the same bytes: root placement candidates, DAG
-// statistics, the grid header and the coding of gathered values.
+// What the encoder (CubeEncoder.h) does with one layer once its geometry is
+// built: the root placements to try and the one kept (the smallest file),
+// the DAG statistics, the grid header, and the coding of the layer's values
+// in attribute order (lossy settings, then value windows).
 #pragma once
 #include <array>
 #include <functional>
@@ -14,7 +15,9 @@
 namespace vdbdag::pipeline {
 
 // Root origins to try for a layer with this box and tile alignment
-// (placementAlignment), best guesses first; `trials` of them at most.
+// (placementAlignment), best guesses first; `trials` of them at most. The
+// encoder (CubeEncoder.cpp) builds the layer at each and keeps the smallest
+// file.
 std::vector<std::array<int64_t, 3>> placementCandidates(const dag::ActiveBounds& box, int64_t alignment, int trials);
 
 format::DagStats statsOf(const dag::ReducedDag& reduced);
@@ -31,27 +34,6 @@ struct CodedValues {
     // stores them precompressed), the normals as the container compresses them.
     uint64_t storedBytes() const;
 };
-
-// How encodeAtBestPlacement codes a candidate's values: `code(dag, origin)`
-// codes them (into the caller's pending slot) and returns their stored
-// bytes; `keep()` runs right after for a candidate that is the best so far,
-// to keep what was just coded.
-struct CandidateValues {
-    std::function<uint64_t(const encoding::CompactDag& dag, const std::array<int64_t, 3>& origin)> code;
-    std::function<void()> keep;
-};
-
-// Builds a layer at each placement candidate and keeps the one whose file
-// is smallest: its geometry as the writer compresses it plus, with
-// `values`, its values as coded in its attribute order (the placement
-// orders the values, so it changes their coding too). With `values` the
-// kept candidate's values are coded and kept (also with a single
-// candidate, so the caller has one path). With `stats`, also the plain
-// SVDAG's node counts at the kept placement when options.computeSvdagStats.
-// `build(origin, symmetry)` builds the layer's DAG with its root at `origin`.
-using PlacedBuild = std::function<dag::ReducedDag(const std::array<int64_t, 3>& origin, bool symmetry)>;
-encoding::CompactDag encodeAtBestPlacement(const dag::ActiveBounds& box, int64_t alignment, const EncodeOptions& options, bool withOffsets,
-                                           format::DagStats* stats, const PlacedBuild& build, const CandidateValues* values = nullptr);
 
 // An EncodedGrid with `grid`'s header and nothing else.
 format::EncodedGrid encodedHeader(const GridRecord& grid, const EncodeOptions& options);
