@@ -368,10 +368,16 @@ encoding::CompactDag encodeLayerByCubes(CubeSource& source, Layer layer, const E
 
 uint64_t cubeBytesPerBrick(unsigned valueSize) { return 160 + 64ull * valueSize; }
 
-unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize) {
-    // A window being coded holds its values, their ids and the partitioner's
-    // per-distinct-value arrays: about 24 bytes per entry beyond the value.
-    const uint64_t perWindow = attributes::kValueWindowEntries * (valueSize + 24);
+unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize, WindowKind kind) {
+    // The bytes a window being coded holds per entry beyond its value,
+    // measured as the peak a second window in flight adds under
+    // --memory-limit 256M (4M entries a window): palette windows their ids
+    // and the partitioner's per-distinct-value arrays, about 24; predicted
+    // float windows (floats as their integers) 8.6 (the d=1024 sphere, +53
+    // MB), taken as 10; predicted integer windows 26 (the 512^3 phantom,
+    // +122 MB), taken as 30.
+    const uint64_t overhead = kind == WindowKind::PredictedFloats ? 10 : kind == WindowKind::PredictedIntegers ? 30 : 24;
+    const uint64_t perWindow = attributes::kValueWindowEntries * (valueSize + overhead);
     return unsigned(std::clamp<uint64_t>(budget.bytes / perWindow, 1, workersOf(budget)));
 }
 
@@ -396,7 +402,11 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     // Gathers the layer into windows (on process 0: all of them).
     auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries,
                            attributes::ScalarQuantizer* quantizer) {
-        const unsigned inFlight = valueWindowsInFlight(budget, vs);
+        const bool inactiveLayer = layer == Layer::Inactive;
+        const WindowKind kind = !usesPredictedWindows(source.header(), options, inactiveLayer) ? WindowKind::Palette
+                                : floatChannelOf(source.header(), options, inactiveLayer)  ? WindowKind::PredictedFloats
+                                                                                           : WindowKind::PredictedIntegers;
+        const unsigned inFlight = valueWindowsInFlight(budget, vs, kind);
         const uint64_t expected = encoding::decodedSize(dag).attributeEntries;
         const bool inactive = layer == Layer::Inactive;
         ValueStream stream;

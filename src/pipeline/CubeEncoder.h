@@ -37,8 +37,10 @@ struct CubeBudget {
 
 // Rough working bytes per brick of a cube being reduced or gathered.
 uint64_t cubeBytesPerBrick(unsigned valueSize);
-// Value windows coded at once within the budget (at least 1, at most the workers).
-unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize);
+// Value windows coded at once within the budget (at least 1, at most the
+// workers), by what the windows are (ValueWindows.h, PredictedWindows.h).
+enum class WindowKind { Palette, PredictedIntegers, PredictedFloats };
+unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize, WindowKind kind);
 
 // --normals: the normals come from source.normals() (a grid in memory
 // has them); a source that cannot give them is refused with a

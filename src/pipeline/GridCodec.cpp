@@ -2,6 +2,8 @@
 // encoder (CubeEncoder.h), the decode by scattering each layer's values.
 #include "src/pipeline/GridCodec.h"
 
+#include <limits>
+
 #include "src/attributes/PredictedWindows.h"
 #include "src/attributes/ScalarTolerance.h"
 #include "src/encoding/AttributeLayout.h"
@@ -43,7 +45,12 @@ namespace {
 // same grid, non-const, whose voxels are dropped once encoded (nullptr:
 // keep them); `keepAttributes` false: the values in windows only.
 format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& options, GridRecord* release, bool keepAttributes) {
-    format::EncodedGrid out = encodeGridByCubes(*recordCubes(grid), options, CubeBudget{});
+    // The grid is in memory whole: no budget bounds the cubes in flight
+    // (each stays within planLayer's own cap) or the windows coded at once
+    // (one per core).
+    CubeBudget budget;
+    budget.bytes = std::numeric_limits<uint64_t>::max() / 4;
+    format::EncodedGrid out = encodeGridByCubes(*recordCubes(grid), options, budget);
     const unsigned vs = keepAttributes ? valueSize(grid.valueType) : 0;
     // Exact values are gathered again; a lossy layer's come from its windows
     // (the values as stored, not the input's).
