@@ -6,7 +6,8 @@
 // underscores (abs_error=0.01 is --abs-error 0.01); an unknown one raises
 // TypeError, a refused value or input vdbdag.Error with the command's
 // one-line message. The GIL is released while a file is coded; warnings and
-// notes come back in the report ("warnings", "notes") instead of on stderr.
+// notes come back in the report ("warnings", "notes"; in each file's report
+// of a list) instead of on stderr.
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -51,7 +52,8 @@ py::object toPython(const nlohmann::json& j) {
     }
 }
 
-std::string pathOf(const py::handle& h) { return py::str(py::module_::import("os").attr("fspath")(h)); }
+// A str, bytes or PathLike path (bytes decoded as os.fsdecode does).
+std::string pathOf(const py::handle& h) { return py::module_::import("os").attr("fsdecode")(h).cast<std::string>(); }
 
 // A str/PathLike or a list of them.
 std::vector<std::string> pathsOf(const py::handle& h) {
@@ -69,18 +71,24 @@ std::vector<std::string> stringsOf(const py::handle& h) {
     return h.cast<std::vector<std::string>>();
 }
 
-uint64_t sizeOf(const py::handle& h, const char* option) {
-    if (py::isinstance<py::str>(h)) return vdbdag::parseByteSize(h.cast<std::string>());
-    const int64_t n = h.cast<int64_t>();
-    if (n <= 0) throw vdbdag::Error(std::string(option) + ": " + std::to_string(n) + " is not a size: give a positive number of bytes, e.g. 512M or 4G");
-    return uint64_t(n);
-}
 
+// A whole number in [low, high]; anything else (a float, a negative
+// number, a string) is refused with the option's name.
 template <typename T>
 T inRange(const py::handle& h, T low, T high, const char* option) {
-    const T v = h.cast<T>();
-    if (!(v >= low && v <= high)) throw vdbdag::Error(std::string(option) + ": " + py::str(h).cast<std::string>() + " is not in " + std::to_string(low) + ".." + std::to_string(high));
-    return v;
+    const std::string text = py::repr(h).cast<std::string>();
+    const std::string refuse = std::string(option) + ": " + text + " is not a whole number in " + std::to_string(low) + ".." + std::to_string(high);
+    if (!py::isinstance<py::int_>(h) || py::isinstance<py::bool_>(h)) throw vdbdag::Error(refuse);
+    const py::int_ n = py::reinterpret_borrow<py::int_>(h);
+    if (n < py::int_(low) || n > py::int_(high)) throw vdbdag::Error(refuse);
+    return n.cast<T>();
+}
+
+uint64_t sizeOf(const py::handle& h, const char* option) {
+    if (py::isinstance<py::str>(h)) return vdbdag::parseByteSize(h.cast<std::string>());
+    const int64_t n = inRange<int64_t>(h, INT64_MIN, INT64_MAX, option);
+    if (n <= 0) throw vdbdag::Error(std::string(option) + ": " + std::to_string(n) + " is not a size: give a positive number of bytes, e.g. 512M or 4G");
+    return uint64_t(n);
 }
 
 double finite(const py::handle& h, const char* option) {
@@ -138,7 +146,7 @@ py::object encode(const py::object& src, const py::object& dst, const py::kwargs
         {"color_bits", colourBits},
         {"colour_grid", colourGrids},
         {"color_grid", colourGrids},
-        {"normals", [&c](const py::handle& h) { c.normalBits = h.cast<unsigned>(); }},
+        {"normals", [&c](const py::handle& h) { c.normalBits = inRange<unsigned>(h, 1, 64, "normals"); }},
         {"normal_grid", [&c](const py::handle& h) { c.normalGrid = h.cast<std::string>(); }},
         {"memory_limit", [&c](const py::handle& h) { c.memoryLimit = sizeOf(h, "memory_limit"); }},
         {"scratch", [&c](const py::handle& h) { c.scratch = pathOf(h); }},
@@ -152,7 +160,7 @@ py::object encode(const py::object& src, const py::object& dst, const py::kwargs
         {"background_below", [&d](const py::handle& h) { d.below = finite(h, "background_below"); }},
         {"background_above", [&d](const py::handle& h) { d.above = finite(h, "background_above"); }},
         {"background_value", [&d](const py::handle& h) { d.backgroundValue = finite(h, "background_value"); }},
-        {"volume", [&d](const py::handle& h) { d.volume = h.cast<int64_t>(); }},
+        {"volume", [&d](const py::handle& h) { d.volume = inRange<int64_t>(h, 0, INT64_MAX, "volume"); }},
         {"drop_patient_tags", flag(d.dropPatientTags)},
         {"allow_external_data", flag(d.allowExternalData)},
     };
@@ -161,12 +169,28 @@ py::object encode(const py::object& src, const py::object& dst, const py::kwargs
     vdbdag::app::EncodeInputsHooks hooks;
     hooks.file.warning = messages.into(messages.warnings);
     hooks.file.note = messages.into(messages.notes);
+    std::vector<std::pair<size_t, size_t>> ends;  // one file each: the messages so far as each file is written
+    hooks.onFile = [&](const nlohmann::json&) {
+        std::lock_guard lock(messages.mutex);
+        ends.emplace_back(messages.warnings.size(), messages.notes.size());
+    };
     nlohmann::json report;
     {
         py::gil_scoped_release release;
         report = vdbdag::app::encodeInputs(request, hooks).report;
     }
-    if (report.is_object()) report["warnings"] = messages.warnings, report["notes"] = messages.notes;
+    const auto slice = [](const std::vector<std::string>& all, size_t begin, size_t end) {
+        return std::vector<std::string>(all.begin() + long(begin), all.begin() + long(end));
+    };
+    if (report.is_object()) {
+        report["warnings"] = messages.warnings, report["notes"] = messages.notes;
+    } else {
+        for (size_t i = 0; i < report.size() && i < ends.size(); ++i) {
+            const auto [w0, n0] = i ? ends[i - 1] : std::pair<size_t, size_t>{0, 0};
+            report[i]["warnings"] = slice(messages.warnings, w0, ends[i].first);
+            report[i]["notes"] = slice(messages.notes, n0, ends[i].second);
+        }
+    }
     return toPython(report);
 }
 
@@ -186,15 +210,15 @@ py::object decode(const py::object& src, const py::object& dst, const py::kwargs
     };
     applyOptions("decode", options, setters);
     request.limits.maxMemory = maxMemory ? maxMemory : vdbdag::format::defaultReadMemory();
-    Messages messages;
+    std::vector<std::vector<std::string>> notes;  // each output's, in the order written
     nlohmann::json report;
     {
         py::gil_scoped_release release;
-        report = vdbdag::app::decodeFiles(request, frames, [&](const std::string& output, const vdbdag::app::DecodeResult& r) {
-            for (const std::string& n : r.notes) messages.into(messages.notes)(output + ": " + n);
-        });
+        report = vdbdag::app::decodeFiles(request, frames, [&](const std::string&, const vdbdag::app::DecodeResult& r) { notes.push_back(r.notes); });
     }
-    if (report.is_object()) report["notes"] = messages.notes;
+    if (report.is_object()) report["notes"] = notes.empty() ? std::vector<std::string>{} : notes.front();
+    else
+        for (size_t i = 0; i < report.size() && i < notes.size(); ++i) report[i]["notes"] = notes[i];
     return toPython(report);
 }
 

@@ -36,6 +36,9 @@ public:
         header_.valueType = ValueType::Vec3S;
         header_.background.assign(valueSize_, 0);
     }
+    // Its references may point at its own empty layer: never copied or moved.
+    RecordCubes(const RecordCubes&) = delete;
+    RecordCubes& operator=(const RecordCubes&) = delete;
     const GridRecord& header() const override { return header_; }
     std::optional<NormalSource> normals() override {
         if (!normals_) return NormalSource{};  // a grid in memory without normals: none to store

@@ -107,6 +107,10 @@ def test_refusals(work):
         vdbdag.encode(src, target, placement_trials=65)
     with pytest.raises(vdbdag.Error, match="exclude each other"):
         vdbdag.encode(src, target, abs_error=0.1, rel_error=0.01)
+    with pytest.raises(vdbdag.Error, match="threads: 2.5 is not a whole number"):
+        vdbdag.encode(src, target, threads=2.5)
+    with pytest.raises(vdbdag.Error, match="normals: -3"):
+        vdbdag.encode(src, target, normals=-3)
     with pytest.raises(vdbdag.Error, match="not a size"):
         vdbdag.encode(src, target, memory_limit="12Q")
     with pytest.raises(vdbdag.Error, match="--dims"):
@@ -116,3 +120,20 @@ def test_refusals(work):
     os.remove(target)
     assert not os.path.exists(target) and not os.path.exists(os.path.join(work, "x.vdb"))
     assert [f for f in os.listdir(work) if f.startswith(".") or f.endswith(".tmp")] == []
+
+
+def test_bytes_paths_and_one_file_each(work):
+    """Paths as bytes (os.fsencode) read as the str; several inputs one
+    file each give a list of reports, each with its own notes."""
+    src = sphere(work)
+    out = os.path.join(work, "bytes.ssvdag")
+    report = vdbdag.encode(os.fsencode(src), os.fsencode(out))
+    assert report["output"] == out and os.path.getsize(out) == report["bytes"]
+    other = os.path.join(work, "sphere2.vdb")
+    shutil.copyfile(src, other)
+    folder = os.path.join(work, "each")
+    reports = vdbdag.encode([src, other], folder)
+    assert isinstance(reports, list) and len(reports) == 2
+    for r in reports:
+        assert os.path.getsize(r["output"]) == r["bytes"]
+        assert isinstance(r["warnings"], list) and isinstance(r["notes"], list)
