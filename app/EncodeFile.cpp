@@ -107,6 +107,7 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
     encodeOptions.colourBits = request.colourBits;
     encodeOptions.colourGrids = request.colourGrids;
     encodeOptions.normalBits = request.normalBits;
+    encodeOptions.keepAttributes = false;  // the file is written, the attribute arrays dropped (below)
     // Each step is 1000 units, filled cube by cube where the encoder reports it.
     constexpr uint64_t kUnits = 1000;
     const uint64_t totalUnits = (imported.volume.grids.size() * pipeline::kEncodeSteps + 1) * kUnits;
@@ -149,7 +150,7 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
             }
             scene = pipeline::encodeSourcesByCubes(std::move(sources), imported.volume.fileMetadata, encodeOptions, budget, onGrid, team);
         } else {
-            scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, onGrid, /*keepAttributes=*/false);
+            scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, onGrid);
         }
     } catch (const Error& e) {
         throw Error(request.input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too

@@ -106,6 +106,7 @@ Verified verifyWhole(const VerifyRequest& opt) {
     const bridge::ImportResult imported = bridge::importVdb(opt.input, importOptions);
     pipeline::EncodeOptions options;
     options.symmetry = !opt.noSymmetry;
+    options.keepAttributes = false;  // written and read back
     const std::vector<uint8_t> bytes = format::writeScene(pipeline::encodeVolume(imported.volume, options));
     const Volume decoded = pipeline::decodeScene(format::readScene(bytes, opt.input + " (in memory)"));
     return {bridge::compareWithFile(opt.input, decoded, !opt.topologyOnly), bytes.size(), decoded.grids.size()};

@@ -43,15 +43,15 @@ namespace {
 // always gave them (`info`, `render` and `verify` of a .vdb read them), so
 // that a layer streamed into windows is gathered once more. `release`: the
 // same grid, non-const, whose voxels are dropped once encoded (nullptr:
-// keep them); `keepAttributes` false: the values in windows only.
-format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& options, GridRecord* release, bool keepAttributes) {
+// keep them). Without options.keepAttributes, the values in windows only.
+format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& options, GridRecord* release) {
     // The grid is in memory whole: no budget bounds the cubes in flight
     // (each stays within planLayer's own cap) or the windows coded at once
     // (one per core).
     CubeBudget budget;
     budget.bytes = std::numeric_limits<uint64_t>::max() / 4;
     format::EncodedGrid out = encodeGridByCubes(*recordCubes(grid), options, budget);
-    const unsigned vs = keepAttributes ? valueSize(grid.valueType) : 0;
+    const unsigned vs = options.keepAttributes ? valueSize(grid.valueType) : 0;
     // Exact values are gathered again; a lossy layer's come from its windows
     // (the values as stored, not the input's).
     const bool exact = options.tolerance.mode == attributes::ScalarTolerance::Mode::Exact;
@@ -71,7 +71,7 @@ format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& 
 
 } // namespace
 
-format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) { return encodeGridImpl(grid, options, nullptr, true); }
+format::EncodedGrid encodeGrid(const GridRecord& grid, const EncodeOptions& options) { return encodeGridImpl(grid, options, nullptr); }
 
 
 GridRecord decodeGrid(const format::EncodedGrid& grid) {
@@ -94,12 +94,12 @@ format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& opti
     return scene;
 }
 
-format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options, const GridProgress& onGrid, bool keepAttributes) {
+format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options, const GridProgress& onGrid) {
     format::SsvdagScene scene;
     scene.fileMetadata = volume.fileMetadata;
     for (size_t g = 0; g < volume.grids.size(); ++g) {
         if (onGrid) onGrid(g, volume.grids.size());
-        scene.grids.push_back(encodeGridImpl(volume.grids[g], options, &volume.grids[g], keepAttributes));
+        scene.grids.push_back(encodeGridImpl(volume.grids[g], options, &volume.grids[g]));
     }
     return scene;
 }

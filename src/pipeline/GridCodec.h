@@ -34,6 +34,13 @@ struct EncodeOptions {
     // predictor (attributes/PredictedChannel.h) and store whichever of
     // palettes and residuals zstd makes smaller.
     bool predictIntegers = true;
+    // A grid in memory (encodeGrid, encodeVolume...): the encoded grid also
+    // holds its values in attribute order (EncodedGrid::attributes, as a
+    // file read whole does), for callers that read them (`info`'s channel
+    // statistics, `render`'s label test). Callers that only write the file
+    // or read it back (encode, verify, bench) turn it off: a layer streamed
+    // into windows is not gathered, nor a lossy one decoded, once more.
+    bool keepAttributes = true;
     // Called as each step of a grid starts (kEncodeSteps per grid), for progress.
     std::function<void(const char* step)> onStep;
     // Within a step of the cube-by-cube encoder: cubes done of the pass's total.
@@ -53,12 +60,8 @@ GridRecord decodeGrid(const format::EncodedGrid& grid);
 using GridProgress = std::function<void(size_t index, size_t count)>;
 format::SsvdagScene encodeVolume(const Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
 // The same, releasing each grid (voxels and header) as soon as it is
-// encoded: the grids are empty afterwards. With
-// `keepAttributes` false the encoded grids hold their values only as the
-// file stores them (value windows), not in attribute order as well: what
-// a caller that only writes the file needs (an in-memory grid's lossless
-// values would be gathered once more for nothing).
-format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {}, bool keepAttributes = true);
+// encoded: the grids are empty afterwards.
+format::SsvdagScene encodeVolumeReleasing(Volume& volume, const EncodeOptions& options = {}, const GridProgress& onGrid = {});
 Volume decodeScene(const format::SsvdagScene& scene, const GridProgress& onGrid = {});
 
 } // namespace vdbdag::pipeline

@@ -10,7 +10,6 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 
 import numpy as np
 import pytest
@@ -18,12 +17,6 @@ import pytest
 import vdbdag
 
 openvdb = pytest.importorskip("pyopenvdb")
-
-
-@pytest.fixture(scope="module")
-def work():
-    with tempfile.TemporaryDirectory() as d:
-        yield d
 
 
 def sphere(work):

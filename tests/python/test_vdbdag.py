@@ -5,7 +5,6 @@ and encode/decode round trips through the command. Inputs: OpenVDB's own
 level-set and fog generators (pyopenvdb.createLevelSetSphere), and the
 bunny level set from ../shared/data when it is present."""
 import os
-import tempfile
 
 import numpy as np
 import pytest
@@ -14,12 +13,6 @@ import vdbdag
 
 openvdb = pytest.importorskip("pyopenvdb")
 SHARED = os.environ.get("VDBDAG_SHARED_DATA", os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "data"))
-
-
-@pytest.fixture(scope="module")
-def work():
-    with tempfile.TemporaryDirectory() as d:
-        yield d
 
 
 def sphere_file(work):
