@@ -47,6 +47,8 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
     bridge::ThresholdReport threshold;
     if (dense) {
         if (!request.grids.empty()) throw Error(request.input + ": --grid applies to .vdb inputs only (a dense scan has one grid)");
+        if (request.normalBits)
+            throw Error(request.input + ": --normals applies to the level sets and vec3 normal grids of a .vdb or .nvdb, not to a dense scan");
         bridge::DenseImportOptions denseOptions = request.dense;
         // Cube by cube, its samples in a scratch file, with
         // --memory-limit, under mpirun, or when the grid would not fit
@@ -71,12 +73,13 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
         // Cube by cube (region by region from the file) whenever the
         // file allows it (grid offsets): less memory than the whole grid
         // and faster too (the cubes' values are gathered in parallel,
-        // each through a small index). Whole, through OpenVDB's
-        // strictest reader, for a stream and for --normals (the
-        // gradient reads across cubes). The same bytes either way.
+        // each through a small index); --normals from each cube with
+        // a one-voxel halo. Whole, through OpenVDB's strictest reader,
+        // for a stream, and for --normals of a topology-only encode (the
+        // gradient needs the values). The same bytes either way.
         if (bridge::isNanoVdbPath(request.input)) {  // NanoVDB: whole, through NanoVDB's own converter
             imported = bridge::importNanoVdb(request.input, importOptions);
-        } else if (!importOptions.normals && bridge::canReadVdbByCubes(request.input)) {
+        } else if (!(importOptions.normals && importOptions.topologyOnly) && bridge::canReadVdbByCubes(request.input)) {
             cubeInput = bridge::openVdbCubes(request.input, importOptions, scratchNear,
                                              scratchInMemory(request.memoryLimit ? request.memoryLimit : defaultMemoryLimit()));
             imported.warnings = cubeInput->warnings;

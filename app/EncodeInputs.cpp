@@ -59,7 +59,6 @@ void checkCoding(const EncodeRequest& c) {
     if (c.normalBits != 0 && c.normalBits != 10 && c.normalBits != 12 && c.normalBits != 16 && c.normalBits != 24 && c.normalBits != 32)
         refuse("--normals is 10, 12, 16, 24 or 32, not " + std::to_string(c.normalBits));
     if (!c.normalGrid.empty() && c.normalBits == 0) refuse("--normal-grid needs --normals");
-    if (c.memoryLimit != 0 && c.normalBits != 0) refuse("--memory-limit and --normals exclude each other");
     if (c.threads > 1024) refuse("--threads is 1 to 1024, not " + std::to_string(c.threads));
     if (!c.scratch.empty() && !std::filesystem::is_directory(c.scratch)) refuse("--scratch " + c.scratch + ": not a folder");
 }

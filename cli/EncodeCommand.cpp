@@ -84,8 +84,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
     cmd->add_option("--memory-limit", opt->memoryLimit,
                     "working memory for the cubes being encoded, e.g. 512M or 4G (default: half the physical memory); "
                     "a .vdb is read region by region, a scan's samples go to a scratch file; the output is the same bytes")
-        ->transform(byteSize())
-        ->excludes(normals);
+        ->transform(byteSize());
     cmd->add_option("--scratch", opt->scratch, "folder for the scratch files of a region-by-region encode: the input's bricks and the coded values (default: the output's folder)")
         ->check(CLI::ExistingDirectory);
     cmd->add_option("--threads", opt->threads, "worker threads (default: one per core); the output is the same bytes")->check(CLI::Range(1u, 1024u));

@@ -7,12 +7,14 @@
 #include "vdb_bridge/VdbCubes.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstring>
 #include <filesystem>
 #include <limits>
 #include <map>
 #include <tuple>
+#include <unordered_map>
 
 #include <malloc.h>
 
@@ -22,7 +24,9 @@
 #include "src/util/Error.h"
 #include "src/util/MappedPages.h"
 #include "src/util/ScratchFile.h"
+#include "vdb_bridge/detail/ImportGrids.h"
 #include "vdb_bridge/detail/LeafBricks.h"
+#include "vdb_bridge/detail/NormalEstimation.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/VdbFile.h"
 #include "vdb_bridge/detail/VdbFileLayout.h"
@@ -48,6 +52,15 @@ void releaseFreedMemory() {
 
 constexpr size_t kLeafChunk = 8192;  // leaves loaded at once by the summary pass
 
+struct CoordHash {
+    size_t operator()(const openvdb::Coord& c) const {
+        return size_t((uint64_t(uint32_t(c.x())) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(uint32_t(c.y())) * 0xC2B2AE3D27D4EB4Full) ^
+                      (uint64_t(uint32_t(c.z())) * 0x165667B19E3779F9ull));
+    }
+};
+
+using detail::NormalsOf;
+
 template <typename GridT, bool hasValues>
 class VdbGridCubes final : public CubeSource {
     using TreeT = typename GridT::TreeType;
@@ -55,8 +68,10 @@ class VdbGridCubes final : public CubeSource {
     using ValueT = typename GridT::ValueType;
 
 public:
-    VdbGridCubes(std::string path, std::string uniqueName, GridRecord header, typename GridT::Ptr grid, std::shared_ptr<ScratchFile> scratch)
-        : path_(std::move(path)), uniqueName_(std::move(uniqueName)), header_(std::move(header)), scratch_(std::move(scratch)) {
+    VdbGridCubes(std::string path, std::string uniqueName, GridRecord header, typename GridT::Ptr grid, std::shared_ptr<ScratchFile> scratch,
+                 NormalsOf normals = NormalsOf::None)
+        : path_(std::move(path)), uniqueName_(std::move(uniqueName)), header_(std::move(header)), scratch_(std::move(scratch)),
+          normalKind_(normals), transform_(grid->transform().copy()) {
         // OpenVDB's delayed loading (LeafBuffer::doLoad) leaves a leaf whose
         // values ran out of memory while they were read flagged out-of-core
         // over its value array; destroying that leaf then frees a FileInfo
@@ -65,6 +80,7 @@ public:
         // is allocated before anything can fail, and leaked.
         auto holder = std::make_unique<typename GridT::Ptr>();
         try {
+            if (normals == NormalsOf::Gradient) bandEdges_ = countBandEdges(*grid);
             summarise(*grid);
         } catch (...) {
             *holder = std::move(grid);
@@ -77,6 +93,15 @@ public:
 
     const GridRecord& header() const override { return header_; }
     LayerSummary summary(Layer layer) override { return summary_[int(layer)]; }
+
+    std::optional<NormalSource> normals() override {
+        if (normalKind_ == NormalsOf::None) return NormalSource{};  // none to store for this grid
+        if constexpr (hasValues) {
+            if (!normalCubes_) normalCubes_ = std::make_unique<NormalCubes>(*this);
+            return NormalSource{normalCubes_.get(), normalKind_ == NormalsOf::Vectors, normalCubes_->oneSided()};
+        }
+        return NormalSource{};
+    }
 
     std::vector<CubeLoad> cubes(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2) override {
         std::map<CubeCell, uint64_t, CellLess> counts;
@@ -100,19 +125,7 @@ public:
     void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {
         layer_ = layer;
         withValues_ = withValues && hasValues;
-        index_.clear();
-        for (size_t i = 0; i < leaves_.size(); ++i) {
-            std::map<CubeCell, uint8_t, CellLess> cells;
-            for (uint8_t bits = leaves_[i].occupancy[int(layer)]; bits; bits &= uint8_t(bits - 1)) {
-                const unsigned b = unsigned(std::countr_zero(bits));
-                const openvdb::Coord c = detail::brickCorner(leaves_[i].origin, b);
-                cells[cellOf(origin, log2, c.x(), c.y(), c.z())] |= uint8_t(1u << b);
-            }
-            for (const auto& [cell, bricks] : cells) index_[cell].leaves.push_back({i, bricks});
-        }
-        const GridTopology& tiles = tiles_[int(layer)];
-        for (size_t t = 0; t < tiles.tiles.size(); ++t)
-            if (tiles.tiles[t].log2Size <= log2) index_[cellOf(origin, log2, tiles.tiles[t].x, tiles.tiles[t].y, tiles.tiles[t].z)].tiles.push_back(t);
+        index_ = cubeIndex(layer, origin, log2);
     }
 
     void read(const CubeCell& cell, GridTopology& topology, LayerValues& values) override {
@@ -195,6 +208,256 @@ private:
         std::vector<std::pair<size_t, uint8_t>> leaves;  // (leaf, its bricks in this cube)
         std::vector<size_t> tiles;
     };
+    using CubeIndexMap = std::map<CubeCell, CubeIndex, CellLess>;
+    // Each cube's leaves (with their bricks in it) and tiles of `layer`.
+    CubeIndexMap cubeIndex(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2) const {
+        CubeIndexMap index;
+        for (size_t i = 0; i < leaves_.size(); ++i) {
+            std::map<CubeCell, uint8_t, CellLess> cells;
+            for (uint8_t bits = leaves_[i].occupancy[int(layer)]; bits; bits &= uint8_t(bits - 1)) {
+                const unsigned b = unsigned(std::countr_zero(bits));
+                const openvdb::Coord c = detail::brickCorner(leaves_[i].origin, b);
+                cells[cellOf(origin, log2, c.x(), c.y(), c.z())] |= uint8_t(1u << b);
+            }
+            for (const auto& [cell, bricks] : cells) index[cell].leaves.push_back({i, bricks});
+        }
+        const GridTopology& tiles = tiles_[int(layer)];
+        for (size_t t = 0; t < tiles.tiles.size(); ++t)
+            if (tiles.tiles[t].log2Size <= log2) index[cellOf(origin, log2, tiles.tiles[t].x, tiles.tiles[t].y, tiles.tiles[t].z)].tiles.push_back(t);
+        return index;
+    }
+
+    // The active voxels of leaves read back from the scratch file, looked
+    // up as OpenVDB's probeValue would: a voxel of a leaf is active if its
+    // brick's mask says so; where no leaf is, an active tile may hold it.
+    class Neighbourhood {
+    public:
+        explicit Neighbourhood(const VdbGridCubes& grid) : grid_(grid) {}
+        // Leaf `i` (and, with `around`, the leaves beside its six faces):
+        // every voxel one step from one of its voxels is then answered.
+        void load(size_t i, bool withValues, bool around) {
+            loadOne(grid_.leaves_[i].origin, withValues);
+            if (!around) return;
+            for (int axis = 0; axis < 3; ++axis)
+                for (int step : {-8, 8}) {
+                    openvdb::Coord o = grid_.leaves_[i].origin;
+                    o[axis] += step;
+                    loadOne(o, withValues);
+                }
+        }
+        // A caller's last two leaves (one cursor per thread), least
+        // recently used replaced: a voxel's own leaf and the one beside it.
+        struct Cursor {
+            openvdb::Coord origin[2] = {openvdb::Coord(INT32_MAX), openvdb::Coord(INT32_MAX)};
+            const void* leaf[2] = {nullptr, nullptr};  // LeafData; null: no leaf there
+            unsigned last = 0;
+        };
+        // OpenVDB's probeValue: the value, and whether the voxel is active.
+        bool probe(const openvdb::Coord& c, ValueT& value, Cursor& cursor) const { return find(c, value, cursor); }
+        // The active voxels of brick b of the loaded leaf at `origin`.
+        uint64_t brickMask(const openvdb::Coord& origin, unsigned b) const { return leaves_.at(origin).masks[b]; }
+
+    private:
+        struct LeafData {
+            uint64_t masks[8] = {};       // brick b's active voxels
+            uint32_t firstValue[8] = {};  // brick b's first active value
+            std::vector<uint8_t> values;  // the leaf's active values, brick order
+        };
+        static openvdb::Coord leafOrigin(const openvdb::Coord& c) { return openvdb::Coord(c.x() & ~7, c.y() & ~7, c.z() & ~7); }
+        void loadOne(const openvdb::Coord& origin, bool withValues) {
+            if (leaves_.count(origin)) return;
+            const auto at = grid_.leafAt_.find(origin);
+            if (at == grid_.leafAt_.end()) return;  // no leaf: a tile or nothing
+            const LeafInfo& leaf = grid_.leaves_[at->second];
+            const unsigned vs = valueSize(grid_.header_.valueType);
+            const size_t masksEnd = size_t(std::popcount(leaf.occupancy[0]) + std::popcount(leaf.occupancy[1])) * 8;
+            const std::span<const uint8_t> record = grid_.scratch_->view(leaf.recordOffset, withValues ? leaf.activeEnd : masksEnd, buffer_);
+            LeafData data;
+            uint32_t value = 0, rank = 0;
+            for (unsigned b = 0; b < 8; ++b) {
+                if (!((leaf.occupancy[0] >> b) & 1u)) continue;
+                data.masks[b] = mask(reinterpret_cast<const uint64_t*>(record.data()), rank++);
+                data.firstValue[b] = value;
+                value += uint32_t(std::popcount(data.masks[b]));
+            }
+            if (withValues) data.values.assign(record.begin() + long(masksEnd), record.begin() + long(masksEnd + size_t(value) * vs));
+            leaves_.emplace(origin, std::move(data));
+        }
+        bool find(const openvdb::Coord& c, ValueT& value, Cursor& cursor) const {
+            const openvdb::Coord origin = leafOrigin(c);
+            unsigned slot = cursor.last;
+            if (origin != cursor.origin[slot]) {
+                slot ^= 1u;
+                if (origin != cursor.origin[slot]) {
+                    const auto it = leaves_.find(origin);
+                    cursor.origin[slot] = origin;
+                    cursor.leaf[slot] = it == leaves_.end() ? nullptr : &it->second;
+                }
+            }
+            cursor.last = slot;
+            if (cursor.leaf[slot]) {
+                const LeafData& leaf = *static_cast<const LeafData*>(cursor.leaf[slot]);
+                const unsigned b = unsigned((c.x() >> 2) & 1) | unsigned((c.y() >> 2) & 1) << 1 | unsigned((c.z() >> 2) & 1) << 2;
+                const unsigned bit = unsigned(c.x() & 3) + 4 * unsigned(c.y() & 3) + 16 * unsigned(c.z() & 3);
+                const uint64_t m = leaf.masks[b];
+                if (!((m >> bit) & 1u)) return false;
+                const size_t n = leaf.firstValue[b] + size_t(std::popcount(m & ((uint64_t(1) << bit) - 1)));
+                value = detail::valueFromBytes<ValueT>(leaf.values.data() + n * sizeof(ValueT));
+                return true;
+            }
+            if (grid_.leafAt_.count(origin)) return false;  // a leaf not loaded: never asked for (see load)
+            for (const auto& [log2, tiles] : grid_.activeTileAt_) {
+                const int32_t low = ~((int32_t(1) << log2) - 1);
+                const auto t = tiles.find(openvdb::Coord(c.x() & low, c.y() & low, c.z() & low));
+                if (t == tiles.end()) continue;
+                value = detail::valueFromBytes<ValueT>(grid_.tileValues_[0].tiles.data() + t->second * sizeof(ValueT));
+                return true;
+            }
+            return false;
+        }
+        const VdbGridCubes& grid_;
+        std::unordered_map<openvdb::Coord, LeafData, CoordHash> leaves_;
+        std::vector<uint8_t> buffer_;
+    };
+
+    // The normals as a source over the grid's own cubes (NormalSource):
+    // each active voxel's and tile's value is its normal (3 x float),
+    // computed from the cube's leaves and the leaves beside them.
+    class NormalCubes final : public CubeSource {
+    public:
+        explicit NormalCubes(VdbGridCubes& grid) : grid_(grid), header_(grid.header_) {
+            grid.indexNeighbours();
+            header_.valueType = ValueType::Vec3S;
+            header_.background.assign(sizeof(detail::NormalVector), 0);
+            const GridTopology& tiles = grid.tiles_[0];
+            tileNormals_.tiles.resize(tiles.tiles.size() * sizeof(detail::NormalVector));
+            Neighbourhood around(grid);  // no leaves: a tile's centre and its neighbours lie in the tile
+            for (size_t t = 0; t < tiles.tiles.size(); ++t) {
+                const int32_t half = int32_t(1) << (tiles.tiles[t].log2Size - 1);
+                bool edge = false;
+                typename Neighbourhood::Cursor cursor;
+                store(tileNormals_.tiles, t, normalAt(around, cursor, openvdb::Coord(tiles.tiles[t].x + half, tiles.tiles[t].y + half, tiles.tiles[t].z + half), edge));
+                oneSided_ += edge ? 1 : 0;
+            }
+            oneSided_ += grid.bandEdges_;
+        }
+        uint64_t oneSided() const { return oneSided_; }
+
+        const GridRecord& header() const override { return header_; }
+        LayerSummary summary(Layer layer) override {
+            if (layer == Layer::Inactive) return {};
+            LayerSummary s = grid_.summary_[0];
+            s.mixed = false;  // the grid's values, not the normals
+            s.uniformValue.clear();
+            return s;
+        }
+        std::vector<CubeLoad> cubes(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2) override {
+            return layer == Layer::Active ? grid_.cubes(layer, origin, log2) : std::vector<CubeLoad>{};
+        }
+        void largeTiles(Layer layer, unsigned log2, GridTopology& tiles, LayerValues& values) override {
+            if (layer == Layer::Active) selectLargeTiles(grid_.tiles_[0], tileNormals_, sizeof(detail::NormalVector), log2, tiles, values);
+            else tiles = {}, values = {};
+        }
+        void beginPass(Layer layer, const std::array<int64_t, 3>& origin, unsigned log2, bool withValues) override {
+            index_ = layer == Layer::Active ? grid_.cubeIndex(layer, origin, log2) : CubeIndexMap{};
+            withValues_ = withValues;
+        }
+        // The cube's active bricks and tiles in the grid's own order
+        // (VdbGridCubes::read), each voxel's value its normal.
+        void read(const CubeCell& cell, GridTopology& topology, LayerValues& values) override {
+            topology = {};
+            values = {};
+            const auto it = index_.find(cell);
+            if (it == index_.end()) return;
+            Neighbourhood around(grid_);
+            for (const auto& [leafIndex, bricks] : it->second.leaves) around.load(leafIndex, withValues_, withValues_ && grid_.normalKind_ == NormalsOf::Gradient);
+            std::vector<uint64_t> first{0};
+            for (const auto& [leafIndex, bricks] : it->second.leaves) {
+                const LeafInfo& leaf = grid_.leaves_[leafIndex];
+                for (unsigned b = 0; b < 8; ++b) {
+                    if (!((bricks >> b) & 1u)) continue;
+                    const openvdb::Coord c = detail::brickCorner(leaf.origin, b);
+                    const uint64_t m = around.brickMask(leaf.origin, b);
+                    topology.bricks.push_back({c.x(), c.y(), c.z(), m});
+                    first.push_back(first.back() + uint64_t(std::popcount(m)));
+                }
+            }
+            if (withValues_) {
+                values.bricks.resize(first.back() * sizeof(detail::NormalVector));
+                tbb::parallel_for(tbb::blocked_range<size_t>(0, topology.bricks.size(), 16), [&](const auto& range) {
+                    typename Neighbourhood::Cursor cursor;
+                    for (size_t i = range.begin(); i != range.end(); ++i) {
+                        const Brick& brick = topology.bricks[i];
+                        uint64_t out = first[i];
+                        for (uint64_t bits = brick.mask; bits; bits &= bits - 1, ++out) {
+                            const int bit = std::countr_zero(bits);
+                            bool edge = false;
+                            store(values.bricks, out, normalAt(around, cursor, openvdb::Coord(brick.x + (bit & 3), brick.y + ((bit >> 2) & 3), brick.z + (bit >> 4)), edge));
+                        }
+                    }
+                });
+            }
+            for (size_t t : it->second.tiles) {
+                topology.tiles.push_back(grid_.tiles_[0].tiles[t]);
+                if (withValues_) values.tiles.insert(values.tiles.end(), tileNormals_.tiles.begin() + long(t * sizeof(detail::NormalVector)),
+                                                     tileNormals_.tiles.begin() + long((t + 1) * sizeof(detail::NormalVector)));
+            }
+            index_.erase(it);
+        }
+        void endPass() override { index_.clear(); }
+
+    private:
+        static void store(std::vector<uint8_t>& out, size_t index, const detail::NormalVector& v) {
+            std::memcpy(&out[index * sizeof(v)], v.data(), sizeof(v));
+        }
+        detail::NormalVector normalAt(const Neighbourhood& around, typename Neighbourhood::Cursor& cursor, const openvdb::Coord& c, bool& edge) const {
+            if constexpr (std::is_same_v<ValueT, float> || std::is_same_v<ValueT, double>) {
+                if (grid_.normalKind_ == NormalsOf::Gradient)
+                    return detail::gradientNormalAt<ValueT>([&](const openvdb::Coord& at, ValueT& v) { return around.probe(at, v, cursor); }, *grid_.transform_,
+                                                            c, edge);
+            } else if constexpr (std::is_same_v<ValueT, openvdb::Vec3s> || std::is_same_v<ValueT, openvdb::Vec3d> || std::is_same_v<ValueT, openvdb::Vec3i>) {
+                ValueT v{};
+                around.probe(c, v, cursor);
+                return detail::vectorNormal(v);
+            }
+            return {0.f, 0.f, 0.f};
+        }
+        VdbGridCubes& grid_;
+        GridRecord header_;
+        LayerValues tileNormals_;
+        uint64_t oneSided_ = 0;
+        CubeIndexMap index_;
+        bool withValues_ = false;
+    };
+
+    // The gradient's one-sided voxels (the report counts them), from the
+    // value masks alone, which delayed loading has read: no buffer is loaded.
+    static uint64_t countBandEdges(const GridT& grid) {
+        std::vector<const LeafT*> leaves;
+        for (auto it = grid.tree().cbeginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
+        std::atomic<uint64_t> edges{0};
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 64), [&](const auto& range) {
+            auto acc = grid.getConstAccessor();
+            uint64_t local = 0;
+            for (size_t i = range.begin(); i != range.end(); ++i)
+                for (auto v = leaves[i]->cbeginValueOn(); v; ++v)
+                    if (detail::bandEdgeAt([&](const openvdb::Coord& at) { return acc.isValueOn(at); }, v.getCoord())) ++local;
+            edges += local;
+        });
+        return edges.load();
+    }
+
+    // Finds leaves and active tiles by position (for the normals).
+    void indexNeighbours() {
+        for (size_t i = 0; i < leaves_.size(); ++i) leafAt_.emplace(leaves_[i].origin, i);
+        const GridTopology& tiles = tiles_[0];
+        for (size_t t = 0; t < tiles.tiles.size(); ++t) {
+            const Tile& tile = tiles.tiles[t];
+            auto level = std::find_if(activeTileAt_.begin(), activeTileAt_.end(), [&](const auto& l) { return l.first == tile.log2Size; });
+            if (level == activeTileAt_.end()) level = activeTileAt_.insert(activeTileAt_.end(), {tile.log2Size, {}});
+            level->second.emplace(openvdb::Coord(tile.x, tile.y, tile.z), t);
+        }
+    }
 
     void summarise(GridT& grid) {
         TreeT& tree = grid.tree();
@@ -303,7 +566,14 @@ private:
     // The current pass.
     Layer layer_ = Layer::Active;
     bool withValues_ = false;
-    std::map<CubeCell, CubeIndex, CellLess> index_;
+    CubeIndexMap index_;
+    // --normals
+    NormalsOf normalKind_ = NormalsOf::None;
+    openvdb::math::Transform::Ptr transform_;
+    uint64_t bandEdges_ = 0;
+    std::unordered_map<openvdb::Coord, size_t, CoordHash> leafAt_;
+    std::vector<std::pair<unsigned, std::unordered_map<openvdb::Coord, size_t, CoordHash>>> activeTileAt_;  // per tile size
+    std::unique_ptr<NormalCubes> normalCubes_;
 };
 
 } // namespace
@@ -317,13 +587,14 @@ bool canReadVdbByCubes(const std::string& path) {
 }
 
 VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options, const std::string& scratchNear, uint64_t scratchInMemory) {
-    if (options.normals) throw Error(path + ": --normals needs the whole grid in memory; use it without --memory-limit");
+    if (options.normals && options.topologyOnly) throw Error(path + ": --normals with --topology-only needs the whole grid in memory");
     const detail::VdbFileIndex index = detail::indexVdbFile(path);
     const std::string near = scratchNear.empty() ? (std::filesystem::temp_directory_path() / "vdbdag").string() : scratchNear;
     std::shared_ptr<ScratchFile> scratch;  // created with the first grid
     VdbCubeInput input;
     input.fileMetadata = detail::serializeMetadata(*index.metadata);
     std::vector<std::string> found;
+    bool anyNormals = false;
     for (size_t i = 0; i < index.uniqueNames.size(); ++i) {
         openvdb::GridBase::Ptr base = detail::readGridDelayed(path, index.uniqueNames[i]);
         detail::checkGridAgainstFile(path, i, *base);
@@ -337,6 +608,8 @@ VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options,
         header.vdbDescriptor = detail::descriptorOf(*base);
         header.rescale = detail::rescaleOf(*base);
         const bool supported = detail::dispatchGridType(*base, [&](const auto& typed, ValueType type) {
+            const NormalsOf normals = detail::normalsOf(typed, options, path);
+            anyNormals = anyNormals || normals != NormalsOf::None;
             if (!scratch) scratch = std::make_shared<ScratchFile>(near, scratchInMemory);
             using GridT = std::decay_t<decltype(typed)>;
             constexpr bool typeHasValues = !std::is_same_v<typename GridT::TreeType::LeafNodeType::BuildType, openvdb::ValueMask>;
@@ -348,7 +621,8 @@ VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options,
             } else {
                 header.valueType = type;
                 detail::appendValue(header.background, grid->tree().background());
-                input.grids.push_back(std::make_unique<VdbGridCubes<GridT, typeHasValues>>(path, index.uniqueNames[i], std::move(header), std::move(grid), scratch));
+                input.grids.push_back(
+                    std::make_unique<VdbGridCubes<GridT, typeHasValues>>(path, index.uniqueNames[i], std::move(header), std::move(grid), scratch, normals));
             }
         });
         if (!supported) {
@@ -364,6 +638,7 @@ VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options,
             for (const auto& n : found) names += (names.empty() ? "'" : ", '") + n + "'";
             throw Error(path + ": no grid named '" + wanted + "' (the file has " + (names.empty() ? "no grids" : names) + ")");
         }
+    if (options.normals) detail::requireSomeNormals(anyNormals, options, path);
     return input;
 }
 

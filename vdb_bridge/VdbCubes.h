@@ -29,7 +29,10 @@ bool canReadVdbByCubes(const std::string& path);
 // boxes) and each grid is read once into the scratch file, created beside
 // `scratchNear` (a path in the folder to use; default: the system's
 // temporary folder), before this returns. The scratch
-// files go with the sources. `options.normals` is not supported (Error).
+// files go with the sources. With `options.normals` a grid's normals are a
+// source of their own (CubeSource::normals), computed cube by cube from the
+// scratch file with a one-voxel halo, the same as importVdb's; not with
+// `options.topologyOnly` (Error: the gradient needs the values).
 VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options = {}, const std::string& scratchNear = "", uint64_t scratchInMemory = 0);
 
 } // namespace vdbdag::bridge

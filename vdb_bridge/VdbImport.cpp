@@ -86,17 +86,15 @@ void collectLayers(const GridT& grid, GridRecord& record) {
 // Exact normals for `--normals` (NormalEstimation.h): the gradient of float
 // and double grids, or the values of the vec3 grid named `normalGrid`.
 template <typename GridT>
-void addNormals(const GridT& grid, GridRecord& record, const std::string& normalGrid, const std::string& path) {
+void addNormals(const GridT& grid, GridRecord& record, const ImportOptions& options, const std::string& path) {
     using ValueT = typename GridT::ValueType;
     constexpr bool scalar = std::is_same_v<ValueT, float> || std::is_same_v<ValueT, double>;
     constexpr bool vec3 = std::is_same_v<ValueT, openvdb::Vec3s> || std::is_same_v<ValueT, openvdb::Vec3d> || std::is_same_v<ValueT, openvdb::Vec3i>;
-    if (normalGrid.empty()) {
-        if constexpr (scalar) record.normals = detail::gradientNormals(grid, record.topology);
-        return;
-    }
-    if (grid.getName() != normalGrid) return;
-    if constexpr (vec3) record.normals = detail::gridNormals(grid, record.topology);
-    else throw Error(path + ": --normal-grid '" + normalGrid + "' has type '" + grid.type() + "', not a vec3 normal grid");
+    const detail::NormalsOf kind = detail::normalsOf(grid, options, path);
+    if constexpr (scalar)
+        if (kind == detail::NormalsOf::Gradient) record.normals = detail::gradientNormals(grid, record.topology);
+    if constexpr (vec3)
+        if (kind == detail::NormalsOf::Vectors) record.normals = detail::gridNormals(grid, record.topology);
 }
 
 } // namespace
@@ -140,7 +138,7 @@ ImportResult detail::importGrids(const openvdb::GridPtrVec& fileGrids, const ope
                 record.valueType = type;
                 collectLayers(grid, record);
             }
-            if (options.normals) addNormals(grid, record, options.normalGrid, path);
+            if (options.normals) addNormals(grid, record, options, path);
         });
         if (!supported) {
             const std::string message = "grid " + std::to_string(index) + " '" + base->getName() + "' has type '" + base->type() + "'" +
@@ -154,12 +152,26 @@ ImportResult detail::importGrids(const openvdb::GridPtrVec& fileGrids, const ope
         record.rescale = detail::rescaleOf(*base);
         result.volume.grids.push_back(std::move(record));
     }
-    if (options.normals && std::none_of(result.volume.grids.begin(), result.volume.grids.end(), [](const GridRecord& g) { return g.normals.has_value(); })) {
-        if (!options.normalGrid.empty())
-            throw Error(path + ": no grid named '" + options.normalGrid + "' among the grids encoded, for --normal-grid");
-        throw Error(path + ": --normals needs a float or double grid (a level set) to take the gradient of, or a vec3 normal grid named with --normal-grid");
-    }
+    if (options.normals)
+        detail::requireSomeNormals(std::any_of(result.volume.grids.begin(), result.volume.grids.end(), [](const GridRecord& g) { return g.normals.has_value(); }),
+                                   options, path);
     return result;
+}
+
+detail::NormalsOf detail::normalsOf(const openvdb::GridBase& grid, const ImportOptions& options, const std::string& path) {
+    if (!options.normals) return NormalsOf::None;
+    const bool scalar = grid.isType<openvdb::FloatGrid>() || grid.isType<openvdb::DoubleGrid>();
+    const bool vec3 = grid.isType<openvdb::Vec3SGrid>() || grid.isType<openvdb::Vec3DGrid>() || grid.isType<openvdb::Vec3IGrid>();
+    if (options.normalGrid.empty()) return scalar ? NormalsOf::Gradient : NormalsOf::None;
+    if (grid.getName() != options.normalGrid) return NormalsOf::None;
+    if (!vec3) throw Error(path + ": --normal-grid '" + options.normalGrid + "' has type '" + grid.type() + "', not a vec3 normal grid");
+    return NormalsOf::Vectors;
+}
+
+void detail::requireSomeNormals(bool found, const ImportOptions& options, const std::string& path) {
+    if (found) return;
+    if (!options.normalGrid.empty()) throw Error(path + ": no grid named '" + options.normalGrid + "' among the grids encoded, for --normal-grid");
+    throw Error(path + ": --normals needs a float or double grid (a level set) to take the gradient of, or a vec3 normal grid named with --normal-grid");
 }
 
 } // namespace vdbdag::bridge

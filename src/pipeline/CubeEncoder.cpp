@@ -384,7 +384,7 @@ unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize, Wind
 format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& options, const CubeBudget& budget, CubeTeam& team) {
     const std::optional<NormalSource> normals = options.normalBits ? source.normals() : std::nullopt;
     if (options.normalBits && !normals)
-        throw Error("--normals needs the whole grid in memory (the gradient reads across cubes): use it without --memory-limit");
+        throw Error("--normals: this input gives no normals (a level set or vec3 grid in a .vdb does)");
     format::EncodedGrid out = encodedHeader(source.header(), options);
     const unsigned vs = valueSize(source.header().valueType);
     auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };

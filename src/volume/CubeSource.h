@@ -79,10 +79,11 @@ class CubeSource {
 public:
     virtual ~CubeSource() = default;
     // The grid's normals (`encode --normals`): a grid in memory gives its
-    // own (GridRecord::normals; cubes null when it has none, which the
-    // encoder then stores none of); none at all from a source that cannot
-    // give them (a file read region by region: the gradient reads across
-    // cubes), which the encoder refuses for --normals.
+    // own (GridRecord::normals), a .vdb read region by region computes them
+    // cube by cube with a one-voxel halo (VdbCubes.h); cubes null when the
+    // grid has none, which the encoder then stores none of. None at all
+    // from a source that cannot give them (a dense scan's), which the
+    // encoder refuses for --normals.
     virtual std::optional<NormalSource> normals() { return std::nullopt; }
     // Name, class, type, transform, descriptor, background; no voxels.
     virtual const GridRecord& header() const = 0;

@@ -19,6 +19,8 @@
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/Error.h"
+#include "src/pipeline/CubeEncoder.h"
+#include "vdb_bridge/VdbCubes.h"
 #include "vdb_bridge/VdbImport.h"
 
 using namespace vdbdag;
@@ -78,12 +80,21 @@ double angle(const std::array<float, 3>& a, const openvdb::Vec3d& b) {
     return attributes::angleDegrees(a, {float(b.x()), float(b.y()), float(b.z())});
 }
 
-format::SsvdagScene encodeFile(const fs::path& in, unsigned bits, const std::string& normalGrid = "") {
+// The whole grid in memory, or (byCubes) read region by region in cubes of
+// 16^3, each cube's normals from its voxels and a one-voxel halo.
+format::SsvdagScene encodeFile(const fs::path& in, unsigned bits, const std::string& normalGrid = "", bool byCubes = false) {
     bridge::ImportOptions io;
     io.normals = bits != 0;
     io.normalGrid = normalGrid;
     pipeline::EncodeOptions options;
     options.normalBits = bits;
+    if (byCubes) {
+        bridge::VdbCubeInput input = bridge::openVdbCubes(in.string(), io);
+        pipeline::CubeBudget budget;
+        budget.cubeLog2 = 4;
+        return format::readScene(format::writeScene(pipeline::encodeSourcesByCubes(std::move(input.grids), input.fileMetadata, options, budget)),
+                                 "normals test");
+    }
     return format::readScene(format::writeScene(pipeline::encodeVolume(bridge::importVdb(in.string(), io).volume, options)), "normals test");
 }
 
@@ -93,8 +104,10 @@ TEST(Normals, SphereGradientNormalsMatchTheClosedFormAndTheOnvBound) {
     const auto grid = sphere();
     const fs::path in = writeVdb("sphere.vdb", {grid});
     auto acc = grid->getConstAccessor();
-    for (unsigned k : {10u, 12u, 16u, 24u, 32u}) {
-        const auto scene = encodeFile(in, k);
+    const std::vector<std::pair<unsigned, bool>> runs{{10, false}, {12, false}, {16, false}, {24, false}, {32, false}, {16, true}, {32, true}};
+    for (const auto& [k, byCubes] : runs) {
+        SCOPED_TRACE(byCubes ? "cube by cube" : "whole grid");
+        const auto scene = encodeFile(in, k, "", byCubes);
         const format::EncodedGrid& g = scene.grids[0];
         ASSERT_TRUE(g.normals.has_value());
         const attributes::NormalChannel& n = *g.normals;
@@ -145,24 +158,27 @@ TEST(Normals, FromAVec3NormalGridOnItsOwnGeometry) {
     }
     acc.setValue(openvdb::Coord(1000, 0, 0), openvdb::Vec3s(0.f));  // no direction -> +z, counted
     const fs::path in = writeVdb("normal_grid.vdb", {ls, normals});
-    const auto scene = encodeFile(in, 16, "N");
-    ASSERT_EQ(scene.grids.size(), 2u);
-    const size_t ni = scene.grids[0].record.name == "N" ? 0 : 1;  // OpenVDB may reorder grids in the file
-    EXPECT_FALSE(scene.grids[1 - ni].normals.has_value()) << "only the normal grid's geometry carries them";
-    ASSERT_TRUE(scene.grids[ni].normals.has_value());
-    const auto& n = *scene.grids[ni].normals;
-    EXPECT_EQ(n.report.source, attributes::NormalReport::Source::NormalGrid);
-    EXPECT_EQ(n.report.zeroLength, 1u);
-    EXPECT_LE(n.report.maxAngleDegrees, 0.95);
-    forEachEntry(scene.grids[ni].dag, [&](const openvdb::Coord& c, uint64_t entry) {
-        const openvdb::Vec3d d = ls->indexToWorld(c) - openvdb::Vec3d(kCentre);
-        if (c.x() == 1000) {
-            const auto z = n.decode(entry);
-            EXPECT_NEAR(z[2], 1.0f, 1e-6f);
-            return;
-        }
-        ASSERT_LE(angle(n.decode(entry), d), 0.95) << c;
-    });
+    for (bool byCubes : {false, true}) {
+        SCOPED_TRACE(byCubes ? "cube by cube" : "whole grid");
+        const auto scene = encodeFile(in, 16, "N", byCubes);
+        ASSERT_EQ(scene.grids.size(), 2u);
+        const size_t ni = scene.grids[0].record.name == "N" ? 0 : 1;  // OpenVDB may reorder grids in the file
+        EXPECT_FALSE(scene.grids[1 - ni].normals.has_value()) << "only the normal grid's geometry carries them";
+        ASSERT_TRUE(scene.grids[ni].normals.has_value());
+        const auto& n = *scene.grids[ni].normals;
+        EXPECT_EQ(n.report.source, attributes::NormalReport::Source::NormalGrid);
+        EXPECT_EQ(n.report.zeroLength, 1u);
+        EXPECT_LE(n.report.maxAngleDegrees, 0.95);
+        forEachEntry(scene.grids[ni].dag, [&](const openvdb::Coord& c, uint64_t entry) {
+            const openvdb::Vec3d d = ls->indexToWorld(c) - openvdb::Vec3d(kCentre);
+            if (c.x() == 1000) {
+                const auto z = n.decode(entry);
+                EXPECT_NEAR(z[2], 1.0f, 1e-6f);
+                return;
+            }
+            ASSERT_LE(angle(n.decode(entry), d), 0.95) << c;
+        });
+    }
 }
 
 TEST(Normals, NoSectionWithoutTheOptionAndCorruptSectionsAreRefused) {

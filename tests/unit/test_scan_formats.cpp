@@ -384,6 +384,13 @@ TEST(ScanFormats, BadNiftiAndImpossibleOutputsAreOneLine) {
             EXPECT_FALSE(fs::exists(ss));
         }
     }
+    // --normals is for a .vdb's level sets and vec3 grids: a scan is refused
+    // (it was encoded without them, silently).
+    const fs::path raw = dir / "tiny.raw", nhdr = dir / "tiny.nhdr";
+    std::ofstream(raw, std::ios::binary) << std::string(8, '\x05');
+    std::ofstream(nhdr) << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: tiny.raw\n";
+    expectOneLineError(runCli("encode " + nhdr.string() + " -o " + ss.string() + " --normals 16"), "not to a dense scan", "normals of a scan");
+    EXPECT_FALSE(fs::exists(ss));
     // An int64 grid has no scan sample type; two grids need --grid.
     openvdb::initialize();
     openvdb::Int64Grid::Ptr wide = openvdb::Int64Grid::create();

@@ -13,13 +13,7 @@
 namespace vdbdag::bridge::detail {
 namespace {
 
-using Vec = std::array<float, 3>;
-
-Vec normalised(const openvdb::Vec3d& v) {
-    const double len = v.length();
-    if (!(len > 0.0) || !std::isfinite(len)) return {0.f, 0.f, 0.f};
-    return {float(v.x() / len), float(v.y() / len), float(v.z() / len)};
-}
+using Vec = NormalVector;
 
 void store(std::vector<uint8_t>& out, size_t index, const Vec& v) { std::memcpy(&out[index * sizeof(Vec)], v.data(), sizeof(Vec)); }
 
@@ -63,35 +57,15 @@ GridRecord::Normals evaluate(const GridT& grid, const GridTopology& topology, Ev
 
 template <typename GridT>
 GridRecord::Normals gradient(const GridT& grid, const GridTopology& topology) {
-    const openvdb::math::MapBase::ConstPtr map = grid.transform().baseMap();
     return evaluate(grid, topology, [&](auto& acc, const openvdb::Coord& c, bool& edge) {
-        using ValueT = typename GridT::ValueType;
-        openvdb::Vec3d g;
-        ValueT centre{};
-        acc.probeValue(c, centre);
-        for (int axis = 0; axis < 3; ++axis) {
-            openvdb::Coord plus = c, minus = c;
-            plus[axis] += 1;
-            minus[axis] -= 1;
-            ValueT vp{}, vm{};
-            const bool onP = acc.probeValue(plus, vp), onM = acc.probeValue(minus, vm);
-            if (onP && onM) {
-                g[axis] = 0.5 * (double(vp) - double(vm));
-            } else {
-                edge = true;
-                g[axis] = onP ? double(vp) - double(centre) : onM ? double(centre) - double(vm) : 0.0;
-            }
-        }
-        return normalised(map->applyIJT(g, grid.indexToWorld(c)));
+        return gradientNormalAt<typename GridT::ValueType>([&](const openvdb::Coord& at, auto& value) { return acc.probeValue(at, value); },
+                                                           grid.transform(), c, edge);
     });
 }
 
 template <typename GridT>
 GridRecord::Normals fromVectors(const GridT& grid, const GridTopology& topology) {
-    GridRecord::Normals n = evaluate(grid, topology, [](auto& acc, const openvdb::Coord& c, bool&) {
-        const auto v = acc.getValue(c);
-        return normalised(openvdb::Vec3d(double(v[0]), double(v[1]), double(v[2])));
-    });
+    GridRecord::Normals n = evaluate(grid, topology, [](auto& acc, const openvdb::Coord& c, bool&) { return vectorNormal(acc.getValue(c)); });
     n.fromNormalGrid = true;
     return n;
 }

@@ -9,12 +9,70 @@
 //    A tile is evaluated at its centre voxel. A zero gradient (flat region)
 //    stays a zero vector: the ONV encoder stores +z and counts it.
 //  - from a vec3 normal grid: its values, normalised (zero stays zero).
+//
+// The per-voxel rules below are the one definition both readers use: the
+// whole-grid import (an OpenVDB accessor) and the region-by-region reader
+// (VdbCubes: the cube's leaves and a one-voxel halo from the scratch file).
 #pragma once
+#include <array>
+#include <cmath>
+
 #include <openvdb/openvdb.h>
 
 #include "src/volume/GridRecord.h"
 
 namespace vdbdag::bridge::detail {
+
+using NormalVector = std::array<float, 3>;
+
+inline NormalVector normalised(const openvdb::Vec3d& v) {
+    const double len = v.length();
+    if (!(len > 0.0) || !std::isfinite(len)) return {0.f, 0.f, 0.f};
+    return {float(v.x() / len), float(v.y() / len), float(v.z() / len)};
+}
+
+// Whether active voxel `c` is at the band's edge: on some axis one of its
+// two neighbours is inactive. `active(coord)` -> bool.
+template <typename Active>
+bool bandEdgeAt(Active&& active, const openvdb::Coord& c) {
+    for (int axis = 0; axis < 3; ++axis) {
+        openvdb::Coord plus = c, minus = c;
+        plus[axis] += 1;
+        minus[axis] -= 1;
+        if (!active(plus) || !active(minus)) return true;
+    }
+    return false;
+}
+
+// The gradient normal at active voxel `c` (see above), with
+// `probe(coord, ValueT&)` -> bool as OpenVDB's probeValue (the value, and
+// whether the voxel is active); `edge` is set where an axis was one-sided.
+template <typename ValueT, typename Probe>
+NormalVector gradientNormalAt(Probe&& probe, const openvdb::math::Transform& transform, const openvdb::Coord& c, bool& edge) {
+    openvdb::Vec3d g;
+    ValueT centre{};
+    probe(c, centre);
+    for (int axis = 0; axis < 3; ++axis) {
+        openvdb::Coord plus = c, minus = c;
+        plus[axis] += 1;
+        minus[axis] -= 1;
+        ValueT vp{}, vm{};
+        const bool onP = probe(plus, vp), onM = probe(minus, vm);
+        if (onP && onM) {
+            g[axis] = 0.5 * (double(vp) - double(vm));
+        } else {
+            edge = true;
+            g[axis] = onP ? double(vp) - double(centre) : onM ? double(centre) - double(vm) : 0.0;
+        }
+    }
+    return normalised(transform.baseMap()->applyIJT(g, transform.indexToWorld(c)));
+}
+
+// The normal a vec3 normal grid's value gives.
+template <typename VecT>
+NormalVector vectorNormal(const VecT& v) {
+    return normalised(openvdb::Vec3d(double(v[0]), double(v[1]), double(v[2])));
+}
 
 // `topology` is the grid's active topology as imported (bricks and tiles).
 GridRecord::Normals gradientNormals(const openvdb::FloatGrid& grid, const GridTopology& topology);
