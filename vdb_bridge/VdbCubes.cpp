@@ -71,7 +71,7 @@ public:
     VdbGridCubes(std::string path, std::string uniqueName, GridRecord header, typename GridT::Ptr grid, std::shared_ptr<ScratchFile> scratch,
                  NormalsOf normals = NormalsOf::None)
         : path_(std::move(path)), uniqueName_(std::move(uniqueName)), header_(std::move(header)), scratch_(std::move(scratch)),
-          normalKind_(normals), transform_(grid->transform().copy()) {
+          normalKind_(normals), map_(grid->transform().baseMap()) {
         // OpenVDB's delayed loading (LeafBuffer::doLoad) leaves a leaf whose
         // values ran out of memory while they were read flagged out-of-core
         // over its value array; destroying that leaf then frees a FileInfo
@@ -413,7 +413,7 @@ private:
         detail::NormalVector normalAt(const Neighbourhood& around, typename Neighbourhood::Cursor& cursor, const openvdb::Coord& c, bool& edge) const {
             if constexpr (std::is_same_v<ValueT, float> || std::is_same_v<ValueT, double>) {
                 if (grid_.normalKind_ == NormalsOf::Gradient)
-                    return detail::gradientNormalAt<ValueT>([&](const openvdb::Coord& at, ValueT& v) { return around.probe(at, v, cursor); }, *grid_.transform_,
+                    return detail::gradientNormalAt<ValueT>([&](const openvdb::Coord& at, ValueT& v) { return around.probe(at, v, cursor); }, *grid_.map_,
                                                             c, edge);
             } else if constexpr (std::is_same_v<ValueT, openvdb::Vec3s> || std::is_same_v<ValueT, openvdb::Vec3d> || std::is_same_v<ValueT, openvdb::Vec3i>) {
                 ValueT v{};
@@ -569,7 +569,7 @@ private:
     CubeIndexMap index_;
     // --normals
     NormalsOf normalKind_ = NormalsOf::None;
-    openvdb::math::Transform::Ptr transform_;
+    openvdb::math::MapBase::ConstPtr map_;  // the grid's transform
     uint64_t bandEdges_ = 0;
     std::unordered_map<openvdb::Coord, size_t, CoordHash> leafAt_;
     std::vector<std::pair<unsigned, std::unordered_map<openvdb::Coord, size_t, CoordHash>>> activeTileAt_;  // per tile size

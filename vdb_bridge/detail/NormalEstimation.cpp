@@ -57,9 +57,9 @@ GridRecord::Normals evaluate(const GridT& grid, const GridTopology& topology, Ev
 
 template <typename GridT>
 GridRecord::Normals gradient(const GridT& grid, const GridTopology& topology) {
+    const openvdb::math::MapBase::ConstPtr map = grid.transform().baseMap();
     return evaluate(grid, topology, [&](auto& acc, const openvdb::Coord& c, bool& edge) {
-        return gradientNormalAt<typename GridT::ValueType>([&](const openvdb::Coord& at, auto& value) { return acc.probeValue(at, value); },
-                                                           grid.transform(), c, edge);
+        return gradientNormalAt<typename GridT::ValueType>([&](const openvdb::Coord& at, auto& value) { return acc.probeValue(at, value); }, *map, c, edge);
     });
 }
 

@@ -47,8 +47,10 @@ bool bandEdgeAt(Active&& active, const openvdb::Coord& c) {
 // The gradient normal at active voxel `c` (see above), with
 // `probe(coord, ValueT&)` -> bool as OpenVDB's probeValue (the value, and
 // whether the voxel is active); `edge` is set where an axis was one-sided.
+// `map` is the grid's transform's base map (taken once: baseMap() copies a
+// shared pointer).
 template <typename ValueT, typename Probe>
-NormalVector gradientNormalAt(Probe&& probe, const openvdb::math::Transform& transform, const openvdb::Coord& c, bool& edge) {
+NormalVector gradientNormalAt(Probe&& probe, const openvdb::math::MapBase& map, const openvdb::Coord& c, bool& edge) {
     openvdb::Vec3d g;
     ValueT centre{};
     probe(c, centre);
@@ -65,7 +67,7 @@ NormalVector gradientNormalAt(Probe&& probe, const openvdb::math::Transform& tra
             g[axis] = onP ? double(vp) - double(centre) : onM ? double(centre) - double(vm) : 0.0;
         }
     }
-    return normalised(transform.baseMap()->applyIJT(g, transform.indexToWorld(c)));
+    return normalised(map.applyIJT(g, map.applyMap(c.asVec3d())));  // Transform::indexToWorld(c)
 }
 
 // The normal a vec3 normal grid's value gives.
