@@ -257,6 +257,42 @@ private:
         // The active voxels of brick b of the loaded leaf at `origin`.
         uint64_t brickMask(const openvdb::Coord& origin, unsigned b) const { return leaves_.at(origin).masks[b]; }
 
+        // The loaded leaf at `origin` and the voxels beside its six faces
+        // (probeValue's answers), in a 10^3 block: voxel (x, y, z) of the
+        // leaf, -1..8 on each axis, at index (x+1) + 10 (y+1) + 100 (z+1).
+        // The block's edges and corners are not filled: a six-neighbour
+        // stencil never reads them.
+        struct Block {
+            std::array<ValueT, 1000> value{};
+            std::array<uint8_t, 1000> on{};
+            static int at(int x, int y, int z) { return (x + 1) + 10 * (y + 1) + 100 * (z + 1); }
+        };
+        void fill(const openvdb::Coord& origin, Block& block, Cursor& cursor) const {
+            block.on.fill(0);
+            const LeafData& leaf = leaves_.at(origin);
+            for (unsigned b = 0; b < 8; ++b) {
+                const openvdb::Coord corner = detail::brickCorner(openvdb::Coord(0), b);
+                size_t n = leaf.firstValue[b];
+                for (uint64_t bits = leaf.masks[b]; bits; bits &= bits - 1, ++n) {
+                    const int bit = std::countr_zero(bits);
+                    const int i = Block::at(corner.x() + (bit & 3), corner.y() + ((bit >> 2) & 3), corner.z() + (bit >> 4));
+                    block.on[size_t(i)] = 1;
+                    block.value[size_t(i)] = detail::valueFromBytes<ValueT>(leaf.values.data() + n * sizeof(ValueT));
+                }
+            }
+            for (int axis = 0; axis < 3; ++axis)
+                for (int side : {-1, 8})
+                    for (int u = 0; u < 8; ++u)
+                        for (int w = 0; w < 8; ++w) {
+                            int local[3];
+                            local[axis] = side;
+                            local[(axis + 1) % 3] = u;
+                            local[(axis + 2) % 3] = w;
+                            const int i = Block::at(local[0], local[1], local[2]);
+                            block.on[size_t(i)] = probe(origin.offsetBy(local[0], local[1], local[2]), block.value[size_t(i)], cursor);
+                        }
+        }
+
     private:
         struct LeafData {
             uint64_t masks[8] = {};       // brick b's active voxels
@@ -336,7 +372,8 @@ private:
                 const int32_t half = int32_t(1) << (tiles.tiles[t].log2Size - 1);
                 bool edge = false;
                 typename Neighbourhood::Cursor cursor;
-                store(tileNormals_.tiles, t, normalAt(around, cursor, openvdb::Coord(tiles.tiles[t].x + half, tiles.tiles[t].y + half, tiles.tiles[t].z + half), edge));
+                const auto probe = [&](const openvdb::Coord& at, ValueT& v) { return around.probe(at, v, cursor); };
+                store(tileNormals_.tiles, t, normalAt(probe, openvdb::Coord(tiles.tiles[t].x + half, tiles.tiles[t].y + half, tiles.tiles[t].z + half), edge));
                 oneSided_ += edge ? 1 : 0;
             }
             oneSided_ += grid.bandEdges_;
@@ -384,15 +421,27 @@ private:
             }
             if (withValues_) {
                 values.bricks.resize(first.back() * sizeof(detail::NormalVector));
-                tbb::parallel_for(tbb::blocked_range<size_t>(0, topology.bricks.size(), 16), [&](const auto& range) {
+                std::vector<size_t> firstBrick{0};  // each leaf's first brick in `topology`
+                for (const auto& [leafIndex, bricks] : it->second.leaves) firstBrick.push_back(firstBrick.back() + size_t(std::popcount(bricks)));
+                tbb::parallel_for(tbb::blocked_range<size_t>(0, it->second.leaves.size(), 4), [&](const auto& range) {
                     typename Neighbourhood::Cursor cursor;
-                    for (size_t i = range.begin(); i != range.end(); ++i) {
-                        const Brick& brick = topology.bricks[i];
-                        uint64_t out = first[i];
-                        for (uint64_t bits = brick.mask; bits; bits &= bits - 1, ++out) {
-                            const int bit = std::countr_zero(bits);
-                            bool edge = false;
-                            store(values.bricks, out, normalAt(around, cursor, openvdb::Coord(brick.x + (bit & 3), brick.y + ((bit >> 2) & 3), brick.z + (bit >> 4)), edge));
+                    auto block = std::make_unique<typename Neighbourhood::Block>();
+                    for (size_t l = range.begin(); l != range.end(); ++l) {
+                        const openvdb::Coord origin = grid_.leaves_[it->second.leaves[l].first].origin;
+                        around.fill(origin, *block, cursor);
+                        const auto probe = [&](const openvdb::Coord& at, ValueT& v) {
+                            const size_t i = size_t(Neighbourhood::Block::at(at.x() - origin.x(), at.y() - origin.y(), at.z() - origin.z()));
+                            v = block->value[i];
+                            return block->on[i] != 0;
+                        };
+                        for (size_t i = firstBrick[l]; i != firstBrick[l + 1]; ++i) {
+                            const Brick& brick = topology.bricks[i];
+                            uint64_t out = first[i];
+                            for (uint64_t bits = brick.mask; bits; bits &= bits - 1, ++out) {
+                                const int bit = std::countr_zero(bits);
+                                bool edge = false;
+                                store(values.bricks, out, normalAt(probe, openvdb::Coord(brick.x + (bit & 3), brick.y + ((bit >> 2) & 3), brick.z + (bit >> 4)), edge));
+                            }
                         }
                     }
                 });
@@ -410,14 +459,14 @@ private:
         static void store(std::vector<uint8_t>& out, size_t index, const detail::NormalVector& v) {
             std::memcpy(&out[index * sizeof(v)], v.data(), sizeof(v));
         }
-        detail::NormalVector normalAt(const Neighbourhood& around, typename Neighbourhood::Cursor& cursor, const openvdb::Coord& c, bool& edge) const {
+        // `probe(coord, ValueT&)` -> bool: OpenVDB's probeValue.
+        template <typename Probe>
+        detail::NormalVector normalAt(Probe&& probe, const openvdb::Coord& c, bool& edge) const {
             if constexpr (std::is_same_v<ValueT, float> || std::is_same_v<ValueT, double>) {
-                if (grid_.normalKind_ == NormalsOf::Gradient)
-                    return detail::gradientNormalAt<ValueT>([&](const openvdb::Coord& at, ValueT& v) { return around.probe(at, v, cursor); }, *grid_.map_,
-                                                            c, edge);
+                if (grid_.normalKind_ == NormalsOf::Gradient) return detail::gradientNormalAt<ValueT>(probe, *grid_.map_, c, edge);
             } else if constexpr (std::is_same_v<ValueT, openvdb::Vec3s> || std::is_same_v<ValueT, openvdb::Vec3d> || std::is_same_v<ValueT, openvdb::Vec3i>) {
                 ValueT v{};
-                around.probe(c, v, cursor);
+                probe(c, v);
                 return detail::vectorNormal(v);
             }
             return {0.f, 0.f, 0.f};
@@ -438,10 +487,29 @@ private:
         std::atomic<uint64_t> edges{0};
         tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 64), [&](const auto& range) {
             auto acc = grid.getConstAccessor();
+            std::array<uint8_t, 1000> on;  // the leaf and its face neighbours, as Neighbourhood::Block
+            const auto at = [](int x, int y, int z) { return size_t((x + 1) + 10 * (y + 1) + 100 * (z + 1)); };
             uint64_t local = 0;
-            for (size_t i = range.begin(); i != range.end(); ++i)
-                for (auto v = leaves[i]->cbeginValueOn(); v; ++v)
-                    if (detail::bandEdgeAt([&](const openvdb::Coord& at) { return acc.isValueOn(at); }, v.getCoord())) ++local;
+            for (size_t i = range.begin(); i != range.end(); ++i) {
+                const openvdb::Coord origin = leaves[i]->origin();
+                on.fill(0);
+                for (auto v = leaves[i]->cbeginValueOn(); v; ++v) {
+                    const openvdb::Coord c = v.getCoord() - origin;
+                    on[at(c.x(), c.y(), c.z())] = 1;
+                }
+                for (int axis = 0; axis < 3; ++axis)
+                    for (int side : {-1, 8})
+                        for (int u = 0; u < 8; ++u)
+                            for (int w = 0; w < 8; ++w) {
+                                int l[3];
+                                l[axis] = side, l[(axis + 1) % 3] = u, l[(axis + 2) % 3] = w;
+                                on[at(l[0], l[1], l[2])] = acc.isValueOn(origin.offsetBy(l[0], l[1], l[2]));
+                            }
+                for (auto v = leaves[i]->cbeginValueOn(); v; ++v) {
+                    const openvdb::Coord c = v.getCoord() - origin;
+                    if (detail::bandEdgeAt([&](const openvdb::Coord& n) { return on[at(n.x(), n.y(), n.z())] != 0; }, c)) ++local;
+                }
+            }
             edges += local;
         });
         return edges.load();
