@@ -80,7 +80,7 @@ public:
         // is allocated before anything can fail, and leaked.
         auto holder = std::make_unique<typename GridT::Ptr>();
         try {
-            if (normals == NormalsOf::Gradient) bandEdges_ = countBandEdges(*grid);
+            if (normals == NormalsOf::Gradient) bandEdges_ = detail::countBandEdges(*grid);
             summarise(*grid);
         } catch (...) {
             *holder = std::move(grid);
@@ -478,42 +478,6 @@ private:
         CubeIndexMap index_;
         bool withValues_ = false;
     };
-
-    // The gradient's one-sided voxels (the report counts them), from the
-    // value masks alone, which delayed loading has read: no buffer is loaded.
-    static uint64_t countBandEdges(const GridT& grid) {
-        std::vector<const LeafT*> leaves;
-        for (auto it = grid.tree().cbeginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
-        std::atomic<uint64_t> edges{0};
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 64), [&](const auto& range) {
-            auto acc = grid.getConstAccessor();
-            std::array<uint8_t, 1000> on;  // the leaf and its face neighbours, as Neighbourhood::Block
-            const auto at = [](int x, int y, int z) { return size_t((x + 1) + 10 * (y + 1) + 100 * (z + 1)); };
-            uint64_t local = 0;
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                const openvdb::Coord origin = leaves[i]->origin();
-                on.fill(0);
-                for (auto v = leaves[i]->cbeginValueOn(); v; ++v) {
-                    const openvdb::Coord c = v.getCoord() - origin;
-                    on[at(c.x(), c.y(), c.z())] = 1;
-                }
-                for (int axis = 0; axis < 3; ++axis)
-                    for (int side : {-1, 8})
-                        for (int u = 0; u < 8; ++u)
-                            for (int w = 0; w < 8; ++w) {
-                                int l[3];
-                                l[axis] = side, l[(axis + 1) % 3] = u, l[(axis + 2) % 3] = w;
-                                on[at(l[0], l[1], l[2])] = acc.isValueOn(origin.offsetBy(l[0], l[1], l[2]));
-                            }
-                for (auto v = leaves[i]->cbeginValueOn(); v; ++v) {
-                    const openvdb::Coord c = v.getCoord() - origin;
-                    if (detail::bandEdgeAt([&](const openvdb::Coord& n) { return on[at(n.x(), n.y(), n.z())] != 0; }, c)) ++local;
-                }
-            }
-            edges += local;
-        });
-        return edges.load();
-    }
 
     // Finds leaves and active tiles by position (for the normals).
     void indexNeighbours() {
