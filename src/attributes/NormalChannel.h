@@ -49,6 +49,27 @@ bool isSupportedNormalBits(unsigned bits);
 // of every entry. `oneSided` and `source` are copied into the report.
 NormalChannel encodeNormals(std::span<const std::array<float, 3>> normals, unsigned bits, NormalReport::Source source, uint64_t oneSided);
 
+// The same a piece at a time, so that a channel is never held as exact
+// normals: quantise() turns a piece of exact normals (3 x float each) into
+// its codes and angular errors in place (12 bytes each still; any thread,
+// any order), add() takes the pieces in attribute order. finish() gives
+// encodeNormals' channel, bit for bit (the errors are summed in the same
+// order).
+class NormalQuantizer {
+public:
+    explicit NormalQuantizer(unsigned bits);
+    void quantise(std::span<uint8_t> piece) const;
+    void add(std::span<const uint8_t> quantised);
+    NormalChannel finish(NormalReport::Source source, uint64_t oneSided);
+
+private:
+    void quantiseEntry(std::span<uint8_t> entry) const;
+    unsigned bits_;
+    std::vector<uint8_t> codes_;
+    uint64_t entries_ = 0, zeroLength_ = 0;
+    double sumAngle_ = 0, maxAngle_ = 0;
+};
+
 // Serialisation of the Normals section (see SsvdagFile.cpp); the reader
 // checks the bit count, the entry count against `expectedEntries` and that
 // every stored code fits in `bits` bits. Throws Error("<what>: ...").

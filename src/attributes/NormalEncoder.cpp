@@ -2,8 +2,11 @@
 // palette-compressed. An encoder's part; reading a channel: NormalChannel.cpp.
 #include "src/attributes/NormalChannel.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+
+#include <tbb/parallel_for.h>
 
 #include "src/attributes/OctahedralNormal.h"
 #include "src/attributes/PaletteCompressor.h"
@@ -11,31 +14,71 @@
 
 namespace vdbdag::attributes {
 
-NormalChannel encodeNormals(std::span<const std::array<float, 3>> normals, unsigned bits, NormalReport::Source source, uint64_t oneSided) {
+// A quantised entry: its code (u32), then its angular error (double, >= 0;
+// -1: no direction), in the 12 bytes of its exact normal.
+constexpr size_t kEntry = sizeof(std::array<float, 3>);
+static_assert(kEntry == sizeof(uint32_t) + sizeof(double));
+
+NormalQuantizer::NormalQuantizer(unsigned bits) : bits_(bits) {
     if (bits < 4 || bits > 32 || bits % 2) throw Error("internal error: ONV bits must be even, 4..32");
-    NormalChannel channel;
-    channel.bits = bits;
-    channel.report.source = source;
-    channel.report.entries = normals.size();
-    channel.report.oneSided = oneSided;
-    std::vector<uint8_t> codes(normals.size() * 4);
-    double sumAngle = 0;
-    for (size_t i = 0; i < normals.size(); ++i) {
+}
+
+void NormalQuantizer::quantise(std::span<uint8_t> piece) const {
+    if (piece.size() % kEntry) throw Error("internal error: normals are 12 bytes each");
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, piece.size() / kEntry, 4096), [&](const auto& range) {
+        for (size_t i = range.begin(); i != range.end(); ++i) quantiseEntry(piece.subspan(i * kEntry, kEntry));
+    });
+}
+
+void NormalQuantizer::quantiseEntry(std::span<uint8_t> piece) const {
+    for (size_t at = 0; at < piece.size(); at += kEntry) {
+        std::array<float, 3> normal;
+        std::memcpy(normal.data(), &piece[at], kEntry);
         bool zero = false;
-        const OctahedralCode c = encodeOctahedral(normals[i], bits, &zero);
-        std::memcpy(&codes[i * 4], &c.bits, 4);
-        if (zero) {
-            ++channel.report.zeroLength;
+        const OctahedralCode c = encodeOctahedral(normal, bits_, &zero);
+        const double angle = zero ? -1.0 : angleDegrees(decodeOctahedral(c, bits_), normal);
+        std::memcpy(&piece[at], &c.bits, sizeof(uint32_t));
+        std::memcpy(&piece[at + sizeof(uint32_t)], &angle, sizeof(double));
+    }
+}
+
+void NormalQuantizer::add(std::span<const uint8_t> quantised) {
+    for (size_t at = 0; at + kEntry <= quantised.size(); at += kEntry) {
+        codes_.insert(codes_.end(), quantised.begin() + long(at), quantised.begin() + long(at + sizeof(uint32_t)));
+        ++entries_;
+        double angle;
+        std::memcpy(&angle, &quantised[at + sizeof(uint32_t)], sizeof(double));
+        if (angle == -1.0) {
+            ++zeroLength_;
             continue;
         }
-        const double angle = angleDegrees(decodeOctahedral(c, bits), normals[i]);
-        sumAngle += angle;
-        channel.report.maxAngleDegrees = std::max(channel.report.maxAngleDegrees, angle);
+        sumAngle_ += angle;
+        maxAngle_ = std::max(maxAngle_, angle);
     }
-    const uint64_t measured = channel.report.entries - channel.report.zeroLength;
-    channel.report.meanAngleDegrees = measured ? sumAngle / double(measured) : 0.0;
-    channel.codes = compressPalette(codes, 4);
+}
+
+NormalChannel NormalQuantizer::finish(NormalReport::Source source, uint64_t oneSided) {
+    NormalChannel channel;
+    channel.bits = bits_;
+    channel.report.source = source;
+    channel.report.entries = entries_;
+    channel.report.oneSided = oneSided;
+    channel.report.zeroLength = zeroLength_;
+    channel.report.maxAngleDegrees = maxAngle_;
+    const uint64_t measured = entries_ - zeroLength_;
+    channel.report.meanAngleDegrees = measured ? sumAngle_ / double(measured) : 0.0;
+    channel.codes = compressPalette(codes_, 4);
+    codes_ = {};
     return channel;
+}
+
+NormalChannel encodeNormals(std::span<const std::array<float, 3>> normals, unsigned bits, NormalReport::Source source, uint64_t oneSided) {
+    NormalQuantizer quantizer(bits);
+    std::vector<uint8_t> piece(normals.size() * kEntry);
+    if (!piece.empty()) std::memcpy(piece.data(), normals.data(), piece.size());
+    quantizer.quantise(piece);
+    quantizer.add(piece);
+    return quantizer.finish(source, oneSided);
 }
 
 } // namespace vdbdag::attributes

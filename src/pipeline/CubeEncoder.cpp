@@ -202,6 +202,7 @@ struct ValueStream {
     attributes::ValueWindowWriter* palette = nullptr;
     attributes::PredictedWindowWriter* predicted = nullptr;
     attributes::ScalarQuantizer* quantizer = nullptr;  // lossy: each subtree's values quantised in attribute order
+    attributes::NormalQuantizer* normals = nullptr;    // normals: quantised as gathered (in parallel), added in order
 };
 
 // The layer's values in attribute order, cube by cube. With several
@@ -255,6 +256,7 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
                 piece.gathered.resize(entriesOf(piece.index) * vs);
                 gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, piece.gathered.data(), s.firstEntry,
                               stream->predicted ? &piece.layout : nullptr, stream->predicted && (vs == 4 || vs == 12) ? &piece.places : nullptr);
+                if (stream->normals) stream->normals->quantise(piece.gathered);
             } else {
                 gatherSubtree(dag, s, large ? largeTopology : piece.topology, large ? largeValues : piece.values, vs, attributes.data(), firstEntry);
             }
@@ -264,7 +266,8 @@ std::vector<uint8_t> gatherLayer(CubeSource& source, Layer layer, const LayerPla
         [&](Piece& piece) {
             if (stream && stream->quantizer) stream->quantizer->apply(piece.gathered);
             if (stream && stream->predicted) stream->predicted->add(piece.gathered, piece.layout, piece.places);
-            else if (stream) stream->palette->add(piece.gathered);
+            else if (stream && stream->palette) stream->palette->add(piece.gathered);
+            else if (stream && stream->normals) stream->normals->add(piece.gathered);
             piece.gathered = {};
             piece.layout = {};
             piece.places = {};
@@ -492,15 +495,20 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
                 if (team.isRoot()) codeActiveValues(dag, trial, source.header(), options);
             }
             if (withNormals) {  // the normals in the same attribute order, from their own source
-                const std::vector<uint8_t> raw = gatherLayer(*normals->cubes, Layer::Active, layerPlan, dag, sizeof(std::array<float, 3>), budget, team,
-                                                             options.onStepProgress);
-                std::vector<std::array<float, 3>> exact(raw.size() / sizeof(std::array<float, 3>));
-                if (!raw.empty()) std::memcpy(exact.data(), raw.data(), raw.size());
-                if (team.isRoot())
-                    trial.normals = attributes::encodeNormals(exact, options.normalBits,
-                                                              normals->fromNormalGrid ? attributes::NormalReport::Source::NormalGrid
-                                                                                      : attributes::NormalReport::Source::Gradient,
-                                                              normals->oneSided);
+                const auto normalSource = normals->fromNormalGrid ? attributes::NormalReport::Source::NormalGrid : attributes::NormalReport::Source::Gradient;
+                constexpr unsigned kNormalBytes = sizeof(std::array<float, 3>);
+                if (team.size() == 1) {  // quantised piece by piece: never held as exact normals
+                    attributes::NormalQuantizer quantizer(options.normalBits);
+                    ValueStream toCodes;
+                    toCodes.normals = &quantizer;
+                    gatherLayer(*normals->cubes, Layer::Active, layerPlan, dag, kNormalBytes, budget, team, options.onStepProgress, &toCodes);
+                    trial.normals = quantizer.finish(normalSource, normals->oneSided);
+                } else {  // process 0 receives them all (the mean error is summed in attribute order)
+                    const std::vector<uint8_t> raw = gatherLayer(*normals->cubes, Layer::Active, layerPlan, dag, kNormalBytes, budget, team, options.onStepProgress);
+                    std::vector<std::array<float, 3>> exact(raw.size() / kNormalBytes);
+                    if (!raw.empty()) std::memcpy(exact.data(), raw.data(), raw.size());
+                    if (team.isRoot()) trial.normals = attributes::encodeNormals(exact, options.normalBits, normalSource, normals->oneSided);
+                }
             }
             return trial.storedBytes();
         };

@@ -2,12 +2,18 @@
 // angular bound 0.95 deg * 2^((16-k)/2) over a dense sphere of directions,
 // the axes, the z = 0 seam and +-0 components (no NaN); CIELAB against
 // published reference values; ΔE*94 against a published pair and its
-// symmetric cases.
+// symmetric cases. A normal channel quantised piece by piece against each
+// entry's own octahedral code and a plain sum of its angular errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
 
 #include "src/attributes/CieLab.h"
+#include "src/attributes/NormalChannel.h"
 #include "src/attributes/OctahedralNormal.h"
 
 using namespace vdbdag::attributes;
@@ -65,6 +71,59 @@ TEST(OctahedralNormal, ZeroLengthInputIsReportedAndEncodesPlusZ) {
     const auto nanIn = decodeOctahedral(encodeOctahedral({NAN, 0, 0}, 16, &zero), 16);
     EXPECT_TRUE(zero);
     EXPECT_TRUE(std::isfinite(nanIn[0]));
+}
+
+// NormalQuantizer (the cube encoder's streamed normals): pieces of any size,
+// quantised in any order and added in attribute order, give the channel
+// whose codes are each entry's encodeOctahedral, whose zero-length count is
+// that of the zero and non-finite entries, and whose mean and max are the
+// plain sum and max of the other entries' errors; encodeNormals the same.
+TEST(NormalQuantizer, PiecesInAnyOrderGiveEachEntrysCodeAndThePlainStatistics) {
+    std::mt19937 rng(5);
+    std::normal_distribution<float> gauss;
+    std::vector<std::array<float, 3>> normals(50000);
+    for (size_t i = 0; i < normals.size(); ++i) {
+        normals[i] = {gauss(rng), gauss(rng), gauss(rng)};
+        if (i % 97 == 0) normals[i] = {0.0f, -0.0f, 0.0f};
+        if (i % 211 == 0) normals[i][1] = std::numeric_limits<float>::quiet_NaN();
+    }
+    const unsigned bits = 16;
+    uint64_t zero = 0;
+    double sum = 0, worst = 0;
+    std::vector<uint32_t> codes;
+    for (const auto& n : normals) {
+        bool z = false;
+        const OctahedralCode c = encodeOctahedral(n, bits, &z);
+        codes.push_back(c.bits);
+        if (z) {
+            ++zero;
+            continue;
+        }
+        const double a = angleDegrees(decodeOctahedral(c, bits), n);
+        sum += a;
+        worst = std::max(worst, a);
+    }
+    auto check = [&](const NormalChannel& channel) {
+        ASSERT_EQ(channel.entryCount(), normals.size());
+        for (size_t i = 0; i < normals.size(); ++i) ASSERT_EQ(channel.code(i), codes[i]) << i;
+        EXPECT_EQ(channel.report.zeroLength, zero);
+        EXPECT_EQ(channel.report.meanAngleDegrees, sum / double(normals.size() - zero));
+        EXPECT_EQ(channel.report.maxAngleDegrees, worst);
+        EXPECT_EQ(channel.report.oneSided, 7u);
+    };
+    check(encodeNormals(normals, bits, NormalReport::Source::Gradient, 7));
+    // Pieces of 1 to 5000 entries, quantised last first.
+    std::vector<std::vector<uint8_t>> pieces;
+    for (size_t at = 0; at < normals.size();) {
+        const size_t n = std::min<size_t>(normals.size() - at, 1 + rng() % 5000);
+        pieces.emplace_back(n * 12);
+        std::memcpy(pieces.back().data(), &normals[at], n * 12);
+        at += n;
+    }
+    NormalQuantizer quantizer(bits);
+    for (size_t k = pieces.size(); k-- > 0;) quantizer.quantise(pieces[k]);
+    for (const auto& piece : pieces) quantizer.add(piece);
+    check(quantizer.finish(NormalReport::Source::Gradient, 7));
 }
 
 TEST(CieLab, PublishedReferenceValues) {

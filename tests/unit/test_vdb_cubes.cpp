@@ -105,18 +105,39 @@ fs::path writeAllTypes(const std::string& name, uint32_t codec, bool half, int s
     return path;
 }
 
-// A level-set sphere with active tiles beside some of its leaves (a voxel
-// whose neighbour lies in a tile reads the tile's value), for --normals.
-fs::path writeSphereBesideTiles(const std::string& name) {
+// A level-set sphere (float, float saved as half, or double) with active
+// tiles beside its band, for --normals: 8^3 tiles beside leaves whose +y
+// face holds active voxels, and a 128^3 tile beside the band's +x end (a
+// voxel whose neighbour lies in a tile reads the tile's value). Checks
+// with OpenVDB that voxels beside both kinds of tile exist.
+template <typename GridT>
+fs::path writeSphereBesideTiles(const std::string& name, bool half = false) {
+    using V = typename GridT::ValueType;
     openvdb::initialize();
-    auto g = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(20.0f, openvdb::Vec3f(0.3f, -0.2f, 0.1f), 1.0f, 3.0f);
+    auto g = openvdb::tools::createLevelSetSphere<GridT>(V(24), openvdb::Vec3f(100.3f, 0.2f, 0.1f), 1.0f, 3.0f);  // the band reaches x = 127
     g->setName("ball");
+    auto& tree = g->tree();
     std::vector<openvdb::Coord> beside;
-    for (auto leaf = g->tree().cbeginLeaf(); leaf && beside.size() < 6; ++leaf) {
-        const openvdb::Coord o = leaf->origin().offsetBy(8, 0, 0);
-        if (!g->tree().probeConstLeaf(o) && !g->tree().isValueOn(o)) beside.push_back(o);
+    for (auto leaf = tree.cbeginLeaf(); leaf && beside.size() < 6; ++leaf) {
+        const openvdb::Coord o = leaf->origin().offsetBy(0, 8, 0);
+        if (tree.probeConstLeaf(o) || tree.isValueOn(o) || std::find(beside.begin(), beside.end(), o) != beside.end()) continue;
+        bool onFace = false;
+        for (int x = 0; x < 8; ++x)
+            for (int z = 0; z < 8; ++z) onFace = onFace || leaf->isValueOn(leaf->origin().offsetBy(x, 7, z));
+        if (onFace) beside.push_back(o);
     }
-    for (size_t i = 0; i < beside.size(); ++i) g->tree().addTile(1, beside[i], 0.25f * float(i), true);
+    for (size_t i = 0; i < beside.size(); ++i) tree.addTile(1, beside[i], V(0.25 * double(i)), true);
+    tree.addTile(2, openvdb::Coord(128, 0, 0), V(-0.5), true);
+    int besideSmall = 0, besideLarge = 0;
+    for (auto v = tree.cbeginLeaf(); v; ++v)
+        for (auto on = v->cbeginValueOn(); on; ++on) {
+            const openvdb::Coord c = on.getCoord();
+            besideSmall += tree.isValueOn(c.offsetBy(0, 1, 0)) && !tree.probeConstLeaf(c.offsetBy(0, 1, 0)) && c.x() < 128;
+            besideLarge += c.x() == 127 && c.y() >= 0 && c.z() >= 0;
+        }
+    EXPECT_GT(besideSmall, 0) << "no voxel beside an 8^3 tile";
+    EXPECT_GT(besideLarge, 0) << "no voxel beside the 128^3 tile";
+    g->setSaveFloatAsHalf(half);
     const fs::path path = tempDir() / (name + ".vdb");
     openvdb::io::File(path.string()).write({g});
     return path;
@@ -182,10 +203,20 @@ TEST(VdbCubes, CliMemoryLimitAndThreadsDoNotChangeTheBytes) {
     EXPECT_EQ(vdbdag::testing::runShell("cmp " + a.string() + " " + c.string()).exitCode, 0);
     const auto bad = vdbdag::testing::runCli("encode " + in.string() + " -o " + b.string() + " -f --memory-limit lots");
     EXPECT_NE(bad.exitCode, 0);
-    ASSERT_EQ(vdbdag::testing::runCli("encode " + in.string() + " -o " + a.string() + " -f --normals 16").exitCode, 0);
-    const auto normals = vdbdag::testing::runCli("encode " + in.string() + " -o " + b.string() + " -f --memory-limit 1M --threads 1 --normals 16");
-    ASSERT_EQ(normals.exitCode, 0) << normals.err;
-    EXPECT_EQ(vdbdag::testing::runShell("cmp " + a.string() + " " + b.string()).exitCode, 0) << "--normals under --memory-limit";
+    // --normals under --memory-limit: the whole grid's file (the library's
+    // import and in-memory encode), a level set with tiles beside its band.
+    const fs::path ball = writeSphereBesideTiles<openvdb::FloatGrid>("cli_ball");
+    bridge::ImportOptions io;
+    io.normals = true;
+    pipeline::EncodeOptions withNormals;
+    withNormals.normalBits = 16;
+    const std::vector<uint8_t> whole = inMemoryFile(ball, io, withNormals);
+    for (const std::string limit : {"", " --memory-limit 1M --threads 1"}) {
+        const auto normals = vdbdag::testing::runCli("encode " + ball.string() + " -o " + b.string() + " -f --normals 16" + limit);
+        ASSERT_EQ(normals.exitCode, 0) << normals.err;
+        std::ifstream file(b, std::ios::binary);
+        EXPECT_EQ(std::vector<uint8_t>(std::istreambuf_iterator<char>(file), {}), whole) << "--normals 16" << limit;
+    }
 }
 
 // --normals read region by region: each cube's normals, the gradient with a
@@ -196,12 +227,17 @@ TEST(VdbCubes, CliMemoryLimitAndThreadsDoNotChangeTheBytes) {
 // as half), double and vec3 grids.
 TEST(VdbCubes, NormalsAcrossCubesGiveTheInMemoryBytes) {
     const std::vector<fs::path> inputs{writeAllTypes("normals_all", openvdb::io::COMPRESS_BLOSC, false, 31),
-                                       writeAllTypes("normals_half", openvdb::io::COMPRESS_ZIP, true, 32), writeSphereBesideTiles("normals_ball")};
+                                       writeAllTypes("normals_half", openvdb::io::COMPRESS_ZIP, true, 32),
+                                       writeSphereBesideTiles<openvdb::FloatGrid>("normals_ball"),
+                                       writeSphereBesideTiles<openvdb::FloatGrid>("normals_ball_half", true),
+                                       writeSphereBesideTiles<openvdb::DoubleGrid>("normals_ball_double")};
     pipeline::EncodeOptions options;
     options.normalBits = 16;
-    for (const fs::path& path : inputs)
+    for (size_t k = 0; k < inputs.size(); ++k)
         for (const std::string normalGrid : {"", "Cd"}) {
-            if (path == inputs[2] && !normalGrid.empty()) continue;
+            const fs::path& path = inputs[k];
+            const bool ball = k >= 2;
+            if (ball && !normalGrid.empty()) continue;
             SCOPED_TRACE(path.string() + " --normal-grid '" + normalGrid + "'");
             bridge::ImportOptions io;
             io.normals = true;
@@ -209,7 +245,7 @@ TEST(VdbCubes, NormalsAcrossCubesGiveTheInMemoryBytes) {
             const std::vector<uint8_t> whole = inMemoryFile(path, io, options);
             const auto scene = format::readScene(whole, "whole");
             EXPECT_EQ(std::count_if(scene.grids.begin(), scene.grids.end(), [](const auto& g) { return g.normals.has_value(); }),
-                      path == inputs[2] || !normalGrid.empty() ? 1 : 2);
+                      ball || !normalGrid.empty() ? 1 : 2);
             for (unsigned cube : {3u, 4u, 7u}) EXPECT_EQ(byCubesFile(path, cube, io, options), whole) << "cubes of 2^" << cube;
             EXPECT_EQ(byCubesFile(path, std::nullopt, io, options), whole) << "default budget";
         }
@@ -248,13 +284,18 @@ TEST(VdbCubes, MpirunGivesTheSingleProcessBytes) {
             EXPECT_EQ(vdbdag::testing::runShell("cmp " + single.string() + " " + out.string()).exitCode, 0) << ranks << " processes";
         }
     }
-    // --normals: each process computes the normals of its cubes.
-    const fs::path single = tempDir() / "normals_single.ssvdag", two = tempDir() / "normals_np2.ssvdag";
-    ASSERT_EQ(vdbdag::testing::runCli("encode " + inputs[0].string() + " -o " + single.string() + " -f --normals 12").exitCode, 0);
+    // --normals: each process computes the normals of its cubes; the file
+    // is the whole grid's (the library's import and in-memory encode).
+    const fs::path ball = writeSphereBesideTiles<openvdb::FloatGrid>("mpi_ball"), two = tempDir() / "normals_np2.ssvdag";
+    bridge::ImportOptions io;
+    io.normals = true;
+    pipeline::EncodeOptions withNormals;
+    withNormals.normalBits = 12;
     const auto run = vdbdag::testing::runShell(std::string(VDBDAG_MPIRUN) + " --oversubscribe --allow-run-as-root -np 2 " + VDBDAG_MPI_BINARY + " encode " +
-                                               inputs[0].string() + " -o " + two.string() + " -f --normals 12 --memory-limit 8M");
+                                               ball.string() + " -o " + two.string() + " -f --normals 12 --memory-limit 8M");
     ASSERT_EQ(run.exitCode, 0) << run.err;
-    EXPECT_EQ(vdbdag::testing::runShell("cmp " + single.string() + " " + two.string()).exitCode, 0) << "--normals, 2 processes";
+    std::ifstream file(two, std::ios::binary);
+    EXPECT_EQ(std::vector<uint8_t>(std::istreambuf_iterator<char>(file), {}), inMemoryFile(ball, io, withNormals)) << "--normals, 2 processes";
     // A failing run (an output that is the input) ends every process with an error.
     const auto bad = vdbdag::testing::runShell(std::string(VDBDAG_MPIRUN) + " --oversubscribe --allow-run-as-root -np 2 " + VDBDAG_MPI_BINARY +
                                                " encode " + inputs[0].string() + " -o " + inputs[0].string() + " -f");

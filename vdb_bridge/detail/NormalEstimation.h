@@ -74,38 +74,45 @@ NormalVector gradientNormalAt(Probe&& probe, const openvdb::math::MapBase& map, 
 }
 
 // The active voxels at the band's edge (bandEdgeAt) of the whole grid, from
-// the value masks alone (a grid read with delayed loading loads no leaf
-// buffer for them): each leaf and the voxels beside its six faces in a 10^3
-// block, as the region-by-region reader (VdbCubes) holds them.
+// the value masks alone: each leaf and the voxels beside its six faces in a
+// 10^3 block. No ValueAccessor: one caches the leaves it passes, and
+// caching a leaf of a grid read with delayed loading loads its values; a
+// leaf's mask and the tree's own isValueOn do not.
 template <typename GridT>
 uint64_t countBandEdges(const GridT& grid) {
-    std::vector<const typename GridT::TreeType::LeafNodeType*> leaves;
-    for (auto it = grid.tree().cbeginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
+    using LeafT = typename GridT::TreeType::LeafNodeType;
+    const auto& tree = grid.tree();
+    std::vector<const LeafT*> leaves;
+    for (auto it = tree.cbeginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
     std::atomic<uint64_t> edges{0};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 64), [&](const auto& range) {
-        auto acc = grid.getConstAccessor();
         std::array<uint8_t, 1000> on;  // leaf voxel (x, y, z), -1..8 each, at (x+1) + 10 (y+1) + 100 (z+1)
         const auto at = [](int x, int y, int z) { return size_t((x + 1) + 10 * (y + 1) + 100 * (z + 1)); };
         uint64_t local = 0;
         for (size_t i = range.begin(); i != range.end(); ++i) {
-            const openvdb::Coord origin = leaves[i]->origin();
+            const LeafT& leaf = *leaves[i];
+            const openvdb::Coord origin = leaf.origin();
             on.fill(0);
-            for (auto v = leaves[i]->cbeginValueOn(); v; ++v) {
-                const openvdb::Coord c = v.getCoord() - origin;
+            for (auto n = leaf.getValueMask().beginOn(); n; ++n) {
+                const openvdb::Coord c = LeafT::offsetToLocalCoord(n.pos());
                 on[at(c.x(), c.y(), c.z())] = 1;
             }
             for (int axis = 0; axis < 3; ++axis)
-                for (int side : {-1, 8})
+                for (int side : {-1, 8}) {
+                    openvdb::Coord beside = origin;
+                    beside[axis] += side < 0 ? -8 : 8;
+                    const LeafT* other = tree.probeConstLeaf(beside);
+                    const bool tileOn = !other && tree.isValueOn(beside);  // no leaf there: one tile (or none) holds all of it
                     for (int u = 0; u < 8; ++u)
                         for (int w = 0; w < 8; ++w) {
                             int l[3];
                             l[axis] = side, l[(axis + 1) % 3] = u, l[(axis + 2) % 3] = w;
-                            on[at(l[0], l[1], l[2])] = acc.isValueOn(origin.offsetBy(l[0], l[1], l[2]));
+                            const openvdb::Coord c = origin.offsetBy(l[0], l[1], l[2]);
+                            on[at(l[0], l[1], l[2])] = other ? other->getValueMask().isOn(LeafT::coordToOffset(c)) : tileOn;
                         }
-            for (auto v = leaves[i]->cbeginValueOn(); v; ++v) {
-                const openvdb::Coord c = v.getCoord() - origin;
-                if (bandEdgeAt([&](const openvdb::Coord& n) { return on[at(n.x(), n.y(), n.z())] != 0; }, c)) ++local;
-            }
+                }
+            for (auto n = leaf.getValueMask().beginOn(); n; ++n)
+                if (bandEdgeAt([&](const openvdb::Coord& c) { return on[at(c.x(), c.y(), c.z())] != 0; }, LeafT::offsetToLocalCoord(n.pos()))) ++local;
         }
         edges += local;
     });
