@@ -485,6 +485,9 @@ struct Writer {
         return "diff " + q(in.vdb) + " " + q(in.ssvdag) + " -o " + q(out);
     }
 };
+// GoogleTest prints a parameter without one as its raw bytes, which for a
+// std::string include unset ones (valgrind reports them).
+void PrintTo(const Writer& w, std::ostream* os) { *os << w.name; }
 
 const std::vector<Writer>& writers() {
     static const std::vector<Writer> w = {{"encode", ".ssvdag"}, {"decode", ".vdb"}, {"import", ".vdb"},
