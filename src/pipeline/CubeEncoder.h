@@ -42,9 +42,11 @@ uint64_t cubeBytesPerBrick(unsigned valueSize);
 enum class WindowKind { Palette, PredictedIntegers, PredictedFloats };
 unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize, WindowKind kind);
 
-// --normals: the normals come from source.normals() (a grid in memory
-// has them); a source that cannot give them is refused with a
-// vdbdag::Error (the gradient reads neighbours across cubes).
+// --normals: the normals come from source.normals() (a grid in memory has
+// them; a .vdb read region by region computes them cube by cube), gathered
+// in attribute order and quantised as they arrive (attributes::
+// NormalQuantizer); a source that cannot give them (a dense scan's) is
+// refused with a vdbdag::Error.
 // With a team of several processes (CubeTeam.h), every process must call
 // this with the same input and options; only process 0's result holds the
 // coded values (the others' are headers and DAGs).
