@@ -18,6 +18,7 @@
 
 #include <malloc.h>
 
+#include <openvdb/io/GridDescriptor.h>
 #include <openvdb/openvdb.h>
 #include <tbb/parallel_for.h>
 
@@ -625,12 +626,19 @@ VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options,
     std::shared_ptr<ScratchFile> scratch;  // created with the first grid
     VdbCubeInput input;
     input.fileMetadata = detail::serializeMetadata(*index.metadata);
+    // --grid names the file lacks: refused before any grid is read.
     std::vector<std::string> found;
+    for (const std::string& unique : index.uniqueNames) found.push_back(openvdb::io::GridDescriptor::stripSuffix(openvdb::io::GridDescriptor::stringAsUniqueName(unique)));
+    for (const std::string& wanted : options.onlyGrids)
+        if (std::find(found.begin(), found.end(), wanted) == found.end()) {
+            std::string names;
+            for (const auto& n : found) names += (names.empty() ? "'" : ", '") + n + "'";
+            throw Error(path + ": no grid named '" + wanted + "' (the file has " + (names.empty() ? "no grids" : names) + ")");
+        }
     bool anyNormals = false;
     for (size_t i = 0; i < index.uniqueNames.size(); ++i) {
         openvdb::GridBase::Ptr base = detail::readGridDelayed(path, index.uniqueNames[i]);
         detail::checkGridAgainstFile(path, i, *base);
-        found.push_back(base->getName());
         if (!options.onlyGrids.empty() && std::find(options.onlyGrids.begin(), options.onlyGrids.end(), base->getName()) == options.onlyGrids.end())
             continue;
         GridRecord header;
@@ -664,12 +672,6 @@ VdbCubeInput openVdbCubes(const std::string& path, const ImportOptions& options,
             input.warnings.push_back(path + ": skipped " + message);
         }
     }
-    for (const std::string& wanted : options.onlyGrids)
-        if (std::find(found.begin(), found.end(), wanted) == found.end()) {
-            std::string names;
-            for (const auto& n : found) names += (names.empty() ? "'" : ", '") + n + "'";
-            throw Error(path + ": no grid named '" + wanted + "' (the file has " + (names.empty() ? "no grids" : names) + ")");
-        }
     if (options.normals) detail::requireSomeNormals(anyNormals, options, path);
     return input;
 }

@@ -257,6 +257,19 @@ TEST(VdbCubes, NormalsAcrossCubesGiveTheInMemoryBytes) {
         EXPECT_THROW(bridge::importVdb(inputs[0].string(), io), Error);
         EXPECT_THROW(bridge::openVdbCubes(inputs[0].string(), io), Error) << normalGrid;
     }
+    // A missing --grid first, as importVdb checks it (before any grid is read).
+    bridge::ImportOptions both;
+    both.normals = true;
+    both.normalGrid = "density";  // also of the wrong type
+    both.onlyGrids = {"density", "missing"};
+    for (const bool byCubes : {false, true})
+        try {
+            if (byCubes) bridge::openVdbCubes(inputs[0].string(), both);
+            else bridge::importVdb(inputs[0].string(), both);
+            ADD_FAILURE() << "accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("no grid named 'missing'"), std::string::npos) << e.what();
+        }
     bridge::ImportOptions topology;
     topology.normals = topology.topologyOnly = true;
     EXPECT_THROW(bridge::openVdbCubes(inputs[0].string(), topology), Error);
