@@ -72,6 +72,29 @@ def test_same_bytes_as_the_command(work):
     assert 0 < lossy["max_abs_error"] <= 0.02
 
 
+def test_normals_keep_to_a_memory_limit(work):
+    """--normals on a .vdb read region by region (memory_limit): the same
+    bytes as without a limit, and the one-sided count equals the active
+    voxels that pyopenvdb finds with an inactive neighbour on some axis."""
+    src = sphere(work)
+    whole, limited = os.path.join(work, "normals.ssvdag"), os.path.join(work, "normals_16M.ssvdag")
+    report = vdbdag.encode(src, whole, normals=16)
+    vdbdag.encode(src, limited, normals=16, memory_limit="16M", threads=1)
+    with open(whole, "rb") as a, open(limited, "rb") as b:
+        assert a.read() == b.read()
+    grid = openvdb.read(src, "sphere")
+    acc = grid.getConstAccessor()
+    edges = 0
+    for item in grid.citerOnValues():
+        x, y, z = item.min
+        around = [(x + 1, y, z), (x - 1, y, z), (x, y + 1, z), (x, y - 1, z), (x, y, z + 1), (x, y, z - 1)]
+        edges += not all(acc.isValueOn(c) for c in around)
+    (normals,) = report["grids_normals"]
+    assert normals["entries"] == grid.activeVoxelCount()
+    assert normals["one_sided"] == edges > 0
+    assert normals["max_angle_degrees"] <= 0.95  # the 16-bit ONV bound
+
+
 def test_raw_scan_options_round_trip_against_numpy(work):
     """dims, type, endian and spacing as keywords; the big-endian int16
     samples come back from the decoded little-endian .nhdr's data as numpy
