@@ -20,6 +20,7 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <deque>
 #include <span>
 #include <string>
 #include <tuple>
@@ -132,16 +133,60 @@ inline std::vector<uint32_t> placedVisitOrder(std::span<const uint64_t> layout, 
 // (read or decoded) and its record, visiting the instances in `order`;
 // `kReach` says which neighbours beyond the near eight it finds.
 // Throws vdbdag::Error when the layout, its places and `entries` disagree.
+//
+// Memory: a brick's values and records are kept only while a brick visited
+// later may still read them (one of the bricks it lies beside in the
+// directions the walk looks back: counted before the walk, the count taken
+// down as each is visited); then its slot is reused. The walk reads the
+// same neighbours either way.
 template <typename Rec, Reach kReach = Reach::Near, typename Tile, typename Voxel>
 void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, Tile&& tile,
                       Voxel&& voxel) {
     if (places.size() != layout.size()) throw Error("the layout has " + std::to_string(layout.size()) + " bricks, their places " + std::to_string(places.size()));
     std::vector<uint64_t> first;
     const std::vector<uint32_t> visit = placedVisitOrder(layout, places, entries, order, first);
-    std::unordered_map<BrickKey, uint32_t, BrickKeyHash> slots;  // brick coordinates (index / 4) -> index in `bricks`
-    slots.reserve(layout.size());
-    std::vector<PlacedBrick<Rec>> bricks;
-    bricks.reserve(layout.size());  // `around` points into it
+    // Every brick by its coordinates (index / 4), and its rank in the walk.
+    constexpr uint32_t kNone = UINT32_MAX;
+    std::unordered_map<BrickKey, uint32_t, BrickKeyHash> brickAt;
+    brickAt.reserve(layout.size());
+    std::vector<uint32_t> rank(layout.size(), kNone);
+    for (size_t r = 0; r < visit.size(); ++r) {
+        const uint32_t b = visit[r];
+        if (layout[b] == 0) continue;
+        const BrickPlace& place = places[b];
+        if ((place.x | place.y | place.z) & 3 || place.mirror > 7) throw Error("brick " + std::to_string(b) + " has no brick's place");
+        if (!brickAt.emplace(BrickKey{place.x >> 2, place.y >> 2, place.z >> 2}, b).second) throw Error("two bricks at the same place");
+        rank[b] = uint32_t(r);
+    }
+    // The bricks around that hold causal neighbours: dx in -1..1, dy in
+    // -1..0 (-1..1 for Reach::Wide and Widest, whose PS lies a row ahead),
+    // dz in -1..0; `lookBack[k]` is offset k, ((dx+1), (dy+1), (dz+1)).
+    constexpr int kDyHigh = kReach >= Reach::Wide ? 1 : 0;
+    std::vector<std::array<int, 3>> lookBack;
+    for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= kDyHigh; ++dy)
+            for (int dz = -1; dz <= 0; ++dz)
+                if (dx || dy || dz) lookBack.push_back({dx, dy, dz});
+    const auto brickBeside = [&](uint32_t b, const std::array<int, 3>& d) {
+        const auto it = brickAt.find(BrickKey{(places[b].x >> 2) + d[0], (places[b].y >> 2) + d[1], (places[b].z >> 2) + d[2]});
+        return it == brickAt.end() ? kNone : it->second;
+    };
+    // Readers still to come of each brick: the later bricks it lies beside.
+    std::vector<uint8_t> readers(layout.size(), 0);
+    for (const uint32_t b : visit) {
+        if (layout[b] == 0) continue;
+        for (const auto& d : lookBack) {
+            const uint32_t n = brickBeside(b, d);
+            if (n != kNone && rank[n] < rank[b]) ++readers[n];
+        }
+    }
+    std::deque<PlacedBrick<Rec>> pool;  // kept bricks (a deque: `around` points into it)
+    std::vector<PlacedBrick<Rec>*> freeSlots;
+    std::vector<PlacedBrick<Rec>*> kept(layout.size(), nullptr);
+    const auto release = [&](uint32_t b) {
+        freeSlots.push_back(kept[b]);
+        kept[b] = nullptr;
+    };
     uint64_t total = 0;
     for (const uint32_t b : visit) {
         const uint64_t mask = layout[b];
@@ -152,20 +197,20 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
             continue;
         }
         const BrickPlace& place = places[b];
-        if ((place.x | place.y | place.z) & 3 || place.mirror > 7) throw Error("brick " + std::to_string(b) + " has no brick's place");
-        const int32_t bx = place.x >> 2, by = place.y >> 2, bz = place.z >> 2;
-        if (!slots.emplace(BrickKey{bx, by, bz}, uint32_t(bricks.size())).second) throw Error("two bricks at the same place");
-        bricks.emplace_back();
-        PlacedBrick<Rec>& self = bricks.back();
-        // The bricks around that hold causal neighbours: dx in -1..1, dy in
-        // -1..0 (-1..1 for Reach::Wide and Widest, whose PS lies a row ahead), dz in -1..0.
-        const PlacedBrick<Rec>* around[3][3][2];
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= (kReach >= Reach::Wide ? 1 : 0); ++dy)
-                for (int dz = -1; dz <= 0; ++dz) {
-                    const auto it = slots.find(BrickKey{bx + dx, by + dy, bz + dz});
-                    around[dx + 1][dy + 1][dz + 1] = (dx == 0 && dy == 0 && dz == 0) ? &self : it == slots.end() ? nullptr : &bricks[it->second];
-                }
+        PlacedBrick<Rec>* slot;
+        if (freeSlots.empty()) slot = &pool.emplace_back();
+        else slot = freeSlots.back(), freeSlots.pop_back();
+        slot->done = 0;
+        kept[b] = slot;
+        PlacedBrick<Rec>& self = *slot;
+        const PlacedBrick<Rec>* around[3][3][2] = {};
+        uint32_t beside[26];
+        for (size_t k = 0; k < lookBack.size(); ++k) {
+            const auto& d = lookBack[k];
+            beside[k] = brickBeside(b, d);
+            around[d[0] + 1][d[1] + 1][d[2] + 1] = beside[k] == kNone ? nullptr : kept[beside[k]];  // null: not visited yet
+        }
+        around[1][1][1] = &self;
         const uint64_t spatial = dag::reflectBrick(mask, place.mirror);
         PlacedNeighbours<Rec> n;
         // A neighbour's brick and bit, or null when it is not visited yet.
@@ -193,6 +238,11 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
             self.done |= uint64_t(1) << p;
         }
         total += uint64_t(std::popcount(mask));
+        // This brick has read the bricks before it beside it: those no
+        // later brick reads are released, and so is this one if none will.
+        for (size_t k = 0; k < lookBack.size(); ++k)
+            if (beside[k] != kNone && rank[beside[k]] < rank[b] && --readers[beside[k]] == 0) release(beside[k]);
+        if (readers[b] == 0) release(b);
     }
     if (total != entries) throw Error("the layout holds " + std::to_string(total) + " entries, the channel " + std::to_string(entries));
 }

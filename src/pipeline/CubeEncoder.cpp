@@ -377,9 +377,10 @@ unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize, Wind
     // --memory-limit 256M (4M entries a window): palette windows their ids
     // and the partitioner's per-distinct-value arrays, about 24; predicted
     // float windows (floats as their integers) 8.6 (the d=1024 sphere, +53
-    // MB), taken as 10; predicted integer windows 26 (the 512^3 phantom,
-    // +122 MB), taken as 30.
-    const uint64_t overhead = kind == WindowKind::PredictedFloats ? 10 : kind == WindowKind::PredictedIntegers ? 30 : 24;
+    // MB), taken as 10; predicted integer windows 5.8 (the 512^3 phantom,
+    // +41 MB; 26 before the placed walk released the bricks no later brick
+    // reads, coding/PlacedWalk.h), taken as 8.
+    const uint64_t overhead = kind == WindowKind::PredictedFloats ? 10 : kind == WindowKind::PredictedIntegers ? 8 : 24;
     const uint64_t perWindow = attributes::kValueWindowEntries * (valueSize + overhead);
     return unsigned(std::clamp<uint64_t>(budget.bytes / perWindow, 1, workersOf(budget)));
 }
