@@ -82,8 +82,9 @@ void walk(std::span<const uint64_t> layout, uint64_t entries, const IntCoderOpti
     if (e != entries) throw Error("the layout holds " + std::to_string(e) + " entries, the channel " + std::to_string(entries));
 }
 
-// What a coded voxel keeps for its neighbours, compactly (a window holds
-// every brick it has coded): errors and residual saturated at 2^16 - 1.
+// What a coded voxel keeps for its neighbours, compactly (the walk holds
+// every coded brick a later brick may still read, PlacedWalk.h): errors and
+// residual saturated at 2^16 - 1.
 struct CompactRecord {
     std::array<uint16_t, kPredictors> err{};
     uint16_t residual = 0;
