@@ -379,9 +379,14 @@ unsigned valueWindowsInFlight(const CubeBudget& budget, unsigned valueSize, Wind
     // float windows (floats as their integers) 8.6 (the d=1024 sphere, +53
     // MB), taken as 10; predicted integer windows 5.8 (the 512^3 phantom,
     // +41 MB; 26 before the placed walk released the bricks no later brick
-    // reads, coding/PlacedWalk.h), taken as 8.
+    // reads, coding/PlacedWalk.h), taken as 8. A float window without a
+    // lattice holds kFloatWindowEntries (1M), the others kValueWindowEntries
+    // (4M): counted as 4M, a float window took a quarter of the windows its
+    // budget allows (at 64M the d=1024 sphere coded one at a time, 3.9 s;
+    // now two, 2.54 s, peak 159 MB).
     const uint64_t overhead = kind == WindowKind::PredictedFloats ? 10 : kind == WindowKind::PredictedIntegers ? 8 : 24;
-    const uint64_t perWindow = attributes::kValueWindowEntries * (valueSize + overhead);
+    const uint64_t entries = kind == WindowKind::PredictedFloats ? attributes::kFloatWindowEntries : attributes::kValueWindowEntries;
+    const uint64_t perWindow = entries * (valueSize + overhead);
     return unsigned(std::clamp<uint64_t>(budget.bytes / perWindow, 1, workersOf(budget)));
 }
 
@@ -407,9 +412,12 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     auto streamLayer = [&](Layer layer, const LayerPlan& layerPlan, const encoding::CompactDag& dag, uint64_t& entries,
                            attributes::ScalarQuantizer* quantizer) {
         const bool inactiveLayer = layer == Layer::Inactive;
+        // A float channel on a rescale lattice is coded as its integers, in
+        // windows of integers' size.
+        const std::optional<attributes::FloatChannel> floats = floatChannelOf(source.header(), options, inactiveLayer);
         const WindowKind kind = !usesPredictedWindows(source.header(), options, inactiveLayer) ? WindowKind::Palette
-                                : floatChannelOf(source.header(), options, inactiveLayer)  ? WindowKind::PredictedFloats
-                                                                                           : WindowKind::PredictedIntegers;
+                                : floats && !floats->lattice                                 ? WindowKind::PredictedFloats
+                                                                                             : WindowKind::PredictedIntegers;
         const unsigned inFlight = valueWindowsInFlight(budget, vs, kind);
         const uint64_t expected = encoding::decodedSize(dag).attributeEntries;
         const bool inactive = layer == Layer::Inactive;
