@@ -246,29 +246,28 @@ private:
                     loadOne(o, withValues);
                 }
         }
-        // A caller's last two leaves (one cursor per thread), least
-        // recently used replaced: a voxel's own leaf and the one beside it.
-        struct Cursor {
-            openvdb::Coord origin[2] = {openvdb::Coord(INT32_MAX), openvdb::Coord(INT32_MAX)};
-            const void* leaf[2] = {nullptr, nullptr};  // LeafData; null: no leaf there
-            unsigned last = 0;
-        };
-        // OpenVDB's probeValue: the value, and whether the voxel is active.
-        bool probe(const openvdb::Coord& c, ValueT& value, Cursor& cursor) const { return find(c, value, cursor); }
+        // The active tile holding `c` (OpenVDB's probeValue where no leaf is):
+        // its value, or false.
+        bool activeTile(const openvdb::Coord& c, ValueT& value) const {
+            for (const auto& [log2, tiles] : grid_.activeTileAt_) {
+                const int32_t low = ~((int32_t(1) << log2) - 1);
+                const auto t = tiles.find(openvdb::Coord(c.x() & low, c.y() & low, c.z() & low));
+                if (t == tiles.end()) continue;
+                value = detail::valueFromBytes<ValueT>(grid_.tileValues_[0].tiles.data() + t->second * sizeof(ValueT));
+                return true;
+            }
+            return false;
+        }
         // The active voxels of brick b of the loaded leaf at `origin`.
         uint64_t brickMask(const openvdb::Coord& origin, unsigned b) const { return leaves_.at(origin).masks[b]; }
 
-        // The loaded leaf at `origin` and the voxels beside its six faces
-        // (probeValue's answers), in a 10^3 block: voxel (x, y, z) of the
-        // leaf, -1..8 on each axis, at index (x+1) + 10 (y+1) + 100 (z+1).
-        // The block's edges and corners are not filled: a six-neighbour
-        // stencil never reads them.
+        // The loaded leaf at `origin` and, with `faces`, the voxels beside
+        // its six faces as probeValue answers them (detail::haloIndex).
         struct Block {
             std::array<ValueT, 1000> value{};
             std::array<uint8_t, 1000> on{};
-            static int at(int x, int y, int z) { return (x + 1) + 10 * (y + 1) + 100 * (z + 1); }
         };
-        void fill(const openvdb::Coord& origin, Block& block, Cursor& cursor) const {
+        void fill(const openvdb::Coord& origin, Block& block, bool faces) const {
             block.on.fill(0);
             const LeafData& leaf = leaves_.at(origin);
             for (unsigned b = 0; b < 8; ++b) {
@@ -276,22 +275,22 @@ private:
                 size_t n = leaf.firstValue[b];
                 for (uint64_t bits = leaf.masks[b]; bits; bits &= bits - 1, ++n) {
                     const int bit = std::countr_zero(bits);
-                    const int i = Block::at(corner.x() + (bit & 3), corner.y() + ((bit >> 2) & 3), corner.z() + (bit >> 4));
-                    block.on[size_t(i)] = 1;
-                    block.value[size_t(i)] = detail::valueFromBytes<ValueT>(leaf.values.data() + n * sizeof(ValueT));
+                    const size_t i = detail::haloIndex(corner.x() + (bit & 3), corner.y() + ((bit >> 2) & 3), corner.z() + (bit >> 4));
+                    block.on[i] = 1;
+                    block.value[i] = detail::valueFromBytes<ValueT>(leaf.values.data() + n * sizeof(ValueT));
                 }
             }
-            for (int axis = 0; axis < 3; ++axis)
-                for (int side : {-1, 8})
-                    for (int u = 0; u < 8; ++u)
-                        for (int w = 0; w < 8; ++w) {
-                            int local[3];
-                            local[axis] = side;
-                            local[(axis + 1) % 3] = u;
-                            local[(axis + 2) % 3] = w;
-                            const int i = Block::at(local[0], local[1], local[2]);
-                            block.on[size_t(i)] = probe(origin.offsetBy(local[0], local[1], local[2]), block.value[size_t(i)], cursor);
-                        }
+            if (!faces) return;
+            detail::forEachHaloFace([&](const openvdb::Coord& offset, auto&& cells) {
+                const auto beside = leaves_.find(origin + offset);  // loaded with this leaf when it exists (load)
+                ValueT tileValue{};
+                const bool tileOn = beside == leaves_.end() && activeTile(origin + offset, tileValue);  // no leaf: one tile (or none) holds it all
+                cells([&](const openvdb::Coord& l) {
+                    const size_t i = detail::haloIndex(l.x(), l.y(), l.z());
+                    if (beside == leaves_.end()) block.on[i] = tileOn, block.value[i] = tileValue;
+                    else block.on[i] = beside->second.voxel(origin + l, block.value[i]);
+                });
+            });
         }
 
     private:
@@ -299,8 +298,16 @@ private:
             uint64_t masks[8] = {};       // brick b's active voxels
             uint32_t firstValue[8] = {};  // brick b's first active value
             std::vector<uint8_t> values;  // the leaf's active values, brick order
+            // Voxel c of this leaf: whether it is active, and its value.
+            bool voxel(const openvdb::Coord& c, ValueT& value) const {
+                const unsigned b = unsigned((c.x() >> 2) & 1) | unsigned((c.y() >> 2) & 1) << 1 | unsigned((c.z() >> 2) & 1) << 2;
+                const unsigned bit = unsigned(c.x() & 3) + 4 * unsigned(c.y() & 3) + 16 * unsigned(c.z() & 3);
+                if (!((masks[b] >> bit) & 1u)) return false;
+                const size_t n = firstValue[b] + size_t(std::popcount(masks[b] & ((uint64_t(1) << bit) - 1)));
+                value = detail::valueFromBytes<ValueT>(values.data() + n * sizeof(ValueT));
+                return true;
+            }
         };
-        static openvdb::Coord leafOrigin(const openvdb::Coord& c) { return openvdb::Coord(c.x() & ~7, c.y() & ~7, c.z() & ~7); }
         void loadOne(const openvdb::Coord& origin, bool withValues) {
             if (leaves_.count(origin)) return;
             const auto at = grid_.leafAt_.find(origin);
@@ -320,38 +327,6 @@ private:
             if (withValues) data.values.assign(record.begin() + long(masksEnd), record.begin() + long(masksEnd + size_t(value) * vs));
             leaves_.emplace(origin, std::move(data));
         }
-        bool find(const openvdb::Coord& c, ValueT& value, Cursor& cursor) const {
-            const openvdb::Coord origin = leafOrigin(c);
-            unsigned slot = cursor.last;
-            if (origin != cursor.origin[slot]) {
-                slot ^= 1u;
-                if (origin != cursor.origin[slot]) {
-                    const auto it = leaves_.find(origin);
-                    cursor.origin[slot] = origin;
-                    cursor.leaf[slot] = it == leaves_.end() ? nullptr : &it->second;
-                }
-            }
-            cursor.last = slot;
-            if (cursor.leaf[slot]) {
-                const LeafData& leaf = *static_cast<const LeafData*>(cursor.leaf[slot]);
-                const unsigned b = unsigned((c.x() >> 2) & 1) | unsigned((c.y() >> 2) & 1) << 1 | unsigned((c.z() >> 2) & 1) << 2;
-                const unsigned bit = unsigned(c.x() & 3) + 4 * unsigned(c.y() & 3) + 16 * unsigned(c.z() & 3);
-                const uint64_t m = leaf.masks[b];
-                if (!((m >> bit) & 1u)) return false;
-                const size_t n = leaf.firstValue[b] + size_t(std::popcount(m & ((uint64_t(1) << bit) - 1)));
-                value = detail::valueFromBytes<ValueT>(leaf.values.data() + n * sizeof(ValueT));
-                return true;
-            }
-            if (grid_.leafAt_.count(origin)) return false;  // a leaf not loaded: never asked for (see load)
-            for (const auto& [log2, tiles] : grid_.activeTileAt_) {
-                const int32_t low = ~((int32_t(1) << log2) - 1);
-                const auto t = tiles.find(openvdb::Coord(c.x() & low, c.y() & low, c.z() & low));
-                if (t == tiles.end()) continue;
-                value = detail::valueFromBytes<ValueT>(grid_.tileValues_[0].tiles.data() + t->second * sizeof(ValueT));
-                return true;
-            }
-            return false;
-        }
         const VdbGridCubes& grid_;
         std::unordered_map<openvdb::Coord, LeafData, CoordHash> leaves_;
         std::vector<uint8_t> buffer_;
@@ -368,12 +343,11 @@ private:
             header_.background.assign(sizeof(detail::NormalVector), 0);
             const GridTopology& tiles = grid.tiles_[0];
             tileNormals_.tiles.resize(tiles.tiles.size() * sizeof(detail::NormalVector));
-            Neighbourhood around(grid);  // no leaves: a tile's centre and its neighbours lie in the tile
+            const Neighbourhood around(grid);  // a tile's centre and its neighbours lie in the tile
             for (size_t t = 0; t < tiles.tiles.size(); ++t) {
                 const int32_t half = int32_t(1) << (tiles.tiles[t].log2Size - 1);
                 bool edge = false;
-                typename Neighbourhood::Cursor cursor;
-                const auto probe = [&](const openvdb::Coord& at, ValueT& v) { return around.probe(at, v, cursor); };
+                const auto probe = [&](const openvdb::Coord& at, ValueT& v) { return around.activeTile(at, v); };
                 store(tileNormals_.tiles, t, normalAt(probe, openvdb::Coord(tiles.tiles[t].x + half, tiles.tiles[t].y + half, tiles.tiles[t].z + half), edge));
                 oneSided_ += edge ? 1 : 0;
             }
@@ -425,13 +399,12 @@ private:
                 std::vector<size_t> firstBrick{0};  // each leaf's first brick in `topology`
                 for (const auto& [leafIndex, bricks] : it->second.leaves) firstBrick.push_back(firstBrick.back() + size_t(std::popcount(bricks)));
                 tbb::parallel_for(tbb::blocked_range<size_t>(0, it->second.leaves.size(), 4), [&](const auto& range) {
-                    typename Neighbourhood::Cursor cursor;
                     auto block = std::make_unique<typename Neighbourhood::Block>();
                     for (size_t l = range.begin(); l != range.end(); ++l) {
                         const openvdb::Coord origin = grid_.leaves_[it->second.leaves[l].first].origin;
-                        around.fill(origin, *block, cursor);
+                        around.fill(origin, *block, grid_.normalKind_ == NormalsOf::Gradient);
                         const auto probe = [&](const openvdb::Coord& at, ValueT& v) {
-                            const size_t i = size_t(Neighbourhood::Block::at(at.x() - origin.x(), at.y() - origin.y(), at.z() - origin.z()));
+                            const size_t i = detail::haloIndex(at.x() - origin.x(), at.y() - origin.y(), at.z() - origin.z());
                             v = block->value[i];
                             return block->on[i] != 0;
                         };

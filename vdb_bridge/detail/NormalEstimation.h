@@ -73,6 +73,30 @@ NormalVector gradientNormalAt(Probe&& probe, const openvdb::math::MapBase& map, 
     return normalised(map.applyIJT(g, map.applyMap(c.asVec3d())));  // Transform::indexToWorld(c)
 }
 
+// A leaf and the voxels beside its six faces, as a six-neighbour stencil
+// reads them: leaf voxel (x, y, z), -1..8 on each axis, at haloIndex(x, y,
+// z) of a 10^3 block (its edges and corners are never read).
+inline size_t haloIndex(int x, int y, int z) { return size_t((x + 1) + 10 * (y + 1) + 100 * (z + 1)); }
+// Calls face(offset, cell) for each of the six faces: `offset` the origin
+// of the leaf beside it relative to this leaf's, `cell(f)` calling f(local)
+// for the face's 64 voxels (leaf-relative coordinates, -1 or 8 on the axis).
+template <typename Face>
+void forEachHaloFace(Face&& face) {
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side : {-1, 8}) {
+            openvdb::Coord offset(0);
+            offset[axis] = side < 0 ? -8 : 8;
+            face(offset, [&](auto&& f) {
+                for (int u = 0; u < 8; ++u)
+                    for (int w = 0; w < 8; ++w) {
+                        openvdb::Coord local;
+                        local[axis] = side, local[(axis + 1) % 3] = u, local[(axis + 2) % 3] = w;
+                        f(local);
+                    }
+            });
+        }
+}
+
 // The active voxels at the band's edge (bandEdgeAt) of the whole grid, from
 // the value masks alone: each leaf and the voxels beside its six faces in a
 // 10^3 block. No ValueAccessor: one caches the leaves it passes, and
@@ -86,8 +110,7 @@ uint64_t countBandEdges(const GridT& grid) {
     for (auto it = tree.cbeginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
     std::atomic<uint64_t> edges{0};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 64), [&](const auto& range) {
-        std::array<uint8_t, 1000> on;  // leaf voxel (x, y, z), -1..8 each, at (x+1) + 10 (y+1) + 100 (z+1)
-        const auto at = [](int x, int y, int z) { return size_t((x + 1) + 10 * (y + 1) + 100 * (z + 1)); };
+        std::array<uint8_t, 1000> on;  // haloIndex
         uint64_t local = 0;
         for (size_t i = range.begin(); i != range.end(); ++i) {
             const LeafT& leaf = *leaves[i];
@@ -95,24 +118,17 @@ uint64_t countBandEdges(const GridT& grid) {
             on.fill(0);
             for (auto n = leaf.getValueMask().beginOn(); n; ++n) {
                 const openvdb::Coord c = LeafT::offsetToLocalCoord(n.pos());
-                on[at(c.x(), c.y(), c.z())] = 1;
+                on[haloIndex(c.x(), c.y(), c.z())] = 1;
             }
-            for (int axis = 0; axis < 3; ++axis)
-                for (int side : {-1, 8}) {
-                    openvdb::Coord beside = origin;
-                    beside[axis] += side < 0 ? -8 : 8;
-                    const LeafT* other = tree.probeConstLeaf(beside);
-                    const bool tileOn = !other && tree.isValueOn(beside);  // no leaf there: one tile (or none) holds all of it
-                    for (int u = 0; u < 8; ++u)
-                        for (int w = 0; w < 8; ++w) {
-                            int l[3];
-                            l[axis] = side, l[(axis + 1) % 3] = u, l[(axis + 2) % 3] = w;
-                            const openvdb::Coord c = origin.offsetBy(l[0], l[1], l[2]);
-                            on[at(l[0], l[1], l[2])] = other ? other->getValueMask().isOn(LeafT::coordToOffset(c)) : tileOn;
-                        }
-                }
+            forEachHaloFace([&](const openvdb::Coord& offset, auto&& cells) {
+                const LeafT* other = tree.probeConstLeaf(origin + offset);
+                const bool tileOn = !other && tree.isValueOn(origin + offset);  // no leaf there: one tile (or none) holds all of it
+                cells([&](const openvdb::Coord& l) {
+                    on[haloIndex(l.x(), l.y(), l.z())] = other ? other->getValueMask().isOn(LeafT::coordToOffset(origin + l)) : tileOn;
+                });
+            });
             for (auto n = leaf.getValueMask().beginOn(); n; ++n)
-                if (bandEdgeAt([&](const openvdb::Coord& c) { return on[at(c.x(), c.y(), c.z())] != 0; }, LeafT::offsetToLocalCoord(n.pos()))) ++local;
+                if (bandEdgeAt([&](const openvdb::Coord& c) { return on[haloIndex(c.x(), c.y(), c.z())] != 0; }, LeafT::offsetToLocalCoord(n.pos()))) ++local;
         }
         edges += local;
     });
