@@ -63,7 +63,6 @@ public:
     NormalChannel finish(NormalReport::Source source, uint64_t oneSided);
 
 private:
-    void quantiseEntry(std::span<uint8_t> entry) const;
     unsigned bits_;
     std::vector<uint8_t> codes_;
     uint64_t entries_ = 0, zeroLength_ = 0;

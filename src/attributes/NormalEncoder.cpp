@@ -26,20 +26,17 @@ NormalQuantizer::NormalQuantizer(unsigned bits) : bits_(bits) {
 void NormalQuantizer::quantise(std::span<uint8_t> piece) const {
     if (piece.size() % kEntry) throw Error("internal error: normals are 12 bytes each");
     tbb::parallel_for(tbb::blocked_range<size_t>(0, piece.size() / kEntry, 4096), [&](const auto& range) {
-        for (size_t i = range.begin(); i != range.end(); ++i) quantiseEntry(piece.subspan(i * kEntry, kEntry));
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+            uint8_t* entry = piece.data() + i * kEntry;
+            std::array<float, 3> normal;
+            std::memcpy(normal.data(), entry, kEntry);
+            bool zero = false;
+            const OctahedralCode c = encodeOctahedral(normal, bits_, &zero);
+            const double angle = zero ? -1.0 : angleDegrees(decodeOctahedral(c, bits_), normal);
+            std::memcpy(entry, &c.bits, sizeof(uint32_t));
+            std::memcpy(entry + sizeof(uint32_t), &angle, sizeof(double));
+        }
     });
-}
-
-void NormalQuantizer::quantiseEntry(std::span<uint8_t> piece) const {
-    for (size_t at = 0; at < piece.size(); at += kEntry) {
-        std::array<float, 3> normal;
-        std::memcpy(normal.data(), &piece[at], kEntry);
-        bool zero = false;
-        const OctahedralCode c = encodeOctahedral(normal, bits_, &zero);
-        const double angle = zero ? -1.0 : angleDegrees(decodeOctahedral(c, bits_), normal);
-        std::memcpy(&piece[at], &c.bits, sizeof(uint32_t));
-        std::memcpy(&piece[at + sizeof(uint32_t)], &angle, sizeof(double));
-    }
 }
 
 void NormalQuantizer::add(std::span<const uint8_t> quantised) {
