@@ -120,7 +120,7 @@ void measureSetting(bench::BenchPoint& p, const Setting& setting, const GridReco
         p.encode = timed.encode;
         p.decode = timed.decode;
         encoded = std::move(timed.grid);
-        p.traceableBytes = encoded->dag.byteSize() + encoded->values.byteSize();
+        p.traceableBytes = encoded->active.dag.byteSize() + encoded->active.values.byteSize();
         const auto& lossy = encoded->lossy;
         p.exact = lossy.changed == 0;
         p.maxError = lossy.maxAbsError;
@@ -149,7 +149,7 @@ void measureSetting(bench::BenchPoint& p, const Setting& setting, const GridReco
         if (first) losslessGrid = *encoded;
     }
     // Trace: the CPU renderer's frame, timed; image error against the lossless render.
-    if (!encoded->dag.empty()) {
+    if (!encoded->active.dag.empty()) {
         const trace::RenderGrid renderGrid = trace::makeRenderGrid(*encoded);
         const trace::GridFrame frame(renderGrid.indexToWorld);
         const trace::Camera camera = trace::frameBounds(frame, renderGrid.cellLo, renderGrid.cellHi, width, height);
@@ -210,7 +210,7 @@ void addMatchedPoints(BenchRun& run, const std::vector<bench::BenchPoint>& peerP
         p.bytes = timed.fileBytes;
         p.encode = timed.encode;
         p.decode = timed.decode;
-        p.traceableBytes = timed.grid.dag.byteSize() + format::traceableValues(timed.grid).byteSize();
+        p.traceableBytes = timed.grid.active.dag.byteSize() + format::traceableValues(timed.grid).byteSize();
         p.exact = timed.grid.lossy.changed == 0;
         p.maxError = timed.grid.lossy.maxAbsError;
         p.rmsError = timed.grid.lossy.rmsError;

@@ -53,13 +53,12 @@ bool decodeDenseByCubes(const format::SsvdagScene& scene, const std::string& inp
     const format::EncodedGrid& grid = denseGridOf(scene.grids, input, gridName, [](const format::EncodedGrid& g) { return g.record.name; });
     if (!bridge::exportsByCubes(grid.record, output)) return false;
     constexpr unsigned kCubeLog2 = 7;
-    const encoding::CompactDag& active = grid.dag;
-    const uint64_t total = (grid.inactiveDag.empty() ? 0 : 1) + (active.empty() ? 0 : 1);
+    const uint64_t total = (grid.inactive.dag.empty() ? 0 : 1) + (grid.active.dag.empty() ? 0 : 1);
     Progress progress("decode " + std::filesystem::path(output).filename().string(), 1000 * std::max<uint64_t>(total, 1));
     const bridge::DenseExportReport report = bridge::exportDenseByCubes(grid.record, output, [&](bridge::DenseCubeSink& sink) {
         uint64_t layer = 0;
         for (const bool inactive : {true, false}) {  // inactive first: active voxels win
-            if ((inactive ? grid.inactiveDag : active).empty()) continue;
+            if (grid.layer(inactive).dag.empty()) continue;
             pipeline::LayerCubes visit;
             visit.begin = [&](const encoding::SubtreeInstance& s) { sink.beginCube(s.x, s.y, s.z, s.solid ? 2 : s.log2Size); };
             visit.voxels.brick = [&](int64_t x, int64_t y, int64_t z, uint64_t mask, const uint8_t* values) { sink.brick(x, y, z, mask, values); };
@@ -124,13 +123,13 @@ DecodeResult decodeFile(const DecodeRequest& request) {
     {
         const format::SsvdagScene scene = format::readSceneFile(request.input, readOptions);
         gridCount = scene.grids.size();
-        for (const auto& g : scene.grids) activeVoxels += g.activeVoxels;
+        for (const auto& g : scene.grids) activeVoxels += g.active.voxels;
         if (dense && decodeDenseByCubes(scene, request.input, output, request.grid, denseOptions, notes)) return result();
         progress.set(50);
         uint64_t voxels = 0, done = 0;
-        for (const auto& g : scene.grids) voxels += g.activeVoxels + g.inactiveVoxels;
+        for (const auto& g : scene.grids) voxels += g.active.voxels + g.inactive.voxels;
         volume = pipeline::decodeScene(scene, [&](size_t i, size_t) {
-            if (i > 0) done += scene.grids[i - 1].activeVoxels + scene.grids[i - 1].inactiveVoxels;
+            if (i > 0) done += scene.grids[i - 1].active.voxels + scene.grids[i - 1].inactive.voxels;
             progress.setLabel("decode: grid '" + scene.grids[i].record.name + "'");
             progress.set(50 + 450 * done / std::max<uint64_t>(voxels, 1));
         });

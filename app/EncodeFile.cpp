@@ -163,8 +163,8 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
     // holds 1 GB in each).
     imported.volume = {};
     for (auto& g : scene.grids) {
-        std::vector<uint8_t>().swap(g.attributes);
-        std::vector<uint8_t>().swap(g.inactiveAttributes);
+        std::vector<uint8_t>().swap(g.active.attributes);
+        std::vector<uint8_t>().swap(g.inactive.attributes);
     }
     EncodeResult result;
     if (!team.isRoot()) return result;  // process 0 writes and reports
@@ -175,7 +175,7 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
     // Section by section, the DAGs and values released as they go: the
     // file is never whole in memory.
     uint64_t fileBytes = 0, geometryBytes = 0;  // the DAGs, uncompressed (released by the writer)
-    for (const auto& g : scene.grids) geometryBytes += g.dag.byteSize() + g.inactiveDag.byteSize();
+    for (const auto& g : scene.grids) geometryBytes += g.active.dag.byteSize() + g.inactive.dag.byteSize();
     writeStreamAtomically(request.output, [&](std::ostream& out) { fileBytes = format::writeSceneReleasing(scene, out, containerOptions); });
     progress.finish();
     // Where the geometry weighs, other root placements may shrink it
@@ -185,11 +185,11 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     uint64_t voxels = 0;
-    for (const auto& g : scene.grids) voxels += g.activeVoxels;
+    for (const auto& g : scene.grids) voxels += g.active.voxels;
     nlohmann::json grids = nlohmann::json::array();
     for (size_t g = 0; g < scene.grids.size(); ++g)
         grids.push_back({{"index", g}, {"name", scene.grids[g].record.name}, {"class", scene.grids[g].record.gridClass},
-                         {"value_type", valueTypeName(scene.grids[g].record.valueType)}, {"active_voxels", scene.grids[g].activeVoxels}});
+                         {"value_type", valueTypeName(scene.grids[g].record.valueType)}, {"active_voxels", scene.grids[g].active.voxels}});
     // "bytes": the file written, as "ssvdag_bytes" (kept for scripts written before the common keys).
     nlohmann::json report{{"input", request.input}, {"output", request.output}, {"ssvdag_bytes", fileBytes}, {"bytes", fileBytes},
                           {"grid_count", scene.grids.size()}, {"grids", grids}, {"active_voxels", voxels}, {"seconds", seconds},

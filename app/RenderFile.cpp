@@ -49,11 +49,11 @@ bool denseScalarScan(const format::EncodedGrid& grid) {
     const ValueType t = grid.record.valueType;
     if (t != ValueType::Int32 && t != ValueType::Int64 && t != ValueType::Float && t != ValueType::Double) return false;
     if (grid.record.gridClass == "level set" || grid.record.gridClass == "fog volume") return false;
-    const std::optional<format::IndexBox> box = format::dagBounds(grid.dag);
-    if (!box || grid.activeVoxels < 4096) return false;
+    const std::optional<format::IndexBox> box = format::dagBounds(grid.active.dag);
+    if (!box || grid.active.voxels < 4096) return false;
     uint64_t volume = 1;
     for (int a = 0; a < 3; ++a) volume *= uint64_t(box->max[size_t(a)] - box->min[size_t(a)] + 1);
-    return volume == grid.activeVoxels;
+    return volume == grid.active.voxels;
 }
 
 // An integer grid of at most 256 distinct values (an atlas, a
@@ -65,18 +65,18 @@ bool denseScalarScan(const format::EncodedGrid& grid) {
 // From the decoded values (a grid read whole); false when there are none.
 bool looksLikeLabels(const format::EncodedGrid& grid) {
     const unsigned vs = grid.record.valueType == ValueType::Int32 ? 4 : grid.record.valueType == ValueType::Int64 ? 8 : 0;
-    if (!vs || grid.attributes.empty()) return false;
+    if (!vs || grid.active.attributes.empty()) return false;
     std::unordered_set<int64_t> seen;
     uint64_t labelled = 0, repeats = 0;
     int64_t before = 0;
-    for (size_t at = 0; at + vs <= grid.attributes.size(); at += vs) {
+    for (size_t at = 0; at + vs <= grid.active.attributes.size(); at += vs) {
         int64_t v = 0;
         if (vs == 4) {
             int32_t w;
-            std::memcpy(&w, grid.attributes.data() + at, 4);
+            std::memcpy(&w, grid.active.attributes.data() + at, 4);
             v = w;
         } else {
-            std::memcpy(&v, grid.attributes.data() + at, 8);
+            std::memcpy(&v, grid.active.attributes.data() + at, 8);
         }
         if (seen.insert(v).second && seen.size() > 256) return false;
         if (v != 0) labelled += 1, repeats += at > 0 && v == before;
@@ -106,7 +106,7 @@ std::vector<RenderedImage> renderImages(const RenderRequest& request, const std:
         for (const format::EncodedGrid& g : scene.grids)
             if (request.grid.empty() || g.record.name == request.grid) { chosen = &g; break; }
         if (!chosen) throw Error(request.input + ": no grid named '" + request.grid + "'");
-        if (chosen->dag.empty()) throw Error(request.input + ": grid '" + chosen->record.name + "' is empty: nothing to render");
+        if (chosen->active.dag.empty()) throw Error(request.input + ": grid '" + chosen->record.name + "' is empty: nothing to render");
         trace::Shading shading = trace::parseShading(request.shading);
         // A dense scan (every voxel of its box active: a CT's air too) shown
         // as voxel blocks is an opaque box: by default it is volume rendered

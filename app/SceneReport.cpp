@@ -132,10 +132,10 @@ std::string formatGridHeader(const nlohmann::json& g) {
 nlohmann::json sceneReport(const format::SsvdagScene& scene, std::span<const uint8_t> fileBytes, const std::string& name, bool valueStats) {
     StoredScene file{format::summarizeContainer(fileBytes, name), fileBytes.size(), [&](uint32_t g, bool inactive) -> std::vector<uint64_t> {
                          const format::EncodedGrid& grid = scene.grids[g];
-                         const attributes::ValueWindowsPayload& w = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+                         const format::EncodedLayer& layer = grid.layer(inactive);
+                         const attributes::ValueWindowsPayload& w = layer.valueWindows;
                          if (!w.predicted || w.empty()) return {};
-                         return attributes::predictedWindowCodings(w.load(), valueSize(grid.record.valueType),
-                                                                   encoding::attributeLayout(inactive ? grid.inactiveDag : grid.dag),
+                         return attributes::predictedWindowCodings(w.load(), valueSize(grid.record.valueType), encoding::attributeLayout(layer.dag),
                                                                    "grid '" + grid.record.name + "' predicted windows");
                      }};
     return sceneReport(scene, file, name, valueStats);
@@ -152,10 +152,10 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, const StoredScene& 
                {"name", grid.record.name},
                {"class", grid.record.gridClass},
                {"value_type", valueTypeName(grid.record.valueType)},
-               {"active_voxels", grid.activeVoxels},
+               {"active_voxels", grid.active.voxels},
                {"encoding", grid.symmetry ? "SSVDAG" : "SVDAG"},
-               {"root_log2_size", grid.dag.log2Size},
-               {"root_origin", grid.dag.origin},
+               {"root_log2_size", grid.active.dag.log2Size},
+               {"root_origin", grid.active.dag.origin},
                {"levels", json::array()},
                {"sections", json::array()}};
         const auto& st = grid.stats;
@@ -188,9 +188,9 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, const StoredScene& 
         // Value channels: the columns of Dado et al.'s Table 1.
         j["channels"] = json::array();
         const unsigned vs = valueSize(grid.record.valueType);
-        uint64_t traceable = grid.dag.byteSize() + grid.inactiveDag.byteSize();
-        for (const auto& [layer, raw, inactive] : {std::tuple{"active", &grid.attributes, false},
-                                                   std::tuple{"inactive", &grid.inactiveAttributes, true}}) {
+        uint64_t traceable = grid.active.dag.byteSize() + grid.inactive.dag.byteSize();
+        for (const auto& [layer, raw, inactive] : {std::tuple{"active", &grid.active.attributes, false},
+                                                   std::tuple{"inactive", &grid.inactive.attributes, true}}) {
             if (!valueStats || !vs || raw->empty()) continue;
             const attributes::PaletteChannel channel = format::traceableValues(grid, inactive);
             const attributes::ChannelStats cs = attributes::channelStats(*raw, vs, channel);
@@ -227,7 +227,7 @@ nlohmann::json sceneReport(const format::SsvdagScene& scene, const StoredScene& 
     // The one bits-per-voxel figure of a file, as `encode` prints it: the
     // whole file over every grid's active voxels.
     uint64_t voxels = 0;
-    for (const format::EncodedGrid& grid : scene.grids) voxels += grid.activeVoxels;
+    for (const format::EncodedGrid& grid : scene.grids) voxels += grid.active.voxels;
     report["active_voxels"] = voxels;
     report["bits_per_active_voxel"] = voxels ? 8.0 * double(file.bytes) / double(voxels) : 0.0;
     return report;

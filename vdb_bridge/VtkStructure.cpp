@@ -65,14 +65,14 @@ struct LevelBlock {
 
 vtkSmartPointer<vtkMultiBlockDataSet> gridBlocks(const format::EncodedGrid& grid, const StructureExportOptions& options, StructureGridReport& report) {
     auto blocks = vtkSmartPointer<vtkMultiBlockDataSet>::New();
-    const std::vector<encoding::StructureLevel> levels = encoding::analyzeStructure(grid.dag);
+    const std::vector<encoding::StructureLevel> levels = encoding::analyzeStructure(grid.active.dag);
     uint64_t total = 0;
     for (const auto& l : levels) total = total > UINT64_MAX - l.totalInstances ? UINT64_MAX : total + l.totalInstances;
     report.perInstance = !options.uniqueNodes && total <= options.maxInstances;
     std::vector<std::unique_ptr<LevelBlock>> out;
     for (size_t i = 0; i < levels.size(); ++i) out.push_back(std::make_unique<LevelBlock>(grid.record.indexToWorld));
     if (report.perInstance) {
-        encoding::visitNodeInstances(grid.dag, [&](const encoding::NodeInstance& n) {
+        encoding::visitNodeInstances(grid.active.dag, [&](const encoding::NodeInstance& n) {
             out[n.levelIndex]->add(n.levelIndex, n.log2Size, {n.x, n.y, n.z}, n.nodeId, levels[n.levelIndex], n.mirror);
         });
     } else {

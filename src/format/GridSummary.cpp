@@ -20,23 +20,23 @@ namespace {
 // and values, whatever its Summary section says.
 GridSummary computedSummary(const EncodedGrid& grid, const encoding::DecodedSize& size) {
     GridSummary s;
-    s.activeVoxels = grid.activeVoxels;
+    s.activeVoxels = grid.active.voxels;
     s.solidNodes = size.emittedTiles;
-    s.indexBox = dagBounds(grid.dag);
+    s.indexBox = dagBounds(grid.active.dag);
     const ValueType type = grid.record.valueType;
     const unsigned vs = valueSize(type);
-    if (!vs || grid.dag.empty()) return s;
-    if (grid.valueWindows.range) {  // kept by the encoder's value writer
-        s.activeRange = *grid.valueWindows.range;
+    if (!vs || grid.active.dag.empty()) return s;
+    if (grid.active.valueWindows.range) {  // kept by the encoder's value writer
+        s.activeRange = *grid.active.valueWindows.range;
         return s;
     }
-    if (!grid.attributes.empty()) {
-        s.activeRange.add(type, grid.attributes);
+    if (!grid.active.attributes.empty()) {
+        s.activeRange.add(type, grid.active.attributes);
         return s;
     }
-    const attributes::ValueWindowsPayload& windows = grid.valueWindows;
+    const attributes::ValueWindowsPayload& windows = grid.active.valueWindows;
     if (windows.empty()) {  // a scene read with its palette channel only
-        s.activeRange.add(type, grid.values.decodeAll());
+        s.activeRange.add(type, grid.active.values.decodeAll());
         return s;
     }
     const std::vector<uint8_t> spilled = windows.file ? windows.load() : std::vector<uint8_t>{};
@@ -53,8 +53,8 @@ GridSummary computedSummary(const EncodedGrid& grid, const encoding::DecodedSize
         }
         return s;
     }
-    const std::vector<uint64_t> layout = encoding::attributeLayout(grid.dag);
-    const std::vector<coding::BrickPlace> places = encoding::attributePlaces(grid.dag, vs);
+    const std::vector<uint64_t> layout = encoding::attributeLayout(grid.active.dag);
+    const std::vector<coding::BrickPlace> places = encoding::attributePlaces(grid.active.dag, vs);
     attributes::WindowCursor cursor(bytes, true, vs, layout, what, places);
     constexpr uint64_t kChunk = uint64_t(1) << 16;
     std::vector<uint8_t> chunk;
@@ -71,9 +71,9 @@ GridSummary computedSummary(const EncodedGrid& grid, const encoding::DecodedSize
 } // namespace
 
 GridSummary summarizeGrid(const EncodedGrid& grid) {
-    if (!grid.summary) return computedSummary(grid, encoding::decodedSize(grid.dag));
+    if (!grid.summary) return computedSummary(grid, encoding::decodedSize(grid.active.dag));
     GridSummary s;
-    s.activeVoxels = grid.activeVoxels;
+    s.activeVoxels = grid.active.voxels;
     s.solidNodes = grid.summary->solidNodes;
     s.indexBox = grid.summary->indexBox;
     s.activeRange = grid.summary->activeRange;
@@ -81,9 +81,9 @@ GridSummary summarizeGrid(const EncodedGrid& grid) {
 }
 
 StoredSummary recomputedSummary(const EncodedGrid& grid) {
-    const encoding::DecodedSize active = encoding::decodedSize(grid.dag);
+    const encoding::DecodedSize active = encoding::decodedSize(grid.active.dag);
     const GridSummary s = computedSummary(grid, active);
-    return {s.indexBox, s.solidNodes, active.attributeEntries, encoding::decodedSize(grid.inactiveDag).attributeEntries, s.activeRange};
+    return {s.indexBox, s.solidNodes, active.attributeEntries, encoding::decodedSize(grid.inactive.dag).attributeEntries, s.activeRange};
 }
 
 StoredSummary summaryToStore(const EncodedGrid& grid) { return grid.summary ? *grid.summary : recomputedSummary(grid); }

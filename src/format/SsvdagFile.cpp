@@ -169,8 +169,10 @@ void releaseIf(std::vector<T>& v, bool take) {
     if (take) std::vector<T>().swap(v);
 }
 
-void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, encoding::CompactDag& dag, const attributes::PaletteChannel& channel,
-              attributes::ValueWindowsPayload& windows, std::vector<uint8_t>& predicted, unsigned valueSize, bool take) {
+void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kinds, EncodedLayer& layer, unsigned valueSize, bool take) {
+    encoding::CompactDag& dag = layer.dag;
+    attributes::ValueWindowsPayload& windows = layer.valueWindows;
+    std::vector<uint8_t>& predicted = layer.predictedValues;
     sections.push_back({kinds.levels, g, serializeDagLevels(dag)});
     if (!dag.empty()) {
         const SectionKind windowKind = windows.predicted ? kinds.predictedWindows : kinds.windows;
@@ -181,7 +183,7 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
         if (valueSize && !predicted.empty()) sections.push_back({kinds.predicted, g, takeOrCopy(predicted, take)});
         else if (valueSize && windows.file) sections.push_back({windowKind, g, {}, take ? std::move(windows.file) : windows.file});
         else if (valueSize && !windows.empty()) sections.push_back({windowKind, g, takeOrCopy(windows.bytes, take)});
-        else if (valueSize) sections.push_back({kinds.values, g, attributes::serializePalette(channel)});
+        else if (valueSize) sections.push_back({kinds.values, g, attributes::serializePalette(layer.values)});
     }
 }
 
@@ -217,17 +219,15 @@ std::vector<Section> toSections(SsvdagScene& scene, bool take) {
         info.put<uint8_t>(uint8_t(grid.record.valueType));
         info.put<uint8_t>(grid.symmetry ? 1 : 0);
         for (double v : grid.record.indexToWorld) info.put<double>(v);
-        info.put<uint64_t>(grid.activeVoxels);
+        info.put<uint64_t>(grid.active.voxels);
         info.putString(std::string(grid.record.background.begin(), grid.record.background.end()));
-        info.put<uint64_t>(grid.inactiveVoxels);
+        info.put<uint64_t>(grid.inactive.voxels);
         sections.push_back({SectionKind::GridInfo, g, info.take()});
         sections.push_back({SectionKind::VdbDescriptor, g, takeOrCopy(grid.record.vdbDescriptor, take)});
 
         const unsigned vs = valueSize(grid.record.valueType);
-        const bool emptyInactive = grid.inactiveDag.empty();
-        putLayer(sections, g, kActive, grid.dag, grid.values, grid.valueWindows, grid.predictedValues, vs, take);
-        if (!emptyInactive)
-            putLayer(sections, g, kInactive, grid.inactiveDag, grid.inactiveValues, grid.inactiveValueWindows, grid.inactivePredictedValues, vs, take);
+        putLayer(sections, g, kActive, grid.active, vs, take);
+        if (!grid.inactive.dag.empty()) putLayer(sections, g, kInactive, grid.inactive, vs, take);
         if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact) {
             ByteWriter e;
             const auto& l = grid.lossy;
@@ -391,10 +391,10 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             grid.record.valueType = ValueType(type);
             grid.symmetry = r.get<uint8_t>() != 0;
             for (double& v : grid.record.indexToWorld) v = r.get<double>();
-            grid.activeVoxels = r.get<uint64_t>();
+            grid.active.voxels = r.get<uint64_t>();
             const std::string background = r.getString(64);
             grid.record.background.assign(background.begin(), background.end());
-            grid.inactiveVoxels = r.get<uint64_t>();
+            grid.inactive.voxels = r.get<uint64_t>();
             r.expectEnd();
             if (grid.record.background.size() != valueSize(grid.record.valueType)) r.fail("background value has the wrong size");
         }
@@ -402,8 +402,9 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         const unsigned vs = valueSize(grid.record.valueType);
         // A layer's DAG first (both layers' before any value), so what the
         // values will take is weighed before any is decoded.
-        auto readLayerDag = [&](const LayerKinds& kinds, encoding::CompactDag& dag, uint64_t expectedVoxels,
-                                const std::string& layer) -> encoding::DecodedSize {
+        auto readLayerDag = [&](const LayerKinds& kinds, EncodedLayer& into, const std::string& layer) -> encoding::DecodedSize {
+            encoding::CompactDag& dag = into.dag;
+            const uint64_t expectedVoxels = into.voxels;
             uint64_t innerWords = 0, leafCount = 0;
             {
                 ByteReader r(find(g, kinds.levels, true)->data, what + " " + layer + " levels");
@@ -454,9 +455,12 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             checkMemory(options.limits, expanded, what, "its sections and decoded values");
             return size;
         };
-        auto readLayerValues = [&](const LayerKinds& kinds, const encoding::CompactDag& dag, const encoding::DecodedSize& size,
-                                   std::vector<uint8_t>& attributes, attributes::PaletteChannel& channel, std::vector<uint8_t>& predicted,
-                                   attributes::ValueWindowsPayload& windows, const std::string& layer) {
+        auto readLayerValues = [&](const LayerKinds& kinds, EncodedLayer& into, const encoding::DecodedSize& size, const std::string& layer) {
+            const encoding::CompactDag& dag = into.dag;
+            std::vector<uint8_t>& attributes = into.attributes;
+            attributes::PaletteChannel& channel = into.values;
+            std::vector<uint8_t>& predicted = into.predictedValues;
+            attributes::ValueWindowsPayload& windows = into.valueWindows;
             Section* predictedSection = find(g, kinds.predicted, false);
             Section* windowSection = find(g, kinds.windows, false);
             Section* paletteSection = find(g, kinds.values, false);
@@ -503,14 +507,11 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 attributes = channel.decodeAll();
             }
         };
-        const encoding::DecodedSize activeSize = readLayerDag(kActive, grid.dag, grid.activeVoxels, "active");
-        const bool inactiveLayer = grid.inactiveVoxels || find(g, kInactive.levels, false);
-        const encoding::DecodedSize inactiveSize = inactiveLayer ? readLayerDag(kInactive, grid.inactiveDag, grid.inactiveVoxels, "inactive")
-                                                                 : encoding::DecodedSize{};
-        if (!options.headersOnly) readLayerValues(kActive, grid.dag, activeSize, grid.attributes, grid.values, grid.predictedValues, grid.valueWindows, "active");
-        if (inactiveLayer && !options.headersOnly)
-            readLayerValues(kInactive, grid.inactiveDag, inactiveSize, grid.inactiveAttributes, grid.inactiveValues, grid.inactivePredictedValues,
-                            grid.inactiveValueWindows, "inactive");
+        const encoding::DecodedSize activeSize = readLayerDag(kActive, grid.active, "active");
+        const bool inactiveLayer = grid.inactive.voxels || find(g, kInactive.levels, false);
+        const encoding::DecodedSize inactiveSize = inactiveLayer ? readLayerDag(kInactive, grid.inactive, "inactive") : encoding::DecodedSize{};
+        if (!options.headersOnly) readLayerValues(kActive, grid.active, activeSize, "active");
+        if (inactiveLayer && !options.headersOnly) readLayerValues(kInactive, grid.inactive, inactiveSize, "inactive");
         if (Section* e = find(g, SectionKind::ValueErrors, false)) {
             ByteReader r(e->data, what + " ValueErrors");
             auto& l = grid.lossy;
@@ -546,8 +547,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             grid.colour = c;
         }
         if (Section* n = options.headersOnly ? nullptr : find(g, SectionKind::Normals, false)) {
-            if (grid.dag.empty()) throw Error(what + ": normals for an empty grid");
-            grid.normals = attributes::deserializeNormals(n->data, encoding::decodedSize(grid.dag).attributeEntries, what + " Normals");
+            if (grid.active.dag.empty()) throw Error(what + ": normals for an empty grid");
+            grid.normals = attributes::deserializeNormals(n->data, encoding::decodedSize(grid.active.dag).attributeEntries, what + " Normals");
         }
         if (Section* st = find(g, SectionKind::DagStats, false)) {
             ByteReader r(st->data, what + " DagStats");

@@ -41,21 +41,32 @@ struct StoredSummary {
     attributes::ValueRange activeRange;
 };
 
+// One layer of a grid (docs/FORMAT.md 6): the active voxels, or the
+// inactive voxels and tiles whose value differs from the background. Its
+// DAG, and its values in the forms a file or an encoder holds them:
+// `attributes` flat in attribute order (valueSize bytes each; what an
+// encoder produced, or a reader decoded), `values` palette-compressed (the
+// traceable layout a reader builds, format/TraceableValues.h), `valueWindows`
+// the ValueWindows or PredictedWindows payload an encoder writes instead of
+// the palettes and a reader keeps as read (empty: `values` is written), and
+// `predictedValues` a file's PredictedValues payload from before
+// PredictedWindows (kept as read; the palettes are rebuilt from it).
+struct EncodedLayer {
+    uint64_t voxels = 0;  // tiles counted as their voxels
+    encoding::CompactDag dag;
+    std::vector<uint8_t> attributes;
+    attributes::PaletteChannel values;
+    attributes::ValueWindowsPayload valueWindows;
+    std::vector<uint8_t> predictedValues;
+};
+
 struct EncodedGrid {
     GridRecord record;          // name, class, type, transform, descriptor, background; no voxels
-    uint64_t activeVoxels = 0;  // tiles counted as their voxels
     bool symmetry = true;       // SSVDAG (true) or plain SVDAG
-    encoding::CompactDag dag;
-    std::vector<uint8_t> attributes;  // active values in attribute order (valueSize bytes each)
-    attributes::PaletteChannel values;  // the same, palette-compressed: the traceable layout (what a reader builds)
-    // What an encoder writes instead: the ValueWindows section payload
-    // (attributes/ValueWindows.h), or for an integer channel (`predicted`
-    // set) the PredictedWindows one (attributes/PredictedWindows.h), which a
-    // reader keeps as read; when empty, `values` is written.
-    attributes::ValueWindowsPayload valueWindows;
-    // A file written before PredictedWindows: its PredictedValues payload
-    // (attributes/PredictedChannel.h), kept as read; the palettes are rebuilt.
-    std::vector<uint8_t> predictedValues;
+    EncodedLayer active;        // the active voxels and tiles
+    EncodedLayer inactive;      // inactive voxels and tiles off the background
+    const EncodedLayer& layer(bool inactiveLayer) const { return inactiveLayer ? inactive : active; }
+    EncodedLayer& layer(bool inactiveLayer) { return inactiveLayer ? inactive : active; }
     attributes::ToleranceReport lossy;  // what a lossy setting changed (mode Exact: nothing)
     // Colour grids encoded with --colour-bits: what the CIELAB clustering
     // changed (the values above already hold the representatives).
@@ -67,13 +78,6 @@ struct EncodedGrid {
     // Its Summary section: as read (none in files written before it), or as
     // an encoder sets it (format::summaryToStore); written when present.
     std::optional<StoredSummary> summary;
-    // Inactive voxels/tiles whose value differs from the background.
-    uint64_t inactiveVoxels = 0;
-    encoding::CompactDag inactiveDag;
-    std::vector<uint8_t> inactiveAttributes;
-    attributes::PaletteChannel inactiveValues;
-    attributes::ValueWindowsPayload inactiveValueWindows;
-    std::vector<uint8_t> inactivePredictedValues;
 };
 
 // One frame of a sequence file (docs/FORMAT.md 4.3): the grids

@@ -9,13 +9,14 @@
 namespace vdbdag::format {
 
 attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactive) {
-    const attributes::PaletteChannel& values = inactive ? grid.inactiveValues : grid.values;
-    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
-    const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
+    const EncodedLayer& layer = grid.layer(inactive);
+    const attributes::PaletteChannel& values = layer.values;
+    const attributes::ValueWindowsPayload& windows = layer.valueWindows;
+    const std::vector<uint8_t>& attributes = layer.attributes;
     if (values.entryCount || values.valueSize) return values;
     if (!windows.empty() && windows.predicted && !attributes.empty()) return attributes::compressPalette(attributes, valueSize(grid.record.valueType));
     if (!windows.empty() && windows.predicted) {
-        const encoding::CompactDag& dag = inactive ? grid.inactiveDag : grid.dag;
+        const encoding::CompactDag& dag = layer.dag;
         const uint32_t vs = valueSize(grid.record.valueType);
         return attributes::compressPalette(attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(dag),
                                                                               "grid '" + grid.record.name + "' predicted windows",

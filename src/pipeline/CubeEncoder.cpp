@@ -398,7 +398,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     const unsigned vs = valueSize(source.header().valueType);
     auto step = [&](const char* name) { if (options.onStep) options.onStep(name); };
     const LayerSummary active = source.summary(Layer::Active);
-    out.activeVoxels = active.voxels;
+    out.active.voxels = active.voxels;
     step("reducing the DAG");
     // Values stream from the gather into the value windows, never held
     // whole: lossless ones, and lossy ones quantised on the way (one value
@@ -521,14 +521,14 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
             }
             return trial.storedBytes();
         };
-        out.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0 || withNormals, &out.stats, team, codeActive, keep);
+        out.active.dag = encodeLayerByCubes(source, Layer::Active, options, budget, vs > 0 || withNormals, &out.stats, team, codeActive, keep);
         storeActiveValues(out, std::move(kept));
     } else {
         step(streamValues ? "coding the last value windows" : "palette compression");
     }
     trial = {};
     const LayerSummary inactive = source.summary(Layer::Inactive);
-    out.inactiveVoxels = inactive.voxels;
+    out.inactive.voxels = inactive.voxels;
     step("inactive values");
     if (!inactive.empty()) {
         const PlanValues codeInactive = [&](const encoding::CompactDag& dag, const LayerPlan& layerPlan) -> uint64_t {
@@ -542,7 +542,7 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
             }
             return trial.storedBytes();
         };
-        out.inactiveDag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, team, codeInactive, keep);
+        out.inactive.dag = encodeLayerByCubes(source, Layer::Inactive, options, budget, vs > 0, nullptr, team, codeInactive, keep);
         storeInactiveValues(out, std::move(kept));
     }
     if (team.isRoot()) out.summary = format::summaryToStore(out);  // the file's Summary section
@@ -557,8 +557,8 @@ format::SsvdagScene encodeSourcesByCubes(std::vector<std::unique_ptr<CubeSource>
         if (onGrid) onGrid(g, grids.size());
         scene.grids.push_back(encodeGridByCubes(*grids[g], options, budget, team));
         grids[g].reset();
-        std::vector<uint8_t>().swap(scene.grids.back().attributes);
-        std::vector<uint8_t>().swap(scene.grids.back().inactiveAttributes);
+        std::vector<uint8_t>().swap(scene.grids.back().active.attributes);
+        std::vector<uint8_t>().swap(scene.grids.back().inactive.attributes);
     }
     return scene;
 }

@@ -20,11 +20,12 @@ namespace {
 // encoded whose values were streamed into windows) decoded from its windows.
 // `store` holds decoded values when they had to be decoded.
 const std::vector<uint8_t>& attributesOf(const format::EncodedGrid& grid, bool inactive, std::vector<uint8_t>& store) {
-    const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
-    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+    const format::EncodedLayer& layer = grid.layer(inactive);
+    const std::vector<uint8_t>& attributes = layer.attributes;
+    const attributes::ValueWindowsPayload& windows = layer.valueWindows;
     if (!attributes.empty() || windows.empty()) return attributes;
     if (windows.predicted) {
-        const encoding::CompactDag& dag = inactive ? grid.inactiveDag : grid.dag;
+        const encoding::CompactDag& dag = layer.dag;
         const uint32_t vs = valueSize(grid.record.valueType);
         store = attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(dag), "grid '" + grid.record.name + "' predicted windows",
                                                    encoding::attributePlaces(dag, vs), util::tbbParallelFor());
@@ -55,16 +56,16 @@ format::EncodedGrid encodeGridImpl(const GridRecord& grid, const EncodeOptions& 
     // Exact values are gathered again; a lossy layer's come from its windows
     // (the values as stored, not the input's).
     const bool exact = options.tolerance.mode == attributes::ScalarTolerance::Mode::Exact;
-    if (vs && out.attributes.empty() && !out.dag.empty()) {
-        if (exact) out.attributes = gatherAttributes(out.dag, grid.topology, grid.values, vs);
+    if (vs && out.active.attributes.empty() && !out.active.dag.empty()) {
+        if (exact) out.active.attributes = gatherAttributes(out.active.dag, grid.topology, grid.values, vs);
         else {
             std::vector<uint8_t> decoded;
             attributesOf(out, false, decoded);
-            out.attributes = std::move(decoded);
+            out.active.attributes = std::move(decoded);
         }
     }
-    if (vs && out.inactiveAttributes.empty() && !out.inactiveDag.empty())
-        out.inactiveAttributes = gatherAttributes(out.inactiveDag, grid.inactiveTopology, grid.inactiveValues, vs);
+    if (vs && out.inactive.attributes.empty() && !out.inactive.dag.empty())
+        out.inactive.attributes = gatherAttributes(out.inactive.dag, grid.inactiveTopology, grid.inactiveValues, vs);
     if (release) *release = GridRecord{};
     return out;
 }
@@ -78,9 +79,9 @@ GridRecord decodeGrid(const format::EncodedGrid& grid) {
     GridRecord record = grid.record;
     const unsigned vs = valueSize(grid.record.valueType);
     std::vector<uint8_t> store;
-    scatterAttributes(grid.dag, attributesOf(grid, false, store), vs, record.topology, record.values);
+    scatterAttributes(grid.active.dag, attributesOf(grid, false, store), vs, record.topology, record.values);
     store = {};
-    scatterAttributes(grid.inactiveDag, attributesOf(grid, true, store), vs, record.inactiveTopology, record.inactiveValues);
+    scatterAttributes(grid.inactive.dag, attributesOf(grid, true, store), vs, record.inactiveTopology, record.inactiveValues);
     return record;
 }
 

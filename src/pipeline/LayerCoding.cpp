@@ -102,16 +102,16 @@ void codeInactiveValues(const encoding::CompactDag& dag, CodedValues& coded, con
 }
 
 void storeActiveValues(format::EncodedGrid& out, CodedValues&& coded) {
-    out.attributes = std::move(coded.attributes);
-    out.valueWindows = std::move(coded.windows);
+    out.active.attributes = std::move(coded.attributes);
+    out.active.valueWindows = std::move(coded.windows);
     out.lossy = coded.lossy;
     out.colour = std::move(coded.colour);
     out.normals = std::move(coded.normals);
 }
 
 void storeInactiveValues(format::EncodedGrid& out, CodedValues&& coded) {
-    out.inactiveAttributes = std::move(coded.attributes);
-    out.inactiveValueWindows = std::move(coded.windows);
+    out.inactive.attributes = std::move(coded.attributes);
+    out.inactive.valueWindows = std::move(coded.windows);
 }
 
 std::optional<attributes::FloatChannel> floatChannelOf(const GridRecord& grid, const EncodeOptions& options, bool inactive) {

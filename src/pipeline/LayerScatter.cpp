@@ -14,12 +14,13 @@ namespace vdbdag::pipeline {
 
 void scatterLayerByCubes(const format::EncodedGrid& grid, bool inactive, unsigned cutLog2, const LayerCubes& visit,
                          const std::function<void(uint64_t, uint64_t)>& progress) {
-    const encoding::CompactDag& dag = inactive ? grid.inactiveDag : grid.dag;
+    const format::EncodedLayer& layer = grid.layer(inactive);
+    const encoding::CompactDag& dag = layer.dag;
     if (dag.empty()) return;
     const unsigned vs = valueSize(grid.record.valueType);
     const uint64_t entries = encoding::decodedSize(dag).attributeEntries;
-    const std::vector<uint8_t>& attributes = inactive ? grid.inactiveAttributes : grid.attributes;
-    const attributes::ValueWindowsPayload& windows = inactive ? grid.inactiveValueWindows : grid.valueWindows;
+    const std::vector<uint8_t>& attributes = layer.attributes;
+    const attributes::ValueWindowsPayload& windows = layer.valueWindows;
     // The values: the attribute array when the reader built it, else the windows.
     std::vector<uint64_t> layout;
     std::vector<coding::BrickPlace> places;

@@ -105,7 +105,7 @@ Layer::Brick Layer::brick(int64_t i, int64_t j, int64_t k, Accessor::Path& path)
 // for c in 0..3); its entries are consecutive in stored-bit order.
 Accessor::Accessor(const detail::GridData* grid) : grid_(grid), valueSize_(grid->valueSize) {
     grid->load();  // the grid's DAGs, on its first walk
-    for (const encoding::CompactDag* d : {&grid->grid.dag, &grid->grid.inactiveDag})
+    for (const encoding::CompactDag* d : {&grid->grid.active.dag, &grid->grid.inactive.dag})
         for (const int64_t o : d->origin)
             if (o % 4 != 0) cache_.usable = false;  // not what the encoder writes (a multiple of the alignment, at least 4)
 }
@@ -289,7 +289,7 @@ void Grid::sampleActive(const IndexBBox& box, uint64_t stride, uint8_t* out) con
 // skipped whole.
 void Grid::forEachActive(const IndexBBox& box, const ActiveVisitor& visit) const {
     data_->load();
-    const encoding::CompactDag& d = data_->grid.dag;
+    const encoding::CompactDag& d = data_->grid.active.dag;
     if (d.empty() || d.innerLevelCount() == 0 || d.log2Size > 62 || box.empty()) return;
     const detail::Layer& layer = data_->active;
     const bool mask = data_->valueSize == 0;

@@ -32,16 +32,15 @@ void GridData::load() const {
         // What no reader touched before now (the once flag orders it before
         // every walk); the header, the counts and the summary stay as read.
         auto& to = const_cast<format::EncodedGrid&>(grid);
-        to.dag = std::move(from.dag);
-        to.inactiveDag = std::move(from.inactiveDag);
-        to.attributes = std::move(from.attributes);
-        to.values = std::move(from.values);
-        to.valueWindows = std::move(from.valueWindows);
-        to.predictedValues = std::move(from.predictedValues);
-        to.inactiveAttributes = std::move(from.inactiveAttributes);
-        to.inactiveValues = std::move(from.inactiveValues);
-        to.inactiveValueWindows = std::move(from.inactiveValueWindows);
-        to.inactivePredictedValues = std::move(from.inactivePredictedValues);
+        for (const bool inactive : {false, true}) {  // each layer but its voxel count, which readers may be reading
+            format::EncodedLayer& layer = to.layer(inactive);
+            format::EncodedLayer& read = from.layer(inactive);
+            layer.dag = std::move(read.dag);
+            layer.attributes = std::move(read.attributes);
+            layer.values = std::move(read.values);
+            layer.valueWindows = std::move(read.valueWindows);
+            layer.predictedValues = std::move(read.predictedValues);
+        }
         to.lossy = from.lossy;
         to.colour = std::move(from.colour);
         to.normals = std::move(from.normals);
@@ -52,9 +51,10 @@ void GridData::load() const {
 void Layer::load() const {
     std::call_once(loaded_, [&] {
         const unsigned vs = valueSize(grid->record.valueType);
-        const attributes::ValueWindowsPayload& windows = inactive ? grid->inactiveValueWindows : grid->valueWindows;
-        const attributes::PaletteChannel& channel = inactive ? grid->inactiveValues : grid->values;
-        const std::vector<uint8_t>& attributes = inactive ? grid->inactiveAttributes : grid->attributes;
+        const format::EncodedLayer& layer = grid->layer(inactive);
+        const attributes::ValueWindowsPayload& windows = layer.valueWindows;
+        const attributes::PaletteChannel& channel = layer.values;
+        const std::vector<uint8_t>& attributes = layer.attributes;
         if (!windows.empty() && windows.predicted) {
             auto w = std::make_unique<Windows>();
             if (windows.file) w->spilled = windows.load();
@@ -156,10 +156,10 @@ std::shared_ptr<FileData> FileData::read(const std::string& path, const OpenLimi
         if (data->grid.record.background.size() != data->valueSize)
             throw Error(what + ": its background holds " + std::to_string(data->grid.record.background.size()) + " bytes, expected " +
                         std::to_string(data->valueSize));
-        data->active.dag = &data->grid.dag;
+        data->active.dag = &data->grid.active.dag;
         data->active.grid = &data->grid;
         data->active.what = what;
-        data->inactive.dag = &data->grid.inactiveDag;
+        data->inactive.dag = &data->grid.inactive.dag;
         data->inactive.grid = &data->grid;
         data->inactive.inactive = true;
         data->inactive.what = what + " inactive values";
@@ -212,8 +212,8 @@ const std::string& Grid::name() const { return data_->grid.record.name; }
 const std::string& Grid::gridClass() const { return data_->grid.record.gridClass; }
 std::string Grid::valueType() const { return valueTypeName(data_->grid.record.valueType); }
 unsigned Grid::valueSize() const { return data_->valueSize; }
-uint64_t Grid::activeVoxelCount() const { return data_->grid.activeVoxels; }
-uint64_t Grid::inactiveVoxelCount() const { return data_->grid.inactiveVoxels; }
+uint64_t Grid::activeVoxelCount() const { return data_->grid.active.voxels; }
+uint64_t Grid::inactiveVoxelCount() const { return data_->grid.inactive.voxels; }
 std::array<double, 16> Grid::indexToWorld() const { return data_->grid.record.indexToWorld; }
 
 IndexBBox Grid::indexBBox() const {
@@ -223,7 +223,7 @@ IndexBBox Grid::indexBBox() const {
         return box;
     }
     data_->load();
-    if (const auto b = format::dagBounds(data_->grid.dag)) {
+    if (const auto b = format::dagBounds(data_->grid.active.dag)) {
         box.min = b->min;
         box.max = b->max;
     }

@@ -19,7 +19,7 @@ struct FileRoundTrip {
     attributes::PaletteChannel traceable;  // its active values as the reader lays them out for tracing (format::traceableValues)
     GridRecord decoded;
     uint64_t channelBytes() const { return traceable.byteSize(); }  // traceable value channel
-    uint64_t dagBytes() const { return stored.dag.byteSize(); }
+    uint64_t dagBytes() const { return stored.active.dag.byteSize(); }
 };
 
 FileRoundTrip roundTripThroughFile(const GridRecord& grid, const pipeline::EncodeOptions& options = {});

@@ -76,7 +76,7 @@ void addCases(std::vector<SelftestCase>& cases) {
     cases.push_back({"geometry", "empty-grid", "empty after decode", "an empty grid decodes to an empty grid (no nodes, no values)", [] {
                          SyntheticGrid grid;
                          Exact e = exactRoundTrip(grid, "empty");
-                         e.checks.require(e.rt.decoded.topology.empty() && e.rt.stored.dag.empty(), "the decoded grid is not empty");
+                         e.checks.require(e.rt.decoded.topology.empty() && e.rt.stored.active.dag.empty(), "the decoded grid is not empty");
                          e.checks.require(e.rt.traceable.entryCount == 0, "the empty grid stores values");
                          return e.checks.result(fmt::format("{} voxels", e.rt.decoded.topology.activeVoxelCount()), fmt::format("0 voxels, DAG {} bytes, file {} bytes", e.rt.dagBytes(), e.rt.fileBytes));
                      }});
@@ -85,7 +85,7 @@ void addCases(std::vector<SelftestCase>& cases) {
                          SyntheticGrid grid;
                          addVoxel(grid, 5, -7, 3);
                          Exact e = exactRoundTrip(grid, "one voxel");
-                         return e.checks.result(e.checks.passed() ? "1 voxel exact" : "differs", fmt::format("{} voxel, root 2^{}, DAG {} bytes, file {} bytes", e.voxels, e.rt.stored.dag.log2Size,
+                         return e.checks.result(e.checks.passed() ? "1 voxel exact" : "differs", fmt::format("{} voxel, root 2^{}, DAG {} bytes, file {} bytes", e.voxels, e.rt.stored.active.dag.log2Size,
                                                             e.rt.dagBytes(), e.rt.fileBytes));
                      }});
 
@@ -98,7 +98,7 @@ void addCases(std::vector<SelftestCase>& cases) {
                              addVoxel(grid, corner & 1 ? kMax : kMin, corner & 2 ? kMax : kMin, corner & 4 ? kMax : kMin);
                              Exact e = exactRoundTrip(grid, fmt::format("corner {}", corner));
                              exact += checks.require(e.checks.passed(), e.checks.result("", fmt::format("corner {}", corner)).measured);
-                             maxRoot = std::max<unsigned>(maxRoot, e.rt.stored.dag.log2Size);
+                             maxRoot = std::max<unsigned>(maxRoot, e.rt.stored.active.dag.log2Size);
                              maxFile = std::max(maxFile, e.rt.fileBytes);
                          }
                          return checks.result(fmt::format("{}/8 exact", exact), fmt::format("{} of 8 corners exact; largest root 2^{}, largest file {} bytes", exact, maxRoot, maxFile));
@@ -130,8 +130,8 @@ void addCases(std::vector<SelftestCase>& cases) {
                          Exact e = exactRoundTrip(grid, "int32 span");
                          return e.checks.result(fmt::format("{} voxels + 1 tile exact", e.voxels), fmt::format("{} voxels (tiles counted as voxels up to 32^3) + 1 large tile exact, root 2^{}, "
                                                             "origin ({},{},{}), file {} bytes",
-                                                            e.voxels, e.rt.stored.dag.log2Size, e.rt.stored.dag.origin[0], e.rt.stored.dag.origin[1],
-                                                            e.rt.stored.dag.origin[2], e.rt.fileBytes));
+                                                            e.voxels, e.rt.stored.active.dag.log2Size, e.rt.stored.active.dag.origin[0], e.rt.stored.active.dag.origin[1],
+                                                            e.rt.stored.active.dag.origin[2], e.rt.fileBytes));
                      }});
 
     static constexpr double kFactor = 1.0;
@@ -186,13 +186,13 @@ void addCases(std::vector<SelftestCase>& cases) {
                          e.checks.require(t.tiles.size() == 1 && t.tiles[0].log2Size == 12 && t.bricks.size() == 1,
                                           fmt::format("decoded as {} tiles and {} bricks", t.tiles.size(), t.bricks.size()));
                          e.checks.require(e.rt.traceable.entryCount == 2, fmt::format("{} attribute entries", e.rt.traceable.entryCount));
-                         e.checks.require(e.rt.stored.activeVoxels == (uint64_t(1) << 36) + 1, fmt::format("{} active voxels", e.rt.stored.activeVoxels));
+                         e.checks.require(e.rt.stored.active.voxels == (uint64_t(1) << 36) + 1, fmt::format("{} active voxels", e.rt.stored.active.voxels));
                          e.checks.require(e.rt.fileBytes <= baseline + kTileExtraBytes, fmt::format("file {} bytes, one voxel alone {}", e.rt.fileBytes, baseline));
                          return e.checks.result(fmt::format("+{} B, {} tile", int64_t(e.rt.fileBytes) - int64_t(baseline), t.tiles.size()),
                                                 fmt::format("{} active voxels in {} attribute entries; file {} bytes (one voxel alone: {}), DAG {} bytes "
                                                             "over {} levels, root 2^{}",
-                                                            e.rt.stored.activeVoxels, e.rt.traceable.entryCount, e.rt.fileBytes, baseline,
-                                                            e.rt.dagBytes(), e.rt.stored.dag.log2Size - 1, e.rt.stored.dag.log2Size));
+                                                            e.rt.stored.active.voxels, e.rt.traceable.entryCount, e.rt.fileBytes, baseline,
+                                                            e.rt.dagBytes(), e.rt.stored.active.dag.log2Size - 1, e.rt.stored.active.dag.log2Size));
                      }});
 }
 

@@ -43,13 +43,13 @@ const char* shadingOf(const RenderGrid& grid) {
 
 RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
     RenderGrid out;
-    out.dag = &grid.dag;
+    out.dag = &grid.active.dag;
     out.valueType = grid.record.valueType;
     out.indexToWorld = grid.record.indexToWorld;
     const bool scalarFloat = out.valueType == ValueType::Float || out.valueType == ValueType::Double;
-    if (valueSize(out.valueType) > 0 && grid.values.entryCount > 0) {
-        out.values = &grid.values;
-    } else if (valueSize(out.valueType) > 0 && (!grid.valueWindows.empty() || !grid.attributes.empty())) {
+    if (valueSize(out.valueType) > 0 && grid.active.values.entryCount > 0) {
+        out.values = &grid.active.values;
+    } else if (valueSize(out.valueType) > 0 && (!grid.active.valueWindows.empty() || !grid.active.attributes.empty())) {
         out.ownValues = std::make_shared<const attributes::PaletteChannel>(format::traceableValues(grid));
         if (out.ownValues->entryCount > 0) out.values = out.ownValues.get();
     }
@@ -123,11 +123,11 @@ RenderGrid makeRenderGrid(const format::EncodedGrid& grid, Shading shading) {
         out.valueMax = std::isfinite(hi) && hi > 0 ? hi : 1;
         out.valueMin = 0;
     }
-    if (!grid.dag.empty()) {
-        const OccupiedBox box = occupiedBox(grid.dag, 5);
+    if (!grid.active.dag.empty()) {
+        const OccupiedBox box = occupiedBox(grid.active.dag, 5);
         for (int a = 0; a < 3; ++a) {
-            out.cellLo[a] = double(box.lo[a] + grid.dag.origin[a]);
-            out.cellHi[a] = double(box.hi[a] + grid.dag.origin[a]);
+            out.cellLo[a] = double(box.lo[a] + grid.active.dag.origin[a]);
+            out.cellHi[a] = double(box.hi[a] + grid.active.dag.origin[a]);
         }
     }
     return out;

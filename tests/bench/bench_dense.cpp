@@ -115,7 +115,7 @@ void BM_DenseEncodeCommand(benchmark::State& state) {
         auto imported = vdbdag::bridge::importDense(phantomPrefix() + ".nhdr", options);
         vdbdag::pipeline::EncodeOptions encode;
         vdbdag::format::SsvdagScene scene = vdbdag::pipeline::encodeVolumeReleasing(imported.volume, encode);
-        for (auto& g : scene.grids) std::vector<uint8_t>().swap(g.attributes);
+        for (auto& g : scene.grids) std::vector<uint8_t>().swap(g.active.attributes);
         const std::vector<uint8_t> file = vdbdag::format::writeScene(scene);
         vdbdag::writeFileAtomically(out, file);
         bytes = file.size();

@@ -114,15 +114,15 @@ void traceAll(benchmark::State& state, TraceOne&& traceOne) {
 }
 
 void BM_Trace_FirstHit_Ssvdag(benchmark::State& state) {
-    const vdbdag::trace::DagTracer tracer(scene().ssvdag.dag);
+    const vdbdag::trace::DagTracer tracer(scene().ssvdag.active.dag);
     traceAll(state, [&](size_t i) { return tracer.trace(scene().cellRays[i]).hit; });
 }
 void BM_Trace_FirstHit_Svdag(benchmark::State& state) {
-    const vdbdag::trace::DagTracer tracer(scene().svdag.dag);
+    const vdbdag::trace::DagTracer tracer(scene().svdag.active.dag);
     traceAll(state, [&](size_t i) { return tracer.trace(scene().cellRays[i]).hit; });
 }
 void BM_Trace_ZeroCrossing_Ssvdag(benchmark::State& state) {
-    const vdbdag::trace::DagTracer tracer(scene().ssvdag.dag);
+    const vdbdag::trace::DagTracer tracer(scene().ssvdag.active.dag);
     const vdbdag::trace::RenderGrid grid = vdbdag::trace::makeRenderGrid(scene().ssvdag);
     traceAll(state, [&](size_t i) { return vdbdag::trace::firstSurfaceHit(grid, tracer, scene().cellRays[i]).hit; });
 }

@@ -141,11 +141,11 @@ void readAll(std::span<const uint8_t> bytes, bool deep) {
             // valid file the readers bound by --max-voxels; the walk below is
             // only for DAGs that decode to at most 2^20 bricks and tiles, so a
             // bomb as a seed never times the run out (issue 38 #11).
-            const encoding::DecodedSize size = encoding::decodedSize(grid.dag);
+            const encoding::DecodedSize size = encoding::decodedSize(grid.active.dag);
             if (size.emittedBricks > (uint64_t(1) << 20) || size.emittedTiles > (uint64_t(1) << 20)) continue;
             uint64_t visited = 0;
             encoding::visitInstances(
-                grid.dag, [&](int64_t, int64_t, int64_t, uint64_t) { ++visited; }, [&](int64_t, int64_t, int64_t, unsigned) { ++visited; });
+                grid.active.dag, [&](int64_t, int64_t, int64_t, uint64_t) { ++visited; }, [&](int64_t, int64_t, int64_t, unsigned) { ++visited; });
         }
     } catch (const Error&) {
     }

@@ -31,7 +31,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         for (const auto& grid : scene.grids) {
             uint64_t visited = 0;
             encoding::visitInstances(
-                grid.dag, [&](int64_t, int64_t, int64_t, uint64_t) { ++visited; }, [&](int64_t, int64_t, int64_t, unsigned) { ++visited; });
+                grid.active.dag, [&](int64_t, int64_t, int64_t, uint64_t) { ++visited; }, [&](int64_t, int64_t, int64_t, unsigned) { ++visited; });
         }
     } catch (const Error&) {
     }

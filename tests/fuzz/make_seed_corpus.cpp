@@ -155,7 +155,7 @@ int main(int argc, char** argv) {
         far.name = "far";
         format::SsvdagScene farScene;
         farScene.grids.push_back(pipeline::encodeGrid(far));
-        farScene.grids[0].dag.origin[0] = 2147483640;  // voxels past INT32_MAX
+        farScene.grids[0].active.dag.origin[0] = 2147483640;  // voxels past INT32_MAX
         const auto farBytes = format::writeScene(farScene);
         std::ofstream(std::string(argv[1]) + "/forged_far.ssvdag", std::ios::binary)
             .write(reinterpret_cast<const char*>(farBytes.data()), std::streamsize(farBytes.size()));

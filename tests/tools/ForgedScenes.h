@@ -29,9 +29,9 @@ inline GridRecord solidFloatBlock(const std::string& name, int side) {
 // The grid's values as files before value windows stored them: one palette
 // (Values) section, which a reader decodes whole.
 inline void useLegacyValues(format::EncodedGrid& grid) {
-    grid.values = format::traceableValues(grid);
-    grid.valueWindows = {};
-    grid.predictedValues.clear();
+    grid.active.values = format::traceableValues(grid);
+    grid.active.valueWindows = {};
+    grid.active.predictedValues.clear();
 }
 
 } // namespace vdbdag::testing

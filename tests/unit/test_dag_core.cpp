@@ -206,7 +206,7 @@ TEST(DagBuilder, SsvdagDecodesToTheVoxelsOfThePlainSvdagAndIsSmaller) {
     const auto plain = pipeline::encodeGrid(record, options);
     EXPECT_EQ(voxelsOf(pipeline::decodeGrid(sym).topology), voxels);
     EXPECT_EQ(voxelsOf(pipeline::decodeGrid(plain).topology), voxels);
-    EXPECT_LT(sym.dag.byteSize(), plain.dag.byteSize() * 6 / 10) << sym.dag.byteSize() << " vs " << plain.dag.byteSize();
+    EXPECT_LT(sym.active.dag.byteSize(), plain.active.dag.byteSize() * 6 / 10) << sym.active.dag.byteSize() << " vs " << plain.active.dag.byteSize();
 }
 
 TEST(DagBuilder, Int32ExtremesAndHugeTileStayCompact) {
@@ -298,12 +298,12 @@ TEST(SsvdagFile, SceneRoundTripsThroughSections) {
     EXPECT_EQ(back.grids[0].record.name, "ramp");
     EXPECT_EQ(back.grids[0].record.gridClass, "fog volume");
     EXPECT_EQ(back.grids[0].record.vdbDescriptor, record.vdbDescriptor);
-    EXPECT_EQ(back.grids[0].activeVoxels, voxels.size());
+    EXPECT_EQ(back.grids[0].active.voxels, voxels.size());
     EXPECT_TRUE(back.grids[0].stats.hasSvdag);
     const GridRecord decoded = pipeline::decodeGrid(back.grids[0]);
     EXPECT_EQ(voxelsOf(decoded.topology), voxels);
     EXPECT_EQ(decoded.values.bricks.size(), record.values.bricks.size());
-    EXPECT_TRUE(back.grids[1].dag.empty());
+    EXPECT_TRUE(back.grids[1].active.dag.empty());
     EXPECT_EQ(back.grids[1].record.name, "");
 }
 

@@ -542,14 +542,14 @@ TEST(PredictedChannel, SurvivesTheFileWithMirroredBricksAndTiles) {
     format::SsvdagScene scene;
     scene.grids.push_back(pipeline::encodeGrid(record));
     {  // one predicted window, coded by the context-modelled predictor with its bricks placed (coding byte 6: int32), not palettes
-        const attributes::ValueWindowsPayload& w = scene.grids[0].valueWindows;
+        const attributes::ValueWindowsPayload& w = scene.grids[0].active.valueWindows;
         ASSERT_TRUE(w.predicted);
-        const auto dir = attributes::readPredictedWindowDirectory(w.bytes, 4, encoding::attributeLayout(scene.grids[0].dag), "test");
+        const auto dir = attributes::readPredictedWindowDirectory(w.bytes, 4, encoding::attributeLayout(scene.grids[0].active.dag), "test");
         ASSERT_EQ(dir.windows.size(), 1u);
         EXPECT_EQ(attributes::windowRawBytes(w.bytes, dir.windows[0], "test").at(0), attributes::detail::kBandedContextCoding)
             << "the predictor should win on this channel";
     }
-    EXPECT_LT(scene.grids[0].dag.leaves.size(), 16u) << "32 distinct masks, pairs of mirror images: reflected instances must exist";
+    EXPECT_LT(scene.grids[0].active.dag.leaves.size(), 16u) << "32 distinct masks, pairs of mirror images: reflected instances must exist";
     const auto bytes = format::writeScene(scene);
     const format::SsvdagScene back = format::readScene(bytes, "mem");
     const GridRecord decoded = pipeline::decodeGrid(back.grids[0]);
@@ -569,5 +569,5 @@ TEST(PredictedChannel, SurvivesTheFileWithMirroredBricksAndTiles) {
     std::memcpy(&gotTile, decoded.values.tiles.data(), 4);
     EXPECT_EQ(gotTile, tileValue);
     // The palettes (the traceable layout) built from them agree entry by entry.
-    EXPECT_EQ(format::traceableValues(back.grids[0]).decodeAll(), back.grids[0].attributes);
+    EXPECT_EQ(format::traceableValues(back.grids[0]).decodeAll(), back.grids[0].active.attributes);
 }

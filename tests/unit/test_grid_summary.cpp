@@ -96,8 +96,8 @@ TEST(GridSummary, DagBoundsEqualAWalkOfEveryVoxel) {
         if (trial % 3 == 0) g.topology.tiles.push_back({64 * (trial + 1), 0, -64, 3});  // an 8^3 tile too
         volume.grids.push_back(g);
         const format::SsvdagScene scene = encodedAndReadBack(volume);
-        const auto walked = walkedBounds(scene.grids[0].dag);
-        const auto bounds = format::dagBounds(scene.grids[0].dag);
+        const auto walked = walkedBounds(scene.grids[0].active.dag);
+        const auto bounds = format::dagBounds(scene.grids[0].active.dag);
         ASSERT_TRUE(walked && bounds);
         EXPECT_EQ(bounds->min, walked->min) << "trial " << trial;
         EXPECT_EQ(bounds->max, walked->max) << "trial " << trial;

@@ -118,7 +118,7 @@ TEST(Normals, SphereGradientNormalsMatchTheClosedFormAndTheOnvBound) {
         EXPECT_GT(n.report.oneSided, 0u) << "the narrow band's edge";
         uint64_t interior = 0, visited = 0;
         double maxClosed = 0, sumClosed = 0;
-        forEachEntry(g.dag, [&](const openvdb::Coord& c, uint64_t entry) {
+        forEachEntry(g.active.dag, [&](const openvdb::Coord& c, uint64_t entry) {
             ++visited;
             const std::array<float, 3> decoded = n.decode(entry);
             const openvdb::Vec3d p = grid->indexToWorld(c);
@@ -169,7 +169,7 @@ TEST(Normals, FromAVec3NormalGridOnItsOwnGeometry) {
         EXPECT_EQ(n.report.source, attributes::NormalReport::Source::NormalGrid);
         EXPECT_EQ(n.report.zeroLength, 1u);
         EXPECT_LE(n.report.maxAngleDegrees, 0.95);
-        forEachEntry(scene.grids[ni].dag, [&](const openvdb::Coord& c, uint64_t entry) {
+        forEachEntry(scene.grids[ni].active.dag, [&](const openvdb::Coord& c, uint64_t entry) {
             const openvdb::Vec3d d = ls->indexToWorld(c) - openvdb::Vec3d(kCentre);
             if (c.x() == 1000) {
                 const auto z = n.decode(entry);

@@ -100,8 +100,8 @@ TEST(ReadLimits, VoxelsPastTheInt32IndexRangeAreRefusedWhenRead) {
     record.topology.bricks.push_back({8, 0, 0, ~uint64_t(0)});
     format::SsvdagScene scene;
     scene.grids.push_back(pipeline::encodeGrid(record));
-    ASSERT_EQ(scene.grids[0].dag.log2Size, 4u);
-    scene.grids[0].dag.origin[0] = 2147483640;  // a multiple of 4 inside int32; the brick at +8 lies past INT32_MAX
+    ASSERT_EQ(scene.grids[0].active.dag.log2Size, 4u);
+    scene.grids[0].active.dag.origin[0] = 2147483640;  // a multiple of 4 inside int32; the brick at +8 lies past INT32_MAX
     const auto bytes = format::writeScene(scene);
     std::string m;
     try {
@@ -155,11 +155,11 @@ TEST(ReadLimits, ValuesOfTheLayoutBeforeWindowsAreWeighedWhenWindowsAreKept) {
     // count of each of the seven values (the order is the DAG's).
     options.limits.maxMemory = uint64_t(64) << 20;
     const format::SsvdagScene read = format::readScene(bytes, "legacy.ssvdag", options);
-    ASSERT_EQ(read.grids[0].attributes.size(), entries * 4);
+    ASSERT_EQ(read.grids[0].active.attributes.size(), entries * 4);
     std::array<uint64_t, 7> counts{};
     for (uint64_t i = 0; i < entries; ++i) {
         float v = 0;
-        std::memcpy(&v, read.grids[0].attributes.data() + 4 * i, 4);
+        std::memcpy(&v, read.grids[0].active.attributes.data() + 4 * i, 4);
         const int k = int(v * 4.0f);
         ASSERT_TRUE(k >= 0 && k < 7 && float(k) * 0.25f == v) << v;
         ++counts[size_t(k)];

@@ -319,7 +319,7 @@ TEST(Reader, AValueThatCannotBeDecodedIsAnErrorEachTimeItIsAsked) {
     });
     format::SsvdagScene scene;
     scene.grids.push_back(pipeline::encodeGrid(selftest::toRecord(c.active, c.name)));
-    std::vector<uint8_t>& windows = scene.grids[0].valueWindows.bytes;
+    std::vector<uint8_t>& windows = scene.grids[0].active.valueWindows.bytes;
     ASSERT_GT(windows.size(), 64u);
     for (size_t i = 28; i < 36; ++i) windows[i] = 0;  // the first window's first bytes (after the 28-byte head, PredictedWindows.h): no zstd frame
     const auto path = std::filesystem::temp_directory_path() / ("reader_cut_" + std::to_string(::getpid()) + ".ssvdag");

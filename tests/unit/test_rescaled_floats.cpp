@@ -159,9 +159,9 @@ TEST(RescaledFloats, AFloatGridWithALatticeStoresItsIntegers) {
         record.rescale = hint ? std::optional<ValueRescale>(kPet) : std::nullopt;
         format::SsvdagScene scene;
         scene.grids.push_back(pipeline::encodeGrid(record));
-        const ValueWindowsPayload& w = scene.grids[0].valueWindows;
+        const ValueWindowsPayload& w = scene.grids[0].active.valueWindows;
         EXPECT_TRUE(w.predicted);
-        const uint8_t coding = codingOf(w.bytes, encoding::attributeLayout(scene.grids[0].dag));
+        const uint8_t coding = codingOf(w.bytes, encoding::attributeLayout(scene.grids[0].active.dag));
         if (hint) EXPECT_EQ(coding, detail::kBandedRescaledFloatCoding);
         else EXPECT_TRUE(coding == detail::kPaletteCoding || coding == detail::kFloatCoding) << int(coding);
         const format::SsvdagScene back = format::readScene(format::writeScene(scene), "mem");

@@ -239,8 +239,8 @@ TEST(VdbRoundTrip, HugeActiveTileStaysAHandfulOfNodes) {
     ASSERT_EQ(imported.volume.grids[0].topology.tiles.size(), 1u);
     EXPECT_EQ(imported.volume.grids[0].topology.tiles[0].log2Size, 12);
     const auto encoded = pipeline::encodeGrid(imported.volume.grids[0]);
-    EXPECT_LT(encoded.dag.byteSize(), 1024u);
-    EXPECT_EQ(encoded.activeVoxels, uint64_t(1) << 36);
+    EXPECT_LT(encoded.active.dag.byteSize(), 1024u);
+    EXPECT_EQ(encoded.active.voxels, uint64_t(1) << 36);
     const fs::path out = roundTrip(in);
     expectSameTopology(in, out);
     const auto decoded = openvdb::gridPtrCast<openvdb::MaskGrid>(readGrids(out)[0]);

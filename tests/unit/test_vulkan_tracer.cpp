@@ -137,7 +137,7 @@ size_t compareOnGrid(const format::EncodedGrid& encoded, int width, int height, 
                      bool primary) {
     const trace::RenderGrid grid = trace::makeRenderGrid(encoded);
     const std::vector<Ray> rays = sceneRays(grid, width, height, randomCount, 99);
-    const trace::DagTracer tracer(encoded.dag);
+    const trace::DagTracer tracer(encoded.active.dag);
     gpu::VulkanTracer gpuTracer(*context(), grid);
     const std::vector<RayHit> wantFirst = cpuHits(tracer, rays);
     hits = 0;
@@ -340,7 +340,7 @@ TEST(VulkanTracer, AgreesWithTheCpuTracerOnTheGeneratedSamples) {
         const auto imported = bridge::importVdb(e.path().string());
         for (const GridRecord& record : imported.volume.grids) {
             const format::EncodedGrid encoded = pipeline::encodeGrid(record);
-            if (encoded.dag.empty()) continue;
+            if (encoded.active.dag.empty()) continue;
             size_t gridHits = 0;
             total += compareOnGrid(encoded, 128, 96, 10000, e.path().filename().string() + ":" + record.name, gridHits, false);
             hits += gridHits;
