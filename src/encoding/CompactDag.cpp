@@ -39,6 +39,7 @@
 // spatial child slot p under accumulated reflection m reads stored slot p^m;
 // in a leaf it reads bit mirror(m, voxel) (DESIGN.md invariant 2).
 #include "src/encoding/CompactDag.h"
+#include "src/encoding/DagDescent.h"
 
 #include <vdbdag/dag_access.h>
 
@@ -221,14 +222,11 @@ void validateCompact(const CompactDag& dag, const std::string& what) {
         const uint64_t begin = dag.levelStart[i], end = dag.levelEnd(i);
         const bool toLeaves = i + 1 == levels;
         here.assign(end - begin, 0);
-        for (uint64_t pos = begin; pos < end; pos += nodeWordCount(dag.inner[pos], dag.offsetWords[i])) {
-            const uint16_t header = dag.inner[pos];
-            if (header == 0) { here[pos - begin] = 1; continue; }
+        forEachNode(dag, i, [&](uint64_t pos, uint16_t header) {
+            if (header == 0) { here[pos - begin] = 1; return; }
             uint64_t preceding = 0;
             bool first = true;
-            for (unsigned j = 0; j < 8; ++j) {
-                if (((header >> (2 * j)) & 3u) == 0) continue;
-                const ChildPointer p = readChild(dag.inner, pos, j, dag.offsetWords[i]);
+            forEachStoredChild(dag, i, pos, [&](unsigned, const ChildPointer& p) {
                 const bool ok = toLeaves ? p.offset < dag.leaves.size()
                                          : p.offset < isNodeStart[i + 1].size() && isNodeStart[i + 1][p.offset];
                 if (!ok) fail("pointer at level " + std::to_string(i) + " word " + std::to_string(pos) + " targets " +
@@ -238,9 +236,9 @@ void validateCompact(const CompactDag& dag, const std::string& what) {
                          std::to_string(p.attributeOffset) + ", expected " + std::to_string(preceding));
                 first = false;
                 preceding = saturatingAdd(preceding, below[p.offset]);
-            }
+            });
             here[pos - begin] = preceding;
-        }
+        });
         below.swap(here);
     }
 }
@@ -256,18 +254,15 @@ std::vector<NodeFacts> computeFacts(const CompactDag& dag) {
         for (auto* v : {&f.voxels, &f.entries, &f.bricks, &f.tiles}) v->assign(end - begin, 0);
         const unsigned log2Size = dag.log2Size - unsigned(i);
         const bool toLeaves = i + 1 == levels;
-        for (uint64_t pos = begin; pos < end; pos += nodeWordCount(dag.inner[pos], dag.offsetWords[i])) {
-            const uint16_t header = dag.inner[pos];
+        forEachNode(dag, i, [&](uint64_t pos, uint16_t header) {
             const uint64_t at = pos - begin;
             if (header == 0) {  // solid node
                 f.voxels[at] = 3 * log2Size >= 64 ? std::numeric_limits<uint64_t>::max() : uint64_t(1) << (3 * log2Size);
                 f.entries[at] = 1;
                 f.tiles[at] = 1;
-                continue;
+                return;
             }
-            for (unsigned j = 0; j < 8; ++j) {
-                if (((header >> (2 * j)) & 3u) == 0) continue;
-                const ChildPointer p = readChild(dag.inner, pos, j, dag.offsetWords[i]);
+            forEachStoredChild(dag, i, pos, [&](unsigned, const ChildPointer& p) {
                 if (toLeaves) {
                     const uint64_t n = uint64_t(std::popcount(dag.leaves[p.offset]));
                     f.voxels[at] += n;
@@ -280,8 +275,8 @@ std::vector<NodeFacts> computeFacts(const CompactDag& dag) {
                     f.bricks[at] = saturatingAdd(f.bricks[at], c.bricks[p.offset]);
                     f.tiles[at] = saturatingAdd(f.tiles[at], c.tiles[p.offset]);
                 }
-            }
-        }
+            });
+        });
     }
     return facts;
 }
@@ -299,8 +294,9 @@ uint64_t BrickInstance::spatialMask() const { return dag::reflectBrick(storedMas
 
 namespace {
 
-// The depth-first walk of DESIGN.md invariant 2. With a cut size, nodes of
-// that size (and solid nodes above it) are reported to `cut` and skipped.
+// The depth-first walk of DESIGN.md invariant 2 (descendFrom), counting
+// attribute entries. With a cut size, nodes of that size (and solid nodes
+// above it) are reported to `cut` and skipped.
 struct Walker {
     const CompactDag& dag;
     const std::vector<NodeFacts>& facts;
@@ -310,32 +306,24 @@ struct Walker {
     std::vector<SubtreeInstance>* cut = nullptr;
     uint64_t entry = 0;
 
-    void visit(size_t i, uint64_t offset, unsigned mirror, int64_t x, int64_t y, int64_t z) {
-        const unsigned log2Size = dag.log2Size - unsigned(i);
-        const uint64_t pos = dag.levelStart[i] + offset;
-        const uint16_t header = dag.inner[pos];
-        if (cut && (log2Size == cutLog2 || header == 0)) {
-            cut->push_back({unsigned(i), offset, mirror, x, y, z, log2Size, entry, header == 0});
-            entry += facts[i].entries[offset];
-            return;
-        }
-        if (header == 0) { (*solid)(x, y, z, log2Size, entry++); return; }
-        const int64_t half = int64_t(1) << (log2Size - 1);
-        const bool toLeaves = i + 1 == dag.innerLevelCount();
-        for (unsigned j = 0; j < 8; ++j) {  // stored slot order = attribute order
-            if (((header >> (2 * j)) & 3u) == 0) continue;
-            const unsigned p = j ^ mirror;   // spatial slot
-            const ChildPointer ptr = readChild(dag.inner, pos, j, dag.offsetWords[i]);
-            const unsigned childMirror = mirror ^ ptr.reflection;
-            const int64_t cx = x + ((p & 1u) ? half : 0), cy = y + ((p & 2u) ? half : 0), cz = z + ((p & 4u) ? half : 0);
-            if (toLeaves) {
-                const uint64_t stored = dag.leaves[ptr.offset];
-                if (brick) (*brick)(BrickInstance{cx, cy, cz, childMirror, stored, entry});
+    void visit(size_t level, uint64_t offset, const NodePlace& at) {
+        descendFrom(
+            dag, level, offset, at,
+            [&](size_t i, uint64_t here, uint16_t header, const NodePlace& p) {
+                const unsigned log2Size = dag.log2Size - unsigned(i);
+                if (cut && (log2Size == cutLog2 || header == 0)) {
+                    cut->push_back({unsigned(i), here, p.mirror, p.x, p.y, p.z, log2Size, entry, header == 0});
+                    entry += facts[i].entries[here];
+                    return false;
+                }
+                if (header == 0) (*solid)(p.x, p.y, p.z, log2Size, entry++);
+                return true;
+            },
+            [&](uint64_t leaf, const NodePlace& p) {
+                const uint64_t stored = dag.leaves[leaf];
+                if (brick) (*brick)(BrickInstance{p.x, p.y, p.z, p.mirror, stored, entry});
                 entry += uint64_t(std::popcount(stored));
-            } else {
-                visit(i + 1, ptr.offset, childMirror, cx, cy, cz);
-            }
-        }
+            });
     }
 };
 
@@ -351,7 +339,7 @@ std::vector<NodeFacts> checkedFacts(const CompactDag& dag) {
 void visitInAttributeOrder(const CompactDag& dag, const BrickInstanceVisitor& brick, const SolidVisitor& solid) {
     if (dag.empty()) return;
     const auto facts = checkedFacts(dag);
-    Walker{dag, facts, &brick, &solid}.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
+    Walker{dag, facts, &brick, &solid}.visit(0, 0, rootPlace(dag));
 }
 
 std::vector<SubtreeInstance> subtreesInAttributeOrder(const CompactDag& dag, unsigned log2Size) {
@@ -360,7 +348,7 @@ std::vector<SubtreeInstance> subtreesInAttributeOrder(const CompactDag& dag, uns
     if (log2Size < 3 || log2Size > dag.log2Size) throw Error("internal error: subtree size out of range");
     const auto facts = computeFacts(dag);
     Walker walker{dag, facts, nullptr, nullptr, log2Size, &out};
-    walker.visit(0, 0, dag.rootReflection, dag.origin[0], dag.origin[1], dag.origin[2]);
+    walker.visit(0, 0, rootPlace(dag));
     return out;
 }
 
@@ -368,7 +356,7 @@ void visitSubtreeInAttributeOrder(const CompactDag& dag, const SubtreeInstance& 
     const std::vector<NodeFacts> none;  // an uncut walk reads no facts
     Walker walker{dag, none, &brick, &solid};
     walker.entry = root.firstEntry;
-    walker.visit(root.level, root.offset, root.mirror, root.x, root.y, root.z);
+    walker.visit(root.level, root.offset, NodePlace{root.x, root.y, root.z, root.mirror});
 }
 
 void visitInstances(const CompactDag& dag, const BrickVisitor& brick, const TileVisitor& tile) {

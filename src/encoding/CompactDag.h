@@ -103,7 +103,9 @@ void visitInstances(const CompactDag& dag, const BrickVisitor& brick, const Tile
 // Convenience: the whole topology (tiles as tiles). Coordinates must fit int32.
 GridTopology decodeTopology(const CompactDag& dag);
 
-// Parsing helpers shared with the tracers.
+// Parsing helpers shared with the tracers (the words themselves are decoded
+// by include/vdbdag/dag_access.h; the loops over a whole DAG are
+// DagDescent.h's).
 struct ChildPointer {
     uint64_t offset;           // in words of the next level (16-bit inner / 64-bit leaf words)
     unsigned reflection;

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 
+#include "src/encoding/DagDescent.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::format {
@@ -102,24 +103,20 @@ std::optional<IndexBox> dagBounds(const encoding::CompactDag& dag) {
         const int64_t size = int64_t(1) << (dag.log2Size - i), half = size / 2;
         const bool toLeaves = i + 1 == levels;
         LevelBoxes here(end - begin, size);
-        for (uint64_t pos = begin; pos < end; pos += encoding::nodeWordCount(dag.inner[pos], dag.offsetWords[i])) {
-            const uint16_t header = dag.inner[pos];
+        encoding::forEachNode(dag, i, [&](uint64_t pos, uint16_t header) {
             LocalBox box;
             if (header == 0) {  // solid node
                 box = LocalBox{{0, 0, 0}, {size - 1, size - 1, size - 1}, true};
             } else {
-                for (unsigned j = 0; j < 8; ++j) {
-                    if (((header >> (2 * j)) & 3u) == 0) continue;
-                    const encoding::ChildPointer p = encoding::readChild(dag.inner, pos, j, dag.offsetWords[i]);
+                encoding::forEachStoredChild(dag, i, pos, [&](unsigned j, const encoding::ChildPointer& p) {
                     const std::array<int64_t, 3> at{(j & 1u) ? half : 0, (j & 2u) ? half : 0, (j & 4u) ? half : 0};
                     const LocalBox child = toLeaves ? brickBox(dag.leaves[p.offset]) : below->get(p.offset);
                     box.merge(child.placed(p.reflection, half, at));
-                }
+                });
             }
-            if (i == 0) root = box;  // the root level holds one node, at word 0
-            else here.set(pos - begin, box);
-            if (i == 0) break;
-        }
+            if (i > 0) here.set(pos - begin, box);
+            else if (pos == 0) root = box;  // the root level holds one node, at word 0
+        });
         below.emplace(std::move(here));
     }
     const LocalBox placed = root.placed(dag.rootReflection, int64_t(1) << dag.log2Size, dag.origin);

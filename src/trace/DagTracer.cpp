@@ -3,6 +3,7 @@
 // gpu/shaders/trace.comp.
 #include "src/trace/DagTracer.h"
 #include "src/trace/DagWalk.h"
+#include "src/encoding/DagDescent.h"
 
 #include <algorithm>
 #include <bit>
@@ -16,29 +17,16 @@ OccupiedBox occupiedBox(const encoding::CompactDag& dag, unsigned levels) {
     if (dag.empty()) return box;
     for (int a = 0; a < 3; ++a) { box.lo[a] = INT64_MAX; box.hi[a] = INT64_MIN; }
     const unsigned maxDepth = std::min<unsigned>(unsigned(dag.innerLevelCount()) - 1, levels);
-    struct Walk {
-        const encoding::CompactDag& dag;
-        unsigned maxDepth;
-        OccupiedBox& box;
-        void visit(unsigned depth, uint64_t pos, unsigned mirror, const int64_t (&c)[3]) {
-            const unsigned log2 = dag.log2Size - depth;
-            const uint16_t header = dag.inner[pos];
-            if (header == 0 || depth == maxDepth) {
-                for (int a = 0; a < 3; ++a) { box.lo[a] = std::min(box.lo[a], c[a]); box.hi[a] = std::max(box.hi[a], c[a] + (int64_t(1) << log2)); }
-                return;
-            }
-            const int64_t half = int64_t(1) << (log2 - 1);
-            for (unsigned j = 0; j < 8; ++j) {
-                if (((header >> (2 * j)) & 3u) == 0) continue;
-                const encoding::ChildPointer child = encoding::readChild(dag.inner, pos, j, dag.offsetWords[depth]);
-                const unsigned p = j ^ mirror;
-                const int64_t corner[3] = {c[0] + ((p & 1) ? half : 0), c[1] + ((p & 2) ? half : 0), c[2] + ((p & 4) ? half : 0)};
-                visit(depth + 1, dag.levelStart[depth + 1] + child.offset, mirror ^ child.reflection, corner);
-            }
-        }
-    };
-    const int64_t origin[3] = {0, 0, 0};
-    Walk{dag, maxDepth, box}.visit(0, 0, dag.rootReflection, origin);
+    // From a root at (0, 0, 0): the box is relative to the DAG's origin.
+    encoding::descendFrom(
+        dag, 0, 0, encoding::NodePlace{0, 0, 0, dag.rootReflection},
+        [&](size_t depth, uint64_t, uint16_t header, const encoding::NodePlace& at) {
+            if (header != 0 && depth < maxDepth) return true;
+            const int64_t c[3] = {at.x, at.y, at.z}, size = int64_t(1) << (dag.log2Size - depth);
+            for (int a = 0; a < 3; ++a) { box.lo[a] = std::min(box.lo[a], c[a]); box.hi[a] = std::max(box.hi[a], c[a] + size); }
+            return false;
+        },
+        [](uint64_t, const encoding::NodePlace&) {});  // maxDepth stops above the leaves
     return box;
 }
 
