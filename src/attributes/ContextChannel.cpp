@@ -23,7 +23,7 @@ int modelOf(std::span<const coding::BrickPlace> places, coding::BrickOrder order
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                          bool labels, coding::BrickOrder order, int model) {
+                                          bool labels, coding::BrickOrder order, int model, int labelModel) {
     if (labels && places.empty()) throw Error("internal error: labels are coded with their bricks' places");
     if (values.size() % 4) throw Error("internal error: a context-coded channel holds int32 entries");
     std::vector<int32_t> entries(values.size() / 4);
@@ -45,7 +45,7 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
     options.maxValue = step > 1 ? (int64_t(hi) - lo) / int64_t(step) : hi;
     options.model = modelOf(places, order, model);
     const std::vector<uint8_t> stream =
-        labels           ? coding::encodePlacedLabels(entries, layout, places, order, int32_t(options.minValue), int32_t(options.maxValue))
+        labels           ? coding::encodePlacedLabels(entries, layout, places, order, int32_t(options.minValue), int32_t(options.maxValue), labelModel)
         : places.empty() ? coding::encodeBrickValues(entries, layout, options)
                          : coding::encodePlacedBrickValues(entries, layout, places, order, options);
     // The header (ContextChannel.h) then the stream, in one allocation.
@@ -61,7 +61,8 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
 }
 
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places, bool labels, coding::BrickOrder order, int model) {
+                                          std::span<const coding::BrickPlace> places, bool labels, coding::BrickOrder order, int model,
+                                          int labelModel) {
     format::ByteReader r(payload, what);
     const uint8_t valueSize = r.get<uint8_t>();
     if (valueSize != 4) r.fail("a context-coded channel of " + std::to_string(valueSize) + "-byte values (4 expected)");
@@ -82,7 +83,8 @@ std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std:
     std::vector<int32_t> decoded(static_cast<size_t>(entries));
     if (labels && (near || places.empty())) r.fail("labels coded near-lossless or without places");
     if (labels)
-        coding::decodePlacedLabels(payload.subspan(kHeaderBytes), layout, places, order, int32_t(options.minValue), int32_t(options.maxValue), decoded, what);
+        coding::decodePlacedLabels(payload.subspan(kHeaderBytes), layout, places, order, int32_t(options.minValue), int32_t(options.maxValue), decoded, what,
+                                   labelModel);
     else if (places.empty()) coding::decodeBrickValues(payload.subspan(kHeaderBytes), layout, options, decoded, what);
     else coding::decodePlacedBrickValues(payload.subspan(kHeaderBytes), layout, places, order, options, decoded, what);
     if (step > 1)

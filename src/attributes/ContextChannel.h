@@ -31,17 +31,20 @@ namespace vdbdag::attributes {
 // around too (codings 6 and 3, encodePlacedBrickValues, its bricks visited
 // in `order`); without, from each brick alone (coding 2).
 // With `labels` (and places), the entries are coded as categories by
-// coding/LabelCoder.h (codings 7 and 4).
+// coding/LabelCoder.h, its model generation `labelModel` (1: codings 7 and
+// 4; 2: coding 17).
 // `model`: the generation in spatial order (ignored otherwise).
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
-                                          coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel);
+                                          coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel,
+                                          int labelModel = 1);
 
 // Inverse (`places` given exactly when the payload was coded with them);
 // validates the payload against `layout` and `entries` (throws
 // vdbdag::Error starting with `what`).
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
-                                          coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel);
+                                          coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel,
+                                          int labelModel = 1);
 
 } // namespace vdbdag::attributes

@@ -16,6 +16,7 @@
 #include "src/attributes/RescaledFloats.h"
 #include "src/coding/FloatIntegerCoder.h"
 #include "src/coding/FloatValueCoder.h"
+#include "src/coding/LabelCoder.h"
 #include "src/format/ByteIO.h"
 #include "src/format/ZstdFrame.h"
 #include "src/util/Error.h"
@@ -87,13 +88,19 @@ bool floatIntegersWin(std::span<const uint32_t> bits, std::span<const uint64_t> 
 }
 
 // Whether the least-squares model (coding 13) may code an int32 window
-// that looks like labels smaller than the label coder (coding 7, coded
+// that looks like labels smaller than the label coder (coding 17, coded
 // whole already: it is the fast one): only where it does on a sample of
 // the window's bricks. Where the labels win there, the model is not run on
 // the window (coding both doubled an atlas's encode); where it wins, both
 // are coded and the smaller kept, since a sample of background favours the
 // model and misleads (labels256: 72,347 bytes kept; 82,004 had the window's
 // first eighth decided alone).
+// A window's entries as labels, as a writer codes them today (coding 17:
+// label model generation 2, bricks in raster order, coding/LabelCoder.h).
+std::vector<uint8_t> encodeLabels(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
+    return encodeContextChannel(values, layout, places, true, coding::BrickOrder::Raster, coding::kLatestIntModel, coding::kLatestLabelModel);
+}
+
 bool modelMayBeatLabels(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
     // Eight runs of bricks spread over the window, each about a 64th of its
     // entries: together an eighth, from everywhere rather than its start.
@@ -116,7 +123,7 @@ bool modelMayBeatLabels(std::span<const uint8_t> values, std::span<const uint64_
         next = b;
     }
     return encodeContextChannel(sample, sampleLayout, samplePlaces, false, coding::spatialOrderOf(coding::kLatestIntModel)).size() <
-           encodeContextChannel(sample, sampleLayout, samplePlaces, true).size();
+           encodeLabels(sample, sampleLayout, samplePlaces).size();
 }
 
 // A window's raw bytes: its coding byte, then the smallest of its entries
@@ -163,9 +170,9 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         const bool placed = !places.empty();
         labelsLike = placed && looksLikeLabels(values);
         if (labelsLike) {
-            std::vector<uint8_t> labels = encodeContextChannel(values, layout, places, true);
+            std::vector<uint8_t> labels = encodeLabels(values, layout, places);
             const uint64_t labelSize = labels.size();
-            consider(std::move(labels), labelSize, detail::kSpatialLabelCoding);
+            consider(std::move(labels), labelSize, detail::kShapedLabelCoding);
         }
         if (!labelsLike || modelMayBeatLabels(values, layout, places)) {
             std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel));

@@ -37,8 +37,10 @@
 // encodePlacedFloats bytes over its bricks and their places, coding/FloatValueCoder.h; 9: vec3s only, encodeFloatVectors
 // bytes: the three components in one stream; 10 and 11: codings 6 and 5
 // with the integers' model generation 2, the least-squares fit,
-// coding/LeastSquaresPredictor.h, which a writer writes today) then that
-// payload;
+// coding/LeastSquaresPredictor.h; 12-16: FORMAT.md 8.2-8.5; 17: coding 7's
+// payload with the labels coded by label model generation 2 and the bricks
+// visited in raster order inside 32^3 blocks, coding/LabelCoder.h) then
+// that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -64,7 +66,8 @@ inline constexpr size_t kPredictedDirectoryEntryBytes = 24;
 inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCoding = 2, kPlacedContextCoding = 3, kPlacedLabelCoding = 4,
                          kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7, kFloatCoding = 8, kFloatVectorCoding = 9,
                          kFittedContextCoding = 10, kFittedRescaledFloatCoding = 11, kFloatIntegerCoding = 12, kWideContextCoding = 13,
-                         kWideRescaledFloatCoding = 14, kBandedContextCoding = 15, kBandedRescaledFloatCoding = 16, kCodingCount = 17;
+                         kWideRescaledFloatCoding = 14, kBandedContextCoding = 15, kBandedRescaledFloatCoding = 16, kShapedLabelCoding = 17,
+                         kCodingCount = 18;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail

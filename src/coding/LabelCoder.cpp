@@ -65,6 +65,124 @@ void walkLabels(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
         });
 }
 
+// Generation 2 (LabelCoder.h): the candidates with which neighbours hold
+// each, and its models.
+constexpr unsigned kShapeBits = 10;  // W N P NE NW PN PW PNW (the near eight), PE PS
+constexpr size_t kLabelList = 1024;
+constexpr int kRankLengths = 11;  // bit lengths of rank + 1: 1 .. 1025
+
+struct ShapeCandidates {
+    std::array<int32_t, kCandidates> value{};
+    std::array<unsigned, kCandidates> mask{};  // bit k: neighbour k holds it
+    size_t size = 0;
+    unsigned distinct = 0;  // among the near eight
+};
+
+struct ShapeModels {
+    ShapeModels() {
+        for (BitModel& m : match) m.warmUp();
+        for (BitModel& m : rankLength) m.warmUp();
+        for (auto& row : rankBits)
+            for (BitModel& m : row) m.warmUp();
+    }
+    // [candidate rank][the neighbours holding it][distinct near values: 1, 2, 3+]
+    std::vector<BitModel> match = std::vector<BitModel>(kCandidates * (size_t(1) << kShapeBits) * 3);
+    std::array<BitModel, kRankLengths> rankLength;                           // [bit length]: one more bit?
+    std::array<std::array<BitModel, kRankLengths>, kRankLengths + 1> rankBits;  // [bit length][position]
+    std::vector<int32_t> list = std::vector<int32_t>(kLabelList);  // the labels met, most recent first
+    size_t listSize = 0;
+    void remember(int32_t v) {
+        size_t i = 0;
+        while (i < listSize && list[i] != v) ++i;
+        if (i == listSize) i = listSize < kLabelList ? listSize++ : kLabelList - 1;
+        for (; i > 0; --i) list[i] = list[i - 1];
+        list[0] = v;
+    }
+};
+
+template <typename Code>
+void walkShapes(std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order, uint64_t entries, Code&& code) {
+    using Nb = PlacedNeighbours<uint8_t>;
+    walkPlacedBricks<uint8_t, Reach::Wide>(
+        layout, places, entries, order, [&](uint64_t entry) { code(ShapeCandidates{}, entry); },
+        [&](const Nb& nb, uint64_t entry, int32_t& value, uint8_t&) {
+            static constexpr Nb::Which kNear[] = {Nb::W, Nb::N, Nb::P, Nb::NE, Nb::NW, Nb::PN, Nb::PW, Nb::PNW};
+            static constexpr Nb::Which kAhead[] = {Nb::PE, Nb::PS};
+            ShapeCandidates c;
+            std::array<int32_t, 8> seen{};
+            for (unsigned k = 0; k < 8; ++k) {
+                if (!nb.has(kNear[k])) continue;
+                const int32_t v = nb.value(kNear[k]);
+                unsigned i = 0;
+                while (i < c.distinct && seen[i] != v) ++i;
+                if (i == c.distinct) seen[c.distinct++] = v;
+                size_t j = 0;
+                while (j < c.size && c.value[j] != v) ++j;
+                if (j == c.size && c.size < kCandidates) c.value[c.size++] = v;
+                if (j < c.size) c.mask[j] |= 1u << k;
+            }
+            for (unsigned k = 0; k < 2; ++k) {
+                if (!nb.has(kAhead[k])) continue;
+                const int32_t v = nb.value(kAhead[k]);
+                for (size_t j = 0; j < c.size; ++j)
+                    if (c.value[j] == v) c.mask[j] |= 1u << (8 + k);
+            }
+            value = code(c, entry);
+        });
+}
+
+// One direction of generation 2's coding: bit(model, b) codes b (the
+// writer) or returns the decoded bit (the reader, which ignores b).
+struct LabelWriter {
+    static constexpr bool kEncoding = true;
+    RangeEncoder& rc;
+    unsigned bit(BitModel& m, unsigned b) { return rc.encode(m, b), b; }
+    uint32_t direct(uint32_t v, unsigned bits) { return rc.encodeDirect(v, bits), v; }
+};
+struct LabelReader {
+    static constexpr bool kEncoding = false;
+    RangeDecoder& rc;
+    unsigned bit(BitModel& m, unsigned) { return rc.decode(m); }
+    uint32_t direct(uint32_t, unsigned bits) { return rc.decodeDirect(bits); }
+};
+
+// Codes label `v` (the writer's; the reader's is ignored) given its
+// candidates; returns the label coded.
+template <typename IO>
+int32_t codeShaped(IO& io, ShapeModels& m, const ShapeCandidates& c, int32_t v, int32_t minValue, int32_t maxValue, unsigned bits) {
+    const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
+    for (size_t i = 0; i < c.size; ++i)
+        if (io.bit(m.match[((i << kShapeBits) | c.mask[i]) * 3 + spread], unsigned(IO::kEncoding && c.value[i] == v))) {
+            m.remember(c.value[i]);
+            return c.value[i];
+        }
+    // rank + 1 in Elias-gamma form; rank = listSize: a new label.
+    uint64_t r = 0;
+    if constexpr (IO::kEncoding) {
+        size_t rank = 0;
+        while (rank < m.listSize && m.list[rank] != v) ++rank;
+        r = rank + 1;
+    }
+    const int length = 64 - std::countl_zero(r);
+    int L = 1;
+    while (L < kRankLengths && io.bit(m.rankLength[size_t(L)], unsigned(L < length))) ++L;
+    uint64_t got = 1;
+    for (int j = L - 2; j >= 0; --j) got = got << 1 | io.bit(m.rankBits[size_t(L)][size_t(j)], unsigned(r >> j) & 1u);
+    const uint64_t rank = got - 1;
+    int32_t label;
+    if (rank < m.listSize) {
+        label = m.list[size_t(rank)];
+    } else if (rank == m.listSize) {
+        const int64_t x = int64_t(minValue) + int64_t(io.direct(uint32_t(int64_t(v) - minValue), bits));
+        if (x > maxValue) throw Error("a label outside its range (corrupt)");
+        label = int32_t(x);
+    } else {
+        throw Error("a label's rank beyond the labels met (corrupt)");
+    }
+    m.remember(label);
+    return label;
+}
+
 unsigned bitsFor(int32_t minValue, int32_t maxValue) {
     const uint64_t range = uint64_t(int64_t(maxValue) - minValue);
     return unsigned(64 - std::countl_zero(range));  // 0..32
@@ -73,12 +191,24 @@ unsigned bitsFor(int32_t minValue, int32_t maxValue) {
 } // namespace
 
 std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
-                                        BrickOrder order, int32_t minValue, int32_t maxValue) {
+                                        BrickOrder order, int32_t minValue, int32_t maxValue, int generation) {
     if (minValue > maxValue) throw Error("label coder: an empty range");
+    if (generation != 1 && generation != 2) throw Error("internal error: label model generation " + std::to_string(generation));
     std::vector<uint8_t> out;
     RangeEncoder rc(out);
-    auto m = std::make_unique<LabelModels>();
     const unsigned bits = bitsFor(minValue, maxValue);
+    if (generation == 2) {
+        auto m = std::make_unique<ShapeModels>();
+        LabelWriter io{rc};
+        walkShapes(layout, places, order, entries.size(), [&](const ShapeCandidates& c, uint64_t entry) {
+            const int32_t v = entries[entry];
+            if (v < minValue || v > maxValue) throw Error("label coder: label " + std::to_string(v) + " lies outside its range");
+            return codeShaped(io, *m, c, v, minValue, maxValue, bits);
+        });
+        rc.finish();
+        return out;
+    }
+    auto m = std::make_unique<LabelModels>();
     walkLabels(layout, places, order, entries.size(), [&](const Candidates& c, uint64_t entry) {
         const int32_t v = entries[entry];
         if (v < minValue || v > maxValue) throw Error("label coder: label " + std::to_string(v) + " lies outside its range");
@@ -107,33 +237,42 @@ std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::s
 }
 
 void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order,
-                        int32_t minValue, int32_t maxValue, std::span<int32_t> out, const std::string& what) {
+                        int32_t minValue, int32_t maxValue, std::span<int32_t> out, const std::string& what, int generation) {
     if (minValue > maxValue) throw Error(what + ": an empty label range");
+    if (generation != 1 && generation != 2) throw Error(what + ": internal error: label model generation " + std::to_string(generation));
     RangeDecoder rc(bytes);
-    auto m = std::make_unique<LabelModels>();
     const unsigned bits = bitsFor(minValue, maxValue);
     try {
-        walkLabels(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry) {
-            const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
-            int32_t v = 0;
-            bool found = false;
-            for (size_t i = 0; i < c.size && !found; ++i)
-                if (rc.decode(m->match[i][c.count[i]][spread])) v = c.value[i], found = true;
-            if (!found) {
-                size_t rank = 0;
-                while (rank < m->listSize && rc.decode(m->recent[rank])) ++rank;
-                if (rank < m->listSize) {
-                    v = m->list[rank];
-                } else {
-                    const int64_t x = int64_t(minValue) + int64_t(rc.decodeDirect(bits));
-                    if (x > maxValue) throw Error("a label outside its range (corrupt)");
-                    v = int32_t(x);
+        if (generation == 2) {
+            auto m = std::make_unique<ShapeModels>();
+            LabelReader io{rc};
+            walkShapes(layout, places, order, out.size(), [&](const ShapeCandidates& c, uint64_t entry) {
+                return out[entry] = codeShaped(io, *m, c, 0, minValue, maxValue, bits);
+            });
+        } else {
+            auto m = std::make_unique<LabelModels>();
+            walkLabels(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry) {
+                const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
+                int32_t v = 0;
+                bool found = false;
+                for (size_t i = 0; i < c.size && !found; ++i)
+                    if (rc.decode(m->match[i][c.count[i]][spread])) v = c.value[i], found = true;
+                if (!found) {
+                    size_t rank = 0;
+                    while (rank < m->listSize && rc.decode(m->recent[rank])) ++rank;
+                    if (rank < m->listSize) {
+                        v = m->list[rank];
+                    } else {
+                        const int64_t x = int64_t(minValue) + int64_t(rc.decodeDirect(bits));
+                        if (x > maxValue) throw Error("a label outside its range (corrupt)");
+                        v = int32_t(x);
+                    }
                 }
-            }
-            m->remember(v);
-            out[entry] = v;
-            return v;
-        });
+                m->remember(v);
+                out[entry] = v;
+                return v;
+            });
+        }
     } catch (const Error& e) {
         throw Error(what + ": " + e.what());
     }

@@ -2,7 +2,8 @@
 // first 8 bytes choose a small shape (up to 16^3; for the brick coder, byte
 // 7 odd, a layout of up to 16 bricks whose masks come from the data, tiles
 // among them; byte 7 & 2, the bricks placed side by side with mirrors; & 4
-// as well, lossless, coded as labels; & 8, the bricks visited in the
+// as well, lossless, coded as labels (byte 4 & 8: label model generation 2,
+// else 1); & 8, the bricks visited in the
 // layout's order rather than spatially, & 16 in raster blocks; with places and byte 5 & 0x40, the
 // entries are float32 bits for coding/FloatValueCoder, & 0x20 too vec3s,
 // any bits allowed and every bit kept), the sample range, near and the
@@ -65,16 +66,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         return 0;
     }
     const bool labels = !places.empty() && (data[7] & 4) && o.near == 0;  // byte 7 & 4: coded as labels (LabelCoder)
+    const int labelModel = data[4] & 8 ? 2 : 1;
     // byte 7 & 8: the layout's brick order; & 16, raster blocks
     const BrickOrder order = data[7] & 8 ? BrickOrder::Attribute : data[7] & 16 ? BrickOrder::Raster : BrickOrder::Spatial;
     const auto decode = [&](std::span<const uint8_t> stream, std::vector<int32_t>& out) {
-        if (labels) decodePlacedLabels(stream, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue), out, "fuzz");
+        if (labels) decodePlacedLabels(stream, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue), out, "fuzz", labelModel);
         else if (!places.empty()) decodePlacedBrickValues(stream, layout, places, order, o, out, "fuzz");
         else if (bricks) decodeBrickValues(stream, layout, o, out, "fuzz");
         else decodeIntVolume(stream, shape, o, out);
     };
     const auto encode = [&](const std::vector<int32_t>& samples) {
-        if (labels) return encodePlacedLabels(samples, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue));
+        if (labels) return encodePlacedLabels(samples, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue), labelModel);
         if (!places.empty()) return encodePlacedBrickValues(samples, layout, places, order, o);
         return bricks ? encodeBrickValues(samples, layout, o) : encodeIntVolume(samples, shape, o);
     };

@@ -3,9 +3,10 @@
 // Morton order, mirrored at random) comes back exactly; it costs a fraction
 // of what the numeric coder of the same entries costs (labels have no
 // magnitude to predict); a label outside the range is refused; corrupt
-// streams are refused or give labels inside the range, never more. Through
-// encodePredictedWindows with places, a label window is stored as coding 7
-// and decodes exactly; one of coding 4 (an older writer's) still does.
+// streams are refused or give labels inside the range, never more; each
+// for label model generations 1 and 2. Through encodePredictedWindows with
+// places, a label window is stored as coding 17 and decodes exactly; ones
+// of codings 7 and 4 (older writers') still do.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -52,50 +53,82 @@ Labels voronoi(uint32_t seed, int regions) {
         97, 5, ids[0]);
 }
 
+// Each generation in the brick order its window coding walks (7: spatial,
+// 17: raster blocks).
+BrickOrder orderOf(int generation) { return generation == 1 ? BrickOrder::Spatial : BrickOrder::Raster; }
+
 TEST(LabelCoder, LabelVolumesComeBackExactlyForAFractionOfTheNumericCost) {
-    for (int regions : {1, 12, 60}) {
-        const Labels l = voronoi(uint32_t(regions), regions);
-        const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
-        const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, BrickOrder::Spatial, *lo, *hi);
-        std::vector<int32_t> back(l.entries.size());
-        decodePlacedLabels(bytes, l.layout, l.places, BrickOrder::Spatial, *lo, *hi, back, "labels");
-        EXPECT_EQ(back, l.entries) << regions;
-        IntCoderOptions o;
-        o.minValue = *lo, o.maxValue = *hi;
-        const size_t numeric = encodePlacedBrickValues(l.entries, l.layout, l.places, BrickOrder::Spatial, o).size();
-        if (regions > 1) EXPECT_LT(bytes.size() * 2, numeric) << regions << " regions: labels " << bytes.size() << ", numeric " << numeric;
-        else EXPECT_LT(bytes.size(), 100u);  // one label: next to nothing
+    // 1,500 regions of about 22 voxels: more labels than generation 2's
+    // list of 1,024 holds, so labels leave it and come back as new ones.
+    for (const int generation : {1, 2}) {
+        for (int regions : {1, 12, 60, 1500}) {
+            const Labels l = voronoi(uint32_t(regions), regions);
+            const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
+            const BrickOrder order = orderOf(generation);
+            const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, order, *lo, *hi, generation);
+            std::vector<int32_t> back(l.entries.size());
+            decodePlacedLabels(bytes, l.layout, l.places, order, *lo, *hi, back, "labels", generation);
+            EXPECT_EQ(back, l.entries) << regions << " regions, generation " << generation;
+            IntCoderOptions o;
+            o.minValue = *lo, o.maxValue = *hi;
+            const size_t numeric = encodePlacedBrickValues(l.entries, l.layout, l.places, BrickOrder::Spatial, o).size();
+            if (regions == 1) {
+                EXPECT_LT(bytes.size(), 100u);  // one label: next to nothing
+            } else if (regions < 1000) {
+                EXPECT_LT(bytes.size() * 2, numeric) << regions << " regions: labels " << bytes.size() << ", numeric " << numeric;
+            }
+        }
     }
+}
+
+// Generation 2's move-to-front list through every case: a label volume of
+// 2x2x2 cells, 2,000 labels cycling over the 4,096 cells, so that a cell's
+// first voxel matches none of its neighbours and is coded by its rank in the
+// list, at every rank up to the list's 1,024 and beyond (a label dropped
+// from the list comes back as a new one).
+TEST(LabelCoder, Generation2RanksEveryLabelItHasMet) {
+    std::mt19937 rng(11);
+    const Labels l = testing::placedBox(
+        rng, true, [&](int X, int Y, int Z) { return int32_t(((X / 2) * 131 + (Y / 2) * 17 + (Z / 2) * 7) % 2000) - 1000; }, 0, 0, 0);
+    const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
+    const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, BrickOrder::Raster, *lo, *hi, 2);
+    std::vector<int32_t> back(l.entries.size());
+    decodePlacedLabels(bytes, l.layout, l.places, BrickOrder::Raster, *lo, *hi, back, "labels", 2);
+    EXPECT_EQ(back, l.entries);
 }
 
 TEST(LabelCoder, OutOfRangeLabelsAndCorruptStreamsAreRefused) {
     const Labels l = voronoi(3, 20);
     const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
-    EXPECT_THROW(encodePlacedLabels(l.entries, l.layout, l.places, BrickOrder::Spatial, *lo + 1, *hi), Error);
-    const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, BrickOrder::Spatial, *lo, *hi);
-    std::vector<int32_t> back(l.entries.size());
-    EXPECT_THROW(decodePlacedLabels(std::vector<uint8_t>(bytes.begin(), bytes.begin() + ptrdiff_t(bytes.size() / 2)), l.layout, l.places, BrickOrder::Spatial, *lo, *hi, back, "half"),
-                 Error);
-    std::mt19937 rng(4);
-    for (int trial = 0; trial < 20; ++trial) {
-        std::vector<uint8_t> garbage(bytes.size());
-        for (auto& b : garbage) b = uint8_t(rng());
-        try {
-            decodePlacedLabels(garbage, l.layout, l.places, BrickOrder::Spatial, *lo, *hi, back, "garbage");
-            for (int32_t v : back) ASSERT_TRUE(v >= *lo && v <= *hi);
-        } catch (const Error&) {
+    for (const int generation : {1, 2}) {
+        const BrickOrder order = orderOf(generation);
+        EXPECT_THROW(encodePlacedLabels(l.entries, l.layout, l.places, order, *lo + 1, *hi, generation), Error);
+        const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, order, *lo, *hi, generation);
+        std::vector<int32_t> back(l.entries.size());
+        EXPECT_THROW(decodePlacedLabels(std::vector<uint8_t>(bytes.begin(), bytes.begin() + ptrdiff_t(bytes.size() / 2)), l.layout, l.places, order, *lo,
+                                        *hi, back, "half", generation),
+                     Error);
+        std::mt19937 rng(4);
+        for (int trial = 0; trial < 20; ++trial) {
+            std::vector<uint8_t> garbage(bytes.size());
+            for (auto& b : garbage) b = uint8_t(rng());
+            try {
+                decodePlacedLabels(garbage, l.layout, l.places, order, *lo, *hi, back, "garbage", generation);
+                for (int32_t v : back) ASSERT_TRUE(v >= *lo && v <= *hi);
+            } catch (const Error&) {
+            }
         }
     }
 }
 
-TEST(LabelCoder, PredictedWindowsStoreLabelsAsCoding7) {
+TEST(LabelCoder, PredictedWindowsStoreLabelsAsCoding17) {
     const Labels l = voronoi(5, 30);
     std::vector<uint8_t> bytes(l.entries.size() * 4);
     std::memcpy(bytes.data(), l.entries.data(), bytes.size());
     const std::vector<uint8_t> windows = attributes::encodePredictedWindows(bytes, 4, l.layout, l.places);
     const attributes::WindowDirectory dir = attributes::readPredictedWindowDirectory(windows, 4, l.layout, "test");
     ASSERT_EQ(dir.windows.size(), 1u);
-    EXPECT_EQ(windows[size_t(dir.windows[0].offset)], attributes::detail::kSpatialLabelCoding);
+    EXPECT_EQ(windows[size_t(dir.windows[0].offset)], attributes::detail::kShapedLabelCoding);
     EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, l.layout, "test", l.places), bytes);
     EXPECT_THROW(attributes::decodePredictedWindows(windows, 4, l.layout, "test", {}), Error);  // a label window needs its places
 }
@@ -114,6 +147,24 @@ std::vector<uint8_t> oneWindowByHand(std::span<const uint8_t> raw, uint64_t entr
     out.insert(out.end(), raw.begin(), raw.end());
     put(uint64_t(raw.size())), put(uint64_t(raw.size())), put(entries);
     return out;
+}
+
+// A window of coding 7 (label model generation 1, what files before coding
+// 17 hold) still reads: written by hand, as that writer wrote it.
+TEST(LabelCoder, WindowsOfLabelGeneration1StillRead) {
+    const Labels l = voronoi(8, 40);
+    std::vector<uint8_t> bytes(l.entries.size() * 4);
+    std::memcpy(bytes.data(), l.entries.data(), bytes.size());
+    std::vector<uint8_t> raw{attributes::detail::kSpatialLabelCoding};
+    const std::vector<uint8_t> payload = attributes::encodeContextChannel(bytes, l.layout, l.places, true, BrickOrder::Spatial, kLatestIntModel, 1);
+    raw.insert(raw.end(), payload.begin(), payload.end());
+    EXPECT_EQ(attributes::decodePredictedWindows(oneWindowByHand(raw, l.entries.size()), 4, l.layout, "coding 7", l.places), bytes);
+    // Read as coding 17, the same payload is another model: it must not give the entries back.
+    raw[0] = attributes::detail::kShapedLabelCoding;
+    try {
+        EXPECT_NE(attributes::decodePredictedWindows(oneWindowByHand(raw, l.entries.size()), 4, l.layout, "misread", l.places), bytes);
+    } catch (const Error&) {
+    }
 }
 
 // Windows of codings 3 and 4 (bricks in the layout's order, what files
