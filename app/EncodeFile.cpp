@@ -18,6 +18,7 @@
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"
+#include "src/util/ParallelFor.h"
 #include "src/util/Progress.h"
 #include "vdb_bridge/NanoVdb.h"
 #include "vdb_bridge/VdbCubes.h"
@@ -172,6 +173,7 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
     progress.setLabel("encode: writing " + request.output);
     format::ContainerOptions containerOptions;
     containerOptions.compress = !request.noCompress;
+    containerOptions.parallel = util::tbbParallelFor();  // the sections compressed side by side
     // Section by section, the DAGs and values released as they go: the
     // file is never whole in memory.
     uint64_t fileBytes = 0, geometryBytes = 0;  // the DAGs, uncompressed (released by the writer)

@@ -329,6 +329,21 @@ uint64_t emitContainer(std::vector<Section>& sections, bool release, const Conta
     std::vector<uint32_t> codec(sections.size(), kCodecRaw);
     std::vector<std::vector<uint8_t>> packed(sections.size());
     auto stored = [&](size_t i) -> const std::vector<uint8_t>& { return codec[i] == kCodecZstd && !release ? packed[i] : sections[i].data; };
+    // The sections zstd may shrink, compressed side by side when the caller
+    // gives threads (each alone: the same frames as one after another).
+    auto compressible = [&](size_t i) {
+        return !sections[i].stored && !sections[i].spilled && options.compress && sections[i].data.size() > kMinBytesToCompress &&
+               !isPrecompressed(sections[i].kind);
+    };
+    std::vector<std::vector<uint8_t>> frames(sections.size());
+    std::vector<uint8_t> framed(sections.size(), 0);
+    if (options.parallel) {
+        std::vector<size_t> todo;
+        for (size_t i = 0; i < sections.size(); ++i)
+            if (compressible(i)) todo.push_back(i);
+        options.parallel(todo.size(), [&](size_t k) { frames[todo[k]] = compressSection(sections[todo[k]].data, options); });
+        for (const size_t i : todo) framed[i] = 1;
+    }
     for (size_t i = 0; i < sections.size(); ++i) {
         if (const auto& from = sections[i].stored) {  // copied as it is (its checksum is checked as it is copied)
             if (!sections[i].data.empty() || sections[i].spilled) throw Error("internal error: a copied section holds data of its own");
@@ -354,8 +369,8 @@ uint64_t emitContainer(std::vector<Section>& sections, bool release, const Conta
         }
         const std::vector<uint8_t>& data = sections[i].data;
         rawSize[i] = data.size();
-        if (options.compress && data.size() > kMinBytesToCompress && !isPrecompressed(sections[i].kind)) {
-            std::vector<uint8_t> frame = compressSection(data, options);
+        if (compressible(i)) {
+            std::vector<uint8_t> frame = framed[i] ? std::move(frames[i]) : compressSection(data, options);
             if (!frame.empty()) {
                 codec[i] = kCodecZstd;
                 (release ? sections[i].data : packed[i]) = std::move(frame);

@@ -90,6 +90,11 @@ struct SectionSummary {
 struct ContainerOptions {
     bool compress = true;  // zstd each section; kept raw if zstd does not shrink it
     int zstdLevel = 9;
+    // parallel(n, body) runs body(0 .. n-1) in any order, on any threads (an
+    // encoder's pool: util::tbbParallelFor): the sections are then compressed
+    // side by side, each alone, so the bytes are those of one thread. Empty:
+    // one after another (the reader library links no pool).
+    std::function<void(size_t n, const std::function<void(size_t)>& body)> parallel;
 };
 
 // Bytes a section of `raw` payload takes in the file (its zstd frame as the

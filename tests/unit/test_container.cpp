@@ -15,6 +15,8 @@
 #include <fstream>
 #include <new>
 #include <random>
+#include <thread>
+#include <sstream>
 
 #include <csignal>
 #include <sys/resource.h>
@@ -37,6 +39,13 @@ using format::SectionKind;
 using test::AllocationProbe;
 
 namespace {
+
+// Container options that store every section as it is.
+format::ContainerOptions raw() {
+    format::ContainerOptions o;
+    o.compress = false;
+    return o;
+}
 
 // Layout constants as documented in SsvdagContainer.cpp.
 constexpr size_t kHeader = 16, kEntry = 48;
@@ -184,6 +193,36 @@ TEST(Container, LargeSectionsUseTheThreadedPathAndRoundTrip) {
     expectSame(format::readContainer(bytes, "mem"), sections);
 }
 
+// ContainerOptions::parallel: the sections compressed side by side (here
+// each on its own thread, started last first) give the bytes of one after
+// another, in memory and streamed (each section released as it goes), a
+// section on zstd's own threaded path (over 4 MiB) among them.
+TEST(Container, SectionsCompressedSideBySideGiveTheBytesOfOneAfterAnother) {
+    std::vector<uint8_t> large(size_t(6) << 20);
+    for (size_t i = 0; i < large.size(); ++i) large[i] = uint8_t((i >> 10) * 31 + (i % 7 == 0 ? i : 0));
+    std::vector<Section> sections = mixedSections();
+    sections.push_back({SectionKind::Values, 1, large});
+    sections.push_back({SectionKind::InactiveInner, 1, noise(64 << 10, 5)});
+    sections.push_back({SectionKind::DagInner, 2, std::vector<uint8_t>(large.begin(), large.begin() + (1 << 20))});
+    format::ContainerOptions threads;
+    std::atomic<int> calls{0};
+    threads.parallel = [&](size_t n, const std::function<void(size_t)>& body) {
+        std::vector<std::thread> pool;
+        for (size_t k = n; k-- > 0;) pool.emplace_back([&body, k] { body(k); });
+        for (std::thread& t : pool) t.join();
+        ++calls;
+    };
+    const std::vector<uint8_t> serial = format::writeContainer(sections);
+    EXPECT_EQ(format::writeContainer(sections, threads), serial);
+    std::ostringstream streamed;
+    std::vector<Section> released = sections;
+    format::writeContainerTo(std::move(released), streamed, threads);
+    const std::string s = streamed.str();
+    EXPECT_EQ(std::vector<uint8_t>(s.begin(), s.end()), serial);
+    EXPECT_EQ(calls.load(), 2);
+    expectSame(format::readContainer(serial, "mem"), sections);
+}
+
 TEST(Container, ByteLayoutIsAsDocumented) {
     const auto sections = mixedSections();
     const auto bytes = format::writeContainer(sections);
@@ -242,7 +281,7 @@ TEST(Container, EveryPrefixIsATruncationError) {
 }
 
 TEST(Container, TruncationMessageSaysWhere) {
-    const auto bytes = format::writeContainer(mixedSections(), {.compress = false});
+    const auto bytes = format::writeContainer(mixedSections(), raw());
     const size_t cut = bytes.size() - 50;  // inside section 4 (100 raw bytes)
     EXPECT_EQ(errorOf(std::span<const uint8_t>(bytes.data(), cut), "file.ssvdag"),
               "file.ssvdag: truncated: section 4 (kind 77 of grid 2) ends at byte " + std::to_string(bytes.size()) + " but the file has " +
@@ -351,14 +390,14 @@ TEST(Container, ForgedHugeRawSizeIsRejectedBeforeAllocating) {
 }
 
 TEST(Container, ForgedRawCodecSizesAreRejected) {
-    auto bytes = format::writeContainer({{SectionKind::DagLeaves, 0, noise(100, 3)}}, {.compress = false});
+    auto bytes = format::writeContainer({{SectionKind::DagLeaves, 0, noise(100, 3)}}, raw());
     store<uint64_t>(bytes, entryAt(0) + kRawAt, 101);
     fixChecksums(bytes);
     EXPECT_NE(errorOf(bytes).find("claims 101 raw bytes for 100 bytes stored uncompressed"), std::string::npos) << errorOf(bytes);
 }
 
 TEST(Container, OverlapsGapsAndOutOfBoundsOffsetsAreRejected) {
-    const auto good = format::writeContainer(mixedSections(), {.compress = false});
+    const auto good = format::writeContainer(mixedSections(), raw());
     const uint64_t off1 = load<uint64_t>(good, entryAt(1) + kOffsetAt);
     const uint64_t off2 = load<uint64_t>(good, entryAt(2) + kOffsetAt);
     struct Case {
@@ -604,7 +643,7 @@ TEST(Container, ForgedRootOriginOutsideInt32IsRejected) {
                 changed = true;
             }
         ASSERT_TRUE(changed);
-        const auto forgedBytes = format::writeContainer(copy, format::ContainerOptions{false});
+        const auto forgedBytes = format::writeContainer(copy, raw());
         try {
             format::readScene(forgedBytes, "forged");
             ADD_FAILURE() << "origin " << forged << " accepted";
@@ -619,7 +658,7 @@ TEST(Container, ForgedRootOriginOutsideInt32IsRejected) {
         for (Section& s : copy)
             if (s.kind == SectionKind::DagLevels) std::memcpy(s.data.data(), &forged, sizeof forged);
         try {
-            format::readScene(format::writeContainer(copy, format::ContainerOptions{false}), "forged");
+            format::readScene(format::writeContainer(copy, raw()), "forged");
             ADD_FAILURE() << "origin " << forged << " accepted";
         } catch (const Error& e) {
             EXPECT_NE(std::string(e.what()).find("not a multiple of 4"), std::string::npos) << e.what();
@@ -633,11 +672,11 @@ TEST(Container, ForgedRootOriginOutsideInt32IsRejected) {
         for (Section& s : copy)
             if (s.kind == SectionKind::DagLevels) std::memcpy(s.data.data(), &edge, sizeof edge);
         if (edge < 0) {
-            EXPECT_NO_THROW(format::readScene(format::writeContainer(copy, format::ContainerOptions{false}), "edge")) << edge;
+            EXPECT_NO_THROW(format::readScene(format::writeContainer(copy, raw()), "edge")) << edge;
             continue;
         }
         try {
-            format::readScene(format::writeContainer(copy, format::ContainerOptions{false}), "edge");
+            format::readScene(format::writeContainer(copy, raw()), "edge");
             ADD_FAILURE() << "voxels past INT32_MAX accepted";
         } catch (const Error& e) {
             EXPECT_NE(std::string(e.what()).find("reaches voxel index"), std::string::npos) << e.what();
