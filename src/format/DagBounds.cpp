@@ -39,13 +39,22 @@ struct LocalBox {
     }
 };
 
+// A 4^3 brick's box (bit x + 4y + 16z): per axis, the first and last of
+// its four planes that hold a voxel.
 LocalBox brickBox(uint64_t mask) {
     LocalBox b;
-    for (uint64_t m = mask; m; m &= m - 1) {
-        const unsigned bit = unsigned(std::countr_zero(m));
-        b.merge(LocalBox{{int64_t(bit & 3u), int64_t((bit >> 2) & 3u), int64_t(bit >> 4)},
-                         {int64_t(bit & 3u), int64_t((bit >> 2) & 3u), int64_t(bit >> 4)}, true});
+    if (!mask) return b;
+    // The voxels of plane c on each axis: x = c (every fourth bit), y = c
+    // (four runs of four), z = c (sixteen bits).
+    static constexpr uint64_t kPlane[3] = {0x1111111111111111ull, 0x000F000F000F000Full, 0xFFFFull};
+    static constexpr unsigned kStep[3] = {1, 4, 16};
+    for (int a = 0; a < 3; ++a) {
+        unsigned planes = 0;
+        for (unsigned c = 0; c < 4; ++c) planes |= unsigned((mask & (kPlane[a] << (kStep[a] * c))) != 0) << c;
+        b.lo[a] = std::countr_zero(planes);
+        b.hi[a] = 31 - std::countl_zero(planes);
     }
+    b.any = true;
     return b;
 }
 
@@ -98,6 +107,9 @@ std::optional<IndexBox> dagBounds(const encoding::CompactDag& dag) {
     const size_t levels = dag.innerLevelCount();
     std::optional<LevelBoxes> below;
     LocalBox root;
+    // Each distinct leaf's box once (a leaf is referenced many times).
+    std::vector<LocalBox> leafBoxes(dag.leaves.size());
+    for (size_t k = 0; k < dag.leaves.size(); ++k) leafBoxes[k] = brickBox(dag.leaves[k]);
     for (size_t i = levels; i-- > 0;) {
         const uint64_t begin = dag.levelStart[i], end = dag.levelEnd(i);
         const int64_t size = int64_t(1) << (dag.log2Size - i), half = size / 2;
@@ -110,7 +122,7 @@ std::optional<IndexBox> dagBounds(const encoding::CompactDag& dag) {
             } else {
                 encoding::forEachStoredChild(dag, i, pos, [&](unsigned j, const encoding::ChildPointer& p) {
                     const std::array<int64_t, 3> at{(j & 1u) ? half : 0, (j & 2u) ? half : 0, (j & 4u) ? half : 0};
-                    const LocalBox child = toLeaves ? brickBox(dag.leaves[p.offset]) : below->get(p.offset);
+                    const LocalBox child = toLeaves ? leafBoxes[p.offset] : below->get(p.offset);
                     box.merge(child.placed(p.reflection, half, at));
                 });
             }
