@@ -87,6 +87,15 @@ bool floatIntegersWin(std::span<const uint32_t> bits, std::span<const uint64_t> 
     return coding::encodePlacedFloatIntegers(sample, sampleLayout, samplePlaces).size() < coding::encodePlacedFloats(sample, sampleLayout, samplePlaces).size();
 }
 
+// A window's entries as labels, as a writer codes them today: coding 17,
+// which PredictedWindows.cpp reads as label model generation 2 with the
+// bricks in raster order (coding/LabelCoder.h). A newer generation needs a
+// coding of its own.
+std::vector<uint8_t> encodeLabels(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
+    static_assert(coding::kLatestLabelModel == 2, "a new label model generation needs a window coding of its own");
+    return encodeContextChannel(values, layout, places, true, coding::BrickOrder::Raster, coding::kLatestIntModel, 2);
+}
+
 // Whether the least-squares model (coding 13) may code an int32 window
 // that looks like labels smaller than the label coder (coding 17, coded
 // whole already: it is the fast one): only where it does on a sample of
@@ -95,12 +104,6 @@ bool floatIntegersWin(std::span<const uint32_t> bits, std::span<const uint64_t> 
 // are coded and the smaller kept, since a sample of background favours the
 // model and misleads (labels256: 72,347 bytes kept; 82,004 had the window's
 // first eighth decided alone).
-// A window's entries as labels, as a writer codes them today (coding 17:
-// label model generation 2, bricks in raster order, coding/LabelCoder.h).
-std::vector<uint8_t> encodeLabels(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
-    return encodeContextChannel(values, layout, places, true, coding::BrickOrder::Raster, coding::kLatestIntModel, coding::kLatestLabelModel);
-}
-
 bool modelMayBeatLabels(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
     // Eight runs of bricks spread over the window, each about a 64th of its
     // entries: together an eighth, from everywhere rather than its start.

@@ -107,9 +107,7 @@ std::optional<IndexBox> dagBounds(const encoding::CompactDag& dag) {
     const size_t levels = dag.innerLevelCount();
     std::optional<LevelBoxes> below;
     LocalBox root;
-    // Each distinct leaf's box once (a leaf is referenced many times).
-    std::vector<LocalBox> leafBoxes(dag.leaves.size());
-    for (size_t k = 0; k < dag.leaves.size(); ++k) leafBoxes[k] = brickBox(dag.leaves[k]);
+
     for (size_t i = levels; i-- > 0;) {
         const uint64_t begin = dag.levelStart[i], end = dag.levelEnd(i);
         const int64_t size = int64_t(1) << (dag.log2Size - i), half = size / 2;
@@ -122,7 +120,7 @@ std::optional<IndexBox> dagBounds(const encoding::CompactDag& dag) {
             } else {
                 encoding::forEachStoredChild(dag, i, pos, [&](unsigned j, const encoding::ChildPointer& p) {
                     const std::array<int64_t, 3> at{(j & 1u) ? half : 0, (j & 2u) ? half : 0, (j & 4u) ? half : 0};
-                    const LocalBox child = toLeaves ? leafBoxes[p.offset] : below->get(p.offset);
+                    const LocalBox child = toLeaves ? brickBox(dag.leaves[p.offset]) : below->get(p.offset);
                     box.merge(child.placed(p.reflection, half, at));
                 });
             }

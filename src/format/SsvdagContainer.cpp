@@ -330,19 +330,35 @@ uint64_t emitContainer(std::vector<Section>& sections, bool release, const Conta
     std::vector<std::vector<uint8_t>> packed(sections.size());
     auto stored = [&](size_t i) -> const std::vector<uint8_t>& { return codec[i] == kCodecZstd && !release ? packed[i] : sections[i].data; };
     // The sections zstd may shrink, compressed side by side when the caller
-    // gives threads (each alone: the same frames as one after another).
+    // gives threads (each alone: the same frames as one after another). With
+    // `release`, a frame replaces its raw bytes as soon as it is made, so
+    // memory holds what one thread's loop would plus the frames in flight.
     auto compressible = [&](size_t i) {
         return !sections[i].stored && !sections[i].spilled && options.compress && sections[i].data.size() > kMinBytesToCompress &&
                !isPrecompressed(sections[i].kind);
     };
+    enum : uint8_t { kUntried, kStaysRaw, kFramed, kFramedInPlace };
+    std::vector<uint8_t> state(sections.size(), kUntried);
     std::vector<std::vector<uint8_t>> frames(sections.size());
-    std::vector<uint8_t> framed(sections.size(), 0);
+    std::vector<uint64_t> rawBefore(sections.size(), 0);
     if (options.parallel) {
         std::vector<size_t> todo;
         for (size_t i = 0; i < sections.size(); ++i)
             if (compressible(i)) todo.push_back(i);
-        options.parallel(todo.size(), [&](size_t k) { frames[todo[k]] = compressSection(sections[todo[k]].data, options); });
-        for (const size_t i : todo) framed[i] = 1;
+        options.parallel(todo.size(), [&](size_t k) {
+            const size_t i = todo[k];
+            std::vector<uint8_t> frame = compressSection(sections[i].data, options);
+            if (frame.empty()) {
+                state[i] = kStaysRaw;
+            } else if (release) {
+                rawBefore[i] = sections[i].data.size();
+                sections[i].data = std::move(frame);
+                state[i] = kFramedInPlace;
+            } else {
+                frames[i] = std::move(frame);
+                state[i] = kFramed;
+            }
+        });
     }
     for (size_t i = 0; i < sections.size(); ++i) {
         if (const auto& from = sections[i].stored) {  // copied as it is (its checksum is checked as it is copied)
@@ -368,9 +384,11 @@ uint64_t emitContainer(std::vector<Section>& sections, bool release, const Conta
             continue;
         }
         const std::vector<uint8_t>& data = sections[i].data;
-        rawSize[i] = data.size();
-        if (compressible(i)) {
-            std::vector<uint8_t> frame = framed[i] ? std::move(frames[i]) : compressSection(data, options);
+        rawSize[i] = state[i] == kFramedInPlace ? rawBefore[i] : data.size();
+        if (state[i] == kFramedInPlace) {
+            codec[i] = kCodecZstd;
+        } else if (state[i] != kStaysRaw && compressible(i)) {
+            std::vector<uint8_t> frame = state[i] == kFramed ? std::move(frames[i]) : compressSection(data, options);
             if (!frame.empty()) {
                 codec[i] = kCodecZstd;
                 (release ? sections[i].data : packed[i]) = std::move(frame);

@@ -56,6 +56,7 @@ std::vector<uint8_t> zstdCompressIfSmaller(std::span<const uint8_t> data, const 
         check(n);
     }
     out.resize(n);
+    out.shrink_to_fit();  // the frame alone: its capacity was the input's size
     return out;
 }
 
