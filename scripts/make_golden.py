@@ -59,6 +59,15 @@ def main():
     raw = os.path.join(out, "labels_24x20x10_int16le.raw")
     labels.tofile(raw)
     sources.append(("labels", raw))
+    # labels_coding17 (added 2026-12-06, label model generation 2): a Voronoi
+    # atlas of 24 labels, which the writer codes as labels.
+    rng = np.random.default_rng(17)
+    z, y, x = np.meshgrid(np.arange(16), np.arange(32), np.arange(32), indexing="ij")
+    seeds, ids = rng.integers(0, 32, (24, 3)), rng.permutation(np.arange(1, 250))[:24]
+    d = np.stack([(x - s[0]) ** 2 + (y - s[1]) ** 2 + (z * 2 - s[2]) ** 2 for s in seeds])
+    voronoi = os.path.join(out, "labels_voronoi_32x32x16_uint8.raw")
+    ids[np.argmin(d, axis=0)].astype(np.uint8).tofile(voronoi)
+    sources.append(("labels_coding17", voronoi))
     for name, src in sources:
         subprocess.run([tool, "encode", src, "-o", os.path.join(out, name + ".ssvdag"), "-f", "-q"], check=True, stdout=subprocess.DEVNULL)
     print("wrote", sorted(os.listdir(out)))

@@ -84,12 +84,16 @@ TEST(Golden, VdbSourcedFilesDecodeToTheirSources) {
 }
 
 TEST(Golden, ScanSourcedFileDecodesToTheSameSamples) {
-    // labels (coding 7) and scan_coding10 (a 24x24x16 crop of
+    // labels (a small int16 scan, its samples in coding 1, brick residuals)
+    // and scan_coding10 (a 24x24x16 crop of
     // ../shared/data/dense/headsq, its int16 CT samples in coding 10, the
     // least-squares fit, as written on 2026-12-05); scan_coding13, the same
     // crop in coding 13 (model generation 3, as written on 2026-12-06);
-    // scan_coding15, in coding 15 (model generation 4, written since).
+    // scan_coding15, in coding 15 (model generation 4, written since);
+    // labels_coding17, a 32x32x16 Voronoi atlas of 24 labels in coding 17
+    // (label model generation 2, written since 2026-12-06).
     for (const auto& [name, raw, bytes] : {std::tuple{"labels", "labels_24x20x10_int16le.raw", 24u * 20 * 10 * 2},
+                                           {"labels_coding17", "labels_voronoi_32x32x16_uint8.raw", 32u * 32 * 16},
                                            {"scan_coding10", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2},
                                            {"scan_coding13", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2},
                                            {"scan_coding15", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2}}) {
@@ -107,4 +111,6 @@ TEST(Golden, ScanSourcedFileDecodesToTheSameSamples) {
     EXPECT_NE(info13.out.find("windows: 1 wide fitted context-coded"), std::string::npos) << info13.out;
     const CommandResult info15 = runCli("info " + (kGolden / "scan_coding15.ssvdag").string());
     EXPECT_NE(info15.out.find("windows: 1 banded context-coded"), std::string::npos) << info15.out;
+    const CommandResult info17 = runCli("info " + (kGolden / "labels_coding17.ssvdag").string());
+    EXPECT_NE(info17.out.find("windows: 1 shaped labels"), std::string::npos) << info17.out;
 }
