@@ -103,7 +103,7 @@ struct ShapeModels {
 template <typename Code>
 void walkShapes(std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order, uint64_t entries, Code&& code) {
     using Nb = PlacedNeighbours<uint8_t>;
-    walkPlacedBricks<uint8_t, Reach::Wide>(
+    walkPlacedBricks<uint8_t, Reach::Ahead>(
         layout, places, entries, order, [&](uint64_t entry) { code(ShapeCandidates{}, entry); },
         [&](const Nb& nb, uint64_t entry, int32_t& value, uint8_t&) {
             static constexpr Nb::Which kNear[] = {Nb::W, Nb::N, Nb::P, Nb::NE, Nb::NW, Nb::PN, Nb::PW, Nb::PNW};

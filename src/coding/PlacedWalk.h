@@ -9,7 +9,7 @@
 // (and, for a walk that asks for them, WW, NN and PP two voxels back along
 // x, y and z, Reach::Far; and also the rest of the slice below, PE, PS,
 // PNE, PSW, PSE, and NWW, NNE, NNW, NEE, Reach::Wide; and also WWW, WWWW,
-// NWWW, NEEE, NNN, Reach::Widest) wherever they were
+// NWWW, NEEE, NNN, Reach::Widest; or only PE and PS, Reach::Ahead) wherever they were
 // visited before in the same walk (in this brick or in any brick before it),
 // and its entry: the rank of its stored bit (dag_access.h dagStoredBit). A
 // tile (mask 0) is one entry without place.
@@ -43,7 +43,13 @@ struct PlacedBrick {
     Rec rec[64];
 };
 
-enum class Reach { Near, Far, Wide, Widest };
+// Which neighbours beyond the near eight a walk finds (the header comment);
+// Ahead: PE and PS alone (the label coder's generation 2). Listed after the
+// others so that the integer coder's `>= Wide` tests keep their meaning.
+enum class Reach { Near, Far, Wide, Widest, Ahead };
+constexpr bool findsFar(Reach r) { return r == Reach::Far || r == Reach::Wide || r == Reach::Widest; }
+constexpr bool findsWide(Reach r) { return r == Reach::Wide || r == Reach::Widest; }
+constexpr bool findsAhead(Reach r) { return r == Reach::Ahead || findsWide(r); }  // PE, PS: the slice below, a row ahead
 
 template <typename Rec>
 struct PlacedNeighbours {
@@ -161,7 +167,7 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
     // The bricks around that hold causal neighbours: dx in -1..1, dy in
     // -1..0 (-1..1 for Reach::Wide and Widest, whose PS lies a row ahead),
     // dz in -1..0; `lookBack[k]` is offset k, ((dx+1), (dy+1), (dz+1)).
-    constexpr int kDyHigh = kReach >= Reach::Wide ? 1 : 0;
+    constexpr int kDyHigh = findsAhead(kReach) ? 1 : 0;
     std::vector<std::array<int, 3>> lookBack;
     for (int dx = -1; dx <= 1; ++dx)
         for (int dy = -1; dy <= kDyHigh; ++dy)
@@ -225,9 +231,10 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
             const int p = std::countr_zero(bits), x = p & 3, y = (p >> 2) & 3, z = p >> 4;
             at(Nb::W, x - 1, y, z), at(Nb::N, x, y - 1, z), at(Nb::NW, x - 1, y - 1, z), at(Nb::NE, x + 1, y - 1, z);
             at(Nb::P, x, y, z - 1), at(Nb::PW, x - 1, y, z - 1), at(Nb::PN, x, y - 1, z - 1), at(Nb::PNW, x - 1, y - 1, z - 1);
-            if constexpr (kReach != Reach::Near) at(Nb::WW, x - 2, y, z), at(Nb::NN, x, y - 2, z), at(Nb::PP, x, y, z - 2);
-            if constexpr (kReach >= Reach::Wide) {
-                at(Nb::PE, x + 1, y, z - 1), at(Nb::PS, x, y + 1, z - 1), at(Nb::PNE, x + 1, y - 1, z - 1), at(Nb::PSW, x - 1, y + 1, z - 1);
+            if constexpr (findsFar(kReach)) at(Nb::WW, x - 2, y, z), at(Nb::NN, x, y - 2, z), at(Nb::PP, x, y, z - 2);
+            if constexpr (findsAhead(kReach)) at(Nb::PE, x + 1, y, z - 1), at(Nb::PS, x, y + 1, z - 1);
+            if constexpr (findsWide(kReach)) {
+                at(Nb::PNE, x + 1, y - 1, z - 1), at(Nb::PSW, x - 1, y + 1, z - 1);
                 at(Nb::PSE, x + 1, y + 1, z - 1), at(Nb::NWW, x - 2, y - 1, z), at(Nb::NNE, x + 1, y - 2, z), at(Nb::NNW, x - 1, y - 2, z);
                 at(Nb::NEE, x + 2, y - 1, z);
             }
