@@ -262,3 +262,27 @@ def test_sequence_frames_equal_pyopenvdb(work):
     back = openvdb.read(os.path.join(work, "back.0011.vdb"), "surface")
     assert back.activeVoxelCount() == openvdb.read(os.path.join(work, "cache.0011.vdb"), "surface").activeVoxelCount()
     assert not os.path.exists(os.path.join(work, "back.0010.vdb"))
+
+
+ATLASES = ["AICHAmc", "HarvardOxford-cort-maxprob-thr0-1mm", "labels256", "torsoLabel"]
+
+
+@pytest.mark.parametrize("name", ATLASES)
+def test_atlas_every_voxel_equals_nibabel(name, work):
+    """A label atlas of ../shared, encoded in process (its windows coded as
+    labels, window coding 17), read back by the reader library: every voxel
+    equal to nibabel's array of the source, and every voxel active."""
+    nib = pytest.importorskip("nibabel")
+    src = os.path.join(SHARED, "medical", "nifti", name + ".nii.gz")
+    if not os.path.exists(src):
+        pytest.skip(f"no {src}")
+    out = os.path.join(work, name + ".ssvdag")
+    vdbdag.encode(src, out)
+    want = np.asanyarray(nib.load(src).dataobj)
+    g = vdbdag.open(out).grids[0]
+    (x0, y0, z0), (x1, y1, z1) = g.index_bbox
+    assert (x0, y0, z0) == (0, 0, 0) and (x1 + 1, y1 + 1, z1 + 1) == want.shape
+    got = np.asarray(g.dense([[0, 0, 0], [x1, y1, z1]]))  # x, y, z as nibabel's
+    assert got.shape == want.shape
+    assert np.array_equal(got.astype(np.int64), want.astype(np.int64))
+    assert g.active_voxel_count == want.size
