@@ -6,10 +6,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
+#include "src/attributes/PredictedWindows.h"
 #include "src/dag/DagBuilder.h"
+#include "src/encoding/AttributeLayout.h"
 #include "src/encoding/CompactDag.h"
+#include "src/format/TraceableValues.h"
+#include "src/pipeline/GridCodec.h"
 #include "src/trace/DagTracer.h"
 #include "src/trace/ExactRayReference.h"
 #include "tests/unit/TracerTestGrids.h"
@@ -229,4 +234,56 @@ TEST(CpuTracer, SegmentWalkVisitsEveryOccupiedBoxInOrderAndPointQueriesAgree) {
         const std::array<int64_t, 3> voxel{int64_t(rng() % 40) - 12, int64_t(rng() % 40) - 12, int64_t(rng() % 40) - 12};
         ASSERT_EQ(tracer.find(voxel), reference.find(voxel));
     }
+}
+
+// An atlas through the whole path a tracer reads labels by: a dense box of
+// Voronoi labels encoded by the pipeline (its window coded as labels,
+// coding 17), the traceable palettes rebuilt from that window (the
+// attributes the encoder kept dropped first), and the tracer's point lookup:
+// every voxel's entry holds the label the generating function gives.
+TEST(DagTracer, FindsEveryVoxelOfAnAtlasWithItsLabel) {
+    const auto label = [](int x, int y, int z) {
+        static constexpr int kSeeds[6][3] = {{2, 3, 1}, {20, 4, 12}, {9, 17, 6}, {22, 18, 2}, {5, 10, 14}, {14, 1, 9}};
+        int best = 0, bestD = 1 << 30;
+        for (int s = 0; s < 6; ++s) {
+            const int d = (x - kSeeds[s][0]) * (x - kSeeds[s][0]) + (y - kSeeds[s][1]) * (y - kSeeds[s][1]) + (z - kSeeds[s][2]) * (z - kSeeds[s][2]);
+            if (d < bestD) bestD = d, best = s;
+        }
+        return int32_t(1000 * best - 2500);
+    };
+    GridRecord atlas;
+    atlas.name = "atlas";
+    atlas.valueType = ValueType::Int32;
+    atlas.background = {0, 0, 0, 0};
+    for (int bz = 0; bz < 4; ++bz)
+        for (int by = 0; by < 5; ++by)
+            for (int bx = 0; bx < 6; ++bx) {
+                atlas.topology.bricks.push_back({4 * bx, 4 * by, 4 * bz, ~uint64_t(0)});
+                for (int k = 0; k < 64; ++k) {
+                    const int32_t v = label(4 * bx + (k & 3), 4 * by + ((k >> 2) & 3), 4 * bz + (k >> 4));
+                    const auto* p = reinterpret_cast<const uint8_t*>(&v);
+                    atlas.values.bricks.insert(atlas.values.bricks.end(), p, p + 4);
+                }
+            }
+    format::EncodedGrid encoded = pipeline::encodeGrid(atlas);
+    const attributes::ValueWindowsPayload& windows = encoded.active.valueWindows;
+    ASSERT_TRUE(windows.predicted);
+    const attributes::WindowDirectory dir =
+        attributes::readPredictedWindowDirectory(windows.bytes, 4, encoding::attributeLayout(encoded.active.dag), "atlas");
+    ASSERT_EQ(dir.windows.size(), 1u);
+    ASSERT_EQ(windows.bytes[size_t(dir.windows[0].offset)], attributes::detail::kShapedLabelCoding);
+    encoded.active.attributes.clear();  // the palettes from the window itself
+    const std::vector<uint8_t> values = format::traceableValues(encoded).decodeAll();
+    const trace::DagTracer tracer(encoded.active.dag);
+    for (int z = 0; z < 16; ++z)
+        for (int y = 0; y < 20; ++y)
+            for (int x = 0; x < 24; ++x) {
+                const std::optional<uint64_t> entry = tracer.find({x, y, z});
+                ASSERT_TRUE(entry.has_value()) << x << " " << y << " " << z;
+                ASSERT_LT(*entry * 4 + 4, values.size() + 1);
+                int32_t got;
+                std::memcpy(&got, values.data() + *entry * 4, 4);
+                ASSERT_EQ(got, label(x, y, z)) << x << " " << y << " " << z;
+            }
+    EXPECT_FALSE(tracer.find({24, 0, 0}).has_value());
 }
