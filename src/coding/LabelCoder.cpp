@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <memory>
+#include <vector>
 
 #include "src/coding/PlacedWalk.h"
 #include "src/coding/RangeCoder.h"
@@ -17,65 +18,31 @@ namespace {
 using namespace detail;
 
 constexpr size_t kCandidates = 4, kRecent = 32;
+// Generation 2 (LabelCoder.h).
+constexpr unsigned kShapeBits = 10;  // W N P NE NW PN PW PNW (the near eight), PE PS
+constexpr size_t kLabelList = 1024;
+constexpr int kRankLengths = 11;  // bit lengths of rank + 1: 1 .. 1025
 
-struct LabelModels {
-    // [candidate rank][neighbours holding it, 0..8][distinct neighbour values: 1, 2, 3+]
-    std::array<std::array<std::array<BitModel, 3>, 9>, kCandidates> match;
-    std::array<BitModel, kRecent> recent;  // unary rank in the recent list (all ones: a new label)
-    std::array<int32_t, kRecent> list{};       // the recent labels, most recent first
-    size_t listSize = 0;
+// The labels met, most recent first, at most `capacity` of them (32 in
+// generation 1, 1,024 in generation 2): each label coded moves to the front.
+struct RecentLabels {
+    explicit RecentLabels(size_t capacity) : list(capacity) {}
+    std::vector<int32_t> list;
+    size_t size = 0;
     void remember(int32_t v) {
         size_t i = 0;
-        while (i < listSize && list[i] != v) ++i;
-        if (i == listSize) i = listSize < kRecent ? listSize++ : kRecent - 1;
+        while (i < size && list[i] != v) ++i;
+        if (i == size) i = size < list.size() ? size++ : list.size() - 1;
         for (; i > 0; --i) list[i] = list[i - 1];
         list[0] = v;
     }
 };
 
-// The neighbours' distinct values (at most kCandidates, in the order of
-// LabelCoder.h), each with how many of the 8 neighbours hold it.
-struct Candidates {
-    std::array<int32_t, kCandidates> value{};
-    std::array<unsigned, kCandidates> count{};
-    size_t size = 0;
-    unsigned distinct = 0;
-};
-
-template <typename Code>
-void walkLabels(std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order, uint64_t entries, Code&& code) {
-    using Nb = PlacedNeighbours<uint8_t>;
-    walkPlacedBricks<uint8_t>(
-        layout, places, entries, order, [&](uint64_t entry) { code(Candidates{}, entry); },
-        [&](const Nb& nb, uint64_t entry, int32_t& value, uint8_t&) {
-            Candidates c;
-            std::array<int32_t, 8> seen{};
-            for (const Nb::Which k : {Nb::W, Nb::N, Nb::P, Nb::NE, Nb::NW, Nb::PN, Nb::PW, Nb::PNW}) {
-                if (!nb.has(k)) continue;
-                const int32_t v = nb.value(k);
-                unsigned i = 0;
-                while (i < c.distinct && seen[i] != v) ++i;
-                if (i == c.distinct) seen[c.distinct++] = v;
-                size_t j = 0;
-                while (j < c.size && c.value[j] != v) ++j;
-                if (j == c.size && c.size < kCandidates) c.value[c.size++] = v;
-                if (j < c.size) ++c.count[j];
-            }
-            value = code(c, entry);
-        });
-}
-
-// Generation 2 (LabelCoder.h): the candidates with which neighbours hold
-// each, and its models.
-constexpr unsigned kShapeBits = 10;  // W N P NE NW PN PW PNW (the near eight), PE PS
-constexpr size_t kLabelList = 1024;
-constexpr int kRankLengths = 11;  // bit lengths of rank + 1: 1 .. 1025
-
-struct ShapeCandidates {
-    std::array<int32_t, kCandidates> value{};
-    std::array<unsigned, kCandidates> mask{};  // bit k: neighbour k holds it
-    size_t size = 0;
-    unsigned distinct = 0;  // among the near eight
+struct LabelModels {
+    // [candidate rank][neighbours holding it, 0..8][distinct neighbour values: 1, 2, 3+]
+    std::array<std::array<std::array<BitModel, 3>, 9>, kCandidates> match;
+    std::array<BitModel, kRecent> recent;  // unary rank in the recent list (all ones: a new label)
+    RecentLabels labels{kRecent};
 };
 
 struct ShapeModels {
@@ -89,26 +56,31 @@ struct ShapeModels {
     std::vector<BitModel> match = std::vector<BitModel>(kCandidates * (size_t(1) << kShapeBits) * 3);
     std::array<BitModel, kRankLengths> rankLength;                           // [bit length]: one more bit?
     std::array<std::array<BitModel, kRankLengths>, kRankLengths + 1> rankBits;  // [bit length][position]
-    std::vector<int32_t> list = std::vector<int32_t>(kLabelList);  // the labels met, most recent first
-    size_t listSize = 0;
-    void remember(int32_t v) {
-        size_t i = 0;
-        while (i < listSize && list[i] != v) ++i;
-        if (i == listSize) i = listSize < kLabelList ? listSize++ : kLabelList - 1;
-        for (; i > 0; --i) list[i] = list[i - 1];
-        list[0] = v;
-    }
+    RecentLabels labels{kLabelList};
 };
 
-template <typename Code>
-void walkShapes(std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order, uint64_t entries, Code&& code) {
+// The neighbours' distinct values (at most kCandidates, in the order of
+// LabelCoder.h), each with how many of the near eight hold it (generation
+// 1's context) and which (bit k: the k-th of W, N, P, NE, NW, PN, PW, PNW;
+// with Reach::Ahead also bits 8 and 9 for PE and PS: generation 2's).
+struct Candidates {
+    std::array<int32_t, kCandidates> value{};
+    std::array<unsigned, kCandidates> count{};
+    std::array<unsigned, kCandidates> mask{};
+    size_t size = 0;
+    unsigned distinct = 0;  // among the near eight
+};
+
+// code(candidates, entry) codes or decodes an entry and returns its label.
+// Generation 1 walks with Reach::Near, generation 2 with Reach::Ahead.
+template <Reach kReach, typename Code>
+void walkLabels(std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order, uint64_t entries, Code&& code) {
     using Nb = PlacedNeighbours<uint8_t>;
-    walkPlacedBricks<uint8_t, Reach::Ahead>(
-        layout, places, entries, order, [&](uint64_t entry) { code(ShapeCandidates{}, entry); },
+    walkPlacedBricks<uint8_t, kReach>(
+        layout, places, entries, order, [&](uint64_t entry) { code(Candidates{}, entry); },
         [&](const Nb& nb, uint64_t entry, int32_t& value, uint8_t&) {
             static constexpr Nb::Which kNear[] = {Nb::W, Nb::N, Nb::P, Nb::NE, Nb::NW, Nb::PN, Nb::PW, Nb::PNW};
-            static constexpr Nb::Which kAhead[] = {Nb::PE, Nb::PS};
-            ShapeCandidates c;
+            Candidates c;
             std::array<int32_t, 8> seen{};
             for (unsigned k = 0; k < 8; ++k) {
                 if (!nb.has(kNear[k])) continue;
@@ -119,13 +91,16 @@ void walkShapes(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
                 size_t j = 0;
                 while (j < c.size && c.value[j] != v) ++j;
                 if (j == c.size && c.size < kCandidates) c.value[c.size++] = v;
-                if (j < c.size) c.mask[j] |= 1u << k;
+                if (j < c.size) ++c.count[j], c.mask[j] |= 1u << k;
             }
-            for (unsigned k = 0; k < 2; ++k) {
-                if (!nb.has(kAhead[k])) continue;
-                const int32_t v = nb.value(kAhead[k]);
-                for (size_t j = 0; j < c.size; ++j)
-                    if (c.value[j] == v) c.mask[j] |= 1u << (8 + k);
+            if constexpr (kReach == Reach::Ahead) {
+                static constexpr Nb::Which kAhead[] = {Nb::PE, Nb::PS};
+                for (unsigned k = 0; k < 2; ++k) {
+                    if (!nb.has(kAhead[k])) continue;
+                    const int32_t v = nb.value(kAhead[k]);
+                    for (size_t j = 0; j < c.size; ++j)
+                        if (c.value[j] == v) c.mask[j] |= 1u << (8 + k);
+                }
             }
             value = code(c, entry);
         });
@@ -149,18 +124,18 @@ struct LabelReader {
 // Codes label `v` (the writer's; the reader's is ignored) given its
 // candidates; returns the label coded.
 template <typename IO>
-int32_t codeShaped(IO& io, ShapeModels& m, const ShapeCandidates& c, int32_t v, int32_t minValue, int32_t maxValue, unsigned bits) {
+int32_t codeShaped(IO& io, ShapeModels& m, const Candidates& c, int32_t v, int32_t minValue, int32_t maxValue, unsigned bits) {
     const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
     for (size_t i = 0; i < c.size; ++i)
         if (io.bit(m.match[((i << kShapeBits) | c.mask[i]) * 3 + spread], unsigned(IO::kEncoding && c.value[i] == v))) {
-            m.remember(c.value[i]);
+            m.labels.remember(c.value[i]);
             return c.value[i];
         }
-    // rank + 1 in Elias-gamma form; rank = listSize: a new label.
+    // rank + 1 in Elias-gamma form; rank = the list's length: a new label.
     uint64_t r = 0;
     if constexpr (IO::kEncoding) {
         size_t rank = 0;
-        while (rank < m.listSize && m.list[rank] != v) ++rank;
+        while (rank < m.labels.size && m.labels.list[rank] != v) ++rank;
         r = rank + 1;
     }
     const int length = 64 - std::countl_zero(r);
@@ -170,16 +145,16 @@ int32_t codeShaped(IO& io, ShapeModels& m, const ShapeCandidates& c, int32_t v, 
     for (int j = L - 2; j >= 0; --j) got = got << 1 | io.bit(m.rankBits[size_t(L)][size_t(j)], unsigned(r >> j) & 1u);
     const uint64_t rank = got - 1;
     int32_t label;
-    if (rank < m.listSize) {
-        label = m.list[size_t(rank)];
-    } else if (rank == m.listSize) {
+    if (rank < m.labels.size) {
+        label = m.labels.list[size_t(rank)];
+    } else if (rank == m.labels.size) {
         const int64_t x = int64_t(minValue) + int64_t(io.direct(uint32_t(int64_t(v) - minValue), bits));
         if (x > maxValue) throw Error("a label outside its range (corrupt)");
         label = int32_t(x);
     } else {
         throw Error("a label's rank beyond the labels met (corrupt)");
     }
-    m.remember(label);
+    m.labels.remember(label);
     return label;
 }
 
@@ -200,7 +175,7 @@ std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::s
     if (generation == 2) {
         auto m = std::make_unique<ShapeModels>();
         LabelWriter io{rc};
-        walkShapes(layout, places, order, entries.size(), [&](const ShapeCandidates& c, uint64_t entry) {
+        walkLabels<Reach::Ahead>(layout, places, order, entries.size(), [&](const Candidates& c, uint64_t entry) {
             const int32_t v = entries[entry];
             if (v < minValue || v > maxValue) throw Error("label coder: label " + std::to_string(v) + " lies outside its range");
             return codeShaped(io, *m, c, v, minValue, maxValue, bits);
@@ -209,7 +184,7 @@ std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::s
         return out;
     }
     auto m = std::make_unique<LabelModels>();
-    walkLabels(layout, places, order, entries.size(), [&](const Candidates& c, uint64_t entry) {
+    walkLabels<Reach::Near>(layout, places, order, entries.size(), [&](const Candidates& c, uint64_t entry) {
         const int32_t v = entries[entry];
         if (v < minValue || v > maxValue) throw Error("label coder: label " + std::to_string(v) + " lies outside its range");
         const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
@@ -217,19 +192,19 @@ std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::s
             const bool hit = c.value[i] == v;
             rc.encode(m->match[i][c.count[i]][spread], hit);
             if (hit) {
-                m->remember(v);
+                m->labels.remember(v);
                 return v;
             }
         }
         size_t rank = 0;
-        while (rank < m->listSize && m->list[rank] != v) ++rank;
+        while (rank < m->labels.size && m->labels.list[rank] != v) ++rank;
         for (size_t i = 0; i < rank; ++i) rc.encode(m->recent[i], 1);
-        if (rank < m->listSize) {
+        if (rank < m->labels.size) {
             rc.encode(m->recent[rank], 0);
         } else {  // as many ones as the list is long: a new label, then its offset
             rc.encodeDirect(uint32_t(int64_t(v) - minValue), bits);
         }
-        m->remember(v);
+        m->labels.remember(v);
         return v;
     });
     rc.finish();
@@ -246,12 +221,12 @@ void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t
         if (generation == 2) {
             auto m = std::make_unique<ShapeModels>();
             LabelReader io{rc};
-            walkShapes(layout, places, order, out.size(), [&](const ShapeCandidates& c, uint64_t entry) {
+            walkLabels<Reach::Ahead>(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry) {
                 return out[entry] = codeShaped(io, *m, c, 0, minValue, maxValue, bits);
             });
         } else {
             auto m = std::make_unique<LabelModels>();
-            walkLabels(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry) {
+            walkLabels<Reach::Near>(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry) {
                 const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
                 int32_t v = 0;
                 bool found = false;
@@ -259,16 +234,16 @@ void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t
                     if (rc.decode(m->match[i][c.count[i]][spread])) v = c.value[i], found = true;
                 if (!found) {
                     size_t rank = 0;
-                    while (rank < m->listSize && rc.decode(m->recent[rank])) ++rank;
-                    if (rank < m->listSize) {
-                        v = m->list[rank];
+                    while (rank < m->labels.size && rc.decode(m->recent[rank])) ++rank;
+                    if (rank < m->labels.size) {
+                        v = m->labels.list[rank];
                     } else {
                         const int64_t x = int64_t(minValue) + int64_t(rc.decodeDirect(bits));
                         if (x > maxValue) throw Error("a label outside its range (corrupt)");
                         v = int32_t(x);
                     }
                 }
-                m->remember(v);
+                m->labels.remember(v);
                 out[entry] = v;
                 return v;
             });

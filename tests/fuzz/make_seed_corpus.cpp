@@ -78,24 +78,9 @@ int main(int argc, char** argv) {
     // Labels: full bricks of a 16x16x8 box in three regions split by planes,
     // most entries repeating the one before: a PredictedWindows section whose
     // window is coded as labels (coding 17, coding/LabelCoder.h).
-    {
-        GridRecord labels;
-        labels.name = "labels";
-        labels.valueType = ValueType::Int32;
-        labels.background = {0, 0, 0, 0};
-        for (int bz = 0; bz < 2; ++bz)
-            for (int by = 0; by < 4; ++by)
-                for (int bx = 0; bx < 4; ++bx) {
-                    labels.topology.bricks.push_back({4 * bx, 4 * by, 4 * bz, ~uint64_t(0)});
-                    for (int k = 0; k < 64; ++k) {
-                        const int x = 4 * bx + (k & 3), y = 4 * by + ((k >> 2) & 3), z = 4 * bz + (k >> 4);
-                        const int32_t v = x + y < 12 ? 17 : x - z > 6 ? 4000 : -250;
-                        const auto* p = reinterpret_cast<const uint8_t*>(&v);
-                        labels.values.bricks.insert(labels.values.bricks.end(), p, p + 4);
-                    }
-                }
-        scene.grids.push_back(pipeline::encodeGrid(labels));
-    }
+    scene.grids.push_back(pipeline::encodeGrid(vdbdag::testing::labelBox("labels", 4, 4, 2, [](int x, int y, int z) {
+        return int32_t(x + y < 12 ? 17 : x - z > 6 ? 4000 : -250);
+    })));
     // Half floats (13 zero low bits) of a turbulent field filling a 16^3
     // box: a float window stored as coding 12, the integers of the floats'
     // order (coding/FloatIntegerCoder.h), for the reader fuzzers to mutate.

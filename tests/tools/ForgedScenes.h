@@ -1,5 +1,6 @@
 // Scenes the read-limit tests and the fuzz seed corpus forge alike
-// (tests/unit/test_read_limits.cpp, tests/fuzz/make_seed_corpus.cpp).
+// (tests/unit/test_read_limits.cpp, tests/fuzz/make_seed_corpus.cpp; the
+// label box also tests/unit/test_tracer.cpp).
 #pragma once
 #include <cstdint>
 #include <string>
@@ -9,6 +10,28 @@
 #include "src/volume/GridRecord.h"
 
 namespace vdbdag::testing {
+
+// A label volume: a box of bricksX x bricksY x bricksZ full 4^3 int32
+// bricks from the origin, each voxel holding label(x, y, z) (values in
+// brick order, each brick's voxels in bit order x + 4y + 16z).
+template <typename Label>
+GridRecord labelBox(const std::string& name, int bricksX, int bricksY, int bricksZ, Label&& label) {
+    GridRecord labels;
+    labels.name = name;
+    labels.valueType = ValueType::Int32;
+    labels.background = {0, 0, 0, 0};
+    for (int bz = 0; bz < bricksZ; ++bz)
+        for (int by = 0; by < bricksY; ++by)
+            for (int bx = 0; bx < bricksX; ++bx) {
+                labels.topology.bricks.push_back({4 * bx, 4 * by, 4 * bz, ~uint64_t(0)});
+                for (int k = 0; k < 64; ++k) {
+                    const int32_t v = label(4 * bx + (k & 3), 4 * by + ((k >> 2) & 3), 4 * bz + (k >> 4));
+                    const auto* p = reinterpret_cast<const uint8_t*>(&v);
+                    labels.values.bricks.insert(labels.values.bricks.end(), p, p + 4);
+                }
+            }
+    return labels;
+}
 
 // A solid side^3 fog block of full 4^3 bricks (side a multiple of 4), its
 // float values all 0 (the caller may set them, in brick order).

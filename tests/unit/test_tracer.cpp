@@ -17,6 +17,7 @@
 #include "src/pipeline/GridCodec.h"
 #include "src/trace/DagTracer.h"
 #include "src/trace/ExactRayReference.h"
+#include "tests/tools/ForgedScenes.h"
 #include "tests/unit/TracerTestGrids.h"
 
 using namespace vdbdag;
@@ -251,20 +252,7 @@ TEST(DagTracer, FindsEveryVoxelOfAnAtlasWithItsLabel) {
         }
         return int32_t(1000 * best - 2500);
     };
-    GridRecord atlas;
-    atlas.name = "atlas";
-    atlas.valueType = ValueType::Int32;
-    atlas.background = {0, 0, 0, 0};
-    for (int bz = 0; bz < 4; ++bz)
-        for (int by = 0; by < 5; ++by)
-            for (int bx = 0; bx < 6; ++bx) {
-                atlas.topology.bricks.push_back({4 * bx, 4 * by, 4 * bz, ~uint64_t(0)});
-                for (int k = 0; k < 64; ++k) {
-                    const int32_t v = label(4 * bx + (k & 3), 4 * by + ((k >> 2) & 3), 4 * bz + (k >> 4));
-                    const auto* p = reinterpret_cast<const uint8_t*>(&v);
-                    atlas.values.bricks.insert(atlas.values.bricks.end(), p, p + 4);
-                }
-            }
+    const GridRecord atlas = vdbdag::testing::labelBox("atlas", 6, 5, 4, label);
     format::EncodedGrid encoded = pipeline::encodeGrid(atlas);
     const attributes::ValueWindowsPayload& windows = encoded.active.valueWindows;
     ASSERT_TRUE(windows.predicted);
