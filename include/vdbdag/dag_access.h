@@ -74,6 +74,16 @@ VDBDAG_FN void dagChildPointer(VDBDAG_INNER_BUF buf, uint64_t pos, uint header, 
     }
 }
 
+// The word where stored child slot j's attribute offset begins, in the node
+// whose nonzero header is at word `pos` (j must not be its first stored
+// child): where a reader fills in the offsets a file keeps at rest as 0
+// (FORMAT.md 6.2).
+VDBDAG_PURE uint64_t dagAttributeOffsetWord(uint64_t pos, uint header, uint j, uint offsetWords) {
+    const uint through = header & ((1u << (2u * j + 2u)) - 1u);  // slots 0..j
+    const uint present = uint(bitCount((through | (through >> 1u)) & 0x5555u));
+    return pos + 1ul + uint64_t(present) + uint64_t(bitCount((through >> 1u) & 0x5555u)) + uint64_t(present - 2u) * uint64_t(offsetWords);
+}
+
 // One step of a point lookup, the walk every reader of a voxel takes (the
 // public reader's Accessor, DagTracer::find, the shaders' findVoxel): in the
 // node whose nonzero header is at word `pos`, the child whose cube holds the

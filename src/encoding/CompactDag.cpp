@@ -167,7 +167,11 @@ struct NodeFacts {
 
 } // namespace
 
-void validateCompact(const CompactDag& dag, const std::string& what) {
+namespace {
+
+// validateCompact, where a level whose atRest flag is set must store every
+// attribute offset as 0 (its offsets are then filled in by the caller).
+void checkCompact(const CompactDag& dag, const std::string& what, const std::vector<uint8_t>& atRest) {
     auto fail = [&](const std::string& why) { throw Error(what + ": " + why); };
     if (dag.log2Size == 0) {
         if (!dag.levelStart.empty() || !dag.inner.empty() || !dag.leaves.empty() || !dag.offsetWords.empty()) fail("an empty grid must have no nodes");
@@ -231,9 +235,10 @@ void validateCompact(const CompactDag& dag, const std::string& what) {
                                          : p.offset < isNodeStart[i + 1].size() && isNodeStart[i + 1][p.offset];
                 if (!ok) fail("pointer at level " + std::to_string(i) + " word " + std::to_string(pos) + " targets " +
                               std::to_string(p.offset) + ", which is not a node of the next level");
-                if (!first && dag.offsetWords[i] && p.attributeOffset != preceding)
+                const uint64_t expected = atRest.empty() || !atRest[i] ? preceding : 0;  // at rest: stored as 0
+                if (!first && dag.offsetWords[i] && p.attributeOffset != expected)
                     fail("attribute offset at level " + std::to_string(i) + " word " + std::to_string(pos) + " is " +
-                         std::to_string(p.attributeOffset) + ", expected " + std::to_string(preceding));
+                         std::to_string(p.attributeOffset) + ", expected " + std::to_string(expected));
                 first = false;
                 preceding = saturatingAdd(preceding, below[p.offset]);
             });
@@ -241,6 +246,76 @@ void validateCompact(const CompactDag& dag, const std::string& what) {
         });
         below.swap(here);
     }
+}
+
+std::vector<NodeFacts> computeFacts(const CompactDag& dag);
+
+// Calls fill(level, word, preceding) for every attribute offset of the
+// levels `levels(i)` picks: its first word and the entries of the
+// preceding siblings (saturating).
+template <typename Levels, typename Fill>
+void forEachAttributeOffset(const CompactDag& dag, Levels&& levels, Fill&& fill) {
+    const std::vector<NodeFacts> facts = computeFacts(dag);
+    const size_t count = dag.innerLevelCount();
+    for (size_t i = 0; i < count; ++i) {
+        const unsigned ow = dag.offsetWords[i];
+        if (ow == 0 || !levels(i)) continue;
+        const bool toLeaves = i + 1 == count;
+        forEachNode(dag, i, [&](uint64_t pos, uint16_t header) {
+            uint64_t preceding = 0;
+            bool first = true;
+            forEachStoredChild(dag, i, pos, [&](unsigned j, const ChildPointer& p) {
+                if (!first) fill(i, access::dagAttributeOffsetWord(pos, header, j, ow), preceding);
+                first = false;
+                preceding = saturatingAdd(preceding, toLeaves ? uint64_t(std::popcount(dag.leaves[p.offset])) : facts[i + 1].entries[p.offset]);
+            });
+        });
+    }
+}
+
+} // namespace
+
+void validateCompact(const CompactDag& dag, const std::string& what) { checkCompact(dag, what, {}); }
+
+std::vector<uint8_t> offsetWordsAtRest(const CompactDag& dag) {
+    std::vector<uint8_t> out = dag.offsetWords;
+    for (uint8_t& w : out)
+        if (w) w |= kOffsetsAtRest;
+    return out;
+}
+
+std::vector<uint16_t> innerWordsAtRest(const CompactDag& dag) {
+    std::vector<uint16_t> out = dag.inner;
+    if (dag.empty()) return out;
+    forEachAttributeOffset(
+        dag, [](size_t) { return true; },
+        [&](size_t i, uint64_t word, uint64_t) { std::fill_n(out.begin() + ptrdiff_t(word), dag.offsetWords[i], uint16_t(0)); });
+    return out;
+}
+
+void validateAndRestoreOffsets(CompactDag& dag, const std::string& what) {
+    std::vector<uint8_t> atRest(dag.offsetWords.size(), 0);
+    bool any = false;
+    for (size_t i = 0; i < dag.offsetWords.size(); ++i) {
+        uint8_t& w = dag.offsetWords[i];
+        if (!(w & kOffsetsAtRest)) continue;
+        w &= uint8_t(~kOffsetsAtRest);
+        if (w == 0) throw Error(what + ": level " + std::to_string(i) + " keeps attribute offsets at rest but stores none");
+        atRest[i] = 1;
+        any = true;
+    }
+    checkCompact(dag, what, atRest);
+    if (!any) return;
+    // Filled in place: a walk reads a node's pointers, never its offsets.
+    forEachAttributeOffset(
+        dag, [&](size_t i) { return atRest[i] != 0; },
+        [&](size_t i, uint64_t word, uint64_t preceding) {
+            const unsigned ow = dag.offsetWords[i];
+            if (ow < 4 && preceding >> (16 * ow))
+                throw Error(what + ": level " + std::to_string(i) + " needs an attribute offset of " + std::to_string(preceding) + ", wider than its " +
+                            std::to_string(ow) + " words");
+            for (unsigned w = 0; w < ow; ++w) dag.inner[size_t(word + w)] = uint16_t(preceding >> (16 * w));
+        });
 }
 
 namespace {

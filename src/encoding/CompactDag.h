@@ -49,6 +49,22 @@ CompactDag encodeCompact(const dag::ReducedDag& dag, bool attributeOffsets = fal
 // siblings. Throws vdbdag::Error("<what>: ...").
 void validateCompact(const CompactDag& dag, const std::string& what);
 
+// At rest (docs/FORMAT.md 6.1-6.2) a level's attribute offsets are stored
+// as 0: they are the entries of the preceding siblings, which a reader
+// computes from the DAG below, so a file need not carry them (1-2 % of a
+// level set's file, most of a label atlas's geometry). Its offset width in
+// DagLevels then carries kOffsetsAtRest; a writer stores every level with
+// offsets so, and an older file's stored offsets still read.
+inline constexpr uint8_t kOffsetsAtRest = 0x80;
+// The inner words and offset widths as a file stores them.
+std::vector<uint16_t> innerWordsAtRest(const CompactDag& dag);
+std::vector<uint8_t> offsetWordsAtRest(const CompactDag& dag);
+// A DAG as read, whose offset widths may carry kOffsetsAtRest: validated as
+// validateCompact does (a flagged level's stored offsets must be 0), then
+// the flagged levels' offsets are computed into `inner` and the flags
+// cleared. Throws vdbdag::Error("<what>: ...").
+void validateAndRestoreOffsets(CompactDag& dag, const std::string& what);
+
 // Decoded size, computed bottom-up without decoding (saturating at 2^64-1).
 struct DecodedSize {
     uint64_t activeVoxels = 0;

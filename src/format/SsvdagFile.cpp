@@ -7,7 +7,8 @@
 //                 string background (raw value bytes), u64 inactive voxels
 //   VdbDescriptor opaque bytes (vdb_bridge)
 //   DagLevels     i64[3] origin, u8 log2Size, u8 root reflection,
-//                 u32 n, u64[n] level starts, u8[n] attribute-offset words,
+//                 u32 n, u64[n] level starts, u8[n] attribute-offset words
+//                 (| 0x80: kept at rest as 0, CompactDag.h kOffsetsAtRest),
 //                 u64 inner words, u64 leaves
 //   DagInner      u16[inner words]     (absent for an empty grid)
 //   DagLeaves     u64[leaves]          (absent for an empty grid)
@@ -88,7 +89,7 @@ std::vector<uint8_t> serializeDagLevels(const encoding::CompactDag& dag) {
     levels.put<uint8_t>(dag.rootReflection);
     levels.put<uint32_t>(uint32_t(dag.levelStart.size()));
     for (uint64_t s : dag.levelStart) levels.put<uint64_t>(s);
-    for (uint8_t w : dag.offsetWords) levels.put<uint8_t>(w);
+    for (uint8_t w : encoding::offsetWordsAtRest(dag)) levels.put<uint8_t>(w);  // offsets at rest (FORMAT.md 6.1)
     levels.put<uint64_t>(dag.inner.size());
     levels.put<uint64_t>(dag.leaves.size());
     return levels.take();
@@ -176,7 +177,7 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
     sections.push_back({kinds.levels, g, serializeDagLevels(dag)});
     if (!dag.empty()) {
         const SectionKind windowKind = windows.predicted ? kinds.predictedWindows : kinds.windows;
-        sections.push_back({kinds.inner, g, rawBytes(dag.inner)});
+        sections.push_back({kinds.inner, g, rawBytes(encoding::innerWordsAtRest(dag))});
         releaseIf(dag.inner, take);
         if (!dag.leaves.empty()) sections.push_back({kinds.leaves, g, rawBytes(dag.leaves)});
         releaseIf(dag.leaves, take);
@@ -418,7 +419,10 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 leafCount = r.get<uint64_t>();
                 r.expectEnd();
             }
-            if (options.headersOnly) return encoding::DecodedSize{};
+            if (options.headersOnly) {
+                for (uint8_t& w : dag.offsetWords) w &= uint8_t(~encoding::kOffsetsAtRest);
+                return encoding::DecodedSize{};
+            }
             Section* inner = find(g, kinds.inner, dag.log2Size != 0);
             Section* leaves = find(g, kinds.leaves, false);
             if (inner) dag.inner = fromRawBytes<uint16_t>(inner->data, innerWords, what + " " + layer + " inner nodes");
@@ -427,7 +431,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             else if (leafCount) throw Error(what + ": " + layer + " levels claim leaves but there is no leaf section");
             for (uint64_t s : dag.levelStart)
                 if (s > dag.inner.size()) throw Error(what + ": " + layer + " level start " + std::to_string(s) + " beyond the inner array");
-            encoding::validateCompact(dag, what + " " + layer);
+            encoding::validateAndRestoreOffsets(dag, what + " " + layer);
             // Every voxel must have an OpenVDB (int32) index: refused here,
             // naming the file, rather than when a decode reaches the voxel.
             if (const std::optional<IndexBox> box = dagBounds(dag))

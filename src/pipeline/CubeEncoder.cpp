@@ -290,7 +290,8 @@ using PlanValues = std::function<uint64_t(const encoding::CompactDag& dag, const
 
 // The level table, inner and leaf sections of `dag` as the file stores them.
 uint64_t storedGeometryBytes(const encoding::CompactDag& dag) {
-    const std::span<const uint8_t> inner(reinterpret_cast<const uint8_t*>(dag.inner.data()), dag.inner.size() * sizeof(uint16_t));
+    const std::vector<uint16_t> words = encoding::innerWordsAtRest(dag);
+    const std::span<const uint8_t> inner(reinterpret_cast<const uint8_t*>(words.data()), words.size() * sizeof(uint16_t));
     const std::span<const uint8_t> leaves(reinterpret_cast<const uint8_t*>(dag.leaves.data()), dag.leaves.size() * sizeof(uint64_t));
     return format::storedSectionBytes(format::serializeDagLevels(dag)) + format::storedSectionBytes(inner) + format::storedSectionBytes(leaves);
 }

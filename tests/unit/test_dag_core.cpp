@@ -272,6 +272,62 @@ TEST(CompactDag, ValidatorRejectsDanglingPointersAndEmptyNodes) {
     }
 }
 
+// Attribute offsets at rest (FORMAT.md 6.2): the file's words carry 0 where
+// the offsets were, and the reader's restore gives back exactly the words
+// the writer laid out (encodeCompact's sums, another code path), on random
+// sets with tiles at several levels; a nonzero word at rest, a flag on a
+// level without offsets, and an offset wider than its words are refused.
+TEST(CompactDag, OffsetsAtRestAreRestoredExactly) {
+    std::mt19937_64 rng(77);
+    for (int trial = 0; trial < 20; ++trial) {
+        std::set<Voxel> voxels;
+        for (int i = 0; i < 3000; ++i) voxels.insert({int64_t(rng() % 90), int64_t(rng() % 70), int64_t(rng() % 40)});
+        GridTopology topo = topologyFromVoxels(voxels);
+        topo.tiles.push_back({128, 0, 0, 3});
+        topo.tiles.push_back({160, 32, 0, 5});
+        const encoding::CompactDag written = encoding::encodeCompact(dag::buildDag(topo), true);
+        encoding::CompactDag read = written;
+        read.inner = encoding::innerWordsAtRest(written);
+        read.offsetWords = encoding::offsetWordsAtRest(written);
+        size_t zeroed = 0;
+        for (size_t w = 0; w < read.inner.size(); ++w) {
+            if (read.inner[w] != written.inner[w]) {
+                EXPECT_EQ(read.inner[w], 0u);
+                ++zeroed;
+            }
+        }
+        EXPECT_GT(zeroed, 0u);
+        bool flagged = false;
+        for (size_t i = 0; i < read.offsetWords.size(); ++i) {
+            EXPECT_EQ(read.offsetWords[i] & ~encoding::kOffsetsAtRest, written.offsetWords[i]);
+            flagged |= (read.offsetWords[i] & encoding::kOffsetsAtRest) != 0;
+        }
+        ASSERT_TRUE(flagged);
+        encoding::CompactDag restored = read;
+        ASSERT_NO_THROW(encoding::validateAndRestoreOffsets(restored, "at rest"));
+        EXPECT_EQ(restored.inner, written.inner);
+        EXPECT_EQ(restored.offsetWords, written.offsetWords);
+        // A file of before (offsets stored, no flag) reads as it is.
+        encoding::CompactDag old = written;
+        ASSERT_NO_THROW(encoding::validateAndRestoreOffsets(old, "stored"));
+        EXPECT_EQ(old.inner, written.inner);
+        if (trial == 0) {
+            // A word at rest that is not 0.
+            for (size_t w = 0; w < read.inner.size(); ++w)
+                if (read.inner[w] != written.inner[w]) {
+                    encoding::CompactDag bad = read;
+                    bad.inner[w] = 1;
+                    EXPECT_THROW(encoding::validateAndRestoreOffsets(bad, "x"), Error);
+                    break;
+                }
+            // The flag on a level without offsets.
+            encoding::CompactDag bad = read;
+            bad.offsetWords[0] = encoding::kOffsetsAtRest;
+            EXPECT_THROW(encoding::validateAndRestoreOffsets(bad, "x"), Error);
+        }
+    }
+}
+
 TEST(SsvdagFile, SceneRoundTripsThroughSections) {
     std::set<Voxel> voxels;
     for (int i = 0; i < 100; ++i) voxels.insert({i, i / 2, -i});
