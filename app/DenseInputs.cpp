@@ -9,7 +9,7 @@ namespace vdbdag::app {
 
 bool DenseInputs::anyGiven() const {
     return !dims.empty() || !type.empty() || !endian.empty() || !spacing.empty() || !origin.empty() || !series.empty() || below || above ||
-           backgroundValue || volume || dropPatientTags;
+           backgroundValue || volume || dropPatientTags || noTiles;
 }
 
 std::string DenseInputs::takeInputs(const std::vector<std::string>& inputs) {
@@ -27,7 +27,7 @@ void DenseInputs::checkApplies(const std::string& path) const {
     if (!series.empty()) throw Error(path + ": --series applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
     if (anyGiven())
         throw Error(path + ": the dense-scan options (--dims, --type, --endian, --spacing, --origin, --background-below/above/value, --volume, "
-                           "--drop-patient-tags) apply to .raw/.nrrd/.nhdr/.mhd/.mha/.nii/DICOM inputs only");
+                           "--drop-patient-tags, --no-tiles) apply to .raw/.nrrd/.nhdr/.mhd/.mha/.nii/DICOM inputs only");
 }
 
 bridge::DenseImportOptions DenseInputs::resolve(const std::string& path) const {
@@ -52,6 +52,7 @@ bridge::DenseImportOptions DenseInputs::resolve(const std::string& path) const {
     }
     o.backgroundBelow = below, o.backgroundAbove = above, o.backgroundValue = backgroundValue;
     o.allowExternalData = allowExternalData;
+    o.solidBlocks = !noTiles;
     if (dropPatientTags && format != bridge::DenseFormat::Dicom)
         throw Error(path + ": --drop-patient-tags applies to DICOM inputs only (a folder, a .dcm file or a DICOMDIR)");
     o.dropPatientTags = dropPatientTags;

@@ -22,6 +22,7 @@ struct DenseInputs {
     std::optional<double> below, above, backgroundValue;  // background thresholds, and the value removed samples become
     std::optional<int64_t> volume;       // 4-D NIfTI or NRRD: which volume
     bool allowExternalData = false, dropPatientTags = false;
+    bool noTiles = false;  // --no-tiles: every voxel in its brick (DenseImportOptions::solidBlocks)
     std::vector<std::string> moreInputs; // DICOM: the inputs after the first, read as one set
 
     // Any option that applies to dense inputs only is set.

@@ -28,6 +28,9 @@ void DenseInputOptions::addTo(CLI::App& cmd) {
     cmd.add_flag("--drop-patient-tags", v.dropPatientTags,
                  "DICOM input: leave the patient-identifying tags (name, ID, birth date, institution, physicians, dates) out of the grid's "
                  "metadata (by default they are kept with the series' other tags)");
+    cmd.add_flag("--no-tiles", v.noTiles,
+                 "dense input: keep every voxel in its 4^3 brick (by default an 8^3 block of one value becomes a tile, one stored value: "
+                 "a label atlas's regions, a zero background)");
     cmd.add_flag("--allow-external-data", v.allowExternalData,
                  "dense header: read a data file outside the header's folder (an absolute path, '..', or a link leading out)");
 }

@@ -68,6 +68,15 @@ def main():
     voronoi = os.path.join(out, "labels_voronoi_32x32x16_uint8.raw")
     ids[np.argmin(d, axis=0)].astype(np.uint8).tofile(voronoi)
     sources.append(("labels_coding17", voronoi))
+    # labels_coding18 (added 2026-12-06, label model generation 3): 5 labels,
+    # whose 5 uniform 8^3 blocks the writer stores as tiles, their
+    # attribute offsets at rest.
+    rng = np.random.default_rng(18)
+    seeds, ids = rng.integers(0, 32, (5, 3)), rng.permutation(np.arange(1, 250))[:5]
+    d = np.stack([(x - s[0]) ** 2 + (y - s[1]) ** 2 + (z * 2 - s[2]) ** 2 for s in seeds])
+    tiled = os.path.join(out, "labels_tiled_32x32x16_uint8.raw")
+    ids[np.argmin(d, axis=0)].astype(np.uint8).tofile(tiled)
+    sources.append(("labels_coding18", tiled))
     for name, src in sources:
         subprocess.run([tool, "encode", src, "-o", os.path.join(out, name + ".ssvdag"), "-f", "-q"], check=True, stdout=subprocess.DEVNULL)
     print("wrote", sorted(os.listdir(out)))

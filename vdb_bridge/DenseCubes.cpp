@@ -4,7 +4,7 @@
 // them into bricks with the import's own rule (detail/DenseBricks.h), so
 // the bricks and values are those of the in-memory import. Only the active
 // layer exists (a scan has no inactive voxels: removed samples are the
-// background), and no tiles.
+// background); its tiles are the solid 8^3 blocks (SolidBlocks.h).
 #include <algorithm>
 #include <cstring>
 
@@ -89,7 +89,7 @@ public:
             }
             for (int64_t by = lo[1] / 4; by * 4 < hi[1]; ++by)
                 for (int64_t bx = lo[0] / 4; bx * 4 < hi[0]; ++bx) {
-                    if (!scratch_.has(bx, by, z / 4)) continue;
+                    if (!scratch_.has(bx, by, z / 4) || scratch_.blocks.covers(bx * 4, by * 4, z)) continue;
                     const uint64_t mask = cutBrick(rule_, slab.data() + size_t((by * 4 - lo[1]) * rx + (bx * 4 - lo[0])), size_t(rx), size_t(rx * ry),
                                                    std::min<int64_t>(4, nx - bx * 4), std::min<int64_t>(4, ny - by * 4), nz, z, ignored, kept);
                     topology.bricks.push_back({int32_t(bx * 4), int32_t(by * 4), int32_t(z), mask});
@@ -99,6 +99,27 @@ public:
             values.bricks.resize(kept.size() * sizeof(V));
             std::memcpy(values.bricks.data(), kept.data(), values.bricks.size());
         }
+        // The solid blocks whose corner is in the cube, as tiles; the
+        // encoder's origin is a multiple of the largest tile's size (8), so
+        // each lies wholly in one cube.
+        const SolidBlocks& blocks = scratch_.blocks;
+        if (blocks.count == 0) return;
+        constexpr int64_t kSize = int64_t(1) << kSolidBlockLog2;
+        int64_t b0[3], b1[3];
+        for (int a = 0; a < 3; ++a) {
+            const int64_t start = origin_[size_t(a)] + c[a] * size;
+            b0[a] = (std::max<int64_t>(0, start) + kSize - 1) >> kSolidBlockLog2;
+            b1[a] = (hi[a] + kSize - 1) >> kSolidBlockLog2;  // blocks past the scan are never solid
+            if (b0[a] < b1[a] && (b0[a] * kSize < start || (b1[a] - 1) * kSize + kSize > start + size))
+                throw Error("internal error: a solid block crosses a cube (the cube origin is not a multiple of 8)");
+        }
+        for (int64_t z = b0[2]; z < b1[2]; ++z)
+            for (int64_t y = b0[1]; y < b1[1]; ++y)
+                for (int64_t x = b0[0]; x < b1[0]; ++x)
+                    if (blocks.covers(x * kSize, y * kSize, z * kSize)) {
+                        topology.tiles.push_back(solidBlockTile(x, y, z));
+                        if (withValues_) values.tiles.insert(values.tiles.end(), blocks.valueOf(x, y, z), blocks.valueOf(x, y, z) + sizeof(V));
+                    }
     }
 
     void endPass() override {}

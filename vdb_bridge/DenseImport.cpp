@@ -5,6 +5,7 @@
 #include "vdb_bridge/DenseImport.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -24,6 +25,7 @@
 #include "vdb_bridge/detail/DenseBricks.h"
 #include "vdb_bridge/detail/HeaderFieldMeta.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
+#include "vdb_bridge/detail/SolidBlocks.h"
 
 namespace vdbdag::bridge {
 namespace {
@@ -135,6 +137,34 @@ DenseImportResult importVector(const DenseVolume& v, ValueType valueType, bool s
     return result;
 }
 
+// The bricks of `record` inside solid blocks leave (with their values, in
+// place), and each block becomes a tile, in block order.
+void replaceSolidBlocks(const detail::SolidBlocks& blocks, GridRecord& record) {
+    std::vector<Brick>& bricks = record.topology.bricks;
+    std::vector<uint8_t>& values = record.values.bricks;
+    const size_t vs = blocks.valueSize;
+    size_t keptBricks = 0, read = 0, written = 0;
+    for (const Brick& b : bricks) {
+        const size_t n = size_t(std::popcount(b.mask)) * vs;
+        if (!blocks.covers(b.x, b.y, b.z)) {
+            if (written != read) std::memmove(values.data() + written, values.data() + read, n);
+            written += n;
+            bricks[keptBricks++] = b;
+        }
+        read += n;
+    }
+    bricks.resize(keptBricks);
+    values.resize(written);
+    for (int64_t z = 0; z < blocks.slabs; ++z)
+        for (int64_t y = 0; y < blocks.rows; ++y)
+            for (int64_t x = 0; x < blocks.cols; ++x)
+                if (blocks.covers(x << detail::kSolidBlockLog2, y << detail::kSolidBlockLog2, z << detail::kSolidBlockLog2)) {
+                    record.topology.tiles.push_back(detail::solidBlockTile(x, y, z));
+                    const uint8_t* p = blocks.valueOf(x, y, z);
+                    record.values.tiles.insert(record.values.tiles.end(), p, p + vs);
+                }
+}
+
 // `cubesNear` (a scalar scan read cube by cube, DenseImportOptions): the
 // samples go to a scratch file there and the result's grid is a CubeSource.
 template <typename S, typename V>
@@ -208,9 +238,19 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
         PassStats stats;
     };
     std::vector<Row> rowOut(static_cast<size_t>(rows));
+    // Solid 8^3 blocks (SolidBlocks.h): each slab's uniform bricks, paired
+    // with the slab below when the slab is the upper half of a block.
+    detail::SolidBlocks blocks;
+    detail::SlabUniformity<V> lowerSlab, slabNow;
+    if (th.solidBlocks) {
+        blocks.reset(cols, rows, slabs, sizeof(V));
+        lowerSlab.reset(cols, rows);
+        slabNow.reset(cols, rows);
+    }
     if (progress) progress->setLabel("import " + name + ": bricks");
     forEachSlab<S>(v, progress.get(), [&](int64_t z0, int64_t nz, const S* s) {
         if (byCubes) scratch.file->append(s, size_t(uint64_t(nz) * v.sliceSamples() * sizeof(S)));
+        if (th.solidBlocks) std::fill(slabNow.uniform.begin(), slabNow.uniform.end(), uint8_t(0));
         tbb::parallel_for(int64_t(0), rows, [&](int64_t by) {
             Row& row = rowOut[size_t(by)];
             row.bricks.clear();
@@ -220,9 +260,14 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
                 const uint64_t mask = detail::cutBrick(rule, s + size_t((by * 4) * nx + bx * 4), size_t(nx), size_t(nx * ny), std::min<int64_t>(4, nx - bx * 4),
                                                        std::min<int64_t>(4, ny - by * 4), nz, z0, row.stats, row.values);
                 if (mask) row.bricks.push_back({int32_t(bx * 4), int32_t(by * 4), int32_t(z0), mask});
+                if (th.solidBlocks) slabNow.note(cols, bx, by, mask, row.values);
             }
             if (byCubes) row.values.clear();  // read back cube by cube
         });
+        if (th.solidBlocks) {
+            if ((z0 / 4) % 2 == 0) std::swap(lowerSlab, slabNow);
+            else detail::markSolidBlocks(lowerSlab, slabNow, cols, rows, z0 / 8, blocks);
+        }
         for (Row& row : rowOut) {
             second.add(row.stats);
             if (byCubes) {
@@ -263,6 +308,16 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
         r.backgroundChosen = th.background.has_value();
     }
 
+    if (blocks.count) {  // the solid blocks become tiles
+        if (byCubes) {
+            scratch.summary.bricks -= 8 * blocks.count;
+            scratch.summary.tiles = blocks.count;
+            scratch.summary.largestTileLog2 = detail::kSolidBlockLog2;
+            scratch.blocks = std::move(blocks);
+        } else {
+            replaceSolidBlocks(blocks, record);
+        }
+    }
     describeGrid<V>(v, background, &th, &r, record);
     if (byCubes) result.cubes.push_back(detail::makeDenseCubes<S, V>(v, rule, std::move(scratch), record));
     result.volume.grids.push_back(std::move(record));
@@ -464,6 +519,7 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
     }
     const DenseVolume v = describeDense(path, options);
     Thresholds th;
+    th.solidBlocks = options.solidBlocks;
     for (auto [set, value, flag] : {std::tuple{&th.below, &th.belowValue, options.backgroundBelow},
                                     std::tuple{&th.above, &th.aboveValue, options.backgroundAbove}}) {
         if (!flag) continue;

@@ -53,6 +53,11 @@ struct DenseImportOptions {
     bool dropPatientTags = false;
     // NIfTI or NRRD: which volume of a 4-D file (`--volume N`, 0-based).
     std::optional<int64_t> volume;
+    // A scalar scan's solid 8^3 blocks (all 512 samples kept, one value bit
+    // for bit) become active tiles: one attribute entry each instead of 512
+    // (detail/SolidBlocks.h). Off (`--no-tiles`): every voxel in its brick,
+    // as a dense .vdb holds it.
+    bool solidBlocks = true;
     // Read a scalar scan cube by cube (DenseImportResult::cubes): its
     // samples go once to a scratch file beside this path (ScratchFile.h)
     // instead of memory. Ignored for vector and colour scans.

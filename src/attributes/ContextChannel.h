@@ -32,7 +32,7 @@ namespace vdbdag::attributes {
 // in `order`); without, from each brick alone (coding 2).
 // With `labels` (and places), the entries are coded as categories by
 // coding/LabelCoder.h, its model generation `labelModel` (1: codings 7 and
-// 4; 2: coding 17).
+// 4; 2: coding 17; 3: coding 18).
 // `model`: the generation in spatial order (ignored otherwise).
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,

@@ -87,17 +87,17 @@ bool floatIntegersWin(std::span<const uint32_t> bits, std::span<const uint64_t> 
     return coding::encodePlacedFloatIntegers(sample, sampleLayout, samplePlaces).size() < coding::encodePlacedFloats(sample, sampleLayout, samplePlaces).size();
 }
 
-// A window's entries as labels, as a writer codes them today: coding 17,
-// which PredictedWindows.cpp reads as label model generation 2 with the
+// A window's entries as labels, as a writer codes them today: coding 18,
+// which PredictedWindows.cpp reads as label model generation 3 with the
 // bricks in raster order (coding/LabelCoder.h). A newer generation needs a
 // coding of its own.
 std::vector<uint8_t> encodeLabels(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) {
-    static_assert(coding::kLatestLabelModel == 2, "a new label model generation needs a window coding of its own");
-    return encodeContextChannel(values, layout, places, true, coding::BrickOrder::Raster, coding::kLatestIntModel, 2);
+    static_assert(coding::kLatestLabelModel == 3, "a new label model generation needs a window coding of its own");
+    return encodeContextChannel(values, layout, places, true, coding::BrickOrder::Raster, coding::kLatestIntModel, 3);
 }
 
 // Whether the least-squares model (coding 13) may code an int32 window
-// that looks like labels smaller than the label coder (coding 17, coded
+// that looks like labels smaller than the label coder (coding 18, coded
 // whole already: it is the fast one): only where it does on a sample of
 // the window's bricks. Where the labels win there, the model is not run on
 // the window (coding both doubled an atlas's encode); where it wins, both
@@ -175,7 +175,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         if (labelsLike) {
             std::vector<uint8_t> labels = encodeLabels(values, layout, places);
             const uint64_t labelSize = labels.size();
-            consider(std::move(labels), labelSize, detail::kShapedLabelCoding);
+            consider(std::move(labels), labelSize, detail::kTiledLabelCoding);
         }
         if (!labelsLike || modelMayBeatLabels(values, layout, places)) {
             std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel));

@@ -42,11 +42,13 @@ uint64_t layoutEntryCount(std::span<const uint64_t> layout);
 
 // Where a brick instance of a layout lies: its minimum corner in index space
 // (multiples of 4) and the reflection accumulated on the way down to it
-// (bit 0: x, 1: y, 2: z; DESIGN.md invariant 2). A tile's place is unused.
+// (bit 0: x, 1: y, 2: z; DESIGN.md invariant 2). A tile's place: tilePlace.
 struct BrickPlace {
     int32_t x = 0, y = 0, z = 0;
     uint32_t mirror = 0;
 };
+// A tile's place: its corner, the log2 of its size in `mirror` (PlacedWalk.h).
+inline BrickPlace tilePlace(int64_t x, int64_t y, int64_t z, unsigned log2Size) { return {int32_t(x), int32_t(y), int32_t(z), log2Size}; }
 
 // The order a placed walk visits a layout's instances in. Attribute: the
 // layout's own (window codings 3 and 4). Spatial: its tiles, then its

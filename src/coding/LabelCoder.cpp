@@ -48,12 +48,16 @@ struct LabelModels {
 struct ShapeModels {
     ShapeModels() {
         for (BitModel& m : match) m.warmUp();
+        for (BitModel& m : tileMatch) m.warmUp();
         for (BitModel& m : rankLength) m.warmUp();
         for (auto& row : rankBits)
             for (BitModel& m : row) m.warmUp();
     }
     // [candidate rank][the neighbours holding it][distinct near values: 1, 2, 3+]
     std::vector<BitModel> match = std::vector<BitModel>(kCandidates * (size_t(1) << kShapeBits) * 3);
+    // Generation 3: a tile's "equals candidate i?" under the candidate's
+    // rank, which of the tiles W, N, P of its size hold it, and the spread.
+    std::vector<BitModel> tileMatch = std::vector<BitModel>(kCandidates * 8 * 3);
     std::array<BitModel, kRankLengths> rankLength;                           // [bit length]: one more bit?
     std::array<std::array<BitModel, kRankLengths>, kRankLengths + 1> rankBits;  // [bit length][position]
     RecentLabels labels{kLabelList};
@@ -71,39 +75,59 @@ struct Candidates {
     unsigned distinct = 0;  // among the near eight
 };
 
-// code(candidates, entry) codes or decodes an entry and returns its label.
-// Generation 1 walks with Reach::Near, generation 2 with Reach::Ahead.
-template <Reach kReach, typename Code>
+// The distinct values of `n` neighbours (value(k), has(k)), at most
+// kCandidates, each with how many hold it and which (bit k).
+template <typename Has, typename Value>
+Candidates candidatesOf(unsigned n, Has&& has, Value&& value) {
+    Candidates c;
+    std::array<int32_t, 8> seen{};
+    for (unsigned k = 0; k < n; ++k) {
+        if (!has(k)) continue;
+        const int32_t v = value(k);
+        unsigned i = 0;
+        while (i < c.distinct && seen[i] != v) ++i;
+        if (i == c.distinct) seen[c.distinct++] = v;
+        size_t j = 0;
+        while (j < c.size && c.value[j] != v) ++j;
+        if (j == c.size && c.size < kCandidates) c.value[c.size++] = v;
+        if (j < c.size) ++c.count[j], c.mask[j] |= 1u << k;
+    }
+    return c;
+}
+
+// code(candidates, entry, tile) codes or decodes an entry and returns its
+// label. Generation 1 walks with Reach::Near, generation 2 with
+// Reach::Ahead, generation 3 also with tiles as neighbours (kTiles: a tile
+// has the candidates of the tiles W, N, P of its size; generations 1 and 2
+// give a tile none).
+template <Reach kReach, bool kTiles, typename Code>
 void walkLabels(std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order, uint64_t entries, Code&& code) {
     using Nb = PlacedNeighbours<uint8_t>;
-    walkPlacedBricks<uint8_t, kReach>(
-        layout, places, entries, order, [&](uint64_t entry) { code(Candidates{}, entry); },
-        [&](const Nb& nb, uint64_t entry, int32_t& value, uint8_t&) {
-            static constexpr Nb::Which kNear[] = {Nb::W, Nb::N, Nb::P, Nb::NE, Nb::NW, Nb::PN, Nb::PW, Nb::PNW};
-            Candidates c;
-            std::array<int32_t, 8> seen{};
-            for (unsigned k = 0; k < 8; ++k) {
-                if (!nb.has(kNear[k])) continue;
-                const int32_t v = nb.value(kNear[k]);
-                unsigned i = 0;
-                while (i < c.distinct && seen[i] != v) ++i;
-                if (i == c.distinct) seen[c.distinct++] = v;
-                size_t j = 0;
-                while (j < c.size && c.value[j] != v) ++j;
-                if (j == c.size && c.size < kCandidates) c.value[c.size++] = v;
-                if (j < c.size) ++c.count[j], c.mask[j] |= 1u << k;
+    const auto voxel = [&](const Nb& nb, uint64_t entry, int32_t& value, uint8_t&) {
+        static constexpr Nb::Which kNear[] = {Nb::W, Nb::N, Nb::P, Nb::NE, Nb::NW, Nb::PN, Nb::PW, Nb::PNW};
+        Candidates c = candidatesOf(8, [&](unsigned k) { return nb.has(kNear[k]); }, [&](unsigned k) { return nb.value(kNear[k]); });
+        if constexpr (kReach == Reach::Ahead) {
+            static constexpr Nb::Which kAhead[] = {Nb::PE, Nb::PS};
+            for (unsigned k = 0; k < 2; ++k) {
+                if (!nb.has(kAhead[k])) continue;
+                const int32_t v = nb.value(kAhead[k]);
+                for (size_t j = 0; j < c.size; ++j)
+                    if (c.value[j] == v) c.mask[j] |= 1u << (8 + k);
             }
-            if constexpr (kReach == Reach::Ahead) {
-                static constexpr Nb::Which kAhead[] = {Nb::PE, Nb::PS};
-                for (unsigned k = 0; k < 2; ++k) {
-                    if (!nb.has(kAhead[k])) continue;
-                    const int32_t v = nb.value(kAhead[k]);
-                    for (size_t j = 0; j < c.size; ++j)
-                        if (c.value[j] == v) c.mask[j] |= 1u << (8 + k);
-                }
-            }
-            value = code(c, entry);
-        });
+        }
+        value = code(c, entry, false);
+    };
+    if constexpr (kTiles) {
+        walkPlacedBricks<uint8_t, kReach, true>(
+            layout, places, entries, order,
+            [&](uint64_t entry, const TileNeighbours& tn) {
+                return code(candidatesOf(TileNeighbours::kCount, [&](unsigned k) { return tn.has[k]; }, [&](unsigned k) { return tn.value[k]; }), entry,
+                            true);
+            },
+            voxel);
+    } else {
+        walkPlacedBricks<uint8_t, kReach>(layout, places, entries, order, [&](uint64_t entry) { code(Candidates{}, entry, true); }, voxel);
+    }
 }
 
 // One direction of generation 2's coding: bit(model, b) codes b (the
@@ -124,10 +148,11 @@ struct LabelReader {
 // Codes label `v` (the writer's; the reader's is ignored) given its
 // candidates; returns the label coded.
 template <typename IO>
-int32_t codeShaped(IO& io, ShapeModels& m, const Candidates& c, int32_t v, int32_t minValue, int32_t maxValue, unsigned bits) {
+int32_t codeShaped(IO& io, ShapeModels& m, const Candidates& c, bool tile, int32_t v, int32_t minValue, int32_t maxValue, unsigned bits) {
     const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
     for (size_t i = 0; i < c.size; ++i)
-        if (io.bit(m.match[((i << kShapeBits) | c.mask[i]) * 3 + spread], unsigned(IO::kEncoding && c.value[i] == v))) {
+        if (io.bit(tile ? m.tileMatch[((i << 3) | c.mask[i]) * 3 + spread] : m.match[((i << kShapeBits) | c.mask[i]) * 3 + spread],
+                   unsigned(IO::kEncoding && c.value[i] == v))) {
             m.labels.remember(c.value[i]);
             return c.value[i];
         }
@@ -168,23 +193,25 @@ unsigned bitsFor(int32_t minValue, int32_t maxValue) {
 std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
                                         BrickOrder order, int32_t minValue, int32_t maxValue, int generation) {
     if (minValue > maxValue) throw Error("label coder: an empty range");
-    if (generation != 1 && generation != 2) throw Error("internal error: label model generation " + std::to_string(generation));
+    if (generation < 1 || generation > 3) throw Error("internal error: label model generation " + std::to_string(generation));
     std::vector<uint8_t> out;
     RangeEncoder rc(out);
     const unsigned bits = bitsFor(minValue, maxValue);
-    if (generation == 2) {
+    if (generation >= 2) {
         auto m = std::make_unique<ShapeModels>();
         LabelWriter io{rc};
-        walkLabels<Reach::Ahead>(layout, places, order, entries.size(), [&](const Candidates& c, uint64_t entry) {
+        const auto code = [&](const Candidates& c, uint64_t entry, bool tile) {
             const int32_t v = entries[entry];
             if (v < minValue || v > maxValue) throw Error("label coder: label " + std::to_string(v) + " lies outside its range");
-            return codeShaped(io, *m, c, v, minValue, maxValue, bits);
-        });
+            return codeShaped(io, *m, c, tile, v, minValue, maxValue, bits);
+        };
+        if (generation == 3) walkLabels<Reach::Ahead, true>(layout, places, order, entries.size(), code);
+        else walkLabels<Reach::Ahead, false>(layout, places, order, entries.size(), code);
         rc.finish();
         return out;
     }
     auto m = std::make_unique<LabelModels>();
-    walkLabels<Reach::Near>(layout, places, order, entries.size(), [&](const Candidates& c, uint64_t entry) {
+    walkLabels<Reach::Near, false>(layout, places, order, entries.size(), [&](const Candidates& c, uint64_t entry, bool) {
         const int32_t v = entries[entry];
         if (v < minValue || v > maxValue) throw Error("label coder: label " + std::to_string(v) + " lies outside its range");
         const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
@@ -214,19 +241,21 @@ std::vector<uint8_t> encodePlacedLabels(std::span<const int32_t> entries, std::s
 void decodePlacedLabels(std::span<const uint8_t> bytes, std::span<const uint64_t> layout, std::span<const BrickPlace> places, BrickOrder order,
                         int32_t minValue, int32_t maxValue, std::span<int32_t> out, const std::string& what, int generation) {
     if (minValue > maxValue) throw Error(what + ": an empty label range");
-    if (generation != 1 && generation != 2) throw Error(what + ": internal error: label model generation " + std::to_string(generation));
+    if (generation < 1 || generation > 3) throw Error(what + ": internal error: label model generation " + std::to_string(generation));
     RangeDecoder rc(bytes);
     const unsigned bits = bitsFor(minValue, maxValue);
     try {
-        if (generation == 2) {
+        if (generation >= 2) {
             auto m = std::make_unique<ShapeModels>();
             LabelReader io{rc};
-            walkLabels<Reach::Ahead>(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry) {
-                return out[entry] = codeShaped(io, *m, c, 0, minValue, maxValue, bits);
-            });
+            const auto code = [&](const Candidates& c, uint64_t entry, bool tile) {
+                return out[entry] = codeShaped(io, *m, c, tile, 0, minValue, maxValue, bits);
+            };
+            if (generation == 3) walkLabels<Reach::Ahead, true>(layout, places, order, out.size(), code);
+            else walkLabels<Reach::Ahead, false>(layout, places, order, out.size(), code);
         } else {
             auto m = std::make_unique<LabelModels>();
-            walkLabels<Reach::Near>(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry) {
+            walkLabels<Reach::Near, false>(layout, places, order, out.size(), [&](const Candidates& c, uint64_t entry, bool) {
                 const unsigned spread = std::min(c.distinct, 3u) - (c.distinct ? 1 : 0);
                 int32_t v = 0;
                 bool found = false;

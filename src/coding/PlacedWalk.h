@@ -12,7 +12,9 @@
 // NWWW, NEEE, NNN, Reach::Widest; or only PE and PS, Reach::Ahead) wherever they were
 // visited before in the same walk (in this brick or in any brick before it),
 // and its entry: the rank of its stored bit (dag_access.h dagStoredBit). A
-// tile (mask 0) is one entry without place.
+// tile (mask 0) is one entry; its place is its corner, with the log2 of its
+// size in `mirror` (a tile has no mirror), which only a walk with tile
+// neighbours reads (walkPlacedBricks' kTiles).
 #pragma once
 
 
@@ -135,9 +137,24 @@ inline std::vector<uint32_t> placedVisitOrder(std::span<const uint64_t> layout, 
     return visit;
 }
 
-// tile(entry); voxel(neighbours, entry, value&, rec&) sets the voxel's value
-// (read or decoded) and its record, visiting the instances in `order`;
-// `kReach` says which neighbours beyond the near eight it finds.
+// With kTiles (label generation 3), tiles are neighbours too: a tile up to
+// kNeighbourTileLog2 wide is visited first (spatial orders), given the
+// values of the tiles of its size W, N and P of it visited before it
+// (TileNeighbours), and returns its value; a voxel whose neighbour lies in
+// such a tile then sees the tile's value there (its record Rec{}), where
+// without kTiles it sees nothing. A larger tile (a .vdb's 128^3) is no
+// neighbour: it would stand for thousands of bricks.
+inline constexpr unsigned kNeighbourTileLog2 = 5;
+struct TileNeighbours {
+    enum Which { W, N, P, kCount };
+    std::array<bool, kCount> has{};
+    std::array<int32_t, kCount> value{};
+};
+
+// tile(entry) (kTiles: tile(entry, TileNeighbours) -> the tile's value);
+// voxel(neighbours, entry, value&, rec&) sets the voxel's value (read or
+// decoded) and its record, visiting the instances in `order`; `kReach`
+// says which neighbours beyond the near eight it finds.
 // Throws vdbdag::Error when the layout, its places and `entries` disagree.
 //
 // Memory: a brick's values and records are kept only while a brick visited
@@ -145,7 +162,7 @@ inline std::vector<uint32_t> placedVisitOrder(std::span<const uint64_t> layout, 
 // directions the walk looks back: counted before the walk, the count taken
 // down as each is visited); then its slot is reused. The walk reads the
 // same neighbours either way.
-template <typename Rec, Reach kReach = Reach::Near, typename Tile, typename Voxel>
+template <typename Rec, Reach kReach = Reach::Near, bool kTiles = false, typename Tile, typename Voxel>
 void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, Tile&& tile,
                       Voxel&& voxel) {
     if (places.size() != layout.size()) throw Error("the layout has " + std::to_string(layout.size()) + " bricks, their places " + std::to_string(places.size()));
@@ -164,6 +181,46 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
         if (!brickAt.emplace(BrickKey{place.x >> 2, place.y >> 2, place.z >> 2}, b).second) throw Error("two bricks at the same place");
         rank[b] = uint32_t(r);
     }
+    // kTiles: each brick cell of a neighbour tile, and that tile.
+    std::unordered_map<BrickKey, uint32_t, BrickKeyHash> tileAt;
+    std::vector<int32_t> tileValue;
+    std::vector<uint8_t> tileDone;
+    if constexpr (kTiles) {
+        if (order == BrickOrder::Attribute) throw Error("internal error: tile neighbours need a spatial order");
+        tileValue.assign(layout.size(), 0);
+        tileDone.assign(layout.size(), 0);
+        for (size_t b = 0; b < layout.size(); ++b) {
+            const BrickPlace& t = places[b];
+            if (layout[b] != 0 || t.mirror < 3 || t.mirror > kNeighbourTileLog2) continue;
+            const int32_t cells = int32_t(1) << (t.mirror - 2);
+            if ((t.x | t.y | t.z) & ((cells << 2) - 1)) throw Error("tile " + std::to_string(b) + " is not aligned to its size");
+            for (int32_t z = 0; z < cells; ++z)
+                for (int32_t y = 0; y < cells; ++y)
+                    for (int32_t x = 0; x < cells; ++x)
+                        if (!tileAt.emplace(BrickKey{(t.x >> 2) + x, (t.y >> 2) + y, (t.z >> 2) + z}, uint32_t(b)).second)
+                            throw Error("two tiles at the same place");
+        }
+    }
+    // A visited tile's value as a brick every voxel of which holds it, one
+    // per value (kTiles).
+    std::unordered_map<int32_t, PlacedBrick<Rec>> uniformBricks;
+    const auto tileBrick = [&](const BrickKey& key) -> const PlacedBrick<Rec>* {
+        if constexpr (kTiles) {
+            const auto it = tileAt.find(key);
+            if (it == tileAt.end() || !tileDone[it->second]) return nullptr;
+            const int32_t v = tileValue[it->second];
+            auto [u, fresh] = uniformBricks.try_emplace(v);
+            if (fresh) {
+                u->second.done = ~uint64_t(0);
+                std::fill(std::begin(u->second.value), std::end(u->second.value), v);
+                std::fill(std::begin(u->second.rec), std::end(u->second.rec), Rec{});
+            }
+            return &u->second;
+        } else {
+            (void)key;
+            return nullptr;
+        }
+    };
     // The bricks around that hold causal neighbours: dx in -1..1, dy in
     // -1..0 (-1..1 for Reach::Wide and Widest, whose PS lies a row ahead),
     // dz in -1..0; `lookBack[k]` is offset k, ((dx+1), (dy+1), (dz+1)).
@@ -198,7 +255,25 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
         const uint64_t mask = layout[b];
         const uint64_t e = first[b];  // the instance's first entry
         if (mask == 0) {
-            tile(e);
+            if constexpr (kTiles) {
+                const BrickPlace& t = places[b];
+                TileNeighbours tn;
+                if (tileAt.count(BrickKey{t.x >> 2, t.y >> 2, t.z >> 2})) {  // a neighbour tile itself
+                    const int32_t size = int32_t(1) << t.mirror;
+                    const BrickKey keys[TileNeighbours::kCount] = {
+                        {(t.x - size) >> 2, t.y >> 2, t.z >> 2}, {t.x >> 2, (t.y - size) >> 2, t.z >> 2}, {t.x >> 2, t.y >> 2, (t.z - size) >> 2}};
+                    for (int k = 0; k < TileNeighbours::kCount; ++k) {
+                        const auto it = tileAt.find(keys[k]);
+                        if (it == tileAt.end() || !tileDone[it->second] || places[it->second].mirror != t.mirror) continue;
+                        tn.has[size_t(k)] = true;
+                        tn.value[size_t(k)] = tileValue[it->second];
+                    }
+                }
+                tileValue[b] = tile(e, tn);
+                tileDone[b] = 1;
+            } else {
+                tile(e);
+            }
             ++total;
             continue;
         }
@@ -214,7 +289,9 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
         for (size_t k = 0; k < lookBack.size(); ++k) {
             const auto& d = lookBack[k];
             beside[k] = brickBeside(b, d);
-            around[d[0] + 1][d[1] + 1][d[2] + 1] = beside[k] == kNone ? nullptr : kept[beside[k]];  // null: not visited yet
+            around[d[0] + 1][d[1] + 1][d[2] + 1] =
+                beside[k] != kNone ? kept[beside[k]]  // null: not visited yet
+                                   : tileBrick(BrickKey{(place.x >> 2) + d[0], (place.y >> 2) + d[1], (place.z >> 2) + d[2]});
         }
         around[1][1][1] = &self;
         const uint64_t spatial = dag::reflectBrick(mask, place.mirror);

@@ -40,7 +40,7 @@ std::vector<coding::BrickPlace> attributePlaces(const CompactDag& dag, uint32_t 
     places.reserve(size_t(emitted));
     visitInAttributeOrder(
         dag, [&](const BrickInstance& b) { places.push_back({int32_t(b.x), int32_t(b.y), int32_t(b.z), b.mirror}); },
-        [&](int64_t, int64_t, int64_t, unsigned, uint64_t) { places.push_back({}); });
+        [&](int64_t x, int64_t y, int64_t z, unsigned log2Size, uint64_t) { places.push_back(coding::tilePlace(x, y, z, log2Size)); });
     return places;
 }
 

@@ -110,7 +110,7 @@ void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInsta
     if (shifted.solid) {
         input.solid(shifted.x, shifted.y, shifted.z, shifted.firstEntry, attributes);
         if (layout) layout->push_back(0);
-        if (places) places->push_back({});
+        if (places) places->push_back(coding::tilePlace(shifted.x, shifted.y, shifted.z, shifted.log2Size));
         return;
     }
     encoding::visitSubtreeInAttributeOrder(
@@ -120,10 +120,10 @@ void gatherSubtree(const encoding::CompactDag& dag, const encoding::SubtreeInsta
             if (layout) layout->push_back(b.storedMask);
             if (places) places->push_back({int32_t(b.x), int32_t(b.y), int32_t(b.z), b.mirror});
         },
-        [&](int64_t x, int64_t y, int64_t z, unsigned, uint64_t entry) {
+        [&](int64_t x, int64_t y, int64_t z, unsigned log2Size, uint64_t entry) {
             input.solid(x, y, z, entry, attributes);
             if (layout) layout->push_back(0);
-            if (places) places->push_back({});
+            if (places) places->push_back(coding::tilePlace(x, y, z, log2Size));
         });
 }
 

@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
     scene.grids.push_back(pipeline::encodeGrid(rescaled));
     // Labels: full bricks of a 16x16x8 box in three regions split by planes,
     // most entries repeating the one before: a PredictedWindows section whose
-    // window is coded as labels (coding 17, coding/LabelCoder.h).
+    // window is coded as labels (coding 18, coding/LabelCoder.h).
     scene.grids.push_back(pipeline::encodeGrid(vdbdag::testing::labelBox("labels", 4, 4, 2, [](int x, int y, int z) {
         return int32_t(x + y < 12 ? 17 : x - z > 6 ? 4000 : -250);
     })));

@@ -13,22 +13,38 @@ namespace vdbdag::testing {
 
 // A label volume: a box of bricksX x bricksY x bricksZ full 4^3 int32
 // bricks from the origin, each voxel holding label(x, y, z) (values in
-// brick order, each brick's voxels in bit order x + 4y + 16z).
+// brick order, each brick's voxels in bit order x + 4y + 16z). With
+// `tiles`, each aligned 8^3 block inside the box whose 512 labels are one
+// is a tile instead of its 8 bricks (as a scan's import makes it).
 template <typename Label>
-GridRecord labelBox(const std::string& name, int bricksX, int bricksY, int bricksZ, Label&& label) {
+GridRecord labelBox(const std::string& name, int bricksX, int bricksY, int bricksZ, Label&& label, bool tiles = false) {
     GridRecord labels;
     labels.name = name;
     labels.valueType = ValueType::Int32;
     labels.background = {0, 0, 0, 0};
+    const auto put = [](std::vector<uint8_t>& to, int32_t v) {
+        const auto* p = reinterpret_cast<const uint8_t*>(&v);
+        to.insert(to.end(), p, p + 4);
+    };
+    const auto solid = [&](int x0, int y0, int z0) {
+        if (!tiles || x0 % 8 || y0 % 8 || z0 % 8 || x0 + 8 > 4 * bricksX || y0 + 8 > 4 * bricksY || z0 + 8 > 4 * bricksZ) return false;
+        for (int k = 0; k < 512; ++k)
+            if (label(x0 + (k & 7), y0 + ((k >> 3) & 7), z0 + (k >> 6)) != label(x0, y0, z0)) return false;
+        return true;
+    };
     for (int bz = 0; bz < bricksZ; ++bz)
         for (int by = 0; by < bricksY; ++by)
             for (int bx = 0; bx < bricksX; ++bx) {
-                labels.topology.bricks.push_back({4 * bx, 4 * by, 4 * bz, ~uint64_t(0)});
-                for (int k = 0; k < 64; ++k) {
-                    const int32_t v = label(4 * bx + (k & 3), 4 * by + ((k >> 2) & 3), 4 * bz + (k >> 4));
-                    const auto* p = reinterpret_cast<const uint8_t*>(&v);
-                    labels.values.bricks.insert(labels.values.bricks.end(), p, p + 4);
+                const int x = 4 * bx, y = 4 * by, z = 4 * bz;
+                if (solid(x & ~7, y & ~7, z & ~7)) {
+                    if (x % 8 == 0 && y % 8 == 0 && z % 8 == 0) {
+                        labels.topology.tiles.push_back({x, y, z, 3});
+                        put(labels.values.tiles, label(x, y, z));
+                    }
+                    continue;
                 }
+                labels.topology.bricks.push_back({x, y, z, ~uint64_t(0)});
+                for (int k = 0; k < 64; ++k) put(labels.values.bricks, label(x + (k & 3), y + ((k >> 2) & 3), z + (k >> 4)));
             }
     return labels;
 }

@@ -4,7 +4,8 @@
 // from `rng` (0 without mirrors); `value(X, Y, Z)` gives the sample at a
 // spatial voxel, stored at the voxel's stored bit (dag_access.h
 // dagStoredBit), so a coder must undo the mirror to see the field. Every
-// brick m with m % tileEvery == tileAt is a tile holding `tileValue`.
+// brick m with m % tileEvery == tileAt is a tile holding `tileValue` (4^3
+// wide, which no DAG stores: no neighbour to label model generation 3).
 #pragma once
 #include <bit>
 #include <cstdint>
@@ -31,7 +32,7 @@ PlacedChannel placedBox(std::mt19937& rng, bool mirrors, Value&& value, uint32_t
         const uint32_t mirror = mirrors ? rng() % 8 : 0;
         const bool tile = tileEvery && m % tileEvery == tileAt;
         c.layout.push_back(tile ? 0 : ~uint64_t(0));
-        c.places.push_back({4 * bx, 4 * by, 4 * bz, mirror});
+        c.places.push_back(tile ? tilePlace(4 * bx, 4 * by, 4 * bz, 2) : BrickPlace{4 * bx, 4 * by, 4 * bz, mirror});
         if (tile) {
             c.entries.push_back(tileValue);
             continue;

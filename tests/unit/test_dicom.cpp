@@ -134,13 +134,23 @@ void expectTransform(const GridRecord& g, const nlohmann::json& m) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(g.indexToWorld[size_t(12 + c)], m["origin"][c].get<double>(), 1e-6);
 }
 
-// Calls fn(x, y, z, valueIndex) for every active voxel of a dense import.
-template <typename F>
+// Calls fn(x, y, z, value) for every active voxel of a dense import (T its value type).
+template <typename T, typename F>
 void forEachVoxel(const GridRecord& g, F fn) {
+    // Each voxel of a brick, then of a tile (a scan's solid 8^3 blocks), with its value.
+    const T* values = reinterpret_cast<const T*>(g.values.bricks.data());
     uint64_t index = 0;
     for (const auto& b : g.topology.bricks)
         for (int bit = 0; bit < 64; ++bit)
-            if (b.mask >> bit & 1) fn(int64_t(b.x + (bit & 3)), int64_t(b.y + ((bit >> 2) & 3)), int64_t(b.z + (bit >> 4)), index++);
+            if (b.mask >> bit & 1) fn(int64_t(b.x + (bit & 3)), int64_t(b.y + ((bit >> 2) & 3)), int64_t(b.z + (bit >> 4)), values[index++]);
+    const T* tileValues = reinterpret_cast<const T*>(g.values.tiles.data());
+    for (size_t t = 0; t < g.topology.tiles.size(); ++t) {
+        const auto& tile = g.topology.tiles[t];
+        const int64_t n = int64_t(1) << tile.log2Size;
+        for (int64_t z = 0; z < n; ++z)
+            for (int64_t y = 0; y < n; ++y)
+                for (int64_t x = 0; x < n; ++x) fn(tile.x + x, tile.y + y, tile.z + z, tileValues[t]);
+    }
 }
 
 bool oneLine(const std::string& s) { return !s.empty() && s.find('\n') == std::string::npos; }
@@ -260,14 +270,13 @@ TEST(DicomSeries, MissingSlicesAreEmptySlotsAtTheRegularStep) {
         const GridRecord& g = imported.volume.grids.front();
         ASSERT_EQ(g.valueType, ValueType::Int32);
         const auto* stored = reinterpret_cast<const uint16_t*>(ref.raw.data());
-        const auto* values = reinterpret_cast<const int32_t*>(g.values.bricks.data());
         std::vector<int64_t> sliceOfSlot(size_t(v.dims[2]), -1);
         for (size_t i = 0; i < slotOf.size(); ++i) sliceOfSlot[size_t(slotOf[i])] = int64_t(i);
         uint64_t count = 0, wrong = 0;
-        forEachVoxel(g, [&](int64_t x, int64_t y, int64_t z, uint64_t i) {
+        forEachVoxel<int32_t>(g, [&](int64_t x, int64_t y, int64_t z, int32_t value) {
             const int64_t slice = sliceOfSlot[size_t(z)];
             if (slice < 0) { ++wrong; return; }  // a voxel in the missing slot
-            if (values[i] != int32_t(stored[(slice * v.dims[1] + y) * v.dims[0] + x])) ++wrong;
+            if (value != int32_t(stored[(slice * v.dims[1] + y) * v.dims[0] + x])) ++wrong;
             ++count;
         });
         EXPECT_EQ(wrong, 0u);
@@ -293,11 +302,10 @@ TEST(DicomSeries, SingleSliceSeriesMatchPydicom) {
         expectTransform(g, ref.meta);
         ASSERT_EQ(g.valueType, ValueType::Float);
         const auto* stored = reinterpret_cast<const uint16_t*>(ref.raw.data());
-        const auto* values = reinterpret_cast<const float*>(g.values.bricks.data());
         uint64_t count = 0;
-        forEachVoxel(g, [&](int64_t x, int64_t y, int64_t z, uint64_t i) {
+        forEachVoxel<float>(g, [&](int64_t x, int64_t y, int64_t z, float value) {
             const double expect = double(stored[(z * v.dims[1] + y) * v.dims[0] + x]) * ref.meta["slope"].get<double>() + ref.meta["intercept"].get<double>();
-            if (values[i] != float(expect) && count < 5) ADD_FAILURE() << "voxel " << x << "," << y << "," << z << ": " << values[i] << " vs " << expect;
+            if (value != float(expect) && count < 5) ADD_FAILURE() << "voxel " << x << "," << y << "," << z << ": " << value << " vs " << expect;
             ++count;
         });
         EXPECT_EQ(count, v.sampleCount());
@@ -364,12 +372,11 @@ TEST(DicomSeries, PetConvertsWithItsRescale) {
     expectTransform(g, ref.meta);
     ASSERT_EQ(g.valueType, ValueType::Float);
     const auto* stored = reinterpret_cast<const int16_t*>(ref.raw.data());
-    const auto* values = reinterpret_cast<const float*>(g.values.bricks.data());
     const double slope = ref.meta["slope"], intercept = ref.meta["intercept"];
     uint64_t count = 0, wrong = 0, nonzero = 0;
-    forEachVoxel(g, [&](int64_t x, int64_t y, int64_t z, uint64_t i) {
+    forEachVoxel<float>(g, [&](int64_t x, int64_t y, int64_t z, float value) {
         const int16_t s = stored[(z * 128 + y) * 128 + x];
-        if (values[i] != float(double(s) * slope + intercept)) ++wrong;
+        if (value != float(double(s) * slope + intercept)) ++wrong;
         if (s != 0) ++nonzero;
         ++count;
     });

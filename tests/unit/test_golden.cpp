@@ -91,9 +91,13 @@ TEST(Golden, ScanSourcedFileDecodesToTheSameSamples) {
     // crop in coding 13 (model generation 3, as written on 2026-12-06);
     // scan_coding15, in coding 15 (model generation 4, written since);
     // labels_coding17, a 32x32x16 Voronoi atlas of 24 labels in coding 17
-    // (label model generation 2, written since 2026-12-06).
+    // (label model generation 2, written on 2026-12-06); labels_coding18, one
+    // of 5 labels whose 5 uniform 8^3 blocks are tiles, in coding 18 (label
+    // model generation 3, tiles as neighbours) with its attribute offsets at
+    // rest (FORMAT.md 6.2), both written since 2026-12-06.
     for (const auto& [name, raw, bytes] : {std::tuple{"labels", "labels_24x20x10_int16le.raw", 24u * 20 * 10 * 2},
                                            {"labels_coding17", "labels_voronoi_32x32x16_uint8.raw", 32u * 32 * 16},
+                                           {"labels_coding18", "labels_tiled_32x32x16_uint8.raw", 32u * 32 * 16},
                                            {"scan_coding10", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2},
                                            {"scan_coding13", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2},
                                            {"scan_coding15", "headsq_crop_24x24x16_int16le.raw", 24u * 24 * 16 * 2}}) {
@@ -113,4 +117,8 @@ TEST(Golden, ScanSourcedFileDecodesToTheSameSamples) {
     EXPECT_NE(info15.out.find("windows: 1 banded context-coded"), std::string::npos) << info15.out;
     const CommandResult info17 = runCli("info " + (kGolden / "labels_coding17.ssvdag").string());
     EXPECT_NE(info17.out.find("windows: 1 shaped labels"), std::string::npos) << info17.out;
+    const CommandResult info18 = runCli("info " + (kGolden / "labels_coding18.ssvdag").string() + " --json");
+    ASSERT_EQ(info18.exitCode, 0) << info18.err;
+    EXPECT_NE(info18.out.find("\"solid_nodes\": 5"), std::string::npos) << info18.out;
+    EXPECT_NE(runCli("info " + (kGolden / "labels_coding18.ssvdag").string()).out.find("windows: 1 tiled labels"), std::string::npos);
 }

@@ -4,9 +4,10 @@
 // of what the numeric coder of the same entries costs (labels have no
 // magnitude to predict); a label outside the range is refused; corrupt
 // streams are refused or give labels inside the range, never more; each
-// for label model generations 1 and 2. Through encodePredictedWindows with
-// places, a label window is stored as coding 17 and decodes exactly; ones
-// of codings 7 and 4 (older writers') still do.
+// for label model generations 1, 2 and 3 (3: tiles as neighbours, on a box
+// whose uniform 8^3 blocks are tiles). Through encodePredictedWindows with
+// places, a label window is stored as coding 18 and decodes exactly; ones
+// of codings 17, 7 and 4 (older writers') still do.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -53,14 +54,66 @@ Labels voronoi(uint32_t seed, int regions) {
         97, 5, ids[0]);
 }
 
+// A 32^3 box of Voronoi regions as a scan's import lays it out: each 8^3
+// block whose samples are all one label a tile (tilePlace, 8 wide), the
+// others 8 full bricks with random mirrors; blocks and bricks in Morton
+// order, as a DAG's attribute order visits them.
+Labels tiledVoronoi(uint32_t seed, int regions) {
+    std::mt19937 rng(seed);
+    std::vector<std::array<int, 3>> centres(static_cast<size_t>(regions));
+    std::vector<int32_t> ids(static_cast<size_t>(regions));
+    for (int r = 0; r < regions; ++r) {
+        centres[size_t(r)] = {int(rng() % 32), int(rng() % 32), int(rng() % 32)};
+        ids[size_t(r)] = int32_t(rng() % 200000) - 100000;
+    }
+    const auto label = [&](int X, int Y, int Z) {
+        int best = 0, bestD = 1 << 30;
+        for (int r = 0; r < regions; ++r) {
+            const auto& c = centres[size_t(r)];
+            const int d = (X - c[0]) * (X - c[0]) + (Y - c[1]) * (Y - c[1]) + (Z - c[2]) * (Z - c[2]);
+            if (d < bestD) bestD = d, best = r;
+        }
+        return ids[size_t(best)];
+    };
+    const auto morton = [](uint32_t m, int& x, int& y, int& z) {
+        x = y = z = 0;
+        for (int k = 0; k < 3; ++k) x |= int(m >> (3 * k) & 1) << k, y |= int(m >> (3 * k + 1) & 1) << k, z |= int(m >> (3 * k + 2) & 1) << k;
+    };
+    Labels c;
+    for (uint32_t b = 0; b < 64; ++b) {  // 4^3 blocks of 8^3
+        int bx, by, bz;
+        morton(b, bx, by, bz);
+        bool uniform = true;
+        for (int k = 0; k < 512 && uniform; ++k) uniform = label(8 * bx + (k & 7), 8 * by + (k >> 3 & 7), 8 * bz + (k >> 6)) == label(8 * bx, 8 * by, 8 * bz);
+        if (uniform) {
+            c.layout.push_back(0);
+            c.places.push_back(tilePlace(8 * bx, 8 * by, 8 * bz, 3));
+            c.entries.push_back(label(8 * bx, 8 * by, 8 * bz));
+            continue;
+        }
+        for (uint32_t m = 0; m < 8; ++m) {
+            int x, y, z;
+            morton(m, x, y, z);
+            const int X0 = 8 * bx + 4 * x, Y0 = 8 * by + 4 * y, Z0 = 8 * bz + 4 * z;
+            const uint32_t mirror = rng() % 8;
+            c.layout.push_back(~uint64_t(0));
+            c.places.push_back({X0, Y0, Z0, mirror});
+            std::vector<int32_t> brick(64);
+            for (int k = 0; k < 64; ++k) brick[access::dagStoredBit(unsigned(k & 3), unsigned(k >> 2 & 3), unsigned(k >> 4), mirror)] = label(X0 + (k & 3), Y0 + (k >> 2 & 3), Z0 + (k >> 4));
+            c.entries.insert(c.entries.end(), brick.begin(), brick.end());
+        }
+    }
+    return c;
+}
+
 // Each generation in the brick order its window coding walks (7: spatial,
-// 17: raster blocks).
+// 17 and 18: raster blocks).
 BrickOrder orderOf(int generation) { return generation == 1 ? BrickOrder::Spatial : BrickOrder::Raster; }
 
 TEST(LabelCoder, LabelVolumesComeBackExactlyForAFractionOfTheNumericCost) {
     // 1,500 regions of about 22 voxels: more labels than generation 2's
     // list of 1,024 holds, so labels leave it and come back as new ones.
-    for (const int generation : {1, 2}) {
+    for (const int generation : {1, 2, 3}) {
         for (int regions : {1, 12, 60, 1500}) {
             const Labels l = voronoi(uint32_t(regions), regions);
             const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
@@ -97,10 +150,34 @@ TEST(LabelCoder, Generation2RanksEveryLabelItHasMet) {
     EXPECT_EQ(back, l.entries);
 }
 
+// Generation 3 on atlases whose uniform 8^3 blocks are tiles: every label
+// comes back, from one region (all tiles) to 400 (few); generation 2 reads
+// the same layout with its tiles as no neighbours.
+TEST(LabelCoder, Generation3SeesTilesAsNeighbours) {
+    for (int regions : {1, 5, 40, 400}) {
+        const Labels l = tiledVoronoi(uint32_t(regions) + 100, regions);
+        const size_t tiles = size_t(std::count(l.layout.begin(), l.layout.end(), uint64_t(0)));
+        if (regions <= 5) {
+            EXPECT_GT(tiles, 0u) << regions;
+        }
+        const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
+        for (const int generation : {2, 3}) {
+            const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, BrickOrder::Raster, *lo, *hi, generation);
+            std::vector<int32_t> back(l.entries.size());
+            decodePlacedLabels(bytes, l.layout, l.places, BrickOrder::Raster, *lo, *hi, back, "labels", generation);
+            EXPECT_EQ(back, l.entries) << regions << " regions, " << tiles << " tiles, generation " << generation;
+        }
+    }
+    // A tile not aligned to its size is refused, not walked.
+    Labels bad = tiledVoronoi(1, 1);
+    bad.places[0].x += 4;
+    EXPECT_THROW(encodePlacedLabels(bad.entries, bad.layout, bad.places, BrickOrder::Raster, bad.entries[0], bad.entries[0], 3), Error);
+}
+
 TEST(LabelCoder, OutOfRangeLabelsAndCorruptStreamsAreRefused) {
-    const Labels l = voronoi(3, 20);
-    const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
-    for (const int generation : {1, 2}) {
+    for (const int generation : {1, 2, 3}) {
+        const Labels l = generation == 3 ? tiledVoronoi(3, 20) : voronoi(3, 20);
+        const auto [lo, hi] = std::minmax_element(l.entries.begin(), l.entries.end());
         const BrickOrder order = orderOf(generation);
         EXPECT_THROW(encodePlacedLabels(l.entries, l.layout, l.places, order, *lo + 1, *hi, generation), Error);
         const std::vector<uint8_t> bytes = encodePlacedLabels(l.entries, l.layout, l.places, order, *lo, *hi, generation);
@@ -121,14 +198,14 @@ TEST(LabelCoder, OutOfRangeLabelsAndCorruptStreamsAreRefused) {
     }
 }
 
-TEST(LabelCoder, PredictedWindowsStoreLabelsAsCoding17) {
+TEST(LabelCoder, PredictedWindowsStoreLabelsAsCoding18) {
     const Labels l = voronoi(5, 30);
     std::vector<uint8_t> bytes(l.entries.size() * 4);
     std::memcpy(bytes.data(), l.entries.data(), bytes.size());
     const std::vector<uint8_t> windows = attributes::encodePredictedWindows(bytes, 4, l.layout, l.places);
     const attributes::WindowDirectory dir = attributes::readPredictedWindowDirectory(windows, 4, l.layout, "test");
     ASSERT_EQ(dir.windows.size(), 1u);
-    EXPECT_EQ(windows[size_t(dir.windows[0].offset)], attributes::detail::kShapedLabelCoding);
+    EXPECT_EQ(windows[size_t(dir.windows[0].offset)], attributes::detail::kTiledLabelCoding);
     EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, l.layout, "test", l.places), bytes);
     EXPECT_THROW(attributes::decodePredictedWindows(windows, 4, l.layout, "test", {}), Error);  // a label window needs its places
 }
@@ -165,6 +242,19 @@ TEST(LabelCoder, WindowsOfLabelGeneration1StillRead) {
         EXPECT_NE(attributes::decodePredictedWindows(oneWindowByHand(raw, l.entries.size()), 4, l.layout, "misread", l.places), bytes);
     } catch (const Error&) {
     }
+}
+
+// A window of coding 17 (label model generation 2, what files of
+// 2026-12-06 before coding 18 hold) still reads, tiles and all: written by
+// hand, as that writer wrote it.
+TEST(LabelCoder, WindowsOfLabelGeneration2StillRead) {
+    const Labels l = tiledVoronoi(9, 30);
+    std::vector<uint8_t> bytes(l.entries.size() * 4);
+    std::memcpy(bytes.data(), l.entries.data(), bytes.size());
+    std::vector<uint8_t> raw{attributes::detail::kShapedLabelCoding};
+    const std::vector<uint8_t> payload = attributes::encodeContextChannel(bytes, l.layout, l.places, true, BrickOrder::Raster, kLatestIntModel, 2);
+    raw.insert(raw.end(), payload.begin(), payload.end());
+    EXPECT_EQ(attributes::decodePredictedWindows(oneWindowByHand(raw, l.entries.size()), 4, l.layout, "coding 17", l.places), bytes);
 }
 
 // Windows of codings 3 and 4 (bricks in the layout's order, what files

@@ -238,13 +238,14 @@ TEST(CpuTracer, SegmentWalkVisitsEveryOccupiedBoxInOrderAndPointQueriesAgree) {
 }
 
 // An atlas through the whole path a tracer reads labels by: a dense box of
-// Voronoi labels encoded by the pipeline (its window coded as labels,
-// coding 17), the traceable palettes rebuilt from that window (the
+// Voronoi labels encoded by the pipeline, its uniform 8^3 blocks tiles (its
+// window coded as labels, coding 18: tiles as neighbours), the traceable
+// palettes rebuilt from that window (the
 // attributes the encoder kept dropped first), and the tracer's point lookup:
 // every voxel's entry holds the label the generating function gives.
 TEST(DagTracer, FindsEveryVoxelOfAnAtlasWithItsLabel) {
     const auto label = [](int x, int y, int z) {
-        static constexpr int kSeeds[6][3] = {{2, 3, 1}, {20, 4, 12}, {9, 17, 6}, {22, 18, 2}, {5, 10, 14}, {14, 1, 9}};
+        static constexpr int kSeeds[6][3] = {{4, 6, 2}, {40, 8, 24}, {18, 34, 12}, {44, 36, 4}, {10, 20, 28}, {28, 2, 18}};
         int best = 0, bestD = 1 << 30;
         for (int s = 0; s < 6; ++s) {
             const int d = (x - kSeeds[s][0]) * (x - kSeeds[s][0]) + (y - kSeeds[s][1]) * (y - kSeeds[s][1]) + (z - kSeeds[s][2]) * (z - kSeeds[s][2]);
@@ -252,20 +253,22 @@ TEST(DagTracer, FindsEveryVoxelOfAnAtlasWithItsLabel) {
         }
         return int32_t(1000 * best - 2500);
     };
-    const GridRecord atlas = vdbdag::testing::labelBox("atlas", 6, 5, 4, label);
+    const GridRecord atlas = vdbdag::testing::labelBox("atlas", 12, 10, 8, label, true);
+    ASSERT_FALSE(atlas.topology.tiles.empty());
     format::EncodedGrid encoded = pipeline::encodeGrid(atlas);
+    EXPECT_EQ(encoding::decodedSize(encoded.active.dag).emittedTiles, atlas.topology.tiles.size());
     const attributes::ValueWindowsPayload& windows = encoded.active.valueWindows;
     ASSERT_TRUE(windows.predicted);
     const attributes::WindowDirectory dir =
         attributes::readPredictedWindowDirectory(windows.bytes, 4, encoding::attributeLayout(encoded.active.dag), "atlas");
     ASSERT_EQ(dir.windows.size(), 1u);
-    ASSERT_EQ(windows.bytes[size_t(dir.windows[0].offset)], attributes::detail::kShapedLabelCoding);
+    ASSERT_EQ(windows.bytes[size_t(dir.windows[0].offset)], attributes::detail::kTiledLabelCoding);
     encoded.active.attributes.clear();  // the palettes from the window itself
     const std::vector<uint8_t> values = format::traceableValues(encoded).decodeAll();
     const trace::DagTracer tracer(encoded.active.dag);
-    for (int z = 0; z < 16; ++z)
-        for (int y = 0; y < 20; ++y)
-            for (int x = 0; x < 24; ++x) {
+    for (int z = 0; z < 32; ++z)
+        for (int y = 0; y < 40; ++y)
+            for (int x = 0; x < 48; ++x) {
                 const std::optional<uint64_t> entry = tracer.find({x, y, z});
                 ASSERT_TRUE(entry.has_value()) << x << " " << y << " " << z;
                 ASSERT_LT(*entry * 4 + 4, values.size() + 1);
@@ -273,5 +276,5 @@ TEST(DagTracer, FindsEveryVoxelOfAnAtlasWithItsLabel) {
                 std::memcpy(&got, values.data() + *entry * 4, 4);
                 ASSERT_EQ(got, label(x, y, z)) << x << " " << y << " " << z;
             }
-    EXPECT_FALSE(tracer.find({24, 0, 0}).has_value());
+    EXPECT_FALSE(tracer.find({48, 0, 0}).has_value());
 }

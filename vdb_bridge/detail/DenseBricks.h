@@ -16,6 +16,7 @@
 #include "src/util/ScratchFile.h"
 #include "src/volume/CubeSource.h"
 #include "vdb_bridge/DenseVolume.h"
+#include "vdb_bridge/detail/SolidBlocks.h"
 
 namespace vdbdag::bridge::detail {
 
@@ -23,6 +24,10 @@ struct Thresholds {
     bool below = false, above = false;
     double belowValue = 0, aboveValue = 0;
     std::optional<double> background;  // --background-value; else the removed samples' mean
+    // Solid 8^3 blocks become tiles (SolidBlocks.h; `--no-tiles` keeps
+    // every voxel in its brick). Not a threshold, but part of the same rule
+    // from samples to the grid.
+    bool solidBlocks = true;
     bool any() const { return below || above; }
     bool removes(double x) const { return (below && x < belowValue) || (above && x > aboveValue); }
 };
@@ -103,6 +108,7 @@ struct DenseCubeScratch {
     int64_t cols = 0, rows = 0, slabs = 0;  // bricks along x, y, z
     std::vector<uint64_t> nonEmpty;         // bit (slab * rows + row) * cols + col
     LayerSummary summary;
+    SolidBlocks blocks;  // read back as tiles (none: every brick is read)
     void add(const Brick& b) {
         const uint64_t i = (uint64_t(b.z / 4) * uint64_t(rows) + uint64_t(b.y / 4)) * uint64_t(cols) + uint64_t(b.x / 4);
         nonEmpty[i / 64] |= uint64_t(1) << (i % 64);
