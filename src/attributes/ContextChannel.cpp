@@ -23,7 +23,7 @@ int modelOf(std::span<const coding::BrickPlace> places, coding::BrickOrder order
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                          bool labels, coding::BrickOrder order, int model, int labelModel) {
+                                          bool labels, coding::BrickOrder order, int model, int labelModel, bool tileNeighbours) {
     if (labels && places.empty()) throw Error("internal error: labels are coded with their bricks' places");
     if (values.size() % 4) throw Error("internal error: a context-coded channel holds int32 entries");
     std::vector<int32_t> entries(values.size() / 4);
@@ -44,6 +44,7 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
     options.minValue = step > 1 ? 0 : lo;
     options.maxValue = step > 1 ? (int64_t(hi) - lo) / int64_t(step) : hi;
     options.model = modelOf(places, order, model);
+    options.tileNeighbours = tileNeighbours;
     const std::vector<uint8_t> stream =
         labels           ? coding::encodePlacedLabels(entries, layout, places, order, int32_t(options.minValue), int32_t(options.maxValue), labelModel)
         : places.empty() ? coding::encodeBrickValues(entries, layout, options)
@@ -62,12 +63,14 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
 
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
                                           std::span<const coding::BrickPlace> places, bool labels, coding::BrickOrder order, int model,
-                                          int labelModel) {
+                                          int labelModel, bool tileNeighbours) {
     format::ByteReader r(payload, what);
     const uint8_t valueSize = r.get<uint8_t>();
     if (valueSize != 4) r.fail("a context-coded channel of " + std::to_string(valueSize) + "-byte values (4 expected)");
     coding::IntCoderOptions options;
     options.model = modelOf(places, order, model);
+    options.tileNeighbours = tileNeighbours;
+    if (tileNeighbours && (labels || places.empty() || options.model != 4)) r.fail("internal error: tiles as neighbours need a placed walk of generation 4");
     const uint32_t near = r.get<uint32_t>();
     if (near > (1u << 20)) r.fail("a near-lossless bound of " + std::to_string(near) + " (at most 2^20)");
     options.near = int32_t(near);

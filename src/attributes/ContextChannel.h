@@ -32,12 +32,13 @@ namespace vdbdag::attributes {
 // in `order`); without, from each brick alone (coding 2).
 // With `labels` (and places), the entries are coded as categories by
 // coding/LabelCoder.h, its model generation `labelModel` (1: codings 7 and
-// 4; 2: coding 17; 3: coding 18).
+// 4; 2: coding 17; 3: coding 18). `tileNeighbours` (coding 19): the
+// integers' placed walk of generation 4 with tiles as neighbours.
 // `model`: the generation in spatial order (ignored otherwise).
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
                                           coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel,
-                                          int labelModel = 1);
+                                          int labelModel = 1, bool tileNeighbours = false);
 
 // Inverse (`places` given exactly when the payload was coded with them);
 // validates the payload against `layout` and `entries` (throws
@@ -45,6 +46,6 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
                                           coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel,
-                                          int labelModel = 1);
+                                          int labelModel = 1, bool tileNeighbours = false);
 
 } // namespace vdbdag::attributes

@@ -125,7 +125,10 @@ bool modelMayBeatLabels(std::span<const uint8_t> values, std::span<const uint64_
         }
         next = b;
     }
-    return encodeContextChannel(sample, sampleLayout, samplePlaces, false, coding::spatialOrderOf(coding::kLatestIntModel)).size() <
+    const bool tiles = std::find(sampleLayout.begin(), sampleLayout.end(), uint64_t(0)) != sampleLayout.end();
+    return encodeContextChannel(sample, sampleLayout, samplePlaces, false, coding::spatialOrderOf(coding::kLatestIntModel), coding::kLatestIntModel, 1,
+                                tiles)
+               .size() <
            encodeLabels(sample, sampleLayout, samplePlaces).size();
 }
 
@@ -178,9 +181,14 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
             consider(std::move(labels), labelSize, detail::kTiledLabelCoding);
         }
         if (!labelsLike || modelMayBeatLabels(values, layout, places)) {
-            std::vector<uint8_t> numeric = encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel));
+            // A window with tiles walks them as neighbours (coding 19); one
+            // without is coding 15, the same stream.
+            static_assert(coding::kLatestIntModel == 4, "coding 19 is generation 4's walk with tiles");
+            const bool tiles = placed && std::find(layout.begin(), layout.end(), uint64_t(0)) != layout.end();
+            std::vector<uint8_t> numeric =
+                encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel), coding::kLatestIntModel, 1, tiles);
             const uint64_t size = numeric.size();
-            consider(std::move(numeric), size, placed ? detail::kBandedContextCoding : detail::kContextCoding);
+            consider(std::move(numeric), size, tiles ? detail::kTiledContextCoding : placed ? detail::kBandedContextCoding : detail::kContextCoding);
         }
     } else {
         std::vector<uint8_t> predicted = encodePredicted(values, vs, layout);

@@ -66,7 +66,8 @@ const char* predictedCodingName(uint8_t coding) {
     static const char* const names[] = {"palettes", "brick residuals", "context-coded", "placed context-coded", "placed labels",
                                         "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors",
                                         "fitted context-coded", "fitted rescaled floats", "float integers", "wide fitted context-coded",
-                                        "wide fitted rescaled floats", "banded context-coded", "banded rescaled floats", "shaped labels", "tiled labels"};
+                                        "wide fitted rescaled floats", "banded context-coded", "banded rescaled floats", "shaped labels", "tiled labels",
+                                        "tiled banded context-coded"};
     static_assert(std::size(names) == detail::kCodingCount);
     return coding < std::size(names) ? names[coding] : "unknown";
 }
@@ -153,13 +154,16 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
     const uint8_t c = raw[0];
     if (c == detail::kContextCoding || c == detail::kPlacedContextCoding || c == detail::kPlacedLabelCoding || c == detail::kSpatialContextCoding ||
         c == detail::kSpatialLabelCoding || c == detail::kFittedContextCoding || c == detail::kWideContextCoding || c == detail::kBandedContextCoding ||
-        c == detail::kShapedLabelCoding || c == detail::kTiledLabelCoding) {
+        c == detail::kShapedLabelCoding || c == detail::kTiledLabelCoding || c == detail::kTiledContextCoding) {
         if (dir.valueSize != 4) throw Error(where + ": a context-coded window of " + std::to_string(dir.valueSize) + "-byte values (int32 only)");
         if (c == detail::kContextCoding) return decodeContextChannel(body, bricks, e.entries, where);
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
         if (c == detail::kShapedLabelCoding || c == detail::kTiledLabelCoding)  // label model generation 2 or 3, bricks in raster order (LabelCoder.h)
             return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)), true,
                                         coding::BrickOrder::Raster, coding::kLatestIntModel, c == detail::kTiledLabelCoding ? 3 : 2);
+        if (c == detail::kTiledContextCoding)  // model generation 4 with tiles as neighbours
+            return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)), false,
+                                        coding::spatialOrderOf(4), 4, 1, true);
         const int model = c == detail::kBandedContextCoding ? 4 : c == detail::kWideContextCoding ? 3 : c == detail::kFittedContextCoding ? 2 : 1;
         const bool spatial = c == detail::kSpatialContextCoding || c == detail::kSpatialLabelCoding || model >= 2;
         return decodeContextChannel(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),

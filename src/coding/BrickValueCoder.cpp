@@ -106,15 +106,15 @@ struct CompactRecord {
 // Generation 2 (kReach Wide) also finds the far neighbours, generation 3
 // (Widest) five more, with the raster walk's substitutes (IntVolumeCoder.cpp)
 // where a neighbour's brick is not visited yet.
-template <Reach kReach, typename Step>
+template <Reach kReach, bool kTiles, typename Step>
 void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
                 Models& models, Step&& step) {
     int64_t last = 0;  // the previous entry visited, and its record
     SampleRecord lastRec{};
     using Nb = PlacedNeighbours<CompactRecord>;
-    walkPlacedBricks<CompactRecord, kReach>(
+    walkPlacedBricks<CompactRecord, kReach, kTiles>(
         layout, places, entries, order,
-        [&](uint64_t entry) {  // a tile: one entry, no neighbours
+        [&](uint64_t entry, auto&&...) {  // a tile: one entry, predicted by the entry before (kTiles: its value a neighbour's)
             Neighbourhood n;
             n.W = n.N = n.NW = n.NE = n.P = n.PW = n.PN = n.PNW = last;
             n.far.fill(last);
@@ -122,6 +122,7 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             const Prediction pr = predict(n, options.minValue, options.maxValue, models);
             last = step(pr, entry);
             learn(pr, last, lastRec);
+            return int32_t(last);
         },
         [&](const Nb& nb, uint64_t entry, int32_t& value, CompactRecord& rec) {
             const auto v = [&](Nb::Which k) { return int64_t(nb.value(k)); };
@@ -183,9 +184,11 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
 template <typename Step>
 void walkPlacedAny(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
                    Models& models, Step&& step) {
-    if (options.model >= 3) walkPlaced<Reach::Widest>(layout, places, entries, order, options, models, step);
-    else if (options.model == 2) walkPlaced<Reach::Wide>(layout, places, entries, order, options, models, step);
-    else walkPlaced<Reach::Near>(layout, places, entries, order, options, models, step);
+    if (options.tileNeighbours && options.model != 4) throw Error("internal error: tiles as neighbours are model generation 4's");
+    if (options.tileNeighbours) walkPlaced<Reach::Widest, true>(layout, places, entries, order, options, models, step);
+    else if (options.model >= 3) walkPlaced<Reach::Widest, false>(layout, places, entries, order, options, models, step);
+    else if (options.model == 2) walkPlaced<Reach::Wide, false>(layout, places, entries, order, options, models, step);
+    else walkPlaced<Reach::Near, false>(layout, places, entries, order, options, models, step);
 }
 
 } // namespace

@@ -63,6 +63,11 @@ struct IntCoderOptions {
     // models and the bias corrections also by the prediction's intensity
     // band (codings 15 and 16, coding 12's generation 2, and this coder).
     int model = kLatestIntModel;
+    // A placed walk of generation 4 with tiles as neighbours (window coding
+    // 19, PlacedWalk.h's kTiles): a voxel beside a tile up to 32^3 sees its
+    // value there, where coding 15's walk sees none. Tiles themselves are
+    // coded as before (from the entry before).
+    bool tileNeighbours = false;
 };
 
 // Codes `samples` (shape.count() of them, raster order). With near > 0,

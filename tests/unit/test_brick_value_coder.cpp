@@ -220,6 +220,65 @@ TEST(BrickValueCoder, PlacedBricksRoundTripAndSeeAcrossBrickBoundaries) {
     }
 }
 
+// Coding 19: model generation 4's placed walk with tiles as neighbours, on a
+// 32^3 box whose 8^3 blocks with x < 8 are zero tiles (tilePlace, 8 wide)
+// and the others 8 mirrored bricks of a noisy ramp (blocks and bricks in
+// Morton order): every entry back exactly, or within near; a window with
+// tiles is stored as coding 19 and reads back; tile neighbours on another
+// generation's walk are refused.
+TEST(BrickValueCoder, TilesAreNeighboursInCoding19) {
+    std::mt19937 rng(19);
+    PlacedChannel c;
+    const auto morton = [](uint32_t m, int& x, int& y, int& z) {
+        x = y = z = 0;
+        for (int k = 0; k < 3; ++k) x |= int(m >> (3 * k) & 1) << k, y |= int(m >> (3 * k + 1) & 1) << k, z |= int(m >> (3 * k + 2) & 1) << k;
+    };
+    for (uint32_t b = 0; b < 64; ++b) {
+        int bx, by, bz;
+        morton(b, bx, by, bz);
+        if (bx == 0) {
+            c.layout.push_back(0);
+            c.places.push_back(tilePlace(0, 8 * by, 8 * bz, 3));
+            c.entries.push_back(0);
+            continue;
+        }
+        for (uint32_t m = 0; m < 8; ++m) {
+            int x, y, z;
+            morton(m, x, y, z);
+            const int X0 = 8 * bx + 4 * x, Y0 = 8 * by + 4 * y, Z0 = 8 * bz + 4 * z;
+            const uint32_t mirror = rng() % 8;
+            c.layout.push_back(~uint64_t(0));
+            c.places.push_back({X0, Y0, Z0, mirror});
+            std::vector<int32_t> brick(64);
+            for (int k = 0; k < 64; ++k)
+                brick[access::dagStoredBit(unsigned(k & 3), unsigned(k >> 2 & 3), unsigned(k >> 4), mirror)] =
+                    int32_t(20 * (X0 + (k & 3)) + 3 * (Y0 + (k >> 2 & 3)) + int(rng() % 9));
+            c.entries.insert(c.entries.end(), brick.begin(), brick.end());
+        }
+    }
+    for (int32_t near : {0, 2}) {
+        IntCoderOptions o;
+        o.minValue = 0, o.maxValue = 1000, o.near = near, o.model = 4, o.tileNeighbours = true;
+        std::vector<int32_t> reconstructed;
+        const std::vector<uint8_t> bytes = encodePlacedBrickValues(c.entries, c.layout, c.places, BrickOrder::Raster, o, &reconstructed);
+        std::vector<int32_t> back(c.entries.size());
+        decodePlacedBrickValues(bytes, c.layout, c.places, BrickOrder::Raster, o, back, "tiled");
+        EXPECT_EQ(back, reconstructed);
+        size_t outside = 0;
+        for (size_t i = 0; i < back.size(); ++i) outside += std::abs(int64_t(back[i]) - c.entries[i]) > near;
+        EXPECT_EQ(outside, 0u) << "near " << near;
+        o.model = 3;
+        EXPECT_THROW(encodePlacedBrickValues(c.entries, c.layout, c.places, BrickOrder::Raster, o), Error);
+    }
+    std::vector<uint8_t> raw(c.entries.size() * 4);
+    std::memcpy(raw.data(), c.entries.data(), raw.size());
+    const std::vector<uint8_t> windows = attributes::encodePredictedWindows(raw, 4, c.layout, c.places);
+    const attributes::WindowDirectory dir = attributes::readPredictedWindowDirectory(windows, 4, c.layout, "test");
+    ASSERT_EQ(dir.windows.size(), 1u);
+    EXPECT_EQ(windows[size_t(dir.windows[0].offset)], attributes::detail::kTiledContextCoding);
+    EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, c.layout, "test", c.places), raw);
+}
+
 TEST(BrickValueCoder, PlacesThatAreNoBricksAreRefused) {
     PlacedChannel c = placedField(4, true);
     IntCoderOptions o;
