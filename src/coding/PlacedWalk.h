@@ -181,8 +181,11 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
         if (!brickAt.emplace(BrickKey{place.x >> 2, place.y >> 2, place.z >> 2}, b).second) throw Error("two bricks at the same place");
         rank[b] = uint32_t(r);
     }
-    // kTiles: each brick cell of a neighbour tile, and that tile.
-    std::unordered_map<BrickKey, uint32_t, BrickKeyHash> tileAt;
+    // kTiles: the neighbour tiles by size (8, 16, 32) and corner (in
+    // bricks): memory per tile, not per voxel, so a window of forged tiles
+    // costs what its layout does.
+    constexpr unsigned kSmallestTileLog2 = 3, kTileSizes = kNeighbourTileLog2 - kSmallestTileLog2 + 1;
+    std::array<std::unordered_map<BrickKey, uint32_t, BrickKeyHash>, kTileSizes> tilesBySize;
     std::vector<int32_t> tileValue;
     std::vector<uint8_t> tileDone;
     if constexpr (kTiles) {
@@ -191,33 +194,36 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
         tileDone.assign(layout.size(), 0);
         for (size_t b = 0; b < layout.size(); ++b) {
             const BrickPlace& t = places[b];
-            if (layout[b] != 0 || t.mirror < 3 || t.mirror > kNeighbourTileLog2) continue;
-            const int32_t cells = int32_t(1) << (t.mirror - 2);
-            if ((t.x | t.y | t.z) & ((cells << 2) - 1)) throw Error("tile " + std::to_string(b) + " is not aligned to its size");
-            for (int32_t z = 0; z < cells; ++z)
-                for (int32_t y = 0; y < cells; ++y)
-                    for (int32_t x = 0; x < cells; ++x)
-                        if (!tileAt.emplace(BrickKey{(t.x >> 2) + x, (t.y >> 2) + y, (t.z >> 2) + z}, uint32_t(b)).second)
-                            throw Error("two tiles at the same place");
+            if (layout[b] != 0 || t.mirror < kSmallestTileLog2 || t.mirror > kNeighbourTileLog2) continue;
+            if ((t.x | t.y | t.z) & ((int32_t(1) << t.mirror) - 1)) throw Error("tile " + std::to_string(b) + " is not aligned to its size");
+            if (!tilesBySize[t.mirror - kSmallestTileLog2].emplace(BrickKey{t.x >> 2, t.y >> 2, t.z >> 2}, uint32_t(b)).second)
+                throw Error("two tiles at the same place");
         }
     }
-    // A visited tile's value as a brick every voxel of which holds it, one
-    // per value (kTiles).
-    std::unordered_map<int32_t, PlacedBrick<Rec>> uniformBricks;
-    const auto tileBrick = [&](const BrickKey& key) -> const PlacedBrick<Rec>* {
+    // The visited neighbour tile holding brick cell `key`, or kNone.
+    const auto tileHolding = [&](const BrickKey& key) -> uint32_t {
+        for (unsigned s = 0; s < kTileSizes; ++s) {
+            const int32_t cells = ~((int32_t(1) << (s + kSmallestTileLog2 - 2)) - 1);  // a tile's corner, in bricks
+            const auto it = tilesBySize[s].find(BrickKey{key.x & cells, key.y & cells, key.z & cells});
+            if (it != tilesBySize[s].end()) return tileDone[it->second] ? it->second : kNone;
+        }
+        return kNone;
+    };
+    // A visited tile beside the brick being visited, as a brick every voxel
+    // of which holds its value (records Rec{}): one scratch brick per
+    // direction, filled when a brick is visited.
+    std::array<PlacedBrick<Rec>, 26> tileScratch;
+    const auto tileBrick = [&](const BrickKey& key, size_t slot) -> const PlacedBrick<Rec>* {
         if constexpr (kTiles) {
-            const auto it = tileAt.find(key);
-            if (it == tileAt.end() || !tileDone[it->second]) return nullptr;
-            const int32_t v = tileValue[it->second];
-            auto [u, fresh] = uniformBricks.try_emplace(v);
-            if (fresh) {
-                u->second.done = ~uint64_t(0);
-                std::fill(std::begin(u->second.value), std::end(u->second.value), v);
-                std::fill(std::begin(u->second.rec), std::end(u->second.rec), Rec{});
-            }
-            return &u->second;
+            const uint32_t t = tileHolding(key);
+            if (t == kNone) return nullptr;
+            PlacedBrick<Rec>& u = tileScratch[slot];
+            u.done = ~uint64_t(0);
+            std::fill(std::begin(u.value), std::end(u.value), tileValue[t]);
+            std::fill(std::begin(u.rec), std::end(u.rec), Rec{});
+            return &u;
         } else {
-            (void)key;
+            (void)key, (void)slot;
             return nullptr;
         }
     };
@@ -258,13 +264,14 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
             if constexpr (kTiles) {
                 const BrickPlace& t = places[b];
                 TileNeighbours tn;
-                if (tileAt.count(BrickKey{t.x >> 2, t.y >> 2, t.z >> 2})) {  // a neighbour tile itself
-                    const int32_t size = int32_t(1) << t.mirror;
+                if (t.mirror >= kSmallestTileLog2 && t.mirror <= kNeighbourTileLog2) {  // a neighbour tile itself: its neighbours of its size
+                    const auto& same = tilesBySize[t.mirror - kSmallestTileLog2];
+                    const int32_t cells = int32_t(1) << (t.mirror - 2);
                     const BrickKey keys[TileNeighbours::kCount] = {
-                        {(t.x - size) >> 2, t.y >> 2, t.z >> 2}, {t.x >> 2, (t.y - size) >> 2, t.z >> 2}, {t.x >> 2, t.y >> 2, (t.z - size) >> 2}};
+                        {(t.x >> 2) - cells, t.y >> 2, t.z >> 2}, {t.x >> 2, (t.y >> 2) - cells, t.z >> 2}, {t.x >> 2, t.y >> 2, (t.z >> 2) - cells}};
                     for (int k = 0; k < TileNeighbours::kCount; ++k) {
-                        const auto it = tileAt.find(keys[k]);
-                        if (it == tileAt.end() || !tileDone[it->second] || places[it->second].mirror != t.mirror) continue;
+                        const auto it = same.find(keys[k]);
+                        if (it == same.end() || !tileDone[it->second]) continue;
                         tn.has[size_t(k)] = true;
                         tn.value[size_t(k)] = tileValue[it->second];
                     }
@@ -291,7 +298,7 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
             beside[k] = brickBeside(b, d);
             around[d[0] + 1][d[1] + 1][d[2] + 1] =
                 beside[k] != kNone ? kept[beside[k]]  // null: not visited yet
-                                   : tileBrick(BrickKey{(place.x >> 2) + d[0], (place.y >> 2) + d[1], (place.z >> 2) + d[2]});
+                                   : tileBrick(BrickKey{(place.x >> 2) + d[0], (place.y >> 2) + d[1], (place.z >> 2) + d[2]}, k);
         }
         around[1][1][1] = &self;
         const uint64_t spatial = dag::reflectBrick(mask, place.mirror);
