@@ -3,8 +3,8 @@
 // (issue 39 item 1). Checked against a brute-force walk over the samples
 // written here: which blocks are solid, the tiles the import and the cube
 // source give, the file's solid nodes, the same bytes under every memory
-// limit, and the samples decoded back; `--no-tiles` keeps every voxel in
-// its brick.
+// limit, thread and process count, and the samples decoded back;
+// `--no-tiles` keeps every voxel in its brick.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -197,4 +197,21 @@ TEST(SolidBlocks, AFileStoresEachSolidBlockOnceAndDecodesToTheSamples) {
     EXPECT_EQ(runShell("cmp -i " + std::to_string(fs::file_size(nii) - v.size()) + ":0 " + nii.string() + " " + raw.string()).exitCode, 0);
     ASSERT_EQ(runCli("decode " + ss.string() + " -o " + gz.string() + " -f").exitCode, 0);
     EXPECT_EQ(runShell("gzip -dc " + gz.string() + " | cmp - " + nii.string()).exitCode, 0);
+}
+
+// Three processes, cube by cube, write the single process's bytes: the
+// solid blocks are decided from the samples, never from a rank's cubes.
+TEST(SolidBlocks, MpirunGivesTheSingleProcessBytes) {
+#if !defined(VDBDAG_MPI_BINARY)
+    GTEST_SKIP() << "vdbdag-mpi not built (no MPI found)";
+#else
+    const fs::path raw = writeRaw(labels());
+    const fs::path single = workDir() / "mpi_single.ssvdag", out = workDir() / "mpi_np3.ssvdag";
+    ASSERT_EQ(runCli("encode " + raw.string() + " -o " + single.string() + " -f").exitCode, 0);
+    const std::string command = std::string(VDBDAG_MPIRUN) + " --oversubscribe --allow-run-as-root -np 3 " + VDBDAG_MPI_BINARY + " encode " +
+                                raw.string() + " -o " + out.string() + " -f --memory-limit 64K";
+    const auto run = runShell(command);
+    ASSERT_EQ(run.exitCode, 0) << command << "\n" << run.err;
+    EXPECT_EQ(runShell("cmp " + single.string() + " " + out.string()).exitCode, 0);
+#endif
 }
