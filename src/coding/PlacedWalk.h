@@ -137,13 +137,13 @@ inline std::vector<uint32_t> placedVisitOrder(std::span<const uint64_t> layout, 
     return visit;
 }
 
-// With kTiles (label generation 3), tiles are neighbours too: a tile up to
-// kNeighbourTileLog2 wide is visited first (spatial orders), given the
-// values of the tiles of its size W, N and P of it visited before it
-// (TileNeighbours), and returns its value; a voxel whose neighbour lies in
-// such a tile then sees the tile's value there (its record Rec{}), where
-// without kTiles it sees nothing. A larger tile (a .vdb's 128^3) is no
-// neighbour: it would stand for thousands of bricks.
+// With kTiles (label generation 3, the integers' coding 19), tiles are
+// neighbours too: a tile up to kNeighbourTileLog2 wide is visited first
+// (spatial orders), given the values of the tiles of its size W, N and P
+// of it visited before it (TileNeighbours), and returns its value; a voxel
+// whose neighbour lies in such a tile then sees the tile's value there (its
+// record Rec{}), where without kTiles it sees nothing. A larger tile (a
+// .vdb's 128^3) is no neighbour: it would stand for thousands of bricks.
 inline constexpr unsigned kNeighbourTileLog2 = 5;
 struct TileNeighbours {
     enum Which { W, N, P, kCount };
