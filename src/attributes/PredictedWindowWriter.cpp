@@ -167,11 +167,14 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
             const uint64_t size = predicted.size();
             consider(std::move(predicted), size, detail::kFloatCoding);
         }
-        if (floats->lattice)
-            if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *floats->lattice)) {
+        if (floats->lattice) {
+            // A window with tiles walks them as neighbours (coding 20); one without is coding 16, the same stream.
+            const bool tiles = std::find(layout.begin(), layout.end(), uint64_t(0)) != layout.end();
+            if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *floats->lattice, coding::kLatestIntModel, tiles)) {
                 const uint64_t latticeSize = integers->size();
-                consider(std::move(*integers), latticeSize, detail::kBandedRescaledFloatCoding);
+                consider(std::move(*integers), latticeSize, tiles ? detail::kTiledRescaledFloatCoding : detail::kBandedRescaledFloatCoding);
             }
+        }
     } else if (vs == 4) {
         const bool placed = !places.empty();
         labelsLike = placed && looksLikeLabels(values);

@@ -67,7 +67,7 @@ const char* predictedCodingName(uint8_t coding) {
                                         "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors",
                                         "fitted context-coded", "fitted rescaled floats", "float integers", "wide fitted context-coded",
                                         "wide fitted rescaled floats", "banded context-coded", "banded rescaled floats", "shaped labels", "tiled labels",
-                                        "tiled banded context-coded"};
+                                        "tiled banded context-coded", "tiled banded rescaled floats"};
     static_assert(std::size(names) == detail::kCodingCount);
     return coding < std::size(names) ? names[coding] : "unknown";
 }
@@ -171,14 +171,15 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
                                     spatial ? coding::spatialOrderOf(model) : coding::BrickOrder::Attribute, model);
     }
     if (raw[0] == detail::kRescaledFloatCoding || raw[0] == detail::kFittedRescaledFloatCoding || raw[0] == detail::kWideRescaledFloatCoding ||
-        raw[0] == detail::kBandedRescaledFloatCoding) {
+        raw[0] == detail::kBandedRescaledFloatCoding || raw[0] == detail::kTiledRescaledFloatCoding) {
         if (dir.valueSize != 4) throw Error(where + ": rescaled floats of " + std::to_string(dir.valueSize) + "-byte values (float32 only)");
         if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
         return decodeRescaledFloats(body, bricks, e.entries, where, places.subspan(size_t(e.firstBrick), size_t(e.bricks)),
-                                    raw[0] == detail::kBandedRescaledFloatCoding   ? 4
-                                    : raw[0] == detail::kWideRescaledFloatCoding   ? 3
-                                    : raw[0] == detail::kFittedRescaledFloatCoding ? 2
-                                                                                   : 1);
+                                    raw[0] == detail::kBandedRescaledFloatCoding || raw[0] == detail::kTiledRescaledFloatCoding ? 4
+                                    : raw[0] == detail::kWideRescaledFloatCoding                                                 ? 3
+                                    : raw[0] == detail::kFittedRescaledFloatCoding                                               ? 2
+                                                                                                                                 : 1,
+                                    raw[0] == detail::kTiledRescaledFloatCoding);
     }
     if (raw[0] == detail::kFloatCoding || raw[0] == detail::kFloatIntegerCoding) {  // float32 bits predicted, or their order's integers
         const bool integers = raw[0] == detail::kFloatIntegerCoding;

@@ -41,7 +41,8 @@
 // payload with the labels coded by label model generation 2 and the bricks
 // visited in raster order inside 32^3 blocks, coding/LabelCoder.h; 18: the
 // same with label model generation 3, tiles as neighbours; 19: coding 15
-// with tiles as neighbours) then that payload;
+// with tiles as neighbours; 20: coding 16 with tiles as neighbours) then
+// that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -68,7 +69,8 @@ inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCodin
                          kRescaledFloatCoding = 5, kSpatialContextCoding = 6, kSpatialLabelCoding = 7, kFloatCoding = 8, kFloatVectorCoding = 9,
                          kFittedContextCoding = 10, kFittedRescaledFloatCoding = 11, kFloatIntegerCoding = 12, kWideContextCoding = 13,
                          kWideRescaledFloatCoding = 14, kBandedContextCoding = 15, kBandedRescaledFloatCoding = 16, kShapedLabelCoding = 17,
-                         kTiledLabelCoding = 18, kTiledContextCoding = 19, kCodingCount = 20;
+                         kTiledLabelCoding = 18, kTiledContextCoding = 19, kTiledRescaledFloatCoding = 20,
+                         kCodingCount = 21;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail

@@ -29,7 +29,8 @@ std::optional<int32_t> latticeIndex(float v, const ValueRescale& r) {
 } // namespace
 
 std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t> values, std::span<const uint64_t> layout,
-                                                         std::span<const coding::BrickPlace> places, const ValueRescale& rescale, int model) {
+                                                         std::span<const coding::BrickPlace> places, const ValueRescale& rescale, int model,
+                                                         bool tileNeighbours) {
     if (values.size() % 4) throw Error("internal error: rescaled floats are 4-byte entries");
     if (!std::isfinite(rescale.slope) || rescale.slope == 0 || !std::isfinite(rescale.intercept)) return std::nullopt;
     const size_t n = values.size() / 4;
@@ -49,7 +50,7 @@ std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t
     }
     const std::vector<uint8_t> coded = encodeContextChannel(
         std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(integers.data()), integers.size() * 4), layout, places, false,
-        coding::spatialOrderOf(model), model);
+        coding::spatialOrderOf(model), model, 1, tileNeighbours);
     format::ByteWriter w;
     w.bytes().reserve(kHeaderBytes + 8 * exceptions.size() + coded.size());
     w.put(rescale.slope);
@@ -64,7 +65,7 @@ std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t
 }
 
 std::vector<uint8_t> decodeRescaledFloats(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places, int model) {
+                                          std::span<const coding::BrickPlace> places, int model, bool tileNeighbours) {
     format::ByteReader r(payload, what);
     ValueRescale rescale;
     rescale.slope = r.get<double>();
@@ -80,7 +81,7 @@ std::vector<uint8_t> decodeRescaledFloats(std::span<const uint8_t> payload, std:
             r.fail("its exceptions are not in increasing entry order inside the window");
     }
     std::vector<uint8_t> out =
-        decodeContextChannel(payload.subspan(r.position()), layout, entries, what, places, false, coding::spatialOrderOf(model), model);
+        decodeContextChannel(payload.subspan(r.position()), layout, entries, what, places, false, coding::spatialOrderOf(model), model, 1, tileNeighbours);
     for (size_t i = 0; i + 4 <= out.size(); i += 4) {
         int32_t k;
         std::memcpy(&k, out.data() + i, 4);

@@ -41,14 +41,15 @@ inline float rescaledFloat(int64_t k, const ValueRescale& r) {
 // Entries (little-endian float32) over `layout`/`places` as coding 5, or
 // nothing when more than a sixteenth of them lie off the lattice or the
 // integers leave int32.
-// `model`: the integers' model generation, 4 (coding 16), 3 (coding 14), 2 (coding 11) or 1 (coding 5).
+// `model`: the integers' model generation, 4 (coding 16), 3 (coding 14), 2 (coding 11) or 1 (coding 5);
+// `tileNeighbours` (coding 20): generation 4's walk with tiles as neighbours (ContextChannel.h).
 std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                                          std::span<const coding::BrickPlace> places, const ValueRescale& rescale,
-                                                         int model = coding::kLatestIntModel);
+                                                         int model = coding::kLatestIntModel, bool tileNeighbours = false);
 
 // Inverse; validates the payload against `layout` and `entries` (throws
 // vdbdag::Error starting with `what`).
 std::vector<uint8_t> decodeRescaledFloats(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places, int model);
+                                          std::span<const coding::BrickPlace> places, int model, bool tileNeighbours = false);
 
 } // namespace vdbdag::attributes

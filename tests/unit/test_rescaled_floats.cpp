@@ -75,6 +75,23 @@ TEST(RescaledFloats, LatticeValuesComeBackBitForBitAsTheirIntegers) {
     }
 }
 
+// The box with its first 8^3 block (Morton bricks 0-7) a tile of sample 0,
+// as a scan's import makes a uniform block: stored as coding 20 (coding 16
+// with tiles as neighbours), bit for bit.
+TEST(RescaledFloats, AWindowWithTilesIsCoding20) {
+    auto c = samplesOverBox(4);
+    c.layout.erase(c.layout.begin(), c.layout.begin() + 8);
+    c.places.erase(c.places.begin(), c.places.begin() + 8);
+    c.entries.erase(c.entries.begin(), c.entries.begin() + 8 * 64);
+    c.layout.insert(c.layout.begin(), 0);
+    c.places.insert(c.places.begin(), coding::tilePlace(0, 0, 0, 3));
+    c.entries.insert(c.entries.begin(), 0);
+    const std::vector<uint8_t> bytes = bytesOf(floatsOf(c, kPet));
+    const std::vector<uint8_t> windows = encodePredictedWindows(bytes, 4, c.layout, c.places, FloatChannel{kPet});
+    EXPECT_EQ(codingOf(windows, c.layout), detail::kTiledRescaledFloatCoding);
+    EXPECT_EQ(decodePredictedWindows(windows, 4, c.layout, "test", c.places), bytes);
+}
+
 TEST(RescaledFloats, ValuesOffTheLatticeAreExceptionsKeptBitForBit) {
     const auto c = samplesOverBox(5);
     std::vector<float> v = floatsOf(c, kPet);
