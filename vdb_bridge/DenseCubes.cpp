@@ -110,8 +110,8 @@ public:
             const int64_t start = origin_[size_t(a)] + c[a] * size;
             b0[a] = (std::max<int64_t>(0, start) + kSize - 1) >> kSolidBlockLog2;
             b1[a] = (hi[a] + kSize - 1) >> kSolidBlockLog2;  // blocks past the scan are never solid
-            if (b0[a] < b1[a] && (b0[a] * kSize < start || (b1[a] - 1) * kSize + kSize > start + size))
-                throw Error("internal error: a solid block crosses a cube (the cube origin is not a multiple of 8)");
+            if ((start & (kSize - 1)) != 0)
+                throw Error("internal error: a cube at " + std::to_string(start) + " would cut a solid block (the cube origin is not a multiple of 8)");
         }
         for (int64_t z = b0[2]; z < b1[2]; ++z)
             for (int64_t y = b0[1]; y < b1[1]; ++y)

@@ -212,7 +212,7 @@ void walkPlacedBricks(std::span<const uint64_t> layout, std::span<const BrickPla
     // A visited tile beside the brick being visited, as a brick every voxel
     // of which holds its value (records Rec{}): one scratch brick per
     // direction, filled when a brick is visited.
-    std::array<PlacedBrick<Rec>, 26> tileScratch;
+    std::array<PlacedBrick<Rec>, kTiles ? 26 : 0> tileScratch;
     const auto tileBrick = [&](const BrickKey& key, size_t slot) -> const PlacedBrick<Rec>* {
         if constexpr (kTiles) {
             const uint32_t t = tileHolding(key);

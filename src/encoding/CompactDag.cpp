@@ -286,7 +286,7 @@ std::vector<uint8_t> offsetWordsAtRest(const CompactDag& dag) {
 
 std::vector<uint16_t> innerWordsAtRest(const CompactDag& dag) {
     std::vector<uint16_t> out = dag.inner;
-    if (dag.empty()) return out;
+    if (dag.empty() || std::all_of(dag.offsetWords.begin(), dag.offsetWords.end(), [](uint8_t w) { return w == 0; })) return out;  // geometry only
     forEachAttributeOffset(
         dag, [](size_t) { return true; },
         [&](size_t i, uint64_t word, uint64_t) { std::fill_n(out.begin() + ptrdiff_t(word), dag.offsetWords[i], uint16_t(0)); });

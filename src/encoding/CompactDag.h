@@ -51,8 +51,8 @@ void validateCompact(const CompactDag& dag, const std::string& what);
 
 // At rest (docs/FORMAT.md 6.1-6.2) a level's attribute offsets are stored
 // as 0: they are the entries of the preceding siblings, which a reader
-// computes from the DAG below, so a file need not carry them (1-2 % of a
-// level set's file, most of a label atlas's geometry). Its offset width in
+// computes from the DAG below, so a file need not carry them (0.6-6.5 % of
+// a level set's or fog's file, most of a label atlas's geometry). Its offset width in
 // DagLevels then carries kOffsetsAtRest; a writer stores every level with
 // offsets so, and an older file's stored offsets still read.
 inline constexpr uint8_t kOffsetsAtRest = 0x80;
