@@ -75,12 +75,13 @@ int main(int argc, char** argv) {
             std::memcpy(values->data() + at, &f, 4);
         }
     scene.grids.push_back(pipeline::encodeGrid(rescaled));
-    // Labels: full bricks of a 16x16x8 box in three regions split by planes,
-    // most entries repeating the one before: a PredictedWindows section whose
-    // window is coded as labels (coding 18, coding/LabelCoder.h).
-    scene.grids.push_back(pipeline::encodeGrid(vdbdag::testing::labelBox("labels", 4, 4, 2, [](int x, int y, int z) {
-        return int32_t(x + y < 12 ? 17 : x - z > 6 ? 4000 : -250);
-    })));
+    // Labels: a 24x16x8 box in three regions split by planes, most entries
+    // repeating the one before, its two uniform 8^3 blocks (x < 8) tiles as
+    // a scan's import makes them: a PredictedWindows section whose window is
+    // coded as labels with tiles as neighbours (coding 18, coding/LabelCoder.h),
+    // over a DAG whose attribute offsets are at rest.
+    scene.grids.push_back(pipeline::encodeGrid(vdbdag::testing::labelBox(
+        "labels", 6, 4, 2, [](int x, int y, int z) { return int32_t(x < 8 ? 17 : x + y < 20 ? 4000 + z / 4 : -250); }, true)));
     // Half floats (13 zero low bits) of a turbulent field filling a 16^3
     // box: a float window stored as coding 12, the integers of the floats'
     // order (coding/FloatIntegerCoder.h), for the reader fuzzers to mutate.

@@ -541,12 +541,12 @@ TEST(PredictedChannel, SurvivesTheFileWithMirroredBricksAndTiles) {
 
     format::SsvdagScene scene;
     scene.grids.push_back(pipeline::encodeGrid(record));
-    {  // one predicted window, coded by the context-modelled predictor with its bricks placed (coding byte 6: int32), not palettes
+    {  // one predicted window, coded by the context-modelled predictor with its bricks placed and its tile a neighbour (coding 19), not palettes
         const attributes::ValueWindowsPayload& w = scene.grids[0].active.valueWindows;
         ASSERT_TRUE(w.predicted);
         const auto dir = attributes::readPredictedWindowDirectory(w.bytes, 4, encoding::attributeLayout(scene.grids[0].active.dag), "test");
         ASSERT_EQ(dir.windows.size(), 1u);
-        EXPECT_EQ(attributes::windowRawBytes(w.bytes, dir.windows[0], "test").at(0), attributes::detail::kBandedContextCoding)
+        EXPECT_EQ(attributes::windowRawBytes(w.bytes, dir.windows[0], "test").at(0), attributes::detail::kTiledContextCoding)
             << "the predictor should win on this channel";
     }
     EXPECT_LT(scene.grids[0].active.dag.leaves.size(), 16u) << "32 distinct masks, pairs of mirror images: reflected instances must exist";
