@@ -249,13 +249,14 @@ void checkCompact(const CompactDag& dag, const std::string& what, const std::vec
 }
 
 std::vector<NodeFacts> computeFacts(const CompactDag& dag);
+// The decoded size: the root's facts.
+DecodedSize rootSize(const std::vector<NodeFacts>& facts) { return {facts[0].voxels[0], facts[0].bricks[0], facts[0].tiles[0], facts[0].entries[0]}; }
 
 // Calls fill(level, word, preceding) for every attribute offset of the
 // levels `levels(i)` picks: its first word and the entries of the
-// preceding siblings (saturating).
+// preceding siblings (saturating), from the DAG's `facts` (computeFacts).
 template <typename Levels, typename Fill>
-void forEachAttributeOffset(const CompactDag& dag, Levels&& levels, Fill&& fill) {
-    const std::vector<NodeFacts> facts = computeFacts(dag);
+void forEachAttributeOffset(const CompactDag& dag, const std::vector<NodeFacts>& facts, Levels&& levels, Fill&& fill) {
     const size_t count = dag.innerLevelCount();
     for (size_t i = 0; i < count; ++i) {
         const unsigned ow = dag.offsetWords[i];
@@ -288,12 +289,12 @@ std::vector<uint16_t> innerWordsAtRest(const CompactDag& dag) {
     std::vector<uint16_t> out = dag.inner;
     if (dag.empty() || std::all_of(dag.offsetWords.begin(), dag.offsetWords.end(), [](uint8_t w) { return w == 0; })) return out;  // geometry only
     forEachAttributeOffset(
-        dag, [](size_t) { return true; },
+        dag, computeFacts(dag), [](size_t) { return true; },
         [&](size_t i, uint64_t word, uint64_t) { std::fill_n(out.begin() + ptrdiff_t(word), dag.offsetWords[i], uint16_t(0)); });
     return out;
 }
 
-void validateAndRestoreOffsets(CompactDag& dag, const std::string& what) {
+DecodedSize validateAndRestoreOffsets(CompactDag& dag, const std::string& what) {
     std::vector<uint8_t> atRest(dag.offsetWords.size(), 0);
     bool any = false;
     for (size_t i = 0; i < dag.offsetWords.size(); ++i) {
@@ -305,17 +306,22 @@ void validateAndRestoreOffsets(CompactDag& dag, const std::string& what) {
         any = true;
     }
     checkCompact(dag, what, atRest);
-    if (!any) return;
+    if (dag.empty()) return {};
+    // The facts count entries through pointers only, so they hold before
+    // the offsets are filled in, and give the decoded size as well.
+    const std::vector<NodeFacts> facts = computeFacts(dag);
     // Filled in place: a walk reads a node's pointers, never its offsets.
-    forEachAttributeOffset(
-        dag, [&](size_t i) { return atRest[i] != 0; },
-        [&](size_t i, uint64_t word, uint64_t preceding) {
-            const unsigned ow = dag.offsetWords[i];
-            if (ow < 4 && preceding >> (16 * ow))
-                throw Error(what + ": level " + std::to_string(i) + " needs an attribute offset of " + std::to_string(preceding) + ", wider than its " +
-                            std::to_string(ow) + " words");
-            for (unsigned w = 0; w < ow; ++w) dag.inner[size_t(word + w)] = uint16_t(preceding >> (16 * w));
-        });
+    if (any)
+        forEachAttributeOffset(
+            dag, facts, [&](size_t i) { return atRest[i] != 0; },
+            [&](size_t i, uint64_t word, uint64_t preceding) {
+                const unsigned ow = dag.offsetWords[i];
+                if (ow < 4 && preceding >> (16 * ow))
+                    throw Error(what + ": level " + std::to_string(i) + " needs an attribute offset of " + std::to_string(preceding) +
+                                ", wider than its " + std::to_string(ow) + " words");
+                for (unsigned w = 0; w < ow; ++w) dag.inner[size_t(word + w)] = uint16_t(preceding >> (16 * w));
+            });
+    return rootSize(facts);
 }
 
 namespace {
@@ -360,9 +366,7 @@ std::vector<NodeFacts> computeFacts(const CompactDag& dag) {
 
 DecodedSize decodedSize(const CompactDag& dag) {
     if (dag.empty()) return {};
-    const auto facts = computeFacts(dag);
-    const NodeFacts& root = facts[0];
-    return {root.voxels[0], root.bricks[0], root.tiles[0], root.entries[0]};
+    return rootSize(computeFacts(dag));
 }
 
 uint64_t BrickInstance::spatialMask() const { return dag::reflectBrick(storedMask, mirror); }

@@ -59,11 +59,6 @@ inline constexpr uint8_t kOffsetsAtRest = 0x80;
 // The inner words and offset widths as a file stores them.
 std::vector<uint16_t> innerWordsAtRest(const CompactDag& dag);
 std::vector<uint8_t> offsetWordsAtRest(const CompactDag& dag);
-// A DAG as read, whose offset widths may carry kOffsetsAtRest: validated as
-// validateCompact does (a flagged level's stored offsets must be 0), then
-// the flagged levels' offsets are computed into `inner` and the flags
-// cleared. Throws vdbdag::Error("<what>: ...").
-void validateAndRestoreOffsets(CompactDag& dag, const std::string& what);
 
 // Decoded size, computed bottom-up without decoding (saturating at 2^64-1).
 struct DecodedSize {
@@ -73,6 +68,13 @@ struct DecodedSize {
     uint64_t attributeEntries = 0;  // = voxels in bricks + tiles
 };
 DecodedSize decodedSize(const CompactDag& dag);
+
+// A DAG as read, whose offset widths may carry kOffsetsAtRest: validated as
+// validateCompact does (a flagged level's stored offsets must be 0), then
+// the flagged levels' offsets are computed into `inner` and the flags
+// cleared. Returns its decodedSize, from the same bottom-up pass. Throws
+// vdbdag::Error("<what>: ...").
+DecodedSize validateAndRestoreOffsets(CompactDag& dag, const std::string& what);
 
 // Walks every instance of a validated DAG in attribute order: depth-first,
 // children in the stored node's own slot order, with the reflections

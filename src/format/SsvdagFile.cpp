@@ -431,7 +431,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             else if (leafCount) throw Error(what + ": " + layer + " levels claim leaves but there is no leaf section");
             for (uint64_t s : dag.levelStart)
                 if (s > dag.inner.size()) throw Error(what + ": " + layer + " level start " + std::to_string(s) + " beyond the inner array");
-            encoding::validateAndRestoreOffsets(dag, what + " " + layer);
+            const encoding::DecodedSize size = encoding::validateAndRestoreOffsets(dag, what + " " + layer);
             // Every voxel must have an OpenVDB (int32) index: refused here,
             // naming the file, rather than when a decode reaches the voxel.
             if (const std::optional<IndexBox> box = dagBounds(dag))
@@ -440,7 +440,6 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                         throw Error(what + ": the " + layer + " DAG reaches voxel index " +
                                     std::to_string(box->min[size_t(a)] < std::numeric_limits<int32_t>::min() ? box->min[size_t(a)] : box->max[size_t(a)]) +
                                     " on axis " + "xyz"[a] + ", outside OpenVDB's int32 index range; the file is corrupted");
-            const encoding::DecodedSize size = encoding::decodedSize(dag);
             if (size.activeVoxels != expectedVoxels)
                 throw Error(what + ": the " + layer + " DAG holds " + std::to_string(size.activeVoxels) + " voxels but the header says " +
                             std::to_string(expectedVoxels) + "; the file is corrupted");
