@@ -5,7 +5,8 @@
 // spatial voxel, stored at the voxel's stored bit (dag_access.h
 // dagStoredBit), so a coder must undo the mirror to see the field. Every
 // brick m with m % tileEvery == tileAt is a tile holding `tileValue` (4^3
-// wide, which no DAG stores: no neighbour to label model generation 3).
+// wide, which no DAG stores: no neighbour to label model generation 3;
+// placedBlockBox below has real 8^3 tiles).
 #pragma once
 #include <bit>
 #include <cstdint>
@@ -23,12 +24,18 @@ struct PlacedChannel {
     std::vector<int32_t> entries;
 };
 
+// Cell m of 8 x 8 x 8 in Morton order (x's bit lowest at each level).
+inline void mortonCell(uint32_t m, int& x, int& y, int& z) {
+    x = y = z = 0;
+    for (int k = 0; k < 3; ++k) x |= int(m >> (3 * k) & 1) << k, y |= int(m >> (3 * k + 1) & 1) << k, z |= int(m >> (3 * k + 2) & 1) << k;
+}
+
 template <typename Value>
 PlacedChannel placedBox(std::mt19937& rng, bool mirrors, Value&& value, uint32_t tileEvery = 0, uint32_t tileAt = 0, int32_t tileValue = 0) {
     PlacedChannel c;
     for (uint32_t m = 0; m < 512; ++m) {  // 8^3 bricks, Morton order
-        int bx = 0, by = 0, bz = 0;
-        for (int k = 0; k < 3; ++k) bx |= int(m >> (3 * k) & 1) << k, by |= int(m >> (3 * k + 1) & 1) << k, bz |= int(m >> (3 * k + 2) & 1) << k;
+        int bx, by, bz;
+        mortonCell(m, bx, by, bz);
         const uint32_t mirror = mirrors ? rng() % 8 : 0;
         const bool tile = tileEvery && m % tileEvery == tileAt;
         c.layout.push_back(tile ? 0 : ~uint64_t(0));
@@ -43,6 +50,42 @@ PlacedChannel placedBox(std::mt19937& rng, bool mirrors, Value&& value, uint32_t
                 for (int x = 0; x < 4; ++x)
                     brick[access::dagStoredBit(unsigned(x), unsigned(y), unsigned(z), mirror)] = value(4 * bx + x, 4 * by + y, 4 * bz + z);
         c.entries.insert(c.entries.end(), brick.begin(), brick.end());
+    }
+    return c;
+}
+
+// The same 32^3 box as a scan's import lays it out: each 8^3 block whose
+// 512 values are one is a tile (tilePlace, 8 wide) holding it, the others
+// their 8 full bricks with mirrors drawn from `rng`; blocks and bricks in
+// Morton order, as a DAG's attribute order visits them. `value` must give
+// the same sample each time it is asked.
+template <typename Value>
+PlacedChannel placedBlockBox(std::mt19937& rng, Value&& value) {
+    PlacedChannel c;
+    for (uint32_t b = 0; b < 64; ++b) {  // 4^3 blocks of 8^3
+        int bx, by, bz;
+        mortonCell(b, bx, by, bz);
+        const int x0 = 8 * bx, y0 = 8 * by, z0 = 8 * bz;
+        bool uniform = true;
+        for (int k = 1; k < 512 && uniform; ++k) uniform = value(x0 + (k & 7), y0 + (k >> 3 & 7), z0 + (k >> 6)) == value(x0, y0, z0);
+        if (uniform) {
+            c.layout.push_back(0);
+            c.places.push_back(tilePlace(x0, y0, z0, 3));
+            c.entries.push_back(value(x0, y0, z0));
+            continue;
+        }
+        for (uint32_t m = 0; m < 8; ++m) {
+            int x, y, z;
+            mortonCell(m, x, y, z);
+            const int X0 = x0 + 4 * x, Y0 = y0 + 4 * y, Z0 = z0 + 4 * z;
+            const uint32_t mirror = rng() % 8;
+            c.layout.push_back(~uint64_t(0));
+            c.places.push_back({X0, Y0, Z0, mirror});
+            std::vector<int32_t> brick(64);
+            for (int k = 0; k < 64; ++k)
+                brick[access::dagStoredBit(unsigned(k & 3), unsigned(k >> 2 & 3), unsigned(k >> 4), mirror)] = value(X0 + (k & 3), Y0 + (k >> 2 & 3), Z0 + (k >> 4));
+            c.entries.insert(c.entries.end(), brick.begin(), brick.end());
+        }
     }
     return c;
 }

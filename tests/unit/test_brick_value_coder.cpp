@@ -167,6 +167,7 @@ namespace vdbdag::coding {
 namespace {
 
 using testing::PlacedChannel;
+using testing::placedBlockBox;
 
 // A smooth field with noise over the placed box (PlacedBoxFixture.h).
 PlacedChannel placedField(uint32_t seed, bool mirrors) {
@@ -228,34 +229,10 @@ TEST(BrickValueCoder, PlacedBricksRoundTripAndSeeAcrossBrickBoundaries) {
 // generation's walk are refused.
 TEST(BrickValueCoder, TilesAreNeighboursInCoding19) {
     std::mt19937 rng(19);
-    PlacedChannel c;
-    const auto morton = [](uint32_t m, int& x, int& y, int& z) {
-        x = y = z = 0;
-        for (int k = 0; k < 3; ++k) x |= int(m >> (3 * k) & 1) << k, y |= int(m >> (3 * k + 1) & 1) << k, z |= int(m >> (3 * k + 2) & 1) << k;
-    };
-    for (uint32_t b = 0; b < 64; ++b) {
-        int bx, by, bz;
-        morton(b, bx, by, bz);
-        if (bx == 0) {
-            c.layout.push_back(0);
-            c.places.push_back(tilePlace(0, 8 * by, 8 * bz, 3));
-            c.entries.push_back(0);
-            continue;
-        }
-        for (uint32_t m = 0; m < 8; ++m) {
-            int x, y, z;
-            morton(m, x, y, z);
-            const int X0 = 8 * bx + 4 * x, Y0 = 8 * by + 4 * y, Z0 = 8 * bz + 4 * z;
-            const uint32_t mirror = rng() % 8;
-            c.layout.push_back(~uint64_t(0));
-            c.places.push_back({X0, Y0, Z0, mirror});
-            std::vector<int32_t> brick(64);
-            for (int k = 0; k < 64; ++k)
-                brick[access::dagStoredBit(unsigned(k & 3), unsigned(k >> 2 & 3), unsigned(k >> 4), mirror)] =
-                    int32_t(20 * (X0 + (k & 3)) + 3 * (Y0 + (k >> 2 & 3)) + int(rng() % 9));
-            c.entries.insert(c.entries.end(), brick.begin(), brick.end());
-        }
-    }
+    const PlacedChannel c = placedBlockBox(rng, [](int X, int Y, int Z) {
+        const uint32_t noise = (uint32_t(X) * 73856093u ^ uint32_t(Y) * 19349663u ^ uint32_t(Z) * 83492791u) % 9;  // the same each time asked
+        return X < 8 ? 0 : int32_t(20 * X + 3 * Y + int(noise));
+    });
     for (int32_t near : {0, 2}) {
         IntCoderOptions o;
         o.minValue = 0, o.maxValue = 1000, o.near = near, o.model = 4, o.tileNeighbours = true;

@@ -30,80 +30,43 @@ namespace {
 
 using Labels = testing::PlacedChannel;
 
-// Voronoi regions of random seeds over the placed box (PlacedBoxFixture.h),
-// every 97th brick (from the 6th) a tile of the first label.
-Labels voronoi(uint32_t seed, int regions) {
-    std::mt19937 rng(seed);
-    std::vector<std::array<int, 3>> centres(static_cast<size_t>(regions));
-    std::vector<int32_t> ids(static_cast<size_t>(regions));
-    for (int r = 0; r < regions; ++r) {
-        centres[size_t(r)] = {int(rng() % 32), int(rng() % 32), int(rng() % 32)};
-        ids[size_t(r)] = int32_t(rng() % 200000) - 100000;
-    }
-    return testing::placedBox(
-        rng, true,
-        [&](int X, int Y, int Z) {
-            int best = 0, bestD = 1 << 30;
-            for (int r = 0; r < regions; ++r) {
-                const auto& c = centres[size_t(r)];
-                const int d = (X - c[0]) * (X - c[0]) + (Y - c[1]) * (Y - c[1]) + (Z - c[2]) * (Z - c[2]);
-                if (d < bestD) bestD = d, best = r;
-            }
-            return ids[size_t(best)];
-        },
-        97, 5, ids[0]);
-}
-
-// A 32^3 box of Voronoi regions as a scan's import lays it out: each 8^3
-// block whose samples are all one label a tile (tilePlace, 8 wide), the
-// others 8 full bricks with random mirrors; blocks and bricks in Morton
-// order, as a DAG's attribute order visits them.
-Labels tiledVoronoi(uint32_t seed, int regions) {
-    std::mt19937 rng(seed);
-    std::vector<std::array<int, 3>> centres(static_cast<size_t>(regions));
-    std::vector<int32_t> ids(static_cast<size_t>(regions));
-    for (int r = 0; r < regions; ++r) {
-        centres[size_t(r)] = {int(rng() % 32), int(rng() % 32), int(rng() % 32)};
-        ids[size_t(r)] = int32_t(rng() % 200000) - 100000;
-    }
-    const auto label = [&](int X, int Y, int Z) {
-        int best = 0, bestD = 1 << 30;
+// The label of the nearest of `regions` random seeds in a 32^3 box, each
+// region a random id (large and negative ones too).
+struct VoronoiField {
+    VoronoiField(std::mt19937& rng, int regions) : centres(size_t(regions)), ids(size_t(regions)) {
         for (int r = 0; r < regions; ++r) {
-            const auto& c = centres[size_t(r)];
+            centres[size_t(r)] = {int(rng() % 32), int(rng() % 32), int(rng() % 32)};
+            ids[size_t(r)] = int32_t(rng() % 200000) - 100000;
+        }
+    }
+    int32_t operator()(int X, int Y, int Z) const {
+        size_t best = 0;
+        int bestD = 1 << 30;
+        for (size_t r = 0; r < centres.size(); ++r) {
+            const auto& c = centres[r];
             const int d = (X - c[0]) * (X - c[0]) + (Y - c[1]) * (Y - c[1]) + (Z - c[2]) * (Z - c[2]);
             if (d < bestD) bestD = d, best = r;
         }
-        return ids[size_t(best)];
-    };
-    const auto morton = [](uint32_t m, int& x, int& y, int& z) {
-        x = y = z = 0;
-        for (int k = 0; k < 3; ++k) x |= int(m >> (3 * k) & 1) << k, y |= int(m >> (3 * k + 1) & 1) << k, z |= int(m >> (3 * k + 2) & 1) << k;
-    };
-    Labels c;
-    for (uint32_t b = 0; b < 64; ++b) {  // 4^3 blocks of 8^3
-        int bx, by, bz;
-        morton(b, bx, by, bz);
-        bool uniform = true;
-        for (int k = 0; k < 512 && uniform; ++k) uniform = label(8 * bx + (k & 7), 8 * by + (k >> 3 & 7), 8 * bz + (k >> 6)) == label(8 * bx, 8 * by, 8 * bz);
-        if (uniform) {
-            c.layout.push_back(0);
-            c.places.push_back(tilePlace(8 * bx, 8 * by, 8 * bz, 3));
-            c.entries.push_back(label(8 * bx, 8 * by, 8 * bz));
-            continue;
-        }
-        for (uint32_t m = 0; m < 8; ++m) {
-            int x, y, z;
-            morton(m, x, y, z);
-            const int X0 = 8 * bx + 4 * x, Y0 = 8 * by + 4 * y, Z0 = 8 * bz + 4 * z;
-            const uint32_t mirror = rng() % 8;
-            c.layout.push_back(~uint64_t(0));
-            c.places.push_back({X0, Y0, Z0, mirror});
-            std::vector<int32_t> brick(64);
-            for (int k = 0; k < 64; ++k) brick[access::dagStoredBit(unsigned(k & 3), unsigned(k >> 2 & 3), unsigned(k >> 4), mirror)] = label(X0 + (k & 3), Y0 + (k >> 2 & 3), Z0 + (k >> 4));
-            c.entries.insert(c.entries.end(), brick.begin(), brick.end());
-        }
+        return ids[best];
     }
-    return c;
+    std::vector<std::array<int, 3>> centres;
+    std::vector<int32_t> ids;
+};
+
+// Voronoi regions over the placed box (PlacedBoxFixture.h), every 97th
+// brick (from the 6th) a tile of the first label.
+Labels voronoi(uint32_t seed, int regions) {
+    std::mt19937 rng(seed);
+    const VoronoiField field(rng, regions);
+    return testing::placedBox(rng, true, field, 97, 5, field.ids[0]);
+}
+
+// The same regions as a scan's import lays them out: each uniform 8^3
+// block a tile (PlacedBoxFixture.h's placedBlockBox).
+Labels tiledVoronoi(uint32_t seed, int regions) {
+    std::mt19937 rng(seed);
+    const VoronoiField field(rng, regions);
+    return testing::placedBlockBox(rng, field);
 }
 
 // Each generation in the brick order its window coding walks (7: spatial,
@@ -226,15 +189,23 @@ std::vector<uint8_t> oneWindowByHand(std::span<const uint8_t> raw, uint64_t entr
     return out;
 }
 
+// A window of `coding` holding `l`'s entries as label model `generation`
+// codes them in `order`, written by hand as an older writer wrote it, and
+// the entries' bytes.
+std::pair<std::vector<uint8_t>, std::vector<uint8_t>> labelWindowByHand(const Labels& l, uint8_t coding, BrickOrder order, int generation) {
+    std::vector<uint8_t> bytes(l.entries.size() * 4);
+    std::memcpy(bytes.data(), l.entries.data(), bytes.size());
+    std::vector<uint8_t> raw{coding};
+    const std::vector<uint8_t> payload = attributes::encodeContextChannel(bytes, l.layout, l.places, true, order, kLatestIntModel, generation);
+    raw.insert(raw.end(), payload.begin(), payload.end());
+    return {raw, bytes};
+}
+
 // A window of coding 7 (label model generation 1, what files before coding
 // 17 hold) still reads: written by hand, as that writer wrote it.
 TEST(LabelCoder, WindowsOfLabelGeneration1StillRead) {
     const Labels l = voronoi(8, 40);
-    std::vector<uint8_t> bytes(l.entries.size() * 4);
-    std::memcpy(bytes.data(), l.entries.data(), bytes.size());
-    std::vector<uint8_t> raw{attributes::detail::kSpatialLabelCoding};
-    const std::vector<uint8_t> payload = attributes::encodeContextChannel(bytes, l.layout, l.places, true, BrickOrder::Spatial, kLatestIntModel, 1);
-    raw.insert(raw.end(), payload.begin(), payload.end());
+    auto [raw, bytes] = labelWindowByHand(l, attributes::detail::kSpatialLabelCoding, BrickOrder::Spatial, 1);
     EXPECT_EQ(attributes::decodePredictedWindows(oneWindowByHand(raw, l.entries.size()), 4, l.layout, "coding 7", l.places), bytes);
     // Read as coding 17, the same payload is another model: it must not give the entries back.
     raw[0] = attributes::detail::kShapedLabelCoding;
@@ -249,11 +220,7 @@ TEST(LabelCoder, WindowsOfLabelGeneration1StillRead) {
 // hand, as that writer wrote it.
 TEST(LabelCoder, WindowsOfLabelGeneration2StillRead) {
     const Labels l = tiledVoronoi(9, 30);
-    std::vector<uint8_t> bytes(l.entries.size() * 4);
-    std::memcpy(bytes.data(), l.entries.data(), bytes.size());
-    std::vector<uint8_t> raw{attributes::detail::kShapedLabelCoding};
-    const std::vector<uint8_t> payload = attributes::encodeContextChannel(bytes, l.layout, l.places, true, BrickOrder::Raster, kLatestIntModel, 2);
-    raw.insert(raw.end(), payload.begin(), payload.end());
+    const auto [raw, bytes] = labelWindowByHand(l, attributes::detail::kShapedLabelCoding, BrickOrder::Raster, 2);
     EXPECT_EQ(attributes::decodePredictedWindows(oneWindowByHand(raw, l.entries.size()), 4, l.layout, "coding 17", l.places), bytes);
 }
 

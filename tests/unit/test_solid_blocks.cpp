@@ -30,12 +30,7 @@ namespace {
 constexpr int kNx = 44, kNy = 27, kNz = 21;  // partial blocks and bricks on three faces
 
 fs::path workDir() {
-    static const fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() / ("vdbdag_solid_blocks_" + std::to_string(getpid()));
-        fs::remove_all(d);
-        fs::create_directories(d);
-        return d;
-    }();
+    static const fs::path dir = vdbdag::testing::testFolder("solid_blocks");
     return dir;
 }
 
