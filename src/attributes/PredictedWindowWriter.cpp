@@ -27,6 +27,20 @@ namespace {
 constexpr uint64_t kSmallWindowBytes = uint64_t(4) << 20;  // level 9 up to this, then 3 (the container's rule)
 constexpr size_t kHeaderBytes = 4 + 8 + 8 + 8;
 
+// Whether zstd is worth trying on a window's raw bytes (the writer keeps
+// them raw where zstd does not shrink them). A range-coded window of more
+// than kProbeBytes is tried only when zstd's fastest level shrinks its
+// first kProbeBytes by 1 %: such windows are near-random bytes that level 9
+// cannot shrink either, and trying was 8 % of a level set's encode (the
+// bunny's 1.7 MB float windows). Small range-coded windows can shrink (a
+// cube level set's 1,947 bytes to 334) and are always tried, as are
+// palettes and brick residuals, which are coded for zstd.
+constexpr size_t kProbeBytes = size_t(64) << 10;
+bool zstdMayShrink(std::span<const uint8_t> raw) {
+    if (raw.empty() || raw[0] == detail::kPaletteCoding || raw[0] == detail::kPredictedCoding || raw.size() <= kProbeBytes) return true;
+    return format::zstdFastSize(raw.first(kProbeBytes)) * 100 < kProbeBytes * 99;
+}
+
 // Whether a window looks like labels: most entries repeat the one before
 // (in attribute order, neighbours mostly), as regions of one label do and
 // a scan's noise does not. Only such windows are also coded as labels.
@@ -297,7 +311,7 @@ void PredictedWindowWriter::codePending() {
         std::vector<uint64_t>().swap(pending_[i].layout);
         std::vector<coding::BrickPlace>().swap(pending_[i].places);
         rawBytes[i] = raw.size();
-        stored[i] = format::zstdCompressIfSmaller(raw, {raw.size() <= kSmallWindowBytes ? 9 : 3, /*checksum*/ true, 0});
+        if (zstdMayShrink(raw)) stored[i] = format::zstdCompressIfSmaller(raw, {raw.size() <= kSmallWindowBytes ? 9 : 3, /*checksum*/ true, 0});
         if (stored[i].empty()) stored[i] = std::move(raw);
     });
     for (size_t i = 0; i < pending_.size(); ++i) {
