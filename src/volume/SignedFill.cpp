@@ -1,0 +1,238 @@
+// See SignedFill.h. The loops below follow openvdb/tools/SignedFloodFill.h's
+// SignedFloodFillOp statement for statement (leaf, internal node, root), on
+// bit sets of which voxels are active and which values are negative instead
+// of OpenVDB's nodes.
+#include "src/volume/SignedFill.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <bitset>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <tuple>
+#include <vector>
+
+#include "src/util/Error.h"
+
+namespace vdbdag {
+namespace {
+
+using Origin = std::array<int32_t, 3>;  // compared as OpenVDB's Coord: x, then y, then z
+
+Origin alignDown(const Origin& c, int log2) {
+    const int32_t m = ~((int32_t(1) << log2) - 1);
+    return {c[0] & m, c[1] & m, c[2] & m};
+}
+
+// A leaf (8^3, index x << 6 | y << 3 | z): which voxels are active, which
+// active values are negative, and after the fill which inactive ones are
+// inside; whether its first and last values (index 0, 511) are negative.
+struct Leaf {
+    std::bitset<512> active, negative, inside;
+    bool first = false, last = false;
+};
+
+// An internal node of 2^(3 log2Dim) slots: which hold a child, each child's
+// first and last values' signs, and after the fill which tiles are inside.
+struct Node {
+    std::vector<bool> child, childFirst, childLast, inside;
+    bool first = false, last = false;
+    explicit Node(unsigned log2Dim)
+        : child(size_t(1) << (3 * log2Dim)), childFirst(child.size()), childLast(child.size()), inside(child.size()) {}
+};
+
+void fillLeaf(Leaf& leaf) {
+    size_t first = 0;
+    while (!leaf.active[first]) ++first;  // a leaf is made by its active voxels: one is on
+    bool xInside = leaf.negative[first], yInside = xInside, zInside = xInside;
+    for (unsigned x = 0; x != 8; ++x) {
+        const unsigned x00 = x << 6;
+        if (leaf.active[x00]) xInside = leaf.negative[x00];
+        yInside = xInside;
+        for (unsigned y = 0; y != 8; ++y) {
+            const unsigned xy0 = x00 + (y << 3);
+            if (leaf.active[xy0]) yInside = leaf.negative[xy0];
+            zInside = yInside;
+            for (unsigned z = 0; z != 8; ++z) {
+                const unsigned xyz = xy0 + z;
+                if (leaf.active[xyz]) zInside = leaf.negative[xyz];
+                else leaf.inside[xyz] = zInside;
+            }
+        }
+    }
+    const auto negativeAt = [&](size_t i) { return leaf.active[i] ? leaf.negative[i] : leaf.inside[i]; };
+    leaf.first = negativeAt(0);
+    leaf.last = negativeAt(511);
+}
+
+void fillNode(Node& node, unsigned log2Dim) {
+    const size_t n = node.child.size();
+    size_t first = 0;
+    while (!node.child[first]) ++first;  // a node is made by its children: one is there
+    bool xInside = node.childFirst[first], yInside = xInside, zInside = xInside;
+    const unsigned dim = 1u << log2Dim;
+    for (unsigned x = 0; x != dim; ++x) {
+        const size_t x00 = size_t(x) << (2 * log2Dim);
+        if (node.child[x00]) xInside = node.childLast[x00];
+        yInside = xInside;
+        for (unsigned y = 0; y != dim; ++y) {
+            const size_t xy0 = x00 + (size_t(y) << log2Dim);
+            if (node.child[xy0]) yInside = node.childLast[xy0];
+            zInside = yInside;
+            for (unsigned z = 0; z != dim; ++z) {
+                const size_t xyz = xy0 + z;
+                if (node.child[xyz]) zInside = node.childLast[xyz];
+                else node.inside[xyz] = zInside;
+            }
+        }
+    }
+    node.first = node.child[0] ? node.childFirst[0] : bool(node.inside[0]);
+    node.last = node.child[n - 1] ? node.childLast[n - 1] : bool(node.inside[n - 1]);
+}
+
+// The slot of a child at `c` in the node at `o` (OpenVDB's coordToOffset).
+size_t slotOf(const Origin& c, const Origin& o, unsigned log2Dim, unsigned childLog2) {
+    const auto at = [&](int a) { return size_t(uint32_t(c[a] - o[a]) >> childLog2); };
+    return at(0) << (2 * log2Dim) | at(1) << log2Dim | at(2);
+}
+
+Origin slotOrigin(const Origin& o, size_t slot, unsigned log2Dim, unsigned childLog2) {
+    const size_t mask = (size_t(1) << log2Dim) - 1;
+    return {o[0] + int32_t((slot >> (2 * log2Dim)) << childLog2), o[1] + int32_t(((slot >> log2Dim) & mask) << childLog2),
+            o[2] + int32_t((slot & mask) << childLog2)};
+}
+
+template <typename T>
+std::optional<InactiveLayer> fillTyped(const GridTopology& active, const LayerValues& values, std::span<const uint8_t> backgroundBytes) {
+    if (!active.tiles.empty() || backgroundBytes.size() != sizeof(T)) return std::nullopt;
+    T background;
+    std::memcpy(&background, backgroundBytes.data(), sizeof(T));
+    if (!(background > T(0)) || !std::isfinite(background)) return std::nullopt;
+    const T insideValue = -background;
+
+    // The leaves, from the active bricks and their values' signs.
+    std::map<Origin, Leaf> leaves;
+    size_t next = 0;
+    for (const Brick& b : active.bricks) {
+        const Origin corner{b.x, b.y, b.z};
+        Leaf& leaf = leaves[alignDown(corner, 3)];
+        for (uint64_t bits = b.mask; bits; bits &= bits - 1) {
+            const int i = std::countr_zero(bits);
+            const unsigned lx = unsigned(b.x & 7) + unsigned(i & 3), ly = unsigned(b.y & 7) + unsigned((i >> 2) & 3), lz = unsigned(b.z & 7) + unsigned(i >> 4);
+            const size_t n = lx << 6 | ly << 3 | lz;
+            if ((next + 1) * sizeof(T) > values.bricks.size()) throw Error("internal error: fewer active values than active voxels");
+            T v;
+            std::memcpy(&v, &values.bricks[next++ * sizeof(T)], sizeof(T));
+            leaf.active[n] = true;
+            leaf.negative[n] = v < T(0);
+        }
+    }
+    for (auto& [origin, leaf] : leaves) fillLeaf(leaf);
+
+    // The internal nodes of 128^3 (16^3 slots of leaves), then of 4096^3
+    // (32^3 slots of 128^3 nodes), each filled once its children are.
+    std::map<Origin, Node> lower, upper;
+    for (const auto& [origin, leaf] : leaves) {
+        const Origin o = alignDown(origin, 7);
+        Node& node = lower.try_emplace(o, 4u).first->second;
+        const size_t s = slotOf(origin, o, 4, 3);
+        node.child[s] = true, node.childFirst[s] = leaf.first, node.childLast[s] = leaf.last;
+    }
+    for (auto& [origin, node] : lower) fillNode(node, 4);
+    for (const auto& [origin, node] : lower) {
+        const Origin o = alignDown(origin, 12);
+        Node& top = upper.try_emplace(o, 5u).first->second;
+        const size_t s = slotOf(origin, o, 5, 7);
+        top.child[s] = true, top.childFirst[s] = node.first, top.childLast[s] = node.last;
+    }
+    for (auto& [origin, node] : upper) fillNode(node, 5);
+
+    // The layer: each leaf's inside voxels as bricks, then the inside tiles.
+    InactiveLayer out;
+    const auto pushValue = [&](std::vector<uint8_t>& to) {
+        const size_t at = to.size();
+        to.resize(at + sizeof(T));
+        std::memcpy(&to[at], &insideValue, sizeof(T));
+    };
+    for (const auto& [origin, leaf] : leaves)
+        for (int bz = 0; bz < 8; bz += 4)
+            for (int by = 0; by < 8; by += 4)
+                for (int bx = 0; bx < 8; bx += 4) {
+                    uint64_t mask = 0;
+                    for (int i = 0; i < 64; ++i) {
+                        const unsigned lx = unsigned(bx + (i & 3)), ly = unsigned(by + ((i >> 2) & 3)), lz = unsigned(bz + (i >> 4));
+                        if (leaf.inside[lx << 6 | ly << 3 | lz]) mask |= uint64_t(1) << i;
+                    }
+                    if (!mask) continue;
+                    out.topology.bricks.push_back({origin[0] + bx, origin[1] + by, origin[2] + bz, mask});
+                    for (int k = std::popcount(mask); k > 0; --k) pushValue(out.values.bricks);
+                }
+    const auto pushTiles = [&](const std::map<Origin, Node>& nodes, unsigned log2Dim, unsigned childLog2) {
+        for (const auto& [origin, node] : nodes)
+            for (size_t s = 0; s < node.inside.size(); ++s)
+                if (!node.child[s] && node.inside[s]) {
+                    const Origin c = slotOrigin(origin, s, log2Dim, childLog2);
+                    out.topology.tiles.push_back({c[0], c[1], c[2], uint8_t(childLog2)});
+                    pushValue(out.values.tiles);
+                }
+    };
+    pushTiles(lower, 4, 3);
+    pushTiles(upper, 5, 7);
+    // The root: runs of missing 4096^3 nodes along z between two inside faces.
+    constexpr int64_t kTop = int64_t(1) << 12;
+    for (auto a = upper.begin(), b = std::next(a); a != upper.end() && b != upper.end(); ++a, ++b) {
+        const Origin& p = a->first;
+        const Origin& q = b->first;
+        if (p[0] != q[0] || p[1] != q[1] || int64_t(q[2]) - p[2] == kTop) continue;
+        if (!a->second.last || !b->second.first) continue;
+        for (int64_t z = int64_t(p[2]) + kTop; z != q[2]; z += kTop) {
+            out.topology.tiles.push_back({p[0], p[1], int32_t(z), uint8_t(12)});
+            pushValue(out.values.tiles);
+        }
+    }
+    return out;
+}
+
+} // namespace
+
+std::optional<InactiveLayer> signedFillInactive(const GridTopology& active, const LayerValues& values, ValueType type,
+                                                std::span<const uint8_t> background) {
+    if (active.bricks.empty()) return std::nullopt;
+    if (type == ValueType::Float) return fillTyped<float>(active, values, background);
+    if (type == ValueType::Double) return fillTyped<double>(active, values, background);
+    return std::nullopt;
+}
+
+bool sameInactiveLayer(const GridTopology& a, const LayerValues& aValues, const GridTopology& b, const LayerValues& bValues, ValueType type) {
+    const size_t vs = valueSize(type);
+    // Each layer's bricks by corner (mask, values) and tiles by corner and size (value).
+    using Key = std::tuple<int32_t, int32_t, int32_t>;
+    struct Bricks {
+        std::map<Key, std::pair<uint64_t, std::vector<uint8_t>>> bricks;
+        std::map<std::tuple<int32_t, int32_t, int32_t, uint8_t>, std::vector<uint8_t>> tiles;
+    };
+    const auto index = [&](const GridTopology& t, const LayerValues& v, Bricks& out) {
+        size_t next = 0;
+        for (const Brick& br : t.bricks) {
+            const size_t n = size_t(std::popcount(br.mask)) * vs;
+            if (next + n > v.bricks.size()) return false;
+            std::vector<uint8_t> bytes(v.bricks.begin() + long(next), v.bricks.begin() + long(next + n));
+            next += n;
+            if (!out.bricks.try_emplace(Key{br.x, br.y, br.z}, br.mask, std::move(bytes)).second) return false;
+        }
+        if (next != v.bricks.size() || t.tiles.size() * vs != v.tiles.size()) return false;
+        for (size_t i = 0; i < t.tiles.size(); ++i) {
+            const Tile& tile = t.tiles[i];
+            std::vector<uint8_t> bytes(v.tiles.begin() + long(i * vs), v.tiles.begin() + long((i + 1) * vs));
+            if (!out.tiles.try_emplace(std::tuple{tile.x, tile.y, tile.z, tile.log2Size}, std::move(bytes)).second) return false;
+        }
+        return true;
+    };
+    Bricks x, y;
+    if (!index(a, aValues, x) || !index(b, bValues, y)) return false;
+    return x.bricks == y.bricks && x.tiles == y.tiles;
+}
+
+} // namespace vdbdag

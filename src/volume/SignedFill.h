@@ -1,0 +1,53 @@
+// A level set's inactive values as OpenVDB's tools::signedFloodFill makes
+// them, computed from its active voxels alone (issue 40 item 3: a level
+// set's inactive values should cost nothing beyond their sign, which the
+// active values imply).
+//
+// signedFloodFill gives every inactive value of a tree -|background|
+// (inside) or +|background| (outside) by propagating the sign of the
+// active values along the index order of each node, bottom-up:
+//   - a leaf (8^3): along z, then y, then x, each inactive voxel takes the
+//     sign of the last voxel before it in its column (x, y, 0..z-1) that is
+//     active, else that of (x, y, 0)'s row start, else of (x, 0, 0), else of
+//     the leaf's first active voxel;
+//   - an internal node (16^3 slots of 8^3, then 32^3 slots of 128^3): the
+//     same over its slots, a child slot giving the sign of the child's last
+//     value (its first value for the scan's start), a tile slot taking one;
+//   - the root: a run of missing 4096^3 nodes along z between two nodes
+//     whose facing values (the last of the lower, the first of the upper)
+//     are inside becomes inside tiles.
+// Outside values equal the background and are not stored; the inside ones
+// are the grid's inactive layer (GridRecord::inactiveTopology).
+//
+// signedFillInactive computes that layer for OpenVDB's standard tree
+// (5, 4, 3) holding exactly the nodes that the active voxels need. A file
+// whose inactive layer equals it can drop the layer and have the reader
+// make it again (the encoder compares the two; they differ where the
+// file's tree held other nodes or other values).
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include "src/volume/GridRecord.h"
+
+namespace vdbdag {
+
+struct InactiveLayer {
+    GridTopology topology;  // inside voxels (bricks) and inside tiles (8^3, 128^3, 4096^3)
+    LayerValues values;     // -|background| each, in the order of the bricks' bits, then of the tiles
+};
+
+// The inactive layer signedFloodFill gives the active voxels `active` with
+// values `values` (GridRecord's order) of a float or double grid with
+// `background` (its bytes). nullopt where it does not apply: another value
+// type, a background that is not a positive finite number, or active tiles
+// (signedFloodFill would overwrite their values).
+std::optional<InactiveLayer> signedFillInactive(const GridTopology& active, const LayerValues& values, ValueType type,
+                                                std::span<const uint8_t> background);
+
+// Whether two inactive layers hold the same voxels and tiles with the same
+// value bits, whatever their order.
+bool sameInactiveLayer(const GridTopology& a, const LayerValues& aValues, const GridTopology& b, const LayerValues& bValues, ValueType type);
+
+} // namespace vdbdag
