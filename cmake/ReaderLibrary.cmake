@@ -14,7 +14,8 @@ set(VDBDAG_READER_SOURCES
     src/attributes/NormalChannel.cpp src/attributes/OctahedralNormal.cpp src/attributes/PaletteChannel.cpp
     src/attributes/ContextChannel.cpp src/attributes/PredictedChannel.cpp src/attributes/PredictedWindows.cpp src/attributes/RescaledFloats.cpp src/coding/BrickValueCoder.cpp src/coding/LeastSquaresKernels.cpp src/coding/FloatValueCoder.cpp src/coding/FloatIntegerCoder.cpp src/coding/LabelCoder.cpp
     src/attributes/ValueWindows.cpp src/attributes/WindowCursor.cpp
-    src/volume/GridRecord.cpp src/volume/GridTopology.cpp
+    src/volume/GridRecord.cpp src/volume/GridTopology.cpp src/volume/SignedFill.cpp src/format/InactiveSignedFill.cpp
+    src/dag/DagBuilder.cpp src/dag/LevelBuilder.cpp
     src/util/InputPath.cpp src/util/ScratchFile.cpp src/util/TemporaryFiles.cpp)
 add_library(vdbdag_lib SHARED ${VDBDAG_READER_SOURCES})
 target_include_directories(vdbdag_lib

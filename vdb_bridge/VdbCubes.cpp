@@ -9,6 +9,9 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <bitset>
+#include <cmath>
+#include <set>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -23,6 +26,7 @@
 #include <tbb/parallel_for.h>
 
 #include "src/util/Error.h"
+#include "src/volume/SignedFill.h"
 #include "src/util/MappedPages.h"
 #include "src/util/ScratchFile.h"
 #include "vdb_bridge/detail/ImportGrids.h"
@@ -94,6 +98,7 @@ public:
 
     const GridRecord& header() const override { return header_; }
     LayerSummary summary(Layer layer) override { return summary_[int(layer)]; }
+    bool inactiveIsSignedFill() override { return signedFill_; }
 
     std::optional<NormalSource> normals() override {
         if (normalKind_ == NormalsOf::None) return NormalSource{};  // none to store for this grid
@@ -496,6 +501,12 @@ private:
         // Chunk by chunk: each leaf's bricks of both layers, with values,
         // into the scratch file; then the chunk's leaves (and the file pages
         // their buffers were read from) are dropped.
+        // Whether the inactive values are OpenVDB's signed flood fill of the
+        // active ones (SignedFill.h), leaf by leaf here, the tiles after.
+        constexpr bool kFillable = hasValues && (std::is_same_v<ValueT, float> || std::is_same_v<ValueT, double>);
+        bool fillable = false;
+        if constexpr (kFillable) fillable = background > ValueT(0) && std::isfinite(double(background)) && tiles_[0].tiles.empty();
+        std::vector<uint8_t> leafFill(fillable ? leaves.size() : 0);  // bit 0: the leaf is its fill; bits 1, 2: its first and last values negative
         std::vector<std::vector<uint8_t>> records(std::min(leaves.size(), kLeafChunk));
         std::vector<uint32_t> activeEnds(records.size());
         std::vector<uint8_t> sameValues(records.size());  // per leaf, bit l: layer l's values all have the same bits
@@ -523,6 +534,8 @@ private:
                         const auto* p = reinterpret_cast<const uint8_t*>(masks[l]);
                         record.insert(record.end(), p, p + size_t(count[l]) * sizeof(uint64_t));
                     }
+                    if constexpr (kFillable)
+                        if (fillable) leafFill[i] = fillOf(*leaves[i], background);
                     sameValues[i - begin] = 0;
                     for (unsigned l = 0; l < 2; ++l) {
                         if (detail::allSameValue(valuesOf[l], valueSize(header_.valueType))) sameValues[i - begin] |= uint8_t(1u << l);
@@ -555,6 +568,8 @@ private:
             }
             s.tiles = tiles_[l].tiles.size();
         }
+        if constexpr (kFillable)
+            if (fillable) signedFill_ = tilesAreFill(leaves, leafFill, background);
         // As GridTopology::activeVoxelCount counts them.
         GridTopology inactive;
         inactive.tiles = tiles_[1].tiles;
@@ -562,8 +577,53 @@ private:
         for (uint64_t n : inactiveVoxels) summary_[1].voxels += n;
     }
 
+    // A leaf's inactive values against the signed flood fill of its active
+    // ones: bit 0 set when they are it (every inactive value -|background|
+    // inside, the background outside), bits 1 and 2 the signs of its first
+    // and last values (for the fill of the nodes above).
+    static uint8_t fillOf(const LeafT& leaf, ValueT background) {
+        const auto& mask = leaf.getValueMask();
+        const ValueT* data = leaf.buffer().data();
+        SignedFillTree::LeafBits active{}, negative{};
+        for (openvdb::Index n = 0; n < LeafT::SIZE; ++n)
+            if (mask.isOn(n)) {
+                SignedFillTree::set(active, n);
+                if (data[n] < ValueT(0)) SignedFillTree::set(negative, n);
+            }
+        if (active == SignedFillTree::LeafBits{}) return 0;  // the fill of such a leaf reads what it overwrites
+        const SignedFillTree::LeafFill fill = SignedFillTree::fillLeaf(active, negative);
+        const ValueT inside = -background;
+        for (openvdb::Index n = 0; n < LeafT::SIZE; ++n)
+            if (!SignedFillTree::test(active, n) && !detail::sameBits(data[n], SignedFillTree::test(fill.inside, n) ? inside : background)) return 0;
+        return uint8_t(1u | unsigned(fill.first) << 1 | unsigned(fill.last) << 2);
+    }
+
+    // Whether every leaf is its fill and the inactive tiles off the
+    // background are exactly the inside tiles the fill puts above them.
+    bool tilesAreFill(const std::vector<LeafT*>& leaves, const std::vector<uint8_t>& leafFill, ValueT background) const {
+        SignedFillTree tree;
+        for (size_t i = 0; i < leaves.size(); ++i) {
+            if (!(leafFill[i] & 1)) return false;
+            const openvdb::Coord o = leaves_[i].origin;
+            tree.addLeaf({o.x(), o.y(), o.z()}, {{}, bool(leafFill[i] & 2), bool(leafFill[i] & 4)});
+        }
+        const std::vector<Tile> want = tree.insideTiles();
+        const GridTopology& have = tiles_[1];
+        if (want.size() != have.tiles.size()) return false;
+        const ValueT inside = -background;
+        std::set<std::tuple<int32_t, int32_t, int32_t, uint8_t>> wanted;
+        for (const Tile& t : want) wanted.insert({t.x, t.y, t.z, t.log2Size});
+        for (size_t t = 0; t < have.tiles.size(); ++t) {
+            const Tile& tile = have.tiles[t];
+            if (!wanted.contains({tile.x, tile.y, tile.z, tile.log2Size})) return false;
+            if (!detail::sameBits(detail::valueFromBytes<ValueT>(&tileValues_[1].tiles[t * sizeof(ValueT)]), inside)) return false;
+        }
+        return true;
+    }
+
     std::string path_, uniqueName_;
     GridRecord header_;
+    bool signedFill_ = false;
     std::vector<LeafInfo> leaves_;
     GridTopology tiles_[2];
     LayerValues tileValues_[2];

@@ -23,9 +23,8 @@
 #include <limits>
 #include <string>
 
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
+#include "src/dag/BuildParallel.h"
 #include "src/dag/LevelBuilder.h"
 #include "src/util/Error.h"
 
@@ -103,10 +102,10 @@ ReducedDag buildDag(const GridTopology& topology, const BuildOptions& options) {
 
     const auto& in = topology.bricks;
     std::vector<Instance> level(in.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, in.size(), 4096), [&](const auto& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) level[i] = {cellOf(dag.origin, in[i].x, in[i].y, in[i].z, 2), uint32_t(i)};  // ref: input position, for now
+    detail::forEachRange(in.size(), 4096, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i != end; ++i) level[i] = {cellOf(dag.origin, in[i].x, in[i].y, in[i].z, 2), uint32_t(i)};  // ref: input position, for now
     });
-    tbb::parallel_sort(level.begin(), level.end(), MortonInstanceLess{});
+    detail::sortRange(level.begin(), level.end(), MortonInstanceLess{});
     std::vector<uint64_t> masks(level.size());
     for (size_t i = 0; i < level.size(); ++i) {
         if (i > 0 && level[i].cell == level[i - 1].cell) throw Error("internal error: two bricks at the same position");

@@ -1,10 +1,11 @@
 // See LevelBuilder.h; the canonical forms are explained in DagBuilder.cpp.
 #include "src/dag/LevelBuilder.h"
 
+#include "src/dag/BuildParallel.h"
+
 #include <algorithm>
 #include <string>
 
-#include <tbb/parallel_for.h>
 
 #include "src/util/Error.h"
 
@@ -57,8 +58,8 @@ ChildRef LevelBuilder::addBrick(uint64_t mask) { return insertBrick(canonicalBri
 
 std::vector<ChildRef> LevelBuilder::addBricks(const std::vector<uint64_t>& masks) {
     std::vector<BrickCanonicalForm> forms(masks.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, masks.size(), 4096), [&](const auto& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) forms[i] = canonicalBrick(masks[i], symmetry_);
+    detail::forEachRange(masks.size(), 4096, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i != end; ++i) forms[i] = canonicalBrick(masks[i], symmetry_);
     });
     std::vector<ChildRef> refs(masks.size());
     for (size_t i = 0; i < masks.size(); ++i) refs[i] = insertBrick(forms[i]);
@@ -112,8 +113,8 @@ std::vector<Instance> LevelBuilder::raise(const std::vector<Instance>& children,
     }
     std::vector<InnerCanonicalForm> forms(raw.size());
     const auto& childInv = invarianceOf(s - 1);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, raw.size(), 2048), [&](const auto& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i)
+    detail::forEachRange(raw.size(), 2048, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i != end; ++i)
             forms[i] = raw[i] == InnerNode{} ? InnerCanonicalForm{raw[i], 0, uint8_t(symmetry_ ? 0xFF : 1)}
                                              : canonicalInner(raw[i], childInv, symmetry_);
     });

@@ -83,7 +83,7 @@ GridSummary summarizeGrid(const EncodedGrid& grid) {
 StoredSummary recomputedSummary(const EncodedGrid& grid) {
     const encoding::DecodedSize active = encoding::decodedSize(grid.active.dag);
     const GridSummary s = computedSummary(grid, active);
-    return {s.indexBox, s.solidNodes, active.attributeEntries, encoding::decodedSize(grid.inactive.dag).attributeEntries, s.activeRange};
+    return {s.indexBox, s.solidNodes, active.attributeEntries, (grid.inactiveSignedFill ? 0 : encoding::decodedSize(grid.inactive.dag).attributeEntries), s.activeRange};
 }
 
 StoredSummary summaryToStore(const EncodedGrid& grid) { return grid.summary ? *grid.summary : recomputedSummary(grid); }

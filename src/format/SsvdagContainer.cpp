@@ -144,8 +144,8 @@ std::vector<Entry> parseTable(std::span<const uint8_t> bytes, const std::string&
     ByteReader header(bytes.subspan(8, 8), name);
     const uint32_t version = header.get<uint32_t>();
     const uint32_t count = header.get<uint32_t>();
-    if (version != kFormatVersion)
-        fail("unsupported format version " + num(version) + " (this vdbdag reads version " + num(kFormatVersion) + ")");
+    if (version < kFormatVersion || version > kLatestFormatVersion)
+        fail("unsupported format version " + num(version) + " (this vdbdag reads versions " + num(kFormatVersion) + " to " + num(kLatestFormatVersion) + ")");
     // count < 2^32, so this cannot overflow.
     const uint64_t tableEnd = kHeaderBytes + uint64_t(count) * kEntryBytes;
     if (tableEnd + kChecksumBytes > size)
@@ -236,6 +236,7 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::FrameMetadata: return "FrameMetadata";
         case SectionKind::SameAs: return "SameAs";
         case SectionKind::Summary: return "Summary";
+        case SectionKind::InactiveSignedFill: return "InactiveSignedFill";
         case SectionKind::GridInfo: return "GridInfo";
         case SectionKind::VdbDescriptor: return "VdbDescriptor";
         case SectionKind::DagLevels: return "DagLevels";
@@ -261,6 +262,12 @@ const char* sectionKindName(SectionKind kind) {
 }
 
 bool isKnownKind(SectionKind kind) { return std::strcmp(sectionKindName(kind), "unknown") != 0; }
+
+uint32_t formatVersionOf(std::span<const Section> sections) {
+    for (const Section& s : sections)
+        if (s.kind == SectionKind::InactiveSignedFill) return kLatestFormatVersion;
+    return kFormatVersion;
+}
 
 bool isPrecompressed(SectionKind kind) {
     return kind == SectionKind::ValueWindows || kind == SectionKind::InactiveValueWindows || kind == SectionKind::PredictedWindows ||
@@ -400,7 +407,7 @@ uint64_t emitContainer(std::vector<Section>& sections, bool release, const Conta
     const uint64_t tableEnd = kHeaderBytes + sections.size() * kEntryBytes;
     ByteWriter w;
     w.putBytes(std::span<const uint8_t>(kMagic, sizeof(kMagic)));
-    w.put<uint32_t>(kFormatVersion);
+    w.put<uint32_t>(formatVersionOf(sections));
     w.put<uint32_t>(uint32_t(sections.size()));
     uint64_t offset = tableEnd + kChecksumBytes;
     for (size_t i = 0; i < sections.size(); ++i) {

@@ -18,8 +18,12 @@
 
 namespace vdbdag::format {
 
-// The container version this build writes and reads (the u32 after the magic).
+// The container versions (the u32 after the magic). A file is written as
+// version 1 unless it holds a section that an older reader must not skip
+// (one whose absence would change what that reader decodes): then as
+// version 2, which readers before it refuse. This build reads both.
 inline constexpr uint32_t kFormatVersion = 1;
+inline constexpr uint32_t kLatestFormatVersion = 2;
 
 // Section kinds. A file holds a section only when the scene needs it
 // (../shared/DESIGN.md invariant 3). Unknown kinds are rejected by readers that need
@@ -51,7 +55,9 @@ enum class SectionKind : uint32_t {
     FrameMetadata = 24,  // sequence files: a frame's .vdb file metadata (as FileMetadata); grid = the frame's first grid
     SameAs = 25,         // sequence files: this grid's section of a kind holds the bytes of an earlier grid's (a grid that does not change between frames)
     Summary = 26,        // per grid: what `info` prints that the DAG and values would otherwise give (index box, solid nodes, value range)
+    InactiveSignedFill = 27,  // per grid (version 2): the inactive layer is OpenVDB's signed flood fill of the active values, made again by the reader (no Inactive* sections)
 };
+
 const char* sectionKindName(SectionKind kind);  // "unknown" for a kind this build does not know
 bool isKnownKind(SectionKind kind);
 // Sections whose payload is compressed already (the writer stores them raw).
@@ -70,6 +76,10 @@ struct Section {
     // its checksum is checked as it is copied.
     std::shared_ptr<const struct StoredPayload> stored = nullptr;
 };
+
+// The version a file of these sections is written as (kFormatVersion, or
+// kLatestFormatVersion with an InactiveSignedFill section).
+uint32_t formatVersionOf(std::span<const Section> sections);
 
 // Where a section lies in an .ssvdag file, as its table says.
 struct StoredPayload {

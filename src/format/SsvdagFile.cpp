@@ -48,6 +48,7 @@
 #include "src/format/ByteIO.h"
 #include "src/format/DagBounds.h"
 #include "src/format/FrameSequence.h"
+#include "src/format/InactiveSignedFill.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/util/Error.h"
 
@@ -228,7 +229,8 @@ std::vector<Section> toSections(SsvdagScene& scene, bool take) {
 
         const unsigned vs = valueSize(grid.record.valueType);
         putLayer(sections, g, kActive, grid.active, vs, take);
-        if (!grid.inactive.dag.empty()) putLayer(sections, g, kInactive, grid.inactive, vs, take);
+        if (grid.inactiveSignedFill) sections.push_back({SectionKind::InactiveSignedFill, g, {0}});  // u8 0: the fill of SignedFill.h
+        else if (!grid.inactive.dag.empty()) putLayer(sections, g, kInactive, grid.inactive, vs, take);
         if (grid.lossy.tolerance.mode != attributes::ScalarTolerance::Mode::Exact) {
             ByteWriter e;
             const auto& l = grid.lossy;
@@ -511,10 +513,19 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             }
         };
         const encoding::DecodedSize activeSize = readLayerDag(kActive, grid.active, "active");
-        const bool inactiveLayer = grid.inactive.voxels || find(g, kInactive.levels, false);
+        if (Section* fill = find(g, SectionKind::InactiveSignedFill, false)) {
+            ByteReader r(fill->data, what + " InactiveSignedFill");
+            if (r.get<uint8_t>() != 0) r.fail("an unknown fill");
+            r.expectEnd();
+            for (SectionKind k : {kInactive.levels, kInactive.inner, kInactive.leaves, kInactive.values, kInactive.predicted, kInactive.windows, kInactive.predictedWindows})
+                if (find(g, k, false)) throw Error(what + ": corrupt (an inactive layer beside its signed fill)");
+            grid.inactiveSignedFill = true;
+        }
+        const bool inactiveLayer = !grid.inactiveSignedFill && (grid.inactive.voxels || find(g, kInactive.levels, false));
         const encoding::DecodedSize inactiveSize = inactiveLayer ? readLayerDag(kInactive, grid.inactive, "inactive") : encoding::DecodedSize{};
         if (!options.headersOnly) readLayerValues(kActive, grid.active, activeSize, "active");
         if (inactiveLayer && !options.headersOnly) readLayerValues(kInactive, grid.inactive, inactiveSize, "inactive");
+        if (grid.inactiveSignedFill && !options.headersOnly) restoreSignedFill(grid, options.parallel, what);
         if (Section* e = find(g, SectionKind::ValueErrors, false)) {
             ByteReader r(e->data, what + " ValueErrors");
             auto& l = grid.lossy;

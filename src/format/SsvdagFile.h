@@ -65,6 +65,11 @@ struct EncodedGrid {
     bool symmetry = true;       // SSVDAG (true) or plain SVDAG
     EncodedLayer active;        // the active voxels and tiles
     EncodedLayer inactive;      // inactive voxels and tiles off the background
+    // The inactive layer is OpenVDB's signed flood fill of the active values
+    // (src/volume/SignedFill.h): the file stores an InactiveSignedFill
+    // section instead of it (docs/FORMAT.md 6.6) and a reader makes it again
+    // from the active layer (inactive.voxels holds its voxel count either way).
+    bool inactiveSignedFill = false;
     const EncodedLayer& layer(bool inactiveLayer) const { return inactiveLayer ? inactive : active; }
     EncodedLayer& layer(bool inactiveLayer) { return inactiveLayer ? inactive : active; }
     attributes::ToleranceReport lossy;  // what a lossy setting changed (mode Exact: nothing)

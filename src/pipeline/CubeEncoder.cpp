@@ -531,7 +531,10 @@ format::EncodedGrid encodeGridByCubes(CubeSource& source, const EncodeOptions& o
     const LayerSummary inactive = source.summary(Layer::Inactive);
     out.inactive.voxels = inactive.voxels;
     step("inactive values");
-    if (!inactive.empty()) {
+    // A level set's inside, as OpenVDB's signed flood fill makes it from
+    // exact active values: the reader makes it again (InactiveSignedFill.h).
+    out.inactiveSignedFill = !inactive.empty() && options.tolerance.mode == attributes::ScalarTolerance::Mode::Exact && source.inactiveIsSignedFill();
+    if (!inactive.empty() && !out.inactiveSignedFill) {
         const PlanValues codeInactive = [&](const encoding::CompactDag& dag, const LayerPlan& layerPlan) -> uint64_t {
             trial = {};
             if (vs > 0) {  // streamed, as the active values above

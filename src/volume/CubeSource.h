@@ -85,6 +85,11 @@ public:
     // from a source that cannot give them (a dense scan's), which the
     // encoder refuses for --normals.
     virtual std::optional<NormalSource> normals() { return std::nullopt; }
+    // Whether the inactive layer is exactly what OpenVDB's signed flood
+    // fill makes of the active voxels (signedFillInactive, SignedFill.h):
+    // then the encoder stores none and the reader makes it again. Known
+    // once the source is open; false where a source cannot tell.
+    virtual bool inactiveIsSignedFill() { return false; }
     // Name, class, type, transform, descriptor, background; no voxels.
     virtual const GridRecord& header() const = 0;
     virtual LayerSummary summary(Layer layer) = 0;

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "src/volume/SignedFill.h"
 #include "src/util/Error.h"
 #include "src/volume/CubeSource.h"
 
@@ -43,6 +44,12 @@ public:
     std::optional<NormalSource> normals() override {
         if (!normals_) return NormalSource{};  // a grid in memory without normals: none to store
         return NormalSource{normals_->cubes.get(), normals_->fromNormalGrid, normals_->oneSided};
+    }
+
+    bool inactiveIsSignedFill() override {
+        if (inactive_.empty()) return false;
+        const std::optional<InactiveLayer> fill = signedFillInactive(active_, activeValues_, header_.valueType, header_.background);
+        return fill && sameInactiveLayer(fill->topology, fill->values, inactive_, inactiveValues_, header_.valueType);
     }
 
     LayerSummary summary(Layer layer) override {

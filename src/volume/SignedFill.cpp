@@ -19,20 +19,12 @@
 namespace vdbdag {
 namespace {
 
-using Origin = std::array<int32_t, 3>;  // compared as OpenVDB's Coord: x, then y, then z
+using Origin = SignedFillTree::Origin;  // compared as OpenVDB's Coord: x, then y, then z
 
 Origin alignDown(const Origin& c, int log2) {
     const int32_t m = ~((int32_t(1) << log2) - 1);
     return {c[0] & m, c[1] & m, c[2] & m};
 }
-
-// A leaf (8^3, index x << 6 | y << 3 | z): which voxels are active, which
-// active values are negative, and after the fill which inactive ones are
-// inside; whether its first and last values (index 0, 511) are negative.
-struct Leaf {
-    std::bitset<512> active, negative, inside;
-    bool first = false, last = false;
-};
 
 // An internal node of 2^(3 log2Dim) slots: which hold a child, each child's
 // first and last values' signs, and after the fill which tiles are inside.
@@ -42,30 +34,6 @@ struct Node {
     explicit Node(unsigned log2Dim)
         : child(size_t(1) << (3 * log2Dim)), childFirst(child.size()), childLast(child.size()), inside(child.size()) {}
 };
-
-void fillLeaf(Leaf& leaf) {
-    size_t first = 0;
-    while (!leaf.active[first]) ++first;  // a leaf is made by its active voxels: one is on
-    bool xInside = leaf.negative[first], yInside = xInside, zInside = xInside;
-    for (unsigned x = 0; x != 8; ++x) {
-        const unsigned x00 = x << 6;
-        if (leaf.active[x00]) xInside = leaf.negative[x00];
-        yInside = xInside;
-        for (unsigned y = 0; y != 8; ++y) {
-            const unsigned xy0 = x00 + (y << 3);
-            if (leaf.active[xy0]) yInside = leaf.negative[xy0];
-            zInside = yInside;
-            for (unsigned z = 0; z != 8; ++z) {
-                const unsigned xyz = xy0 + z;
-                if (leaf.active[xyz]) zInside = leaf.negative[xyz];
-                else leaf.inside[xyz] = zInside;
-            }
-        }
-    }
-    const auto negativeAt = [&](size_t i) { return leaf.active[i] ? leaf.negative[i] : leaf.inside[i]; };
-    leaf.first = negativeAt(0);
-    leaf.last = negativeAt(511);
-}
 
 void fillNode(Node& node, unsigned log2Dim) {
     const size_t n = node.child.size();
@@ -112,33 +80,108 @@ std::optional<InactiveLayer> fillTyped(const GridTopology& active, const LayerVa
     if (!(background > T(0)) || !std::isfinite(background)) return std::nullopt;
     const T insideValue = -background;
 
-    // The leaves, from the active bricks and their values' signs.
-    std::map<Origin, Leaf> leaves;
-    size_t next = 0;
-    for (const Brick& b : active.bricks) {
-        const Origin corner{b.x, b.y, b.z};
-        Leaf& leaf = leaves[alignDown(corner, 3)];
-        for (uint64_t bits = b.mask; bits; bits &= bits - 1) {
-            const int i = std::countr_zero(bits);
-            const unsigned lx = unsigned(b.x & 7) + unsigned(i & 3), ly = unsigned(b.y & 7) + unsigned((i >> 2) & 3), lz = unsigned(b.z & 7) + unsigned(i >> 4);
-            const size_t n = lx << 6 | ly << 3 | lz;
-            if ((next + 1) * sizeof(T) > values.bricks.size()) throw Error("internal error: fewer active values than active voxels");
-            T v;
-            std::memcpy(&v, &values.bricks[next++ * sizeof(T)], sizeof(T));
-            leaf.active[n] = true;
-            leaf.negative[n] = v < T(0);
+    // The leaves, from the active bricks (grouped by leaf: sorted by their
+    // leaf's origin, as OpenVDB's Coord orders them) and their values' signs.
+    struct Leaf {
+        SignedFillTree::LeafBits active{}, negative{};
+    };
+    std::vector<std::pair<Origin, size_t>> byLeaf(active.bricks.size());  // (leaf origin, brick)
+    std::vector<size_t> firstValue(active.bricks.size());
+    size_t count = 0;
+    for (size_t k = 0; k < active.bricks.size(); ++k) {
+        const Brick& b = active.bricks[k];
+        byLeaf[k] = {alignDown({b.x, b.y, b.z}, 3), k};
+        firstValue[k] = count;
+        count += size_t(std::popcount(b.mask));
+    }
+    if (count * sizeof(T) != values.bricks.size()) throw Error("internal error: the active values do not match the active voxels");
+    std::sort(byLeaf.begin(), byLeaf.end());
+    // The layer: each leaf's inside voxels as bricks, then the inside tiles.
+    InactiveLayer out;
+    SignedFillTree tree;
+    for (size_t g = 0; g < byLeaf.size();) {
+        const Origin origin = byLeaf[g].first;
+        Leaf leaf;
+        for (; g < byLeaf.size() && byLeaf[g].first == origin; ++g) {
+            const Brick& b = active.bricks[byLeaf[g].second];
+            size_t next = firstValue[byLeaf[g].second];
+            for (uint64_t bits = b.mask; bits; bits &= bits - 1) {
+                const int i = std::countr_zero(bits);
+                const size_t n = SignedFillTree::leafIndex(unsigned(b.x & 7) + unsigned(i & 3), unsigned(b.y & 7) + unsigned((i >> 2) & 3),
+                                                           unsigned(b.z & 7) + unsigned(i >> 4));
+                T v;
+                std::memcpy(&v, &values.bricks[next++ * sizeof(T)], sizeof(T));
+                SignedFillTree::set(leaf.active, n);
+                if (v < T(0)) SignedFillTree::set(leaf.negative, n);
+            }
+        }
+        const SignedFillTree::LeafFill fill = SignedFillTree::fillLeaf(leaf.active, leaf.negative);
+        tree.addLeaf(origin, fill);
+        if (fill.inside == SignedFillTree::LeafBits{}) continue;
+        for (int bz = 0; bz < 8; bz += 4)
+            for (int by = 0; by < 8; by += 4)
+                for (int bx = 0; bx < 8; bx += 4) {
+                    uint64_t mask = 0;
+                    for (int i = 0; i < 64; ++i)
+                        if (SignedFillTree::test(fill.inside, SignedFillTree::leafIndex(unsigned(bx + (i & 3)), unsigned(by + ((i >> 2) & 3)), unsigned(bz + (i >> 4)))))
+                            mask |= uint64_t(1) << i;
+                    if (mask) out.topology.bricks.push_back({origin[0] + bx, origin[1] + by, origin[2] + bz, mask});
+                }
+    }
+    out.topology.tiles = tree.insideTiles();
+    // Every value -|background|.
+    size_t inside = out.topology.tiles.size();
+    for (const Brick& b : out.topology.bricks) inside += size_t(std::popcount(b.mask));
+    std::vector<uint8_t> all(inside * sizeof(T));
+    for (size_t i = 0; i < inside; ++i) std::memcpy(&all[i * sizeof(T)], &insideValue, sizeof(T));
+    out.values.tiles.assign(all.end() - long(out.topology.tiles.size() * sizeof(T)), all.end());
+    all.resize(all.size() - out.topology.tiles.size() * sizeof(T));
+    out.values.bricks = std::move(all);
+    return out;
+}
+
+} // namespace
+
+SignedFillTree::LeafFill SignedFillTree::fillLeaf(const LeafBits& active, const LeafBits& negative) {
+    LeafFill out;
+    size_t first = 512;
+    for (size_t w = 0; w < 8 && first == 512; ++w)
+        if (active[w]) first = w * 64 + size_t(std::countr_zero(active[w]));
+    if (first == 512) throw Error("internal error: a leaf with no active voxel has no fill");
+    bool xInside = test(negative, first), yInside = xInside, zInside = xInside;
+    for (unsigned x = 0; x != 8; ++x) {
+        if (active[x] & 1) xInside = negative[x] & 1;  // element (x, 0, 0)
+        yInside = xInside;
+        for (unsigned y = 0; y != 8; ++y) {
+            const unsigned rowActive = unsigned(active[x] >> (8 * y)) & 0xFFu, rowNegative = unsigned(negative[x] >> (8 * y)) & 0xFFu;
+            if (rowActive & 1u) yInside = rowNegative & 1u;  // element (x, y, 0)
+            zInside = yInside;
+            for (unsigned z = 0; z != 8; ++z) {
+                if ((rowActive >> z) & 1u) zInside = (rowNegative >> z) & 1u;
+                else if (zInside) out.inside[x] |= uint64_t(1) << (8 * y + z);
+            }
         }
     }
-    for (auto& [origin, leaf] : leaves) fillLeaf(leaf);
+    const auto negativeAt = [&](size_t i) { return test(active, i) ? test(negative, i) : test(out.inside, i); };
+    out.first = negativeAt(0);
+    out.last = negativeAt(511);
+    return out;
+}
 
+void SignedFillTree::addLeaf(const Origin& origin, const LeafFill& fill) {
+    if ((origin[0] | origin[1] | origin[2]) & 7) throw Error("internal error: a leaf origin that is not a multiple of 8");
+    if (!leaves_.try_emplace(origin, fill.first, fill.last).second) throw Error("internal error: a leaf added twice");
+}
+
+std::vector<Tile> SignedFillTree::insideTiles() const {
     // The internal nodes of 128^3 (16^3 slots of leaves), then of 4096^3
     // (32^3 slots of 128^3 nodes), each filled once its children are.
     std::map<Origin, Node> lower, upper;
-    for (const auto& [origin, leaf] : leaves) {
+    for (const auto& [origin, ends] : leaves_) {
         const Origin o = alignDown(origin, 7);
         Node& node = lower.try_emplace(o, 4u).first->second;
         const size_t s = slotOf(origin, o, 4, 3);
-        node.child[s] = true, node.childFirst[s] = leaf.first, node.childLast[s] = leaf.last;
+        node.child[s] = true, node.childFirst[s] = ends.first, node.childLast[s] = ends.second;
     }
     for (auto& [origin, node] : lower) fillNode(node, 4);
     for (const auto& [origin, node] : lower) {
@@ -148,54 +191,28 @@ std::optional<InactiveLayer> fillTyped(const GridTopology& active, const LayerVa
         top.child[s] = true, top.childFirst[s] = node.first, top.childLast[s] = node.last;
     }
     for (auto& [origin, node] : upper) fillNode(node, 5);
-
-    // The layer: each leaf's inside voxels as bricks, then the inside tiles.
-    InactiveLayer out;
-    const auto pushValue = [&](std::vector<uint8_t>& to) {
-        const size_t at = to.size();
-        to.resize(at + sizeof(T));
-        std::memcpy(&to[at], &insideValue, sizeof(T));
-    };
-    for (const auto& [origin, leaf] : leaves)
-        for (int bz = 0; bz < 8; bz += 4)
-            for (int by = 0; by < 8; by += 4)
-                for (int bx = 0; bx < 8; bx += 4) {
-                    uint64_t mask = 0;
-                    for (int i = 0; i < 64; ++i) {
-                        const unsigned lx = unsigned(bx + (i & 3)), ly = unsigned(by + ((i >> 2) & 3)), lz = unsigned(bz + (i >> 4));
-                        if (leaf.inside[lx << 6 | ly << 3 | lz]) mask |= uint64_t(1) << i;
-                    }
-                    if (!mask) continue;
-                    out.topology.bricks.push_back({origin[0] + bx, origin[1] + by, origin[2] + bz, mask});
-                    for (int k = std::popcount(mask); k > 0; --k) pushValue(out.values.bricks);
-                }
+    std::vector<Tile> tiles;
     const auto pushTiles = [&](const std::map<Origin, Node>& nodes, unsigned log2Dim, unsigned childLog2) {
         for (const auto& [origin, node] : nodes)
             for (size_t s = 0; s < node.inside.size(); ++s)
                 if (!node.child[s] && node.inside[s]) {
                     const Origin c = slotOrigin(origin, s, log2Dim, childLog2);
-                    out.topology.tiles.push_back({c[0], c[1], c[2], uint8_t(childLog2)});
-                    pushValue(out.values.tiles);
+                    tiles.push_back({c[0], c[1], c[2], uint8_t(childLog2)});
                 }
     };
     pushTiles(lower, 4, 3);
     pushTiles(upper, 5, 7);
     // The root: runs of missing 4096^3 nodes along z between two inside faces.
     constexpr int64_t kTop = int64_t(1) << 12;
-    for (auto a = upper.begin(), b = std::next(a); a != upper.end() && b != upper.end(); ++a, ++b) {
+    for (auto a = upper.begin(), b = upper.empty() ? upper.end() : std::next(a); b != upper.end(); ++a, ++b) {
         const Origin& p = a->first;
         const Origin& q = b->first;
         if (p[0] != q[0] || p[1] != q[1] || int64_t(q[2]) - p[2] == kTop) continue;
         if (!a->second.last || !b->second.first) continue;
-        for (int64_t z = int64_t(p[2]) + kTop; z != q[2]; z += kTop) {
-            out.topology.tiles.push_back({p[0], p[1], int32_t(z), uint8_t(12)});
-            pushValue(out.values.tiles);
-        }
+        for (int64_t z = int64_t(p[2]) + kTop; z != q[2]; z += kTop) tiles.push_back({p[0], p[1], int32_t(z), uint8_t(12)});
     }
-    return out;
+    return tiles;
 }
-
-} // namespace
 
 std::optional<InactiveLayer> signedFillInactive(const GridTopology& active, const LayerValues& values, ValueType type,
                                                 std::span<const uint8_t> background) {

@@ -25,13 +25,46 @@
 // make it again (the encoder compares the two; they differ where the
 // file's tree held other nodes or other values).
 #pragma once
+#include <array>
+#include <bitset>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "src/volume/GridRecord.h"
 
 namespace vdbdag {
+
+// The fill in pieces, for a source that reads a grid leaf by leaf (the
+// encoder's check, vdb_bridge/VdbCubes.cpp): each leaf alone (fillLeaf),
+// then the tiles above the leaves from each leaf's first and last values.
+class SignedFillTree {
+public:
+    using Origin = std::array<int32_t, 3>;
+    // Leaf voxels by OpenVDB's index n = x << 6 | y << 3 | z (x, y, z in
+    // 0..7): bit n & 63 of word n >> 6 (word x holds y << 3 | z).
+    static size_t leafIndex(unsigned x, unsigned y, unsigned z) { return size_t(x) << 6 | size_t(y) << 3 | size_t(z); }
+    using LeafBits = std::array<uint64_t, 8>;
+    static void set(LeafBits& bits, size_t n) { bits[n >> 6] |= uint64_t(1) << (n & 63); }
+    static bool test(const LeafBits& bits, size_t n) { return (bits[n >> 6] >> (n & 63)) & 1; }
+    struct LeafFill {
+        LeafBits inside{};  // the inactive voxels the fill makes inside
+        bool first = false, last = false;  // whether the leaf's values at index 0 and 511 are then negative
+    };
+    // One leaf with at least one active voxel: which are active and which
+    // of their values are negative.
+    static LeafFill fillLeaf(const LeafBits& active, const LeafBits& negative);
+    // Each leaf once (its origin a multiple of 8), in any order.
+    void addLeaf(const Origin& origin, const LeafFill& fill);
+    // The inside tiles: 8^3 and 128^3 tiles of the internal nodes, then the
+    // root's 4096^3 ones, in a fixed order.
+    std::vector<Tile> insideTiles() const;
+
+private:
+    std::map<Origin, std::pair<bool, bool>> leaves_;  // first, last
+};
 
 struct InactiveLayer {
     GridTopology topology;  // inside voxels (bricks) and inside tiles (8^3, 128^3, 4096^3)

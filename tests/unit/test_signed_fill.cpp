@@ -12,6 +12,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 #include <openvdb/openvdb.h>
@@ -19,9 +20,17 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/SignedFloodFill.h>
 
+#include "src/format/SsvdagContainer.h"
+#include "src/format/SsvdagFile.h"
+#include "src/pipeline/CubeEncoder.h"
+#include "src/pipeline/GridCodec.h"
+#include "src/util/Error.h"
 #include "src/volume/SignedFill.h"
 #include "tests/unit/TestInputs.h"
+#include "vdb_bridge/VdbCubes.h"
+#include "vdb_bridge/VdbExport.h"
 #include "vdb_bridge/VdbImport.h"
+#include <vdbdag/vdbdag.h>
 
 namespace fs = std::filesystem;
 using namespace vdbdag;
@@ -57,6 +66,35 @@ GridRecord roundTrip(const typename GridT::Ptr& grid, const std::string& name) {
         return ::testing::AssertionFailure() << "computed " << fill->topology.bricks.size() << " bricks, " << fill->topology.tiles.size()
                                              << " tiles; the file " << r.inactiveTopology.bricks.size() << " bricks, "
                                              << r.inactiveTopology.tiles.size() << " tiles";
+    return ::testing::AssertionSuccess();
+}
+
+// A .vdb file encoded cube by cube (as `vdbdag encode` does), under a budget
+// whose cubes are 2^cubeLog2 when given.
+std::vector<uint8_t> encodeByCubes(const fs::path& path, std::optional<unsigned> cubeLog2 = std::nullopt) {
+    bridge::VdbCubeInput input = bridge::openVdbCubes(path.string());
+    pipeline::CubeBudget budget;
+    budget.cubeLog2 = cubeLog2;
+    return format::writeScene(pipeline::encodeSourcesByCubes(std::move(input.grids), input.fileMetadata, {}, budget));
+}
+
+bool hasSection(const std::vector<uint8_t>& file, format::SectionKind kind) {
+    for (const format::Section& s : format::readContainer(file, "test", true))
+        if (s.kind == kind) return true;
+    return false;
+}
+
+// Every value of `b` (active or not, voxels and tiles) as OpenVDB gives it,
+// against `a`'s.
+::testing::AssertionResult sameTrees(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b) {
+    auto i = a.tree().cbeginValueAll();
+    auto j = b.tree().cbeginValueAll();
+    for (; i && j; ++i, ++j) {
+        if (i.getBoundingBox() != j.getBoundingBox() || i.isValueOn() != j.isValueOn() || std::memcmp(&*i, &*j, sizeof(float)) != 0)
+            return ::testing::AssertionFailure() << "differ at " << i.getCoord() << " / " << j.getCoord();
+    }
+    if (i || j) return ::testing::AssertionFailure() << "one tree has more values";
+    if (a.tree().leafCount() != b.tree().leafCount()) return ::testing::AssertionFailure() << "leaf counts differ";
     return ::testing::AssertionSuccess();
 }
 
@@ -171,4 +209,105 @@ TEST(SignedFill, DoesNotApplyWhereTheFillCannotHold) {
     uint64_t inside = 0;
     for (const Brick& b : fill->topology.bricks) inside += uint64_t(std::popcount(b.mask));
     EXPECT_EQ(inside, 511u);
+}
+
+TEST(SignedFill, ALevelSetFileStoresNoInactiveLayerAndReadsBackExactly) {
+    openvdb::initialize();
+    auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(40.0f, {0.5f, 3.f, -2.f}, 0.5f, 3.f);
+    sphere->setName("sphere");
+    const fs::path in = tempFile("sphere_in.vdb");
+    openvdb::io::File(in.string()).write({sphere});
+    const std::vector<uint8_t> file = encodeByCubes(in);
+    // An InactiveSignedFill section instead of the inactive layer's, in a
+    // version 2 container (which earlier readers refuse).
+    EXPECT_TRUE(hasSection(file, format::SectionKind::InactiveSignedFill));
+    EXPECT_FALSE(hasSection(file, format::SectionKind::InactiveLevels));
+    uint32_t version = 0;
+    std::memcpy(&version, file.data() + 8, 4);
+    EXPECT_EQ(version, format::kLatestFormatVersion);
+    // The same bytes in small cubes.
+    EXPECT_EQ(encodeByCubes(in, 5u), file);
+    // Decoded, every value OpenVDB holds is the original's.
+    const Volume back = pipeline::decodeScene(format::readScene(file, "sphere"));
+    ASSERT_EQ(back.grids.size(), 1u);
+    const GridRecord original = importOne(in);
+    EXPECT_TRUE(sameInactiveLayer(back.grids[0].inactiveTopology, back.grids[0].inactiveValues, original.inactiveTopology, original.inactiveValues,
+                                  ValueType::Float));
+    const fs::path out = tempFile("sphere_out.vdb");
+    bridge::exportVdb(back, out.string());
+    openvdb::io::File f(out.string());
+    f.open();
+    const auto decoded = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid("sphere"));
+    f.close();
+    EXPECT_TRUE(sameTrees(*sphere, *decoded));
+    // The reader library answers inside voxels with -background, as OpenVDB does.
+    const fs::path ssvdag = tempFile("sphere.ssvdag");
+    {
+        std::ofstream o(ssvdag, std::ios::binary);
+        o.write(reinterpret_cast<const char*>(file.data()), std::streamsize(file.size()));
+    }
+    const vdbdag::File reader = vdbdag::File::open(ssvdag.string());
+    vdbdag::Accessor acc = reader.grid(0).accessor();
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> c(-100, 100);  // inside (tiles and voxels), the band and outside
+    const auto vdb = sphere->getConstAccessor();
+    for (int k = 0; k < 20000; ++k) {
+        const openvdb::Coord ijk(c(rng), c(rng), c(rng));
+        ASSERT_EQ(acc.value<float>(ijk.x(), ijk.y(), ijk.z()), vdb.getValue(ijk)) << ijk;
+    }
+    for (const fs::path& p : {in, out, ssvdag}) fs::remove(p);
+}
+
+TEST(SignedFill, OtherInactiveValuesKeepTheirLayer) {
+    // One inside voxel changed: the fill no longer gives the file's values,
+    // so the inactive layer is stored (version 1) and reads back exactly.
+    openvdb::initialize();
+    auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(20.0f, {}, 0.5f, 3.f);
+    sphere->setName("sphere");
+    sphere->tree().setValueOff(openvdb::Coord(0, 0, 0), -2.0f);
+    const fs::path in = tempFile("changed.vdb");
+    openvdb::io::File(in.string()).write({sphere});
+    const std::vector<uint8_t> file = encodeByCubes(in);
+    EXPECT_FALSE(hasSection(file, format::SectionKind::InactiveSignedFill));
+    EXPECT_TRUE(hasSection(file, format::SectionKind::InactiveLevels));
+    uint32_t version = 0;
+    std::memcpy(&version, file.data() + 8, 4);
+    EXPECT_EQ(version, format::kFormatVersion);
+    const Volume back = pipeline::decodeScene(format::readScene(file, "changed"));
+    const GridRecord original = importOne(in);
+    EXPECT_TRUE(sameInactiveLayer(back.grids[0].inactiveTopology, back.grids[0].inactiveValues, original.inactiveTopology, original.inactiveValues,
+                                  ValueType::Float));
+    fs::remove(in);
+}
+
+TEST(SignedFill, ForgedFlagsAreRefused) {
+    openvdb::initialize();
+    auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(12.0f, {}, 0.5f, 3.f);
+    const fs::path in = tempFile("forged.vdb");
+    openvdb::io::File(in.string()).write({sphere});
+    std::vector<format::Section> sections = format::readContainer(encodeByCubes(in), "forged", true);
+    fs::remove(in);
+    const auto refused = [](const std::vector<format::Section>& s, const std::string& why) {
+        try {
+            format::readScene(format::writeContainer(s), "forged");
+        } catch (const Error& e) {
+            return std::string(e.what()).find(why) != std::string::npos ? ::testing::AssertionSuccess()
+                                                                         : ::testing::AssertionFailure() << "refused for " << e.what();
+        }
+        return ::testing::AssertionFailure() << "read";
+    };
+    // A fill section beside an inactive layer.
+    std::vector<format::Section> both = sections;
+    both.push_back({format::SectionKind::InactiveLevels, 0, {1, 2, 3}});
+    EXPECT_TRUE(refused(both, "beside its signed fill"));
+    // Another fill.
+    std::vector<format::Section> other = sections;
+    for (format::Section& s : other)
+        if (s.kind == format::SectionKind::InactiveSignedFill) s.data = {1};
+    EXPECT_TRUE(refused(other, "unknown fill"));
+    // An inactive voxel count the fill does not give (GridInfo's last u64).
+    std::vector<format::Section> count = sections;
+    for (format::Section& s : count)
+        if (s.kind == format::SectionKind::GridInfo) s.data[s.data.size() - 1] ^= 0x40;
+    EXPECT_TRUE(refused(count, "the signed fill gives"));
 }

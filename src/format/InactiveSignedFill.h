@@ -1,0 +1,21 @@
+// A grid whose inactive layer is OpenVDB's signed flood fill of its active
+// values (EncodedGrid::inactiveSignedFill; docs/FORMAT.md 6.6) stores no
+// inactive layer: the reader makes it again here, from the active layer,
+// with src/volume/SignedFill.h, as the layer an encoder would have stored
+// (its DAG built afresh, every value -|background|).
+#pragma once
+#include <string>
+
+#include "src/attributes/ValueWindows.h"
+#include "src/format/SsvdagFile.h"
+
+namespace vdbdag::format {
+
+// Sets grid.inactive from grid.active (whose DAG and values are read: as
+// attributes, a palette channel or value windows, decoded through
+// `parallel`). Throws vdbdag::Error starting with `what` when the fill does
+// not apply to the grid or gives another voxel count than the file says
+// (grid.inactive.voxels, from GridInfo): the file is corrupt.
+void restoreSignedFill(EncodedGrid& grid, const attributes::ParallelFor& parallel, const std::string& what);
+
+} // namespace vdbdag::format
