@@ -195,6 +195,7 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoRequest& opt, con
     // By magic number (bridge::inputKindOf; only a regular file is opened to
     // look: a FIFO or a device goes on to readFileBytes, which refuses it).
     const bridge::InputKind kind = bridge::inputKindOf(input);
+    std::optional<uint32_t> fileVersion;  // an .ssvdag input's container version
     if (kind == bridge::InputKind::NanoVdb) {
         // NanoVDB: read through NanoVDB's converter as `encode` reads it,
         // then the DAG figures of its encoding in memory.
@@ -229,6 +230,10 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoRequest& opt, con
         }
         report["format"] = "ssvdag";
         report["input_bytes"] = report["ssvdag_bytes"];
+        // The file's container version: 2 where a grid's inside is a signed fill (docs/FORMAT.md 3.1).
+        fileVersion = std::any_of(scene.grids.begin(), scene.grids.end(), [](const format::EncodedGrid& g) { return g.inactiveSignedFill; })
+                          ? format::kLatestFormatVersion
+                          : format::kFormatVersion;
         for (size_t g = 0; g < scene.grids.size(); ++g) {
             const format::EncodedGrid& grid = scene.grids[g];
             const std::string what = input + " grid " + std::to_string(g);
@@ -264,6 +269,7 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoRequest& opt, con
         report["file_metadata"] = metadataJson(facts.fileMetadata);
     }
     addVersions(report);  // the text names the format version too
+    if (fileVersion) report["format_version"] = *fileVersion;  // an .ssvdag's own
     std::string text = formatSceneReport(report);
     if (report.contains("frames")) {  // after the file's line: the frames and their grids
         const auto& frames = report["frames"];

@@ -13,7 +13,7 @@ inline constexpr const char* kToolVersion = "0.1.0";
 inline void addVersions(nlohmann::json& report) {
     report["tool"] = "vdbdag";
     report["tool_version"] = kToolVersion;
-    report["format_version"] = format::kFormatVersion;
+    if (!report.contains("format_version")) report["format_version"] = format::kFormatVersion;  // an .ssvdag's report has its own (InputReport.cpp)
 }
 
 } // namespace vdbdag::app

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <cstring>
 #include <fstream>
 #include <regex>
 
@@ -90,9 +91,20 @@ TEST(Cli, EncodeDecodeVerifyInfoOnASphere) {
     EXPECT_EQ(info["input_bytes"].get<uint64_t>(), fs::file_size(encoded));
     EXPECT_EQ(info["ssvdag_bytes"].get<uint64_t>(), fs::file_size(encoded));
     EXPECT_EQ(info["tool"], "vdbdag");
-    EXPECT_EQ(info["format_version"].get<uint32_t>(), 1u);
+    // The file's own container version (the u32 after the magic): 2, a
+    // level set whose inside is OpenVDB's signed flood fill (docs/FORMAT.md 3.1).
+    const uint32_t fileVersion = [&] {
+        std::ifstream f(encoded, std::ios::binary);
+        char header[12] = {};
+        f.read(header, 12);
+        uint32_t v = 0;
+        std::memcpy(&v, header + 8, 4);
+        return v;
+    }();
+    EXPECT_EQ(fileVersion, 2u);
+    EXPECT_EQ(info["format_version"].get<uint32_t>(), fileVersion);
     const CommandResult text = runCli("info " + encoded.string());
-    EXPECT_NE(text.out.find(".ssvdag file (format 1), " + std::to_string(fs::file_size(encoded)) + " bytes"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find(".ssvdag file (format 2), " + std::to_string(fs::file_size(encoded)) + " bytes"), std::string::npos) << text.out;
     uint64_t sectionBytes = 0;
     for (const auto& s : info["grids"][0]["sections"]) sectionBytes += s["stored_bytes"].get<uint64_t>();
     EXPECT_LT(sectionBytes, fs::file_size(encoded));
@@ -450,7 +462,8 @@ TEST(Cli, EveryJsonReportCarriesTheVersionsAndTheCommonKeys) {
         const nlohmann::json j = nlohmann::json::parse(r.out);
         EXPECT_EQ(j["tool"], "vdbdag") << args;
         EXPECT_TRUE(j["tool_version"].is_string()) << args;
-        EXPECT_EQ(j["format_version"].get<uint32_t>(), 1u) << args;
+        // An .ssvdag's report gives its file's version (this level set's: 2), the others the version the tool writes by default.
+        EXPECT_EQ(j["format_version"].get<uint32_t>(), args.starts_with("info " + s) ? 2u : 1u) << args;
         EXPECT_TRUE(j.contains(inputKey)) << args;
         if (j.contains("ssvdag_bytes") && (args.starts_with("encode") || args.starts_with("info " + s))) {
             EXPECT_EQ(j["ssvdag_bytes"].get<uint64_t>(), fs::file_size(ss)) << args;
