@@ -67,7 +67,7 @@ void restoreSignedFill(EncodedGrid& grid, const attributes::ParallelFor& paralle
         },
         [&](int64_t, int64_t, int64_t, unsigned, uint64_t) { solid = true; });
     activeBricks.bricks.resize(written);
-    const std::optional<InactiveLayer> fill = solid ? std::nullopt : signedFillInactive(active, activeBricks, type, grid.record.background);
+    const std::optional<InactiveLayer> fill = solid ? std::nullopt : signedFillInactive(active, activeBricks, type, grid.record.background, parallel);
     if (!fill) throw Error(what + ": corrupt (a signed fill for a grid it does not apply to)");
     const uint64_t voxels = fill->topology.activeVoxelCount();
     if (voxels != grid.inactive.voxels)

@@ -73,7 +73,8 @@ Origin slotOrigin(const Origin& o, size_t slot, unsigned log2Dim, unsigned child
 }
 
 template <typename T>
-std::optional<InactiveLayer> fillTyped(const GridTopology& active, const LayerValues& values, std::span<const uint8_t> backgroundBytes) {
+std::optional<InactiveLayer> fillTyped(const GridTopology& active, const LayerValues& values, std::span<const uint8_t> backgroundBytes,
+                                       const FillParallel& parallel) {
     if (!active.tiles.empty() || backgroundBytes.size() != sizeof(T)) return std::nullopt;
     T background;
     std::memcpy(&background, backgroundBytes.data(), sizeof(T));
@@ -96,13 +97,19 @@ std::optional<InactiveLayer> fillTyped(const GridTopology& active, const LayerVa
     }
     if (count * sizeof(T) != values.bricks.size()) throw Error("internal error: the active values do not match the active voxels");
     std::sort(byLeaf.begin(), byLeaf.end());
-    // The layer: each leaf's inside voxels as bricks, then the inside tiles.
-    InactiveLayer out;
-    SignedFillTree tree;
-    for (size_t g = 0; g < byLeaf.size();) {
-        const Origin origin = byLeaf[g].first;
+    std::vector<size_t> groupStart;  // each leaf's first entry of byLeaf
+    for (size_t g = 0; g < byLeaf.size(); ++g)
+        if (g == 0 || byLeaf[g].first != byLeaf[g - 1].first) groupStart.push_back(g);
+    groupStart.push_back(byLeaf.size());
+    // Each leaf alone: its fill and its inside voxels' bricks (x fastest, then y, then z).
+    struct LeafOut {
+        SignedFillTree::LeafFill fill;
+        std::array<uint64_t, 8> bricks{};
+    };
+    std::vector<LeafOut> leafOut(groupStart.size() - 1);
+    const auto fillOne = [&](size_t l) {
         Leaf leaf;
-        for (; g < byLeaf.size() && byLeaf[g].first == origin; ++g) {
+        for (size_t g = groupStart[l]; g < groupStart[l + 1]; ++g) {
             const Brick& b = active.bricks[byLeaf[g].second];
             size_t next = firstValue[byLeaf[g].second];
             for (uint64_t bits = b.mask; bits; bits &= bits - 1) {
@@ -115,18 +122,30 @@ std::optional<InactiveLayer> fillTyped(const GridTopology& active, const LayerVa
                 if (v < T(0)) SignedFillTree::set(leaf.negative, n);
             }
         }
-        const SignedFillTree::LeafFill fill = SignedFillTree::fillLeaf(leaf.active, leaf.negative);
-        tree.addLeaf(origin, fill);
-        if (fill.inside == SignedFillTree::LeafBits{}) continue;
-        for (int bz = 0; bz < 8; bz += 4)
-            for (int by = 0; by < 8; by += 4)
-                for (int bx = 0; bx < 8; bx += 4) {
-                    uint64_t mask = 0;
-                    for (int i = 0; i < 64; ++i)
-                        if (SignedFillTree::test(fill.inside, SignedFillTree::leafIndex(unsigned(bx + (i & 3)), unsigned(by + ((i >> 2) & 3)), unsigned(bz + (i >> 4)))))
-                            mask |= uint64_t(1) << i;
-                    if (mask) out.topology.bricks.push_back({origin[0] + bx, origin[1] + by, origin[2] + bz, mask});
-                }
+        LeafOut& o = leafOut[l];
+        o.fill = SignedFillTree::fillLeaf(leaf.active, leaf.negative);
+        if (o.fill.inside == SignedFillTree::LeafBits{}) return;
+        for (int k = 0; k < 8; ++k) {
+            const int bx = (k & 1) * 4, by = ((k >> 1) & 1) * 4, bz = (k >> 2) * 4;
+            uint64_t mask = 0;
+            for (int i = 0; i < 64; ++i)
+                if (SignedFillTree::test(o.fill.inside, SignedFillTree::leafIndex(unsigned(bx + (i & 3)), unsigned(by + ((i >> 2) & 3)), unsigned(bz + (i >> 4)))))
+                    mask |= uint64_t(1) << i;
+            o.bricks[size_t(k)] = mask;
+        }
+    };
+    if (parallel) parallel(leafOut.size(), fillOne);
+    else
+        for (size_t l = 0; l < leafOut.size(); ++l) fillOne(l);
+    // The layer: each leaf's inside voxels as bricks, then the inside tiles.
+    InactiveLayer out;
+    SignedFillTree tree;
+    for (size_t l = 0; l < leafOut.size(); ++l) {
+        const Origin& origin = byLeaf[groupStart[l]].first;
+        tree.addLeaf(origin, leafOut[l].fill);
+        for (int k = 0; k < 8; ++k)
+            if (const uint64_t mask = leafOut[l].bricks[size_t(k)])
+                out.topology.bricks.push_back({origin[0] + (k & 1) * 4, origin[1] + ((k >> 1) & 1) * 4, origin[2] + (k >> 2) * 4, mask});
     }
     out.topology.tiles = tree.insideTiles();
     // Every value -|background|.
@@ -215,10 +234,10 @@ std::vector<Tile> SignedFillTree::insideTiles() const {
 }
 
 std::optional<InactiveLayer> signedFillInactive(const GridTopology& active, const LayerValues& values, ValueType type,
-                                                std::span<const uint8_t> background) {
+                                                std::span<const uint8_t> background, const FillParallel& parallel) {
     if (active.bricks.empty()) return std::nullopt;
-    if (type == ValueType::Float) return fillTyped<float>(active, values, background);
-    if (type == ValueType::Double) return fillTyped<double>(active, values, background);
+    if (type == ValueType::Float) return fillTyped<float>(active, values, background, parallel);
+    if (type == ValueType::Double) return fillTyped<double>(active, values, background, parallel);
     return std::nullopt;
 }
 

@@ -28,6 +28,7 @@
 #include <array>
 #include <bitset>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <span>
@@ -76,8 +77,11 @@ struct InactiveLayer {
 // `background` (its bytes). nullopt where it does not apply: another value
 // type, a background that is not a positive finite number, or active tiles
 // (signedFloodFill would overwrite their values).
+// `parallel(n, body)` runs body(0 .. n-1) in any order (the leaves, each
+// alone); empty: one after another. The result is the same either way.
+using FillParallel = std::function<void(size_t n, const std::function<void(size_t)>& body)>;
 std::optional<InactiveLayer> signedFillInactive(const GridTopology& active, const LayerValues& values, ValueType type,
-                                                std::span<const uint8_t> background);
+                                                std::span<const uint8_t> background, const FillParallel& parallel = {});
 
 // Whether two inactive layers hold the same voxels and tiles with the same
 // value bits, whatever their order.
