@@ -9,13 +9,12 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
-#include <bitset>
 #include <cmath>
-#include <set>
 #include <cstring>
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <set>
 #include <tuple>
 #include <unordered_map>
 
@@ -26,9 +25,9 @@
 #include <tbb/parallel_for.h>
 
 #include "src/util/Error.h"
-#include "src/volume/SignedFill.h"
 #include "src/util/MappedPages.h"
 #include "src/util/ScratchFile.h"
+#include "src/volume/SignedFill.h"
 #include "vdb_bridge/detail/ImportGrids.h"
 #include "vdb_bridge/detail/LeafBricks.h"
 #include "vdb_bridge/detail/NormalEstimation.h"
@@ -498,15 +497,15 @@ private:
         for (auto it = tree.beginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
         leaves_.resize(leaves.size());
         std::vector<uint64_t> inactiveVoxels(leaves.size(), 0);
-        // Chunk by chunk: each leaf's bricks of both layers, with values,
-        // into the scratch file; then the chunk's leaves (and the file pages
-        // their buffers were read from) are dropped.
         // Whether the inactive values are OpenVDB's signed flood fill of the
-        // active ones (SignedFill.h), leaf by leaf here, the tiles after.
+        // active ones (SignedFill.h), leaf by leaf in the pass below, the tiles after.
         constexpr bool kFillable = hasValues && (std::is_same_v<ValueT, float> || std::is_same_v<ValueT, double>);
         bool fillable = false;
         if constexpr (kFillable) fillable = background > ValueT(0) && std::isfinite(double(background)) && tiles_[0].tiles.empty();
         std::vector<uint8_t> leafFill(fillable ? leaves.size() : 0);  // bit 0: the leaf is its fill; bits 1, 2: its first and last values negative
+        // Chunk by chunk: each leaf's bricks of both layers, with values,
+        // into the scratch file; then the chunk's leaves (and the file pages
+        // their buffers were read from) are dropped.
         std::vector<std::vector<uint8_t>> records(std::min(leaves.size(), kLeafChunk));
         std::vector<uint32_t> activeEnds(records.size());
         std::vector<uint8_t> sameValues(records.size());  // per leaf, bit l: layer l's values all have the same bits
@@ -582,14 +581,11 @@ private:
     // inside, the background outside), bits 1 and 2 the signs of its first
     // and last values (for the fill of the nodes above).
     static uint8_t fillOf(const LeafT& leaf, ValueT background) {
-        const auto& mask = leaf.getValueMask();
         const ValueT* data = leaf.buffer().data();
-        SignedFillTree::LeafBits active{}, negative{};
+        SignedFillTree::LeafBits active{}, negative{};  // the value mask's words are LeafBits' (bit n & 63 of word n >> 6)
+        for (unsigned w = 0; w < 8; ++w) active[w] = leaf.getValueMask().template getWord<uint64_t>(w);
         for (openvdb::Index n = 0; n < LeafT::SIZE; ++n)
-            if (mask.isOn(n)) {
-                SignedFillTree::set(active, n);
-                if (data[n] < ValueT(0)) SignedFillTree::set(negative, n);
-            }
+            if (SignedFillTree::test(active, n) && data[n] < ValueT(0)) SignedFillTree::set(negative, n);
         if (active == SignedFillTree::LeafBits{}) return 0;  // the fill of such a leaf reads what it overwrites
         const SignedFillTree::LeafFill fill = SignedFillTree::fillLeaf(active, negative);
         const ValueT inside = -background;

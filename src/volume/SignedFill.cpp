@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <bitset>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "src/util/Error.h"
+#include "src/volume/LeafMask.h"
 
 namespace vdbdag {
 namespace {
@@ -64,6 +64,23 @@ void fillNode(Node& node, unsigned log2Dim) {
 size_t slotOf(const Origin& c, const Origin& o, unsigned log2Dim, unsigned childLog2) {
     const auto at = [&](int a) { return size_t(uint32_t(c[a] - o[a]) >> childLog2); };
     return at(0) << (2 * log2Dim) | at(1) << log2Dim | at(2);
+}
+
+// The nodes of 2^(3 log2Dim) slots of 2^childLog2 voxels holding
+// `children` (origin -> child; ends(child): its first and last values'
+// signs), filled.
+template <typename Children, typename Ends>
+std::map<Origin, Node> fillParents(const Children& children, unsigned log2Dim, unsigned childLog2, Ends&& ends) {
+    std::map<Origin, Node> parents;
+    for (const auto& [origin, child] : children) {
+        const Origin o = alignDown(origin, int(log2Dim + childLog2));
+        Node& node = parents.try_emplace(o, log2Dim).first->second;
+        const size_t s = slotOf(origin, o, log2Dim, childLog2);
+        const auto [first, last] = ends(child);
+        node.child[s] = true, node.childFirst[s] = first, node.childLast[s] = last;
+    }
+    for (auto& [origin, node] : parents) fillNode(node, log2Dim);
+    return parents;
 }
 
 Origin slotOrigin(const Origin& o, size_t slot, unsigned log2Dim, unsigned childLog2) {
@@ -125,14 +142,7 @@ std::optional<InactiveLayer> fillTyped(const GridTopology& active, const LayerVa
         LeafOut& o = leafOut[l];
         o.fill = SignedFillTree::fillLeaf(leaf.active, leaf.negative);
         if (o.fill.inside == SignedFillTree::LeafBits{}) return;
-        for (int k = 0; k < 8; ++k) {
-            const int bx = (k & 1) * 4, by = ((k >> 1) & 1) * 4, bz = (k >> 2) * 4;
-            uint64_t mask = 0;
-            for (int i = 0; i < 64; ++i)
-                if (SignedFillTree::test(o.fill.inside, SignedFillTree::leafIndex(unsigned(bx + (i & 3)), unsigned(by + ((i >> 2) & 3)), unsigned(bz + (i >> 4)))))
-                    mask |= uint64_t(1) << i;
-            o.bricks[size_t(k)] = mask;
-        }
+        for (unsigned k = 0; k < 8; ++k) o.bricks[k] = brickOfLeafMask(o.fill.inside.data(), k);
     };
     if (parallel) parallel(leafOut.size(), fillOne);
     else
@@ -195,21 +205,8 @@ void SignedFillTree::addLeaf(const Origin& origin, const LeafFill& fill) {
 std::vector<Tile> SignedFillTree::insideTiles() const {
     // The internal nodes of 128^3 (16^3 slots of leaves), then of 4096^3
     // (32^3 slots of 128^3 nodes), each filled once its children are.
-    std::map<Origin, Node> lower, upper;
-    for (const auto& [origin, ends] : leaves_) {
-        const Origin o = alignDown(origin, 7);
-        Node& node = lower.try_emplace(o, 4u).first->second;
-        const size_t s = slotOf(origin, o, 4, 3);
-        node.child[s] = true, node.childFirst[s] = ends.first, node.childLast[s] = ends.second;
-    }
-    for (auto& [origin, node] : lower) fillNode(node, 4);
-    for (const auto& [origin, node] : lower) {
-        const Origin o = alignDown(origin, 12);
-        Node& top = upper.try_emplace(o, 5u).first->second;
-        const size_t s = slotOf(origin, o, 5, 7);
-        top.child[s] = true, top.childFirst[s] = node.first, top.childLast[s] = node.last;
-    }
-    for (auto& [origin, node] : upper) fillNode(node, 5);
+    const std::map<Origin, Node> lower = fillParents(leaves_, 4, 3, [](const std::pair<bool, bool>& ends) { return ends; });
+    const std::map<Origin, Node> upper = fillParents(lower, 5, 7, [](const Node& n) { return std::pair{n.first, n.last}; });
     std::vector<Tile> tiles;
     const auto pushTiles = [&](const std::map<Origin, Node>& nodes, unsigned log2Dim, unsigned childLog2) {
         for (const auto& [origin, node] : nodes)

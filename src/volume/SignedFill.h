@@ -26,7 +26,6 @@
 // file's tree held other nodes or other values).
 #pragma once
 #include <array>
-#include <bitset>
 #include <cstdint>
 #include <functional>
 #include <map>

@@ -78,6 +78,20 @@ std::vector<uint8_t> encodeByCubes(const fs::path& path, std::optional<unsigned>
     return format::writeScene(pipeline::encodeSourcesByCubes(std::move(input.grids), input.fileMetadata, {}, budget));
 }
 
+// `grid` written alone to a .vdb file in the test's folder.
+fs::path writeVdb(const openvdb::FloatGrid::Ptr& grid, const std::string& name) {
+    const fs::path path = tempFile(name + ".vdb");
+    openvdb::io::File(path.string()).write({grid});
+    return path;
+}
+
+// The container version of an .ssvdag file (the u32 after the magic).
+uint32_t containerVersion(const std::vector<uint8_t>& file) {
+    uint32_t version = 0;
+    std::memcpy(&version, file.data() + 8, 4);
+    return version;
+}
+
 bool hasSection(const std::vector<uint8_t>& file, format::SectionKind kind) {
     for (const format::Section& s : format::readContainer(file, "test", true))
         if (s.kind == kind) return true;
@@ -215,16 +229,13 @@ TEST(SignedFill, ALevelSetFileStoresNoInactiveLayerAndReadsBackExactly) {
     openvdb::initialize();
     auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(40.0f, {0.5f, 3.f, -2.f}, 0.5f, 3.f);
     sphere->setName("sphere");
-    const fs::path in = tempFile("sphere_in.vdb");
-    openvdb::io::File(in.string()).write({sphere});
+    const fs::path in = writeVdb(sphere, "sphere_in");
     const std::vector<uint8_t> file = encodeByCubes(in);
     // An InactiveSignedFill section instead of the inactive layer's, in a
     // version 2 container (which earlier readers refuse).
     EXPECT_TRUE(hasSection(file, format::SectionKind::InactiveSignedFill));
     EXPECT_FALSE(hasSection(file, format::SectionKind::InactiveLevels));
-    uint32_t version = 0;
-    std::memcpy(&version, file.data() + 8, 4);
-    EXPECT_EQ(version, format::kLatestFormatVersion);
+    EXPECT_EQ(containerVersion(file), format::kLatestFormatVersion);
     // The same bytes in small cubes.
     EXPECT_EQ(encodeByCubes(in, 5u), file);
     // Decoded, every value OpenVDB holds is the original's.
@@ -265,14 +276,11 @@ TEST(SignedFill, OtherInactiveValuesKeepTheirLayer) {
     auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(20.0f, {}, 0.5f, 3.f);
     sphere->setName("sphere");
     sphere->tree().setValueOff(openvdb::Coord(0, 0, 0), -2.0f);
-    const fs::path in = tempFile("changed.vdb");
-    openvdb::io::File(in.string()).write({sphere});
+    const fs::path in = writeVdb(sphere, "changed");
     const std::vector<uint8_t> file = encodeByCubes(in);
     EXPECT_FALSE(hasSection(file, format::SectionKind::InactiveSignedFill));
     EXPECT_TRUE(hasSection(file, format::SectionKind::InactiveLevels));
-    uint32_t version = 0;
-    std::memcpy(&version, file.data() + 8, 4);
-    EXPECT_EQ(version, format::kFormatVersion);
+    EXPECT_EQ(containerVersion(file), format::kFormatVersion);
     const Volume back = pipeline::decodeScene(format::readScene(file, "changed"));
     const GridRecord original = importOne(in);
     EXPECT_TRUE(sameInactiveLayer(back.grids[0].inactiveTopology, back.grids[0].inactiveValues, original.inactiveTopology, original.inactiveValues,
@@ -283,8 +291,7 @@ TEST(SignedFill, OtherInactiveValuesKeepTheirLayer) {
 TEST(SignedFill, ForgedFlagsAreRefused) {
     openvdb::initialize();
     auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(12.0f, {}, 0.5f, 3.f);
-    const fs::path in = tempFile("forged.vdb");
-    openvdb::io::File(in.string()).write({sphere});
+    const fs::path in = writeVdb(sphere, "forged");
     std::vector<format::Section> sections = format::readContainer(encodeByCubes(in), "forged", true);
     fs::remove(in);
     const auto refused = [](const std::vector<format::Section>& s, const std::string& why) {
