@@ -111,6 +111,7 @@ DecodeResult decodeFile(const DecodeRequest& request) {
     readOptions.frame = request.frame;
     readOptions.parallel = util::tbbParallelFor();  // predicted windows on every core
     readOptions.keepValueWindows = dense;  // a scan is written window by window when it can be
+    readOptions.signedFillLayer = dense;   // a .vdb's inside is filled from the decoded active voxels (pipeline::decodeGrid)
     // A .vdb decode builds OpenVDB's grid beside the decoded values: one more copy of each.
     readOptions.limits = request.limits;
     readOptions.limits.valueCopies = dense ? 0 : 1;

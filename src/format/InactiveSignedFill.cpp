@@ -30,6 +30,17 @@ std::vector<uint8_t> activeValues(const EncodedGrid& grid, uint32_t vs, const at
 
 } // namespace
 
+InactiveLayer signedFillOf(const EncodedGrid& grid, const GridTopology& active, const LayerValues& values, const attributes::ParallelFor& parallel,
+                           const std::string& what) {
+    std::optional<InactiveLayer> fill = signedFillInactive(active, values, grid.record.valueType, grid.record.background, parallel);
+    if (!fill) throw Error(what + ": corrupt (a signed fill for a grid it does not apply to)");
+    const uint64_t voxels = fill->topology.activeVoxelCount();
+    if (voxels != grid.inactive.voxels)
+        throw Error(what + ": corrupt (the signed fill gives " + std::to_string(voxels) + " inactive voxels, the file says " +
+                    std::to_string(grid.inactive.voxels) + ")");
+    return std::move(*fill);
+}
+
 void restoreSignedFill(EncodedGrid& grid, const attributes::ParallelFor& parallel, const std::string& what) {
     const ValueType type = grid.record.valueType;
     const uint32_t vs = valueSize(type);
@@ -67,21 +78,18 @@ void restoreSignedFill(EncodedGrid& grid, const attributes::ParallelFor& paralle
         },
         [&](int64_t, int64_t, int64_t, unsigned, uint64_t) { solid = true; });
     activeBricks.bricks.resize(written);
-    const std::optional<InactiveLayer> fill = solid ? std::nullopt : signedFillInactive(active, activeBricks, type, grid.record.background, parallel);
-    if (!fill) throw Error(what + ": corrupt (a signed fill for a grid it does not apply to)");
-    const uint64_t voxels = fill->topology.activeVoxelCount();
-    if (voxels != grid.inactive.voxels)
-        throw Error(what + ": corrupt (the signed fill gives " + std::to_string(voxels) + " inactive voxels, the file says " +
-                    std::to_string(grid.inactive.voxels) + ")");
+    if (solid) throw Error(what + ": corrupt (a signed fill for a grid it does not apply to)");
+    const InactiveLayer fill = signedFillOf(grid, active, activeBricks, parallel, what);
+    const uint64_t voxels = fill.topology.activeVoxelCount();
     EncodedLayer layer;
     layer.voxels = voxels;
-    if (!fill->topology.empty()) {
+    if (!fill.topology.empty()) {
         dag::BuildOptions options;
         options.symmetry = grid.symmetry;
-        layer.dag = encoding::encodeCompact(dag::buildDag(fill->topology, options), /*attributeOffsets=*/true);
+        layer.dag = encoding::encodeCompact(dag::buildDag(fill.topology, options), /*attributeOffsets=*/true);
         const uint64_t n = encoding::decodedSize(layer.dag).attributeEntries;
         layer.attributes.resize(size_t(n) * vs);
-        const std::vector<uint8_t>& inside = fill->values.bricks.empty() ? fill->values.tiles : fill->values.bricks;  // -|background| each
+        const std::vector<uint8_t>& inside = fill.values.bricks.empty() ? fill.values.tiles : fill.values.bricks;  // -|background| each
         for (uint64_t i = 0; i < n; ++i) std::memcpy(&layer.attributes[size_t(i) * vs], inside.data(), vs);
     }
     grid.inactive = std::move(layer);

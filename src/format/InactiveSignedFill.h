@@ -8,6 +8,7 @@
 
 #include "src/attributes/ValueWindows.h"
 #include "src/format/SsvdagFile.h"
+#include "src/volume/SignedFill.h"
 
 namespace vdbdag::format {
 
@@ -17,5 +18,13 @@ namespace vdbdag::format {
 // not apply to the grid or gives another voxel count than the file says
 // (grid.inactive.voxels, from GridInfo): the file is corrupt.
 void restoreSignedFill(EncodedGrid& grid, const attributes::ParallelFor& parallel, const std::string& what);
+
+// The fill itself, from the active voxels `active` with `values` (in
+// GridRecord's order) of `grid`, checked as restoreSignedFill checks it:
+// for a reader that has the active voxels decoded already and needs no DAG
+// of the inside (pipeline::decodeGrid, of a scene read without
+// ReadOptions::signedFillLayer).
+InactiveLayer signedFillOf(const EncodedGrid& grid, const GridTopology& active, const LayerValues& values, const attributes::ParallelFor& parallel,
+                           const std::string& what);
 
 } // namespace vdbdag::format

@@ -525,7 +525,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         const encoding::DecodedSize inactiveSize = inactiveLayer ? readLayerDag(kInactive, grid.inactive, "inactive") : encoding::DecodedSize{};
         if (!options.headersOnly) readLayerValues(kActive, grid.active, activeSize, "active");
         if (inactiveLayer && !options.headersOnly) readLayerValues(kInactive, grid.inactive, inactiveSize, "inactive");
-        if (grid.inactiveSignedFill && !options.headersOnly) restoreSignedFill(grid, options.parallel, what);
+        if (grid.inactiveSignedFill && !options.headersOnly && options.signedFillLayer) restoreSignedFill(grid, options.parallel, what);
         if (Section* e = find(g, SectionKind::ValueErrors, false)) {
             ByteReader r(e->data, what + " ValueErrors");
             auto& l = grid.lossy;

@@ -7,6 +7,7 @@
 #include "src/attributes/PredictedWindows.h"
 #include "src/attributes/ScalarTolerance.h"
 #include "src/encoding/AttributeLayout.h"
+#include "src/format/InactiveSignedFill.h"
 #include "src/format/TraceableValues.h"
 #include "src/pipeline/AttributeOrder.h"
 #include "src/pipeline/CubeEncoder.h"
@@ -81,6 +82,12 @@ GridRecord decodeGrid(const format::EncodedGrid& grid) {
     std::vector<uint8_t> store;
     scatterAttributes(grid.active.dag, attributesOf(grid, false, store), vs, record.topology, record.values);
     store = {};
+    if (grid.inactiveSignedFill && grid.inactive.dag.empty()) {  // read without its layer (ReadOptions::signedFillLayer)
+        InactiveLayer fill = format::signedFillOf(grid, record.topology, record.values, util::tbbParallelFor(), "grid '" + grid.record.name + "'");
+        record.inactiveTopology = std::move(fill.topology);
+        record.inactiveValues = std::move(fill.values);
+        return record;
+    }
     scatterAttributes(grid.inactive.dag, attributesOf(grid, true, store), vs, record.inactiveTopology, record.inactiveValues);
     return record;
 }

@@ -251,6 +251,15 @@ TEST(SignedFill, ALevelSetFileStoresNoInactiveLayerAndReadsBackExactly) {
     const auto decoded = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid("sphere"));
     f.close();
     EXPECT_TRUE(sameTrees(*sphere, *decoded));
+    // Read without the inside's DAG (a .vdb decode), the fill is made from
+    // the decoded active voxels: the same layer.
+    format::ReadOptions noLayer;
+    noLayer.signedFillLayer = false;
+    const format::SsvdagScene bare = format::readScene(file, "sphere", noLayer);
+    EXPECT_TRUE(bare.grids[0].inactive.dag.empty());
+    const Volume filled = pipeline::decodeScene(bare);
+    EXPECT_TRUE(sameInactiveLayer(filled.grids[0].inactiveTopology, filled.grids[0].inactiveValues, original.inactiveTopology,
+                                  original.inactiveValues, ValueType::Float));
     // The reader library answers inside voxels with -background, as OpenVDB does.
     const fs::path ssvdag = tempFile("sphere.ssvdag");
     {
@@ -294,9 +303,11 @@ TEST(SignedFill, ForgedFlagsAreRefused) {
     const fs::path in = writeVdb(sphere, "forged");
     std::vector<format::Section> sections = format::readContainer(encodeByCubes(in), "forged", true);
     fs::remove(in);
-    const auto refused = [](const std::vector<format::Section>& s, const std::string& why) {
+    const auto refused = [](const std::vector<format::Section>& s, const std::string& why, bool layer = true) {
         try {
-            format::readScene(format::writeContainer(s), "forged");
+            format::ReadOptions options;
+            options.signedFillLayer = layer;
+            pipeline::decodeScene(format::readScene(format::writeContainer(s), "forged", options));
         } catch (const Error& e) {
             return std::string(e.what()).find(why) != std::string::npos ? ::testing::AssertionSuccess()
                                                                          : ::testing::AssertionFailure() << "refused for " << e.what();
@@ -317,4 +328,6 @@ TEST(SignedFill, ForgedFlagsAreRefused) {
     for (format::Section& s : count)
         if (s.kind == format::SectionKind::GridInfo) s.data[s.data.size() - 1] ^= 0x40;
     EXPECT_TRUE(refused(count, "the signed fill gives"));
+    // The same when the decode makes the fill (ReadOptions::signedFillLayer off).
+    EXPECT_TRUE(refused(count, "the signed fill gives", false));
 }
