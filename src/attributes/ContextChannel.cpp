@@ -23,7 +23,7 @@ int modelOf(std::span<const coding::BrickPlace> places, coding::BrickOrder order
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                          bool labels, coding::BrickOrder order, int model, int labelModel, bool tileNeighbours) {
+                                          bool labels, coding::BrickOrder order, int model, int labelModel, bool tileNeighbours, bool codeAside) {
     if (labels && places.empty()) throw Error("internal error: labels are coded with their bricks' places");
     if (values.size() % 4) throw Error("internal error: a context-coded channel holds int32 entries");
     std::vector<int32_t> entries(values.size() / 4);
@@ -45,6 +45,7 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
     options.maxValue = step > 1 ? (int64_t(hi) - lo) / int64_t(step) : hi;
     options.model = modelOf(places, order, model);
     options.tileNeighbours = tileNeighbours;
+    options.codeAside = codeAside;
     const std::vector<uint8_t> stream =
         labels           ? coding::encodePlacedLabels(entries, layout, places, order, int32_t(options.minValue), int32_t(options.maxValue), labelModel)
         : places.empty() ? coding::encodeBrickValues(entries, layout, options)

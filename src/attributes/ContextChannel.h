@@ -35,10 +35,11 @@ namespace vdbdag::attributes {
 // 4; 2: coding 17; 3: coding 18). `tileNeighbours` (coding 19): the
 // integers' placed walk of generation 4 with tiles as neighbours.
 // `model`: the generation in spatial order (ignored otherwise).
+// `codeAside`: IntCoderOptions::codeAside (speed only).
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
                                           coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel,
-                                          int labelModel = 1, bool tileNeighbours = false);
+                                          int labelModel = 1, bool tileNeighbours = false, bool codeAside = false);
 
 // Inverse (`places` given exactly when the payload was coded with them);
 // validates the payload against `layout` and `entries` (throws

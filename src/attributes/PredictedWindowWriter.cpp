@@ -7,8 +7,10 @@
 #include <bit>
 #include <cstring>
 
+#include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "src/attributes/ContextChannel.h"
 #include "src/attributes/PaletteCompressor.h"
@@ -98,7 +100,10 @@ bool floatIntegersWin(std::span<const uint32_t> bits, std::span<const uint64_t> 
     const auto sample = std::span<const uint32_t>(bits).first(size_t(w.entries));
     const auto sampleLayout = layout.first(w.bricks);
     const auto samplePlaces = places.first(w.bricks);
-    return coding::encodePlacedFloatIntegers(sample, sampleLayout, samplePlaces).size() < coding::encodePlacedFloats(sample, sampleLayout, samplePlaces).size();
+    size_t integers = 0, floats = 0;  // side by side: a window coded while the other cores idle is a grid's only one
+    tbb::parallel_invoke([&] { integers = coding::encodePlacedFloatIntegers(sample, sampleLayout, samplePlaces).size(); },
+                         [&] { floats = coding::encodePlacedFloats(sample, sampleLayout, samplePlaces).size(); });
+    return integers < floats;
 }
 
 // A window's entries as labels, as a writer codes them today: coding 18,
@@ -140,10 +145,15 @@ bool modelMayBeatLabels(std::span<const uint8_t> values, std::span<const uint64_
         next = b;
     }
     const bool tiles = std::find(sampleLayout.begin(), sampleLayout.end(), uint64_t(0)) != sampleLayout.end();
-    return encodeContextChannel(sample, sampleLayout, samplePlaces, false, coding::spatialOrderOf(coding::kLatestIntModel), coding::kLatestIntModel, 1,
-                                tiles)
-               .size() <
-           encodeLabels(sample, sampleLayout, samplePlaces).size();
+    size_t model = 0, labels = 0;
+    tbb::parallel_invoke(
+        [&] {
+            model = encodeContextChannel(sample, sampleLayout, samplePlaces, false, coding::spatialOrderOf(coding::kLatestIntModel), coding::kLatestIntModel, 1,
+                                         tiles)
+                        .size();
+        },
+        [&] { labels = encodeLabels(sample, sampleLayout, samplePlaces).size(); });
+    return model < labels;
 }
 
 // A window's raw bytes: its coding byte, then the smallest of its entries
@@ -157,6 +167,10 @@ bool modelMayBeatLabels(std::span<const uint8_t> values, std::span<const uint64_
 // cannot win.
 std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
                                 uint32_t vs, const std::optional<FloatChannel>& floats) {
+    // The integer coders range-code on a thread beside their walk where
+    // --threads allows more than one (IntCoderOptions::codeAside: a grid of
+    // one window, or its last, would leave a core idle; the same bytes).
+    const bool aside = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
     std::vector<uint8_t> best;
     uint64_t bestSize = UINT64_MAX;
     uint8_t coding = detail::kPaletteCoding;
@@ -173,7 +187,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         std::vector<uint32_t> bits(values.size() / 4);
         std::memcpy(bits.data(), values.data(), bits.size() * 4);
         if (floatIntegersWin(bits, layout, places)) {
-            std::vector<uint8_t> integers = coding::encodePlacedFloatIntegers(bits, layout, places);
+            std::vector<uint8_t> integers = coding::encodePlacedFloatIntegers(bits, layout, places, aside);
             const uint64_t size = integers.size();
             consider(std::move(integers), size, detail::kFloatIntegerCoding);
         } else {
@@ -184,7 +198,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
         if (floats->lattice) {
             // A window with tiles walks them as neighbours (coding 20); one without is coding 16, the same stream.
             const bool tiles = std::find(layout.begin(), layout.end(), uint64_t(0)) != layout.end();
-            if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *floats->lattice, coding::kLatestIntModel, tiles)) {
+            if (std::optional<std::vector<uint8_t>> integers = encodeRescaledFloats(values, layout, places, *floats->lattice, coding::kLatestIntModel, tiles, aside)) {
                 const uint64_t latticeSize = integers->size();
                 consider(std::move(*integers), latticeSize, tiles ? detail::kTiledRescaledFloatCoding : detail::kBandedRescaledFloatCoding);
             }
@@ -203,7 +217,7 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
             static_assert(coding::kLatestIntModel == 4, "coding 19 is generation 4's walk with tiles");
             const bool tiles = placed && std::find(layout.begin(), layout.end(), uint64_t(0)) != layout.end();
             std::vector<uint8_t> numeric =
-                encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel), coding::kLatestIntModel, 1, tiles);
+                encodeContextChannel(values, layout, places, false, coding::spatialOrderOf(coding::kLatestIntModel), coding::kLatestIntModel, 1, tiles, aside);
             const uint64_t size = numeric.size();
             consider(std::move(numeric), size, tiles ? detail::kTiledContextCoding : placed ? detail::kBandedContextCoding : detail::kContextCoding);
         }

@@ -30,7 +30,7 @@ std::optional<int32_t> latticeIndex(float v, const ValueRescale& r) {
 
 std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                                          std::span<const coding::BrickPlace> places, const ValueRescale& rescale, int model,
-                                                         bool tileNeighbours) {
+                                                         bool tileNeighbours, bool codeAside) {
     if (values.size() % 4) throw Error("internal error: rescaled floats are 4-byte entries");
     if (!std::isfinite(rescale.slope) || rescale.slope == 0 || !std::isfinite(rescale.intercept)) return std::nullopt;
     const size_t n = values.size() / 4;
@@ -50,7 +50,7 @@ std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t
     }
     const std::vector<uint8_t> coded = encodeContextChannel(
         std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(integers.data()), integers.size() * 4), layout, places, false,
-        coding::spatialOrderOf(model), model, 1, tileNeighbours);
+        coding::spatialOrderOf(model), model, 1, tileNeighbours, codeAside);
     format::ByteWriter w;
     w.bytes().reserve(kHeaderBytes + 8 * exceptions.size() + coded.size());
     w.put(rescale.slope);

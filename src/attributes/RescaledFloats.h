@@ -43,9 +43,10 @@ inline float rescaledFloat(int64_t k, const ValueRescale& r) {
 // integers leave int32.
 // `model`: the integers' model generation, 4 (coding 16), 3 (coding 14), 2 (coding 11) or 1 (coding 5);
 // `tileNeighbours` (coding 20): generation 4's walk with tiles as neighbours (ContextChannel.h).
+// `codeAside`: coding/IntVolumeCoder.h's IntCoderOptions::codeAside (speed only).
 std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                                          std::span<const coding::BrickPlace> places, const ValueRescale& rescale,
-                                                         int model = coding::kLatestIntModel, bool tileNeighbours = false);
+                                                         int model = coding::kLatestIntModel, bool tileNeighbours = false, bool codeAside = false);
 
 // Inverse; validates the payload against `layout` and `entries` (throws
 // vdbdag::Error starting with `what`).

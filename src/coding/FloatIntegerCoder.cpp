@@ -35,7 +35,8 @@ unsigned floatZeroLowBits(std::span<const uint32_t> bits) {
     return any ? unsigned(std::countr_zero(any)) : 31u;
 }
 
-std::vector<uint8_t> encodePlacedFloatIntegers(std::span<const uint32_t> bits, std::span<const uint64_t> layout, std::span<const BrickPlace> places) {
+std::vector<uint8_t> encodePlacedFloatIntegers(std::span<const uint32_t> bits, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
+                                               bool codeAside) {
     const unsigned shift = floatZeroLowBits(bits);
     std::vector<int32_t> ints(bits.size());
     int32_t lo = INT32_MAX, hi = INT32_MIN;
@@ -48,7 +49,9 @@ std::vector<uint8_t> encodePlacedFloatIntegers(std::span<const uint32_t> bits, s
     std::vector<uint8_t> out{kGeneration, uint8_t(shift)};
     putI32(out, lo);
     putI32(out, hi);
-    const std::vector<uint8_t> stream = encodePlacedBrickValues(ints, layout, places, BrickOrder::Raster, optionsFor(lo, hi, kGeneration));
+    IntCoderOptions options = optionsFor(lo, hi, kGeneration);
+    options.codeAside = codeAside;
+    const std::vector<uint8_t> stream = encodePlacedBrickValues(ints, layout, places, BrickOrder::Raster, options);
     out.insert(out.end(), stream.begin(), stream.end());
     return out;
 }

@@ -38,7 +38,9 @@ unsigned floatZeroLowBits(std::span<const uint32_t> bits);
 
 // `bits`: the float32 entries' bit patterns, as many as `layout` implies.
 // Throws vdbdag::Error when the layout, its places and the entries disagree.
-std::vector<uint8_t> encodePlacedFloatIntegers(std::span<const uint32_t> bits, std::span<const uint64_t> layout, std::span<const BrickPlace> places);
+// `codeAside`: IntCoderOptions::codeAside (speed only).
+std::vector<uint8_t> encodePlacedFloatIntegers(std::span<const uint32_t> bits, std::span<const uint64_t> layout, std::span<const BrickPlace> places,
+                                               bool codeAside = false);
 
 // Inverse: fills `out` (as many entries as `layout` implies). Throws
 // vdbdag::Error naming `what` on a corrupt or truncated payload; never reads

@@ -68,6 +68,10 @@ struct IntCoderOptions {
     // value there, where coding 15's walk sees none. Tiles themselves are
     // coded as before (from the entry before).
     bool tileNeighbours = false;
+    // Encoding only, and only its speed: the range coding runs on a thread
+    // of its own beside the walk (CodingLoop.h's PipelinedCoder; the same
+    // bytes). For an encoder that may use one more thread than it runs on.
+    bool codeAside = false;
 };
 
 // Codes `samples` (shape.count() of them, raster order). With near > 0,

@@ -128,3 +128,37 @@ TEST(IntVolumeCoder, TruncatedOrPaddedStreamsAreRefused) {
 
 } // namespace
 } // namespace vdbdag::coding
+
+namespace vdbdag::coding {
+namespace {
+
+// IntCoderOptions::codeAside (the range coding on a thread beside the walk)
+// changes the speed only: the stream is the one coded in turn, and it
+// decodes to every sample (lossless) or within near, over several chunks of
+// the hand-over (8,192 samples each) and with the floor flag in play. A
+// sample outside the range is refused with the coder thread running, and
+// nothing hangs.
+TEST(IntVolumeCoder, RangeCodingBesideTheWalkGivesTheSameBytes) {
+    const IntVolumeShape s{96, 80, 24};  // 184,320 samples: 22.5 chunks
+    std::vector<int32_t> v = phantom(s, 11);
+    for (size_t i = 0; i < v.size(); i += 7) v[i] = -1100;  // the range's minimum next to tissue: floor flags
+    for (int32_t near : {0, 2}) {
+        IntCoderOptions o;
+        o.minValue = -1100, o.maxValue = 2600, o.near = near;
+        const std::vector<uint8_t> inTurn = encodeIntVolume(v, s, o);
+        o.codeAside = true;
+        std::vector<int32_t> reconstructed;
+        EXPECT_EQ(encodeIntVolume(v, s, o, &reconstructed), inTurn) << "near " << near;
+        expectRoundTrip(v, s, o, "aside, near " + std::to_string(near));
+    }
+    IntCoderOptions o;
+    o.minValue = -1100, o.maxValue = 2600, o.codeAside = true;
+    v[v.size() - 5] = 2601;  // found after many chunks were handed over
+    EXPECT_THROW(encodeIntVolume(v, s, o), Error);
+    v[v.size() - 5] = 0;
+    v[3] = -1101;  // found before the first hand-over
+    EXPECT_THROW(encodeIntVolume(v, s, o), Error);
+}
+
+} // namespace
+} // namespace vdbdag::coding
