@@ -69,7 +69,7 @@ struct IntCoderOptions {
     // coded as before (from the entry before).
     bool tileNeighbours = false;
     // Encoding only, and only its speed: the range coding runs on a thread
-    // of its own beside the walk (CodingLoop.h's PipelinedCoder; the same
+    // of its own beside the walk (CodeAside.h; the same
     // bytes). For an encoder that may use one more thread than it runs on.
     bool codeAside = false;
 };
