@@ -50,12 +50,14 @@ openvdb::FloatGrid::Ptr tiltedTorus(float R, float r, float halfWidth) {
 } // namespace
 
 int main(int argc, char** argv) {
-    if (argc < 2) {
-        std::fprintf(stderr, "usage: vdbdag_make_samples OUTDIR [--large]\n");
-        return 2;
+    const bool asked = argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h");
+    // No folder, an option where the folder belongs, or an unknown option: the usage, nothing made.
+    if (argc < 2 || argc > 3 || argv[1][0] == '-' || (argc == 3 && std::string(argv[2]) != "--large")) {
+        std::fprintf(asked ? stdout : stderr, "usage: vdbdag_make_samples OUTDIR [--large]\n");
+        return asked ? 0 : 2;
     }
     const std::filesystem::path out = argv[1];
-    const bool large = argc > 2 && std::string(argv[2]) == "--large";
+    const bool large = argc == 3;
     std::filesystem::create_directories(out);
     openvdb::initialize();
 

@@ -35,15 +35,17 @@ std::string frameName(const std::string& stem, int frame) {
     return stem + buffer;
 }
 
-int usage() {
-    std::fprintf(stderr, "usage: vdbdag_make_sequence OUTDIR [--frames N (1-9999, 48)] [--dim D (16-4096, 256)] [--no-fog]\n");
-    return 2;
+int usage(bool asked = false) {
+    std::fprintf(asked ? stdout : stderr, "usage: vdbdag_make_sequence OUTDIR [--frames N (1-9999, 48)] [--dim D (16-4096, 256)] [--no-fog]\n");
+    return asked ? 0 : 2;
 }
 
 } // namespace
 
 int main(int argc, char** argv) {
     if (argc < 2) return usage();
+    // An option where the folder belongs (--help) is not made a folder.
+    if (argv[1][0] == '-') return usage(std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h");
     const std::filesystem::path out = argv[1];
     int frames = 48, dim = 256;
     bool fog = true;
