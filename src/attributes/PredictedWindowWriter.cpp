@@ -16,6 +16,7 @@
 #include "src/attributes/PaletteCompressor.h"
 #include "src/attributes/PredictedChannel.h"
 #include "src/attributes/RescaledFloats.h"
+#include "src/coding/CodeAside.h"
 #include "src/coding/FloatIntegerCoder.h"
 #include "src/coding/FloatValueCoder.h"
 #include "src/coding/LabelCoder.h"
@@ -165,15 +166,10 @@ bool modelMayBeatLabels(std::span<const uint8_t> values, std::span<const uint64_
 // and its palettes
 // (by zstd's fast estimate; they win a tie), unless a sample says they
 // cannot win.
+// `aside`: the integer coders may range-code on a thread beside their walk
+// (coding/CodeAside.h; the same bytes).
 std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                uint32_t vs, const std::optional<FloatChannel>& floats) {
-    // The integer coders range-code on a thread beside their walk where
-    // --threads allows more than one (coding/CodeAside.h: a grid of one
-    // window, or its last, would leave a core idle; the same bytes). The
-    // float coder does not: its coding is too small a part of its time
-    // (aside, the bunny level set encoded 5 % slower, smoke1's float sample
-    // and unnamed_levelset 7 %).
-    const bool aside = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
+                                uint32_t vs, const std::optional<FloatChannel>& floats, bool aside) {
     std::vector<uint8_t> best;
     uint64_t bestSize = UINT64_MAX;
     uint8_t coding = detail::kPaletteCoding;
@@ -322,8 +318,18 @@ void PredictedWindowWriter::add(std::span<const uint8_t> values, std::span<const
 void PredictedWindowWriter::codePending() {
     std::vector<std::vector<uint8_t>> stored(pending_.size());
     std::vector<uint64_t> rawBytes(pending_.size());
+    // The integer coders range-code beside their walk (coding/CodeAside.h)
+    // where a thread --threads allows would otherwise idle: fewer windows
+    // large enough for it are coded together than there are threads (a grid
+    // of one window, a layer's last). Its threads then stay within
+    // --threads. The float coder never does: its coding is too small a part
+    // of its time (aside, the bunny level set encoded 5 % slower,
+    // unnamed_levelset 7 %).
+    size_t large = 0;
+    for (const Window& w : pending_) large += w.entries >= coding::kCodeAsideSamples;
+    const bool aside = large < tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
     tbb::parallel_for(size_t(0), pending_.size(), [&](size_t i) {
-        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, pending_[i].places, valueSize_, floats_);
+        std::vector<uint8_t> raw = codeWindow(pending_[i].values, pending_[i].layout, pending_[i].places, valueSize_, floats_, aside);
         std::vector<uint8_t>().swap(pending_[i].values);
         std::vector<uint64_t>().swap(pending_[i].layout);
         std::vector<coding::BrickPlace>().swap(pending_[i].places);
