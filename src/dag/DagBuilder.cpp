@@ -23,7 +23,6 @@
 #include <limits>
 #include <string>
 
-
 #include "src/dag/BuildParallel.h"
 #include "src/dag/LevelBuilder.h"
 #include "src/util/Error.h"

@@ -80,9 +80,8 @@ void restoreSignedFill(EncodedGrid& grid, const attributes::ParallelFor& paralle
     activeBricks.bricks.resize(written);
     if (solid) throw Error(what + ": corrupt (a signed fill for a grid it does not apply to)");
     const InactiveLayer fill = signedFillOf(grid, active, activeBricks, parallel, what);
-    const uint64_t voxels = fill.topology.activeVoxelCount();
     EncodedLayer layer;
-    layer.voxels = voxels;
+    layer.voxels = grid.inactive.voxels;  // the fill's count: signedFillOf checked it
     if (!fill.topology.empty()) {
         dag::BuildOptions options;
         options.symmetry = grid.symmetry;
