@@ -71,6 +71,10 @@ struct VulkanTracer::Impl {
     DeviceBuffer counter;
     TraceParamsGpu host{};
     std::map<uint32_t, ComputePipeline*> pipelines;
+    // VulkanTracer::setFloatWalk: on by default on GPUs. On a CPU device
+    // (lavapipe) doubles run as fast as floats, and the float walk's error
+    // bounds cost more than they save (docs/measurements.md).
+    bool floatWalk = true;
 
     // The parameters reach the shader as a uniform buffer (set 0, binding 0).
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
@@ -80,6 +84,7 @@ struct VulkanTracer::Impl {
     Impl(VulkanContext& c) : context(c), params(c, sizeof(TraceParamsGpu), MemoryKind::HostVisible, "trace parameters"),
                              counter(c, 16, MemoryKind::HostVisible, "shadow ray counter") {
         const VkDevice device = c.device();
+        floatWalk = c.deviceInfo().type != "CPU";
         setLayout = ComputePipeline::uniformBufferSetLayout(device);
         VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1};
         VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -131,7 +136,7 @@ struct VulkanTracer::Impl {
         const bool oneChunk = arrays[0].chunkCount() == 1 && arrays[1].chunkCount() == 1;
         const bool normals = mode == Mode::Render && !fog && grid.normals;  // only surface shading reads them
         const uint32_t key = uint32_t(mode) | (levelSet ? 4u : 0u) | (fog ? 8u : 0u) | (shadows ? 16u : 0u) | (colouring << 5) | (valueType << 8) |
-                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u) | (labels ? 1u << 20 : 0u) | (iso ? 1u << 21 : 0u) | (volume ? 1u << 22 : 0u);
+                             (oneChunk ? 1u << 16 : 0u) | (normals ? 1u << 17 : 0u) | (mip ? 1u << 18 : 0u) | (slice ? 1u << 19 : 0u) | (labels ? 1u << 20 : 0u) | (iso ? 1u << 21 : 0u) | (volume ? 1u << 22 : 0u) | (floatWalk ? 1u << 23 : 0u);
         auto& slot = pipelines[key];
         if (!slot) {
             // Shared by every tracer on this context: compiling costs ~1 s on lavapipe.
@@ -151,6 +156,7 @@ struct VulkanTracer::Impl {
                 constants.setBool(11, labels);
                 constants.setBool(12, iso);
                 constants.setBool(13, volume);
+                constants.setBool(14, floatWalk);
                 shared = std::make_shared<ComputePipeline>(context, embeddedShader("trace"), constants, uint32_t(sizeof(TracePush)), kWorkgroup,
                                                            "trace.comp", true);
             }
@@ -237,12 +243,16 @@ void VulkanTracer::unpackHits(const void* words, std::span<trace::RayHit> hits) 
         h.faceAxis = int8_t(int((flags >> 8) & 0xFF) - 1);
         h.faceSign = int8_t(int((flags >> 16) & 0xFF) - 1);
         h.lodLevel = uint8_t((flags >> 24) & 0xFF);
+        h.wideSteps = uint8_t((flags >> 1) & 0x7F);
         h.steps = uint32_t(flags >> 32);
         for (int a = 0; a < 3; ++a) h.voxel[a] = int64_t(w[6 * i + 1 + a]);
         std::memcpy(&h.t, &w[6 * i + 4], 8);
         h.attribute = w[6 * i + 5];
     }
 }
+
+void VulkanTracer::setFloatWalk(bool on) { impl_->floatWalk = on; }
+bool VulkanTracer::floatWalk() const { return impl_->floatWalk; }
 
 const DeviceInfo& VulkanTracer::deviceInfo() const { return impl_->context.deviceInfo(); }
 

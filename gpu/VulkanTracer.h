@@ -64,6 +64,14 @@ public:
     // Renders `grid` (the grid given at construction) like trace::renderCpu.
     trace::Image render(const trace::RenderGrid& grid, const trace::Camera& camera, const trace::RenderOptions& options,
                         trace::RenderStats& stats);
+    // The walk's arithmetic (gpu/shaders/trace_walk.glsl): each step decided
+    // in 32-bit floats, in doubles only where the floats are too close to
+    // call (the default on GPUs, which run doubles at 1/2-1/64 the rate of
+    // floats), or every step in doubles (the default on a CPU device such
+    // as lavapipe, where doubles cost no more). The hits are the same either
+    // way, bit for bit; RayHit::wideSteps counts the steps run in doubles.
+    void setFloatWalk(bool on);
+    bool floatWalk() const;
     // Device time of the last traceHits/render dispatch, in ms.
     double lastDeviceMs() const { return lastDeviceMs_; }
 

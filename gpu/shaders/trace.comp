@@ -8,8 +8,9 @@
 //
 // Two modes (specialisation constant MODE):
 //  - hits:   item i traces cell-space ray i (8 doubles: origin, direction,
-//            tMin, tMax) and writes 6 uint64: flags (hit | (faceAxis+1) << 8
-//            | (faceSign+1) << 16 | lodLevel << 24 | steps << 32), voxel xyz,
+//            tMin, tMax) and writes 6 uint64: flags (hit | min(wideSteps,
+//            127) << 1 | (faceAxis+1) << 8 | (faceSign+1) << 16 | lodLevel
+//            << 24 | steps << 32), voxel xyz,
 //            t (bits), entry;
 //  - render: items are pixels in 8x8 tiles (one workgroup of 64 per tile:
 //            neighbouring rays walk the same nodes); writes 8 floats per
@@ -24,6 +25,7 @@
 // product and a sum, so camera rays, crossing times and shading match the
 // CPU tracer bit for bit (exp, for fog, is a polynomial here: ~1e-15).
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_control_flow_attributes : require
 
 #include "dispatch.glsl"
 #include "trace_params.glsl"
@@ -43,6 +45,7 @@ layout(constant_id = 10) const bool SLICE = false;         // render: each pixel
 layout(constant_id = 11) const bool LABELS = false;        // render: each pixel's first voxel whose label is shown (a hit), shaded on the host
 layout(constant_id = 12) const bool ISO = false;           // render: each pixel's first crossing of P.iso (a hit and its t), shaded on the host
 layout(constant_id = 13) const bool VOLUME = false;        // render: emission-absorption through the transfer function (VolumeRender.cpp)
+layout(constant_id = 14) const bool WALK_FP32 = true;      // the walk decides in floats, doubles only where they cannot tell (trace_walk.glsl)
 
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer F64Array { double v[]; };
 
@@ -80,7 +83,7 @@ void writeHit(uint i, Hit h) {
     U64Array res = U64Array(pc.results);
     const uint w = 6u * i;
     res.v[w] = uint64_t(h.hit ? 1u : 0u) | (uint64_t(uint(h.faceAxis + 1)) << 8) | (uint64_t(uint(h.faceSign + 1)) << 16) |
-               (uint64_t(h.lodLevel) << 24) | (uint64_t(h.steps) << 32);
+               (uint64_t(min(h.wideSteps, 127u)) << 1) | (uint64_t(h.lodLevel) << 24) | (uint64_t(h.steps) << 32);
     res.v[w + 1u] = uint64_t(h.voxel.x);
     res.v[w + 2u] = uint64_t(h.voxel.y);
     res.v[w + 3u] = uint64_t(h.voxel.z);
@@ -430,15 +433,22 @@ void renderPixel(uint i) {
                 const dvec3 sd = vec3At(P.lightCell);
                 const int f = hit.faceAxis;
                 so[f] = double(hit.faceSign < 0 ? hit.voxel[f] : hit.voxel[f] + 1l);
+                // One shadow ray, one call of the walk (spirv-opt inlines
+                // it at every call site: SPIR-V has 4M ids).
+                bool castShadow = false;
+                double bias = P.shadowBias;
                 if (haveGradient) {
                     // CpuRenderer.cpp: off the surface along the gradient.
                     const dvec3 n = g / sqrt(dot3(g, g));
                     so = so + kShadowNormalOffset * n;
-                    atomicAdd(U32Array(pc.counter).v[0], 1u);
-                    if (firstSurfaceHit(so, sd, 0.0lf, infinity(), P.shadowBias, 0.0lf).hit) lambert = 0.0lf;
+                    castShadow = true;
                 } else if ((sd[f] > 0.0lf) == (hit.faceSign > 0) && sd[f] != 0.0lf) {
+                    castShadow = true;
+                    bias = LEVEL_SET ? P.shadowBias : 0.0lf;
+                }
+                if (castShadow) {
                     atomicAdd(U32Array(pc.counter).v[0], 1u);
-                    if (firstSurfaceHit(so, sd, 0.0lf, infinity(), LEVEL_SET ? P.shadowBias : 0.0lf, 0.0lf).hit) lambert = 0.0lf;
+                    if (firstSurfaceHit(so, sd, 0.0lf, infinity(), bias, 0.0lf).hit) lambert = 0.0lf;
                 }
             }
             precise dvec3 shaded = baseColour(hit.entry) * (kAmbient + (1.0lf - kAmbient) * lambert);

@@ -89,9 +89,10 @@ struct Hit {
     int faceSign;
     uint lodLevel;
     uint steps;
+    uint wideSteps;     // steps decided in doubles (all of them without WALK_FP32)
 };
 
-Hit noHit() { return Hit(false, i64vec3(0), 0.0lf, 0ul, -1, 0, 0u, 0u); }
+Hit noHit() { return Hit(false, i64vec3(0), 0.0lf, 0ul, -1, 0, 0u, 0u, 0u); }
 
 double infinity() { return packDouble2x32(uvec2(0u, 0x7FF00000u)); }
 
@@ -99,6 +100,41 @@ double infinity() { return packDouble2x32(uvec2(0u, 0x7FF00000u)); }
 dvec3 gO, gD;
 
 double crossing(int a, int64_t boundary) { return (double(boundary) - gO[a]) / gD[a]; }
+
+// ---- The walk in 32 bits (WALK_FP32) ----------------------------------------
+// GPUs outside the data centre run double precision at 1/32-1/64 of float.
+// With WALK_FP32 the walk decides each step from float approximations of
+// the crossing times and falls back to the doubles above only where the
+// floats cannot tell; every decision is the one the doubles make, so the
+// hits (voxel, t, face) are bit for bit those of the fp64 walk and of the
+// CPU tracer, which stays in doubles.
+//
+// Error bound. F = (float(b) - float(o)) / float(d) against the double
+// crossing T(b) = (b - o) / d: with every conversion, the subtraction and
+// the quotient off by at most 1, 1 and 2.5 units in the last place (Vulkan's
+// fp32 division is 2.5 ulp; conversions may truncate), |F - T| <= 4.5 2^-23
+// |F| + (|b| + |o|) 2^-23 / |d| (plus T's own 2^-52, negligible). errOf
+// takes twice each term: |F| 2^-20 + gK[a], gK[a] = (|o| + max|b|) 2^-21 /
+// |d| over the occupied box's boundaries, which leaves room for the
+// rounding of the comparisons themselves. A decision "T(x) < T(y)" is taken
+// in floats only when Fx + Ex < Fy - Ey; otherwise (near ties, exact ties,
+// a ray whose numbers a float cannot hold) the step runs in doubles.
+vec3 gOf, gDf, gK;  // the ray in floats, and errOf's constant per axis (set per ray by walkRay)
+const float kFloatRel = 9.5367431640625e-7;  // 2^-20
+
+float crossF(int a, int64_t boundary) { return (float(boundary) - gOf[a]) / gDf[a]; }
+float errOf(float f, int a) { return isinf(f) ? 0.0 : abs(f) * kFloatRel + gK[a]; }
+float infinityF() { return uintBitsToFloat(0x7F800000u); }
+
+// The time the walk is at, in doubles, from its integer state: the entry
+// crossing of the voxel on the lowest axis crossed, or tEnter if none
+// (every step crosses at least one axis; only the start may cross none).
+// This is bit for bit the fp64 walk's t: there t is that same crossing.
+double entryTime(i64vec3 v, uint crossed, double tEnter) {
+    if (crossed == 0u) return tEnter;
+    const int a = findLSB(crossed);
+    return crossing(a, gD[a] > 0.0lf ? v[a] : v[a] + 1l);
+}
 
 int64_t clamp64(int64_t c, int64_t lo, int64_t hi) { return c < lo ? lo : (hi < c ? hi : c); }
 
@@ -239,7 +275,7 @@ bool visitBox(uint visitKind, inout Hit box, double tLeave, double ignoreBefore,
     return gFogTransmittance < 1e-3lf;
 }
 
-Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, uint steps) {
+Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, uint steps, uint wideSteps) {
     int faceAxis = -1;
     const int64_t within = (int64_t(1) << lodLevel) - 1l;
     // The lowest crossed axis whose face is also the box's (straight-line:
@@ -255,7 +291,41 @@ Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, ui
     h.faceSign = faceAxis < 0 ? 0 : (gD[faceAxis] > 0.0lf ? -1 : 1);
     h.lodLevel = lodLevel;
     h.steps = steps;
+    h.wideSteps = wideSteps;
     return h;
+}
+
+// WALK_FP32: the voxel of [lo, hi] on axis a at the time whose float is tF
+// (error eT), as voxelAt finds it, with the float of its exit time; false
+// when a comparison is too close to call in floats (or the guess is more
+// than a few voxels off). The voxel it returns is entered strictly before
+// that time (voxelAt's tIn < t), so the axis is not crossed at it.
+bool voxelAtFloat(int a, float tF, float eT, int64_t lo, int64_t hi, out int64_t c, out float tOutF) {
+    const bool up = gD[a] > 0.0lf;
+    const float p = gOf[a] + tF * gDf[a];
+    c = lo;
+    if (!(p > float(lo) - 1.0)) c = lo;
+    else if (!(p < float(hi) + 2.0)) c = hi;
+    else c = up ? int64_t(floor(p)) : int64_t(ceil(p)) - 1l;
+    c = clamp64(c, lo, hi);
+    const int64_t forwardStep = up ? 1l : -1l;
+    const int64_t first = up ? lo : hi, last = up ? hi : lo;
+    const int64_t exitOffset = up ? 1l : 0l;
+    float tInF = crossF(a, c + 1l - exitOffset);
+    tOutF = crossF(a, c + exitOffset);
+    [[dont_unroll]] for (int turn = 0; turn < 4; ++turn) {
+        const float eIn = errOf(tInF, a), eOut = errOf(tOutF, a);
+        const bool outBefore = c != last && tOutF + eOut < tF - eT;   // voxelAt moves forward
+        const bool outUnsure = c != last && !outBefore && !(tOutF - eOut > tF + eT);
+        const bool inAfter = c != first && tInF - eIn > tF + eT;      // voxelAt moves back
+        const bool inUnsure = c != first && !inAfter && !(tInF + eIn < tF - eT);
+        if (outUnsure || inUnsure) return false;
+        if (!outBefore && !inAfter) return true;
+        c += outBefore ? forwardStep : -forwardStep;
+        tInF = crossF(a, c + 1l - exitOffset);
+        tOutF = crossF(a, c + exitOffset);
+    }
+    return false;
 }
 
 // walkRay. kVisitFirstHit returns the first occupied box, kVisitZeroCrossing,
@@ -299,6 +369,28 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
     dvec3 tNext;  // a vector, not an array: indexed by a varying axis below
     for (int a = 0; a < 3; ++a) tNext[a] = gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? v[a] + 1l : v[a]);
 
+    // WALK_FP32: the floats of tNext and tExit; t and tNext then hold only
+    // where a step ran in doubles (entryTime gives t at a hit). Rays with
+    // numbers too large or too small for a float walk in doubles throughout.
+    vec3 fNext = vec3(0.0);
+    float fExit = 0.0, eExit = 0.0;
+    bool useF = WALK_FP32;
+    if (useF) {
+        const double kBig = 1152921504606846976.0lf;  // 2^60
+        const double kScale = 1.0lf / 2097152.0lf;      // 2^-21
+        for (int a = 0; a < 3; ++a) {
+            const double ad = abs(gD[a]);
+            const double maxB = double(max(abs(gBoxLo[a]), abs(gBoxHi[a])));
+            if (ad != 0.0lf && !(ad >= 1.0lf / kBig && ad <= kBig && abs(gO[a]) <= kBig)) useF = false;
+            gOf[a] = float(gO[a]);
+            gDf[a] = float(gD[a]);
+            gK[a] = ad == 0.0lf ? 0.0 : float((abs(gO[a]) + maxB) / ad * kScale) * 1.0001;
+            fNext[a] = float(tNext[a]);
+        }
+        fExit = float(tExit);
+        eExit = isinf(fExit) ? 0.0 : abs(fExit) * kFloatRel;
+    }
+
     // The stack of stored nodes containing v, a node's word position and
     // mirror mask packed in one word (pos | mirror << 61), and the node at
     // `depth` also in registers (node*): the stack is private memory, whose
@@ -311,7 +403,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
     stackPosMirror[0] = uint64_t(gRootReflection) << 61;
     stackBase[0] = 0ul;
     const uint innerLevels = gInnerLevels;
-    uint steps = 0u;
+    uint steps = 0u, wideSteps = 0u;
     bool inLeaf = false;
     uint64_t leafStored = 0ul, leafSpatial = 0ul, leafBase = 0ul;
     uint leafMirror = 0u;
@@ -356,7 +448,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 leafBase = base;
                 break;
             }
-            if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * t) {
+            if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * (useF ? entryTime(v, crossed, tEnter) : t)) {
                 hitEntry = base;
                 hitLevel = halfLog2;
                 occupied = true;
@@ -388,7 +480,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         // loop, the axis a variable, until a voxel to stop at, a tie between
         // axes, the leaf's or the box's end, or tExit: the same voxels, t and
         // faces as the steps of the main loop, whose every turn costs the
-        // whole walk on lavapipe.
+        // whole walk on lavapipe. In floats, a step too close to call is
+        // left to the main loop as a tie is.
         while (inLeaf && !occupied && skip == 0u) {
             const uint x = uint(v[0] & 3l), y = uint(v[1] & 3l), z = uint(v[2] & 3l);
             if (((leafSpatial >> (x + 4u * y + 16u * z)) & 1ul) != 0ul) {
@@ -396,17 +489,33 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 const uint rank = dagLeafRank(leafStored, dagStoredBit(x, y, z, leafMirror));
                 if (((leafInside >> rank) & 1ul) != 0ul) break;
             }
-            const double tNew = min(tNext[0], min(tNext[1], tNext[2]));
-            if (!(tNew < tExit)) break;
-            const int a = tNext[0] == tNew ? 0 : (tNext[1] == tNew ? 1 : 2);
-            if ((a < 1 && tNext[1] == tNew) || (a < 2 && tNext[2] == tNew)) break;  // a tie: the main loop's step
+            int a;
+            double tStep = t;
+            if (useF) {
+                const float fNew = min(fNext[0], min(fNext[1], fNext[2]));
+                a = fNext[0] == fNew ? 0 : (fNext[1] == fNew ? 1 : 2);
+                const float e = errOf(fNew, a);
+                if (!(fNew + e < fExit - eExit)) break;
+                const float lead = fNew + e;
+                if ((a != 0 && !(lead < fNext[0] - errOf(fNext[0], 0))) || (a != 1 && !(lead < fNext[1] - errOf(fNext[1], 1))) ||
+                    (a != 2 && !(lead < fNext[2] - errOf(fNext[2], 2))))
+                    break;
+            } else {
+                const double tNew = min(tNext[0], min(tNext[1], tNext[2]));
+                if (!(tNew < tExit)) break;
+                a = tNext[0] == tNew ? 0 : (tNext[1] == tNew ? 1 : 2);
+                if ((a < 1 && tNext[1] == tNew) || (a < 2 && tNext[2] == tNew)) break;  // a tie: the main loop's step
+                tStep = tNew;
+            }
             const int64_t nx = gD[a] > 0.0lf ? v[a] + 1l : v[a] - 1l;
             if ((nx >> 2) != (v[a] >> 2) || nx < gBoxLo[a] || nx >= gBoxHi[a]) break;
             if (++steps > gMaxSteps) break;
-            tNext[a] = crossing(a, gD[a] > 0.0lf ? nx + 1l : nx);
+            if (useF) fNext[a] = crossF(a, gD[a] > 0.0lf ? nx + 1l : nx);
+            else tNext[a] = crossing(a, gD[a] > 0.0lf ? nx + 1l : nx);
             v[a] = nx;
             crossed = 1u << a;
-            t = tNew;
+            t = tStep;
+            if (!useF) ++wideSteps;
         }
         bool occupiedInside = false;
         if (inLeaf && !occupied && skip == 0u) {
@@ -426,7 +535,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 if ((leafSpatial & (uint64_t(0x330033) << corner)) == 0ul) skip = 1u;
             }
         }
-        if (occupied) result = makeHit(v, crossed, t, hitEntry, hitLevel, steps);
+        if (occupied) result = makeHit(v, crossed, useF ? entryTime(v, crossed, tEnter) : t, hitEntry, hitLevel, steps, wideSteps);
         if (firstOnly && occupied) return result;
         pending = occupied;
         pendingInside = occupiedInside;
@@ -434,50 +543,124 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         if (++steps > gMaxSteps) return firstOnly ? noHit() : found;
         const int64_t cube = int64_t(1) << skip;
         i64vec3 lo, hi;
-        dvec3 tc;
-        double tNew = infinity();
         for (int a = 0; a < 3; ++a) {
             lo[a] = v[a] & ~(cube - 1l);
             hi[a] = lo[a] + cube - 1l;
-            // The cube's far face on this axis (one crossing whatever the
-            // sign: both sides of a branch run here); the voxel's own exit
-            // when v is the cube's last voxel that way.
-            const bool up = gD[a] > 0.0lf;
-            const double tFar = crossing(a, up ? hi[a] + 1l : lo[a]);
-            tc[a] = gD[a] == 0.0lf ? infinity() : (v[a] == (up ? hi[a] : lo[a]) ? tNext[a] : tFar);
-            tNew = tc[a] < tNew ? tc[a] : tNew;
         }
-        if (!firstOnly && pending) {
-            pending = false;
-            if (visitBox(visitKind, result, tExit < tNew ? tExit : tNew, ignoreBefore, found, pendingInside)) return found;
-        }
-        if (!(tNew < tExit)) return firstOnly ? noHit() : found;
         i64vec3 next = v;
-        crossed = 0u;
-        uint unknown = 0u;  // axes whose voxel at tNew voxelAt must find
-        for (int a = 0; a < 3; ++a) {
-            if (tc[a] == tNew) {
-                next[a] = gD[a] > 0.0lf ? hi[a] + 1l : lo[a] - 1l;
-                if (next[a] < gBoxLo[a] || next[a] >= gBoxHi[a]) return firstOnly ? noHit() : found;
-                tNext[a] = crossing(a, gD[a] > 0.0lf ? next[a] + 1l : next[a]);
-                crossed |= 1u << a;
-            } else if (!(tNext[a] > tNew)) {
-                unknown |= 1u << a;
+        // The step in floats where they can tell (WALK_FP32): the axis that
+        // leaves the cube first (am) at fNew, surely alone and surely before
+        // or after tExit, and every other axis surely without a boundary
+        // before it or with its voxel there found by voxelAtFloat.
+        bool stepped = false;
+        int am = 0;
+        bool after = false;
+        vec3 fNextNew = fNext;
+        if (useF) {
+            vec3 tcF;
+            for (int a = 0; a < 3; ++a) {
+                const bool up = gD[a] > 0.0lf;
+                const float tFar = crossF(a, up ? hi[a] + 1l : lo[a]);
+                tcF[a] = gD[a] == 0.0lf ? infinityF() : (v[a] == (up ? hi[a] : lo[a]) ? fNext[a] : tFar);
+            }
+            const float fNew = min(tcF[0], min(tcF[1], tcF[2]));
+            am = tcF[0] == fNew ? 0 : (tcF[1] == fNew ? 1 : 2);
+            const float eNew = errOf(fNew, am);
+            bool sure = !isinf(fNew);
+            for (int a = 0; a < 3; ++a)
+                if (a != am && !(fNew + eNew < tcF[a] - errOf(tcF[a], a))) sure = false;
+            const bool before = fNew + eNew < fExit - eExit;
+            after = fNew - eNew > fExit + eExit;
+            if (!before && !after) sure = false;
+            if (sure && before) {
+                const bool upM = gD[am] > 0.0lf;
+                next[am] = upM ? hi[am] + 1l : lo[am] - 1l;
+                fNextNew[am] = crossF(am, upM ? next[am] + 1l : next[am]);
+                uint unknown = 0u;
+                for (int a = 0; a < 3; ++a) {
+                    if (a == am || gD[a] == 0.0lf) continue;
+                    const float e = errOf(fNext[a], a);
+                    if (fNext[a] - e > fNew + eNew) continue;  // stays in v[a]
+                    if (fNext[a] + e < fNew - eNew) unknown |= 1u << a;
+                    else sure = false;
+                }
+                while (sure && unknown != 0u) {
+                    const int a = findLSB(unknown);
+                    unknown &= unknown - 1u;
+                    const bool up = gD[a] > 0.0lf;
+                    int64_t c;
+                    float tOutF;
+                    if (!voxelAtFloat(a, fNew, eNew, up ? v[a] : lo[a], up ? hi[a] : v[a], c, tOutF)) sure = false;
+                    next[a] = c;
+                    fNextNew[a] = tOutF;
+                }
+            }
+            stepped = sure;
+            if (!sure) {
+                next = v;
+                // The doubles of the state, for the step in doubles below.
+                for (int a = 0; a < 3; ++a) tNext[a] = gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? v[a] + 1l : v[a]);
+                t = entryTime(v, crossed, tEnter);
             }
         }
-        // At most two axes (one at least is crossed), through one copy of
-        // voxelAt with the axis as a variable: lavapipe runs every copy of
-        // code in the loop for every subgroup, and voxelAt is the costliest.
-        while (unknown != 0u) {
-            const int a = findLSB(unknown);
-            unknown &= unknown - 1u;
-            double tIn, tOut;
-            // From v forwards to the cube's far end: one call, the range chosen first.
-            const bool up = gD[a] > 0.0lf;
-            const int64_t c = voxelAt(a, tNew, up ? v[a] : lo[a], up ? hi[a] : v[a], tIn, tOut);
-            next[a] = c;
-            tNext[a] = tOut;
-            if (c != v[a] && tIn == tNew) crossed |= 1u << a;
+        dvec3 tc;
+        double tNew = infinity();
+        if (!stepped) {
+            ++wideSteps;
+            for (int a = 0; a < 3; ++a) {
+                // The cube's far face on this axis (one crossing whatever the
+                // sign: both sides of a branch run here); the voxel's own exit
+                // when v is the cube's last voxel that way.
+                const bool up = gD[a] > 0.0lf;
+                const double tFar = crossing(a, up ? hi[a] + 1l : lo[a]);
+                tc[a] = gD[a] == 0.0lf ? infinity() : (v[a] == (up ? hi[a] : lo[a]) ? tNext[a] : tFar);
+                tNew = tc[a] < tNew ? tc[a] : tNew;
+            }
+        }
+        // The box just left, visited once for both arithmetics (spirv-opt
+        // inlines the visitors at every call: SPIR-V has only 4M ids).
+        if (!firstOnly && pending) {
+            pending = false;
+            double tLeave = tExit < tNew ? tExit : tNew;
+            if (stepped) tLeave = after ? tExit : crossing(am, gD[am] > 0.0lf ? hi[am] + 1l : lo[am]);
+            if (visitBox(visitKind, result, tLeave, ignoreBefore, found, pendingInside)) return found;
+        }
+        if (stepped) {
+            if (after) return firstOnly ? noHit() : found;
+            if (next[am] < gBoxLo[am] || next[am] >= gBoxHi[am]) return firstOnly ? noHit() : found;
+            fNext = fNextNew;
+            crossed = 1u << am;
+        } else {
+            if (!(tNew < tExit)) return firstOnly ? noHit() : found;
+            crossed = 0u;
+            uint unknown = 0u;  // axes whose voxel at tNew voxelAt must find
+            for (int a = 0; a < 3; ++a) {
+                if (tc[a] == tNew) {
+                    next[a] = gD[a] > 0.0lf ? hi[a] + 1l : lo[a] - 1l;
+                    if (next[a] < gBoxLo[a] || next[a] >= gBoxHi[a]) return firstOnly ? noHit() : found;
+                    tNext[a] = crossing(a, gD[a] > 0.0lf ? next[a] + 1l : next[a]);
+                    crossed |= 1u << a;
+                } else if (!(tNext[a] > tNew)) {
+                    unknown |= 1u << a;
+                }
+            }
+            // At most two axes (one at least is crossed), through one copy of
+            // voxelAt with the axis as a variable: lavapipe runs every copy of
+            // code in the loop for every subgroup, and voxelAt is the costliest.
+            while (unknown != 0u) {
+                const int a = findLSB(unknown);
+                unknown &= unknown - 1u;
+                double tIn, tOut;
+                // From v forwards to the cube's far end: one call, the range chosen first.
+                const bool up = gD[a] > 0.0lf;
+                const int64_t c = voxelAt(a, tNew, up ? v[a] : lo[a], up ? hi[a] : v[a], tIn, tOut);
+                next[a] = c;
+                tNext[a] = tOut;
+                if (c != v[a] && tIn == tNew) crossed |= 1u << a;
+            }
+            t = tNew;
+            if (useF)
+                for (int a = 0; a < 3; ++a) fNext[a] = float(tNext[a]);
         }
         const uint64_t changed = uint64_t(next[0] ^ v[0]) | uint64_t(next[1] ^ v[1]) | uint64_t(next[2] ^ v[2]);
         const uint keepLog2 = bitWidth64(changed);
@@ -490,7 +673,6 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             nodeBase = stackBase[depth];
         }
         v = next;
-        t = tNew;
     }
     return result;
 }

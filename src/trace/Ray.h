@@ -31,6 +31,7 @@ struct RayHit {
     int8_t faceSign = 0;                     // outward normal sign of that face (-1 or +1)
     uint8_t lodLevel = 0;                    // log2 size of the node accepted as a hit (0: a voxel)
     uint32_t steps = 0;                      // nodes left behind on the way (for statistics)
+    uint8_t wideSteps = 0;                   // Vulkan walk: steps decided in doubles, up to 127 (statistics; 0 on the CPU)
 };
 
 } // namespace vdbdag::trace

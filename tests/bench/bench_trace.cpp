@@ -20,6 +20,8 @@
 // Run: build/vdbdag_bench --benchmark_filter=Trace
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+
 #include <atomic>
 #include <filesystem>
 #include <optional>
@@ -144,6 +146,8 @@ void BM_Trace_ZeroCrossing_NanoVdb(benchmark::State& state) {
 // The Vulkan tracer on the same camera: the rays are generated on the device
 // exactly as Camera::pixelRay does (tests/unit/test_vulkan_tracer.cpp checks
 // the hits are the CPU's), so no ray upload is timed; the hits are read back.
+// The argument is the walk's arithmetic: 32 (floats, doubles only where they
+// cannot tell; the default) or 64 (doubles throughout). The same hits.
 void vulkanPrimary(benchmark::State& state, const vdbdag::format::EncodedGrid& encoded, vdbdag::gpu::HitKind kind) {
     std::unique_ptr<vdbdag::gpu::VulkanContext> context;
     try {
@@ -154,19 +158,21 @@ void vulkanPrimary(benchmark::State& state, const vdbdag::format::EncodedGrid& e
     }
     const vdbdag::trace::RenderGrid grid = vdbdag::trace::makeRenderGrid(encoded);
     vdbdag::gpu::VulkanTracer tracer(*context, grid);
+    tracer.setFloatWalk(state.range(0) == 32);
     tracer.tracePrimary(scene().camera, kind);  // compiles the pipeline outside the timing
-    uint64_t hits = 0;
+    uint64_t hits = 0, steps = 0, wideSteps = 0;
     double deviceMs = 0;
     for (auto _ : state) {
         const std::vector<vdbdag::trace::RayHit>& result = tracer.tracePrimary(scene().camera, kind);
         deviceMs += tracer.lastDeviceMs();
-        hits = 0;
-        for (const auto& h : result) hits += h.hit;
+        hits = steps = wideSteps = 0;
+        for (const auto& h : result) hits += h.hit, steps += h.steps, wideSteps += h.wideSteps;
     }
     const size_t n = size_t(kWidth) * kHeight;
     state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(n));
     state.counters["hit_fraction"] = double(hits) / double(n);
     state.counters["device_ms"] = deviceMs / double(state.iterations());
+    state.counters["steps_in_doubles"] = double(wideSteps) / double(std::max<uint64_t>(steps, 1));  // of the hits' steps (each ray's count saturates at 127)
     state.SetLabel(tracer.deviceInfo().name);
 }
 
@@ -176,9 +182,9 @@ void BM_Trace_Vulkan_ZeroCrossing_Ssvdag(benchmark::State& state) { vulkanPrimar
 
 } // namespace
 
-BENCHMARK(BM_Trace_Vulkan_FirstHit_Ssvdag)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Trace_Vulkan_FirstHit_Svdag)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Trace_Vulkan_ZeroCrossing_Ssvdag)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Trace_Vulkan_FirstHit_Ssvdag)->Unit(benchmark::kMillisecond)->Arg(32)->Arg(64)->UseRealTime();
+BENCHMARK(BM_Trace_Vulkan_FirstHit_Svdag)->Unit(benchmark::kMillisecond)->Arg(32)->UseRealTime();
+BENCHMARK(BM_Trace_Vulkan_ZeroCrossing_Ssvdag)->Unit(benchmark::kMillisecond)->Arg(32)->Arg(64)->UseRealTime();
 BENCHMARK(BM_Trace_FirstHit_Ssvdag)->Unit(benchmark::kMillisecond)->Arg(0)->Arg(1)->UseRealTime();
 BENCHMARK(BM_Trace_FirstHit_Svdag)->Unit(benchmark::kMillisecond)->Arg(0)->Arg(1)->UseRealTime();
 BENCHMARK(BM_Trace_ZeroCrossing_Ssvdag)->Unit(benchmark::kMillisecond)->Arg(0)->Arg(1)->UseRealTime();

@@ -59,6 +59,7 @@ TEST(VulkanTracer, MaximumIntensityProjectionAndSliceEqualTheCpuRenderer) {
         for (const auto& window : {std::optional<std::pair<double, double>>{}, std::optional(std::pair{-500.0, 100.0})}) {
             trace::RenderOptions options;
             options.window = window;
+            gpuTracer.setFloatWalk(window.has_value());  // both arithmetics of the walk, the same image
             // A slice through the middle, seen from the default camera's slant.
             options.slice = {1 + int(window.has_value()), grid == scan ? 15 : 0};
             trace::RenderStats cpuStats, gpuStats;
@@ -98,6 +99,7 @@ TEST(VulkanTracer, LabelsEqualTheCpuRenderer) {
     for (const std::vector<int64_t>& shown : {std::vector<int64_t>{}, std::vector<int64_t>{2, 7}}) {
         trace::RenderOptions options;
         options.labels = shown;
+        gpuTracer.setFloatWalk(!shown.empty());  // both arithmetics of the walk, the same image
         trace::RenderStats stats;
         const trace::Image cpu = trace::renderCpu(rg, camera, options);
         const trace::Image gpu = gpuTracer.render(rg, camera, options, stats);
@@ -133,6 +135,7 @@ TEST(VulkanTracer, IsosurfaceEqualsTheCpuRenderer) {
     for (const std::optional<double> iso : {std::optional<double>{}, std::optional(420.5)}) {
         trace::RenderOptions options;
         options.iso = iso;
+        gpuTracer.setFloatWalk(iso.has_value());  // both arithmetics of the walk, the same image
         trace::RenderStats cpuStats, gpuStats;
         const trace::Image cpu = trace::renderCpu(rg, camera, options, &cpuStats);
         const trace::Image gpu = gpuTracer.render(rg, camera, options, gpuStats);
@@ -172,6 +175,7 @@ TEST(VulkanTracer, VolumeRenderingAgreesWithTheCpuRenderer) {
     for (const std::optional<trace::TransferFunction>& tf : {std::optional<trace::TransferFunction>{}, std::optional(points)}) {
         trace::RenderOptions options;
         options.transfer = tf;
+        gpuTracer.setFloatWalk(tf.has_value());  // both arithmetics of the walk, the same image
         trace::RenderStats cpuStats, gpuStats;
         const trace::Image cpu = trace::renderCpu(rg, camera, options, &cpuStats);
         const trace::Image gpu = gpuTracer.render(rg, camera, options, gpuStats);

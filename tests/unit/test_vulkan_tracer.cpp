@@ -133,7 +133,7 @@ std::vector<Ray> sceneRays(const trace::RenderGrid& grid, int width, int height,
 // the device (tracePrimary; then first hits only from those: every pipeline
 // variant costs a compile of seconds on lavapipe). Returns the rays traced in
 // all; `hits` gets the CPU's first hits among the distinct rays.
-size_t compareOnGrid(const format::EncodedGrid& encoded, int width, int height, size_t randomCount, const std::string& label, size_t& hits,
+size_t compareOnGrid(const format::EncodedGrid& encoded, int width, int height, size_t randomCount, const std::string& walkLabel, size_t& hits,
                      bool primary) {
     const trace::RenderGrid grid = trace::makeRenderGrid(encoded);
     const std::vector<Ray> rays = sceneRays(grid, width, height, randomCount, 99);
@@ -146,6 +146,9 @@ size_t compareOnGrid(const format::EncodedGrid& encoded, int width, int height, 
     const size_t pixels = size_t(width) * size_t(height);
     const std::span<const Ray> cameraRays(rays.data(), pixels);
     const trace::Camera camera = trace::frameBounds(trace::GridFrame(grid.indexToWorld), grid.cellLo, grid.cellHi, width, height);
+    for (const bool floatWalk : {false, true}) {  // both arithmetics of the walk (VulkanTracer::setFloatWalk)
+    gpuTracer.setFloatWalk(floatWalk);
+    const std::string label = walkLabel + (floatWalk ? " (float walk)" : " (double walk)");
     if (primary) {
         EXPECT_EQ(countMismatches(gpuTracer.tracePrimary(camera), std::span<const RayHit>(wantFirst.data(), pixels), cameraRays,
                                   label + " primary rays"),
@@ -166,6 +169,7 @@ size_t compareOnGrid(const format::EncodedGrid& encoded, int width, int height, 
                       0u);
             traced += pixels;
         }
+    }
     }
     return traced;
 }
@@ -194,6 +198,8 @@ TEST(VulkanTracer, AgreesWithTheCpuTracerOnRandomGridsWithTilesAndMirroredBricks
         }
         const std::vector<RayHit> want = cpuHits(tracer, rays);
         EXPECT_EQ(countMismatches(gpuTracer.traceHits(rays), want, rays, "random grid " + std::to_string(g)), 0u);
+        gpuTracer.setFloatWalk(!gpuTracer.floatWalk());  // the other arithmetic of the walk, the same hits
+        EXPECT_EQ(countMismatches(gpuTracer.traceHits(rays), want, rays, "random grid, other walk " + std::to_string(g)), 0u);
         // LOD cut-off: a node no larger than lodScale * t is a hit.
         trace::TraceOptions lod;
         lod.lodScale = 0.05;
@@ -246,7 +252,10 @@ TEST(VulkanTracer, AdversarialRaysRootsSpanning2To32AndTheUnitCubeAgreeWithTheEx
     }
     EXPECT_GT(hits, 600u);
     // The reference's t is exact; the tracers' is the rounded crossing time.
-    EXPECT_EQ(countMismatches(gpuTracer.traceHits(rays), want, rays, "adversarial", false), 0u);
+    for (const bool floatWalk : {false, true}) {
+        gpuTracer.setFloatWalk(floatWalk);
+        EXPECT_EQ(countMismatches(gpuTracer.traceHits(rays), want, rays, floatWalk ? "adversarial, float walk" : "adversarial", false), 0u);
+    }
 
     // Non-finite rays miss; tMax stops a ray before the grid.
     std::vector<Ray> bad;
@@ -302,9 +311,12 @@ TEST(VulkanTracer, AdversarialRaysRootsSpanning2To32AndTheUnitCubeAgreeWithTheEx
             want.push_back(reference.trace(ray));
             ASSERT_TRUE(want.back().hit);
         }
-        const std::vector<RayHit> got = gpuTracer.traceHits(rays);
-        EXPECT_EQ(countMismatches(got, want, rays, "root 2^" + std::to_string(dag.log2Size), false), 0u);
-        for (const RayHit& h : got) EXPECT_LT(h.steps, 64u * dag.log2Size);
+        for (const bool floatWalk : {false, true}) {
+            gpuTracer.setFloatWalk(floatWalk);
+            const std::vector<RayHit> got = gpuTracer.traceHits(rays);
+            EXPECT_EQ(countMismatches(got, want, rays, "root 2^" + std::to_string(dag.log2Size) + (floatWalk ? " float walk" : ""), false), 0u);
+            for (const RayHit& h : got) EXPECT_LT(h.steps, 64u * dag.log2Size);
+        }
     }
     // Origin (0.49, 0.49, -1), direction (0, 0, 2) into a one-voxel grid: voxel (0,0,0) at t = 0.5 through -z.
     GridTopology one;
@@ -421,6 +433,8 @@ TEST(VulkanTracer, RendersALevelSetSphereLikeTheCpuRenderer) {
     lod.lodPixels = 4;
     trace::RenderStats stats;
     expectSameImage(gpuTracer.render(grid, camera, lod, stats), trace::renderCpu(grid, camera, lod), 1e-6, "sphere LOD 4 px");
+    gpuTracer.setFloatWalk(!gpuTracer.floatWalk());  // the other arithmetic of the walk: the same image
+    expectSameImage(gpuTracer.render(grid, camera, lod, stats), trace::renderCpu(grid, camera, lod), 1e-6, "sphere LOD 4 px, other walk");
     // Every array (DAG and palette sections) split into 4 KiB chunks: the
     // path of arrays beyond one allocation.
     trace::RenderOptions shadows;
@@ -444,7 +458,10 @@ TEST(VulkanTracer, RendersAFogSphereLikeTheCpuRenderer) {
     options.densityScale = 0.3;
     trace::RenderStats stats;
     // exp() differs in the last bits (a polynomial on the GPU): colours agree to ~1e-6.
-    expectSameImage(gpuTracer.render(grid, camera, options, stats), trace::renderCpu(grid, camera, options), 1e-5, "fog sphere");
+    const trace::Image cpu = trace::renderCpu(grid, camera, options);
+    expectSameImage(gpuTracer.render(grid, camera, options, stats), cpu, 1e-5, "fog sphere");
+    gpuTracer.setFloatWalk(!gpuTracer.floatWalk());  // the other arithmetic of the walk: the same image
+    expectSameImage(gpuTracer.render(grid, camera, options, stats), cpu, 1e-5, "fog sphere, other walk");
 }
 
 // `encode --normals K` on a level set: the GPU decodes the stored ONV codes
@@ -543,4 +560,78 @@ TEST(VulkanTracer, ShadesWithNormalGridOnvNormalsFlippedLikeTheCpuRenderer) {
         }
     EXPECT_GT(covered, 100u);
     EXPECT_EQ(facing, covered);
+}
+
+// The walk in floats (VulkanTracer::setFloatWalk; WALK_FP32 in
+// trace_walk.glsl) against the walk in doubles and the CPU tracer: the same
+// hits, t bit for bit, on rays built to fall near ties (crossings a float
+// cannot tell apart and a double can: directions 2^-10..2^-40 off a
+// diagonal, from lattice points, near and 1000 voxels away), and on a
+// level set's camera rays with almost every step decided in floats.
+TEST(VulkanTracer, TheFloatWalkReturnsTheDoubleWalksHitsAndDecidesMostStepsInFloats) {
+    VULKAN_OR_SKIP();
+    std::mt19937_64 rng(23);
+    const encoding::CompactDag dag = compactOf(randomTopology(rng, 6, 8), true);
+    const trace::DagTracer tracer(dag);
+    gpu::VulkanTracer gpuTracer(*context(), geometryOnly(dag));
+    EXPECT_EQ(gpuTracer.floatWalk(), gpuTracer.deviceInfo().type != "CPU") << "the float walk is the default on GPUs";
+    std::vector<Ray> rays(60000);
+    for (size_t i = 0; i < rays.size(); ++i) {
+        Ray& ray = rays[i];
+        for (int a = 0; a < 3; ++a) {
+            const double sign = (rng() & 1) ? 1.0 : -1.0;
+            const double off = std::ldexp(double(int(rng() % 3) - 1), -int(10 + rng() % 31));
+            ray.direction[a] = i % 4 == 3 ? std::uniform_real_distribution<double>(-1, 1)(rng) : sign * (1.0 + off);
+            ray.origin[a] = double(int64_t(rng() % 90) - 25) + (i % 2 ? 0.5 : 0.0);
+        }
+        if (i % 5 == 0)
+            for (int a = 0; a < 3; ++a) ray.origin[a] -= 1000.0 * ray.direction[a];
+        if (i % 11 == 0) ray.direction[i % 3] = 0.0;
+    }
+    const std::vector<RayHit> want = cpuHits(tracer, rays);
+    gpuTracer.setFloatWalk(false);
+    const std::vector<RayHit> wide = gpuTracer.traceHits(rays);
+    gpuTracer.setFloatWalk(true);
+    const std::vector<RayHit> narrow = gpuTracer.traceHits(rays);
+    EXPECT_EQ(countMismatches(wide, want, rays, "double walk"), 0u);
+    EXPECT_EQ(countMismatches(narrow, want, rays, "float walk"), 0u);
+    size_t hits = 0, wideOnly = 0, fellBack = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        hits += want[i].hit;
+        wideOnly += wide[i].hit && std::min(wide[i].steps, 127u) != wide[i].wideSteps;
+        fellBack += narrow[i].wideSteps > 0;
+    }
+    EXPECT_GT(hits, rays.size() / 10);
+    EXPECT_EQ(wideOnly, 0u) << "without the float walk every step runs in doubles";
+    std::printf("float walk, near ties: %zu of %zu rays took a step in doubles\n", fellBack, rays.size());
+    EXPECT_GT(fellBack, 100u) << "the near ties should need the doubles";
+
+    // A level set's camera rays, first hit and zero crossing.
+    openvdb::initialize();
+    auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.1f, -0.2f, 0.3f), 1.0f / 60.0f, 3.0f);
+    sphere->setName("sphere");
+    const format::EncodedGrid encoded = encodeVdbGrid(sphere, "vdbdag_vk_float_walk");
+    const trace::RenderGrid grid = trace::makeRenderGrid(encoded);
+    const std::vector<Ray> camera = sceneRays(grid, 160, 120, 0, 5);
+    const trace::DagTracer sphereTracer(encoded.active.dag);
+    gpu::VulkanTracer sphereGpu(*context(), grid);
+    sphereGpu.setFloatWalk(true);
+    for (const gpu::HitKind kind : {gpu::HitKind::FirstHit, gpu::HitKind::Surface}) {
+        const std::vector<RayHit> got = sphereGpu.traceHits(camera, kind);
+        const std::vector<RayHit> expect = kind == gpu::HitKind::FirstHit ? cpuHits(sphereTracer, camera) : cpuSurfaceHits(grid, sphereTracer, camera);
+        EXPECT_EQ(countMismatches(got, expect, camera, "sphere camera rays"), 0u);
+        uint64_t steps = 0, wideSteps = 0;
+        size_t sphereHits = 0;
+        for (const RayHit& h : got) {
+            steps += h.steps;
+            wideSteps += h.wideSteps;
+            sphereHits += h.hit;
+        }
+        EXPECT_GT(sphereHits, camera.size() / 10);
+        std::printf("float walk, sphere %s: %llu of %llu steps in doubles\n", kind == gpu::HitKind::FirstHit ? "first hit" : "zero crossing",
+                    (unsigned long long)wideSteps, (unsigned long long)steps);
+        EXPECT_LT(double(wideSteps), 0.01 * double(steps)) << wideSteps << " of " << steps << " steps in doubles";
+        RecordProperty(kind == gpu::HitKind::FirstHit ? "first_hit_steps_in_doubles_per_mille" : "surface_steps_in_doubles_per_mille",
+                       int(1000.0 * double(wideSteps) / double(std::max<uint64_t>(steps, 1))));
+    }
 }
