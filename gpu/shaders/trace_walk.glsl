@@ -5,7 +5,9 @@
 // exact integer boundary, and every product-plus-sum is `precise` (no
 // contraction into an FMA), as the CPU build (-ffp-contract=off on
 // src/trace): both tracers walk the same boxes and return the same voxels
-// and bit-identical t (tests/unit/test_vulkan_tracer.cpp).
+// and bit-identical t (tests/unit/test_vulkan_tracer.cpp). With WALK_FP32
+// (the default on GPUs) the steps are decided in floats wherever floats
+// can tell, with the same outcome (see "The walk in 32 bits" below).
 //
 // The code is arranged for how lavapipe (llvmpipe) runs a shader, 8 lanes
 // of a subgroup in SIMD: both sides of every `if` run, every loop body at
