@@ -276,7 +276,9 @@ std::vector<trace::RayHit> VulkanTracer::traceHits(std::span<const trace::Ray> r
                 r[8 * i + a] = ray.origin[a];
                 r[8 * i + 3 + a] = ray.direction[a];
             }
-            r[8 * i + 6] = ray.tMin;
+            // The shader's hits mode takes tMin as it is (DagTracer::trace);
+            // firstSurfaceHit on a grid that is no level set starts at 0.
+            r[8 * i + 6] = kind == HitKind::Surface && !grid_.levelSet ? std::max(ray.tMin, 0.0) : ray.tMin;
             r[8 * i + 7] = ray.tMax;
         }
         TracePush push{rayBuffer.address(), hitBuffer.address(), impl.counter.address(), uint32_t(n), 0};

@@ -97,7 +97,9 @@ void traceOneRay(uint i) {
     const uint r = 8u * i;
     const dvec3 o = dvec3(rays.v[r], rays.v[r + 1u], rays.v[r + 2u]);
     const dvec3 d = dvec3(rays.v[r + 3u], rays.v[r + 4u], rays.v[r + 5u]);
-    writeHit(i, firstSurfaceHit(o, d, rays.v[r + 6u], rays.v[r + 7u], 0.0lf, P.lodScale));
+    // First hits from tMin as given, negative too (DagTracer::trace; the host
+    // clamps a surface query on a grid that is no level set to 0).
+    writeHit(i, firstSurfaceHit(o, d, rays.v[r + 6u], rays.v[r + 7u], LEVEL_SET ? 0.0lf : -infinity(), P.lodScale));
 }
 
 // ---- shading (Shading.cpp, CpuRenderer.cpp) ----------------------------------

@@ -112,15 +112,22 @@ double crossing(int a, int64_t boundary) { return (double(boundary) - gO[a]) / g
 // CPU tracer, which stays in doubles.
 //
 // Error bound. F = (float(b) - float(o)) / float(d) against the double
-// crossing T(b) = (b - o) / d: with every conversion, the subtraction and
-// the quotient off by at most 1, 1 and 2.5 units in the last place (Vulkan's
-// fp32 division is 2.5 ulp; conversions may truncate), |F - T| <= 4.5 2^-23
-// |F| + (|b| + |o|) 2^-23 / |d| (plus T's own 2^-52, negligible). errOf
-// takes twice each term: |F| 2^-20 + gK[a], gK[a] = (|o| + max|b|) 2^-21 /
-// |d| over the occupied box's boundaries, which leaves room for the
-// rounding of the comparisons themselves. A decision "T(x) < T(y)" is taken
-// in floats only when Fx + Ex < Fy - Ey; otherwise (near ties, exact ties,
-// a ray whose numbers a float cannot hold) the step runs in doubles.
+// crossing T(b) = (b - o) / d: with the conversions of b, o and d, the
+// subtraction and the quotient off by at most 1, 1, 1, 1 and 2.5 units in
+// the last place (Vulkan's fp32 division is 2.5 ulp; conversions may
+// truncate), |F - T| <= 4.5 2^-23 |F| + (|b| + |o|) 2^-23 / |d| (T's own
+// 2^-52 aside). As |b| <= |d| |T| + |o|, that is at most 5.5 2^-23 |F| +
+// |o| 2^-22 / |d| for any boundary b, inside the occupied box or not.
+// errOf gives |F| 8 2^-23 + gK[a], gK[a] = (|o| + max|b| over the occupied
+// box) 2^-21 / |d|: room for the rounding of the comparisons and of errOf
+// itself, and gK >= 2^-81 (|d| <= 2^60, the box reaching 1) keeps a
+// flushed denormal harmless. A decision "T(x) < T(y)" is taken in floats
+// only when Fx + Ex < Fy - Ey; otherwise (near ties, exact ties, a ray whose
+// numbers a float cannot hold) the step runs in doubles. (The doubles must
+// be correctly rounded on the device, as before: Vulkan promises less.)
+// The walk's `steps` (statistics) may differ between the two: a step too
+// close to call in a leaf is left to the main loop, which may skip a 2^3
+// cube the leaf loop would have crossed voxel by voxel.
 vec3 gOf, gDf, gK;  // the ray in floats, and errOf's constant per axis (set per ray by walkRay)
 const float kFloatRel = 9.5367431640625e-7;  // 2^-20
 
@@ -129,9 +136,12 @@ float errOf(float f, int a) { return isinf(f) ? 0.0 : abs(f) * kFloatRel + gK[a]
 float infinityF() { return uintBitsToFloat(0x7F800000u); }
 
 // The time the walk is at, in doubles, from its integer state: the entry
-// crossing of the voxel on the lowest axis crossed, or tEnter if none
-// (every step crosses at least one axis; only the start may cross none).
-// This is bit for bit the fp64 walk's t: there t is that same crossing.
+// crossing of the voxel on the lowest axis crossed, or tEnter if none.
+// After a step decided in floats (one axis crossed, surely the first) it
+// is bit for bit the fp64 walk's t, which is that same crossing; walkRay
+// keeps its own t at the start and after a step in doubles, where several
+// axes may cross at once and a crossing at 0 may be +0 on one and -0 on
+// another.
 double entryTime(i64vec3 v, uint crossed, double tEnter) {
     if (crossed == 0u) return tEnter;
     const int a = findLSB(crossed);
@@ -377,6 +387,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
     vec3 fNext = vec3(0.0);
     float fExit = 0.0, eExit = 0.0;
     bool useF = WALK_FP32;
+    bool tFresh = true;  // t is the walk's time (else entryTime gives it: the last step was in floats)
     if (useF) {
         const double kBig = 1152921504606846976.0lf;  // 2^60
         const double kScale = 1.0lf / 2097152.0lf;      // 2^-21
@@ -450,7 +461,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 leafBase = base;
                 break;
             }
-            if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * (useF ? entryTime(v, crossed, tEnter) : t)) {
+            if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * (tFresh ? t : entryTime(v, crossed, tEnter))) {
                 hitEntry = base;
                 hitLevel = halfLog2;
                 occupied = true;
@@ -516,8 +527,12 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             else tNext[a] = crossing(a, gD[a] > 0.0lf ? nx + 1l : nx);
             v[a] = nx;
             crossed = 1u << a;
-            t = tStep;
-            if (!useF) ++wideSteps;
+            if (useF) {
+                tFresh = false;
+            } else {
+                t = tStep;
+                ++wideSteps;
+            }
         }
         bool occupiedInside = false;
         if (inLeaf && !occupied && skip == 0u) {
@@ -537,7 +552,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 if ((leafSpatial & (uint64_t(0x330033) << corner)) == 0ul) skip = 1u;
             }
         }
-        if (occupied) result = makeHit(v, crossed, useF ? entryTime(v, crossed, tEnter) : t, hitEntry, hitLevel, steps, wideSteps);
+        if (occupied) result = makeHit(v, crossed, tFresh ? t : entryTime(v, crossed, tEnter), hitEntry, hitLevel, steps, wideSteps);
         if (firstOnly && occupied) return result;
         pending = occupied;
         pendingInside = occupiedInside;
@@ -602,7 +617,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 next = v;
                 // The doubles of the state, for the step in doubles below.
                 for (int a = 0; a < 3; ++a) tNext[a] = gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? v[a] + 1l : v[a]);
-                t = entryTime(v, crossed, tEnter);
+                if (!tFresh) t = entryTime(v, crossed, tEnter);
+                tFresh = true;
             }
         }
         dvec3 tc;
@@ -632,6 +648,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             if (next[am] < gBoxLo[am] || next[am] >= gBoxHi[am]) return firstOnly ? noHit() : found;
             fNext = fNextNew;
             crossed = 1u << am;
+            tFresh = false;
         } else {
             if (!(tNew < tExit)) return firstOnly ? noHit() : found;
             crossed = 0u;

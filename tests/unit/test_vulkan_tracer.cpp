@@ -606,6 +606,38 @@ TEST(VulkanTracer, TheFloatWalkReturnsTheDoubleWalksHitsAndDecidesMostStepsInFlo
     std::printf("float walk, near ties: %zu of %zu rays took a step in doubles\n", fellBack, rays.size());
     EXPECT_GT(fellBack, 100u) << "the near ties should need the doubles";
 
+    // Rays from lattice points with tMin < 0 (first hits start there, as
+    // DagTracer::trace does): hits at t = 0, where the crossing on an axis
+    // moving down is -0.0 and on one moving up +0.0. The float walk keeps
+    // the double walk's sign. (Against the CPU, a tie of +0 and -0 may come
+    // out with the other sign in either walk: equal values, not yet the
+    // same bits.)
+    std::vector<Ray> lattice(20000);
+    for (Ray& ray : lattice) {
+        for (int a = 0; a < 3; ++a) {
+            ray.origin[a] = double(rng() % 30);
+            const double m[4] = {1.0, 0.5, 0.3, 0.0};
+            ray.direction[a] = ((rng() & 1) ? 1.0 : -1.0) * m[rng() % 4];
+        }
+        ray.tMin = -1.0;
+    }
+    const std::vector<RayHit> latticeWant = cpuHits(tracer, lattice);
+    gpuTracer.setFloatWalk(false);
+    const std::vector<RayHit> latticeWide = gpuTracer.traceHits(lattice);
+    EXPECT_EQ(countMismatches(latticeWide, latticeWant, lattice, "lattice rays, double walk"), 0u);
+    gpuTracer.setFloatWalk(true);
+    const std::vector<RayHit> latticeGot = gpuTracer.traceHits(lattice);
+    EXPECT_EQ(countMismatches(latticeGot, latticeWant, lattice, "lattice rays, float walk"), 0u);
+    size_t atZero = 0, negativeZero = 0, signs = 0;
+    for (size_t i = 0; i < lattice.size(); ++i)
+        if (latticeWant[i].hit && latticeWant[i].t == 0) {
+            ++atZero;
+            negativeZero += std::signbit(latticeWant[i].t);
+            signs += std::signbit(latticeGot[i].t) != std::signbit(latticeWide[i].t);
+        }
+    EXPECT_GT(negativeZero, 10u) << "of " << atZero << " hits at t = 0";
+    EXPECT_EQ(signs, 0u) << "hits at t = 0 whose sign the float walk changed, of " << atZero;
+
     // A level set's camera rays, first hit and zero crossing.
     openvdb::initialize();
     auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, openvdb::Vec3f(0.1f, -0.2f, 0.3f), 1.0f / 60.0f, 3.0f);
