@@ -157,6 +157,8 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                          {"dicom_icon_samples_per_pixel_abort",
                                                           "its Icon Image Sequence (0088,0200) has Samples per Pixel (0028,0002) 79, which GDCM's image reader aborts on"},
                                                          {"dicom_curve_element_abort", "curve group 5000 holds element (5000,0050), which GDCM's image reader aborts on"},
+                                                         {"dicom_samples_per_pixel_values_abort",
+                                                          "Samples per Pixel (0028,0002) holds 8 values where DICOM has one (GDCM's image reader takes the first, 21333"},
                                                          // refused by the walk
                                                          {"dicom_pixel_data_od_undefined_abort",
                                                           "element (7FE0,0010) at byte 936 has an undefined length under VR OD (GDCM takes it for OB, OW or UN pixel data only)"},

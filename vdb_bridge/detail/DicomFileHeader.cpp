@@ -379,7 +379,13 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
         // (Deflated data sets are not walked: their pixel data are native.)
         std::string why = overlayProblem(ds, !px.encapsulated, bits && bits->size() == 1 ? unsigned((*bits)[0]) : 0,
                                          spp && spp->size() == 1 ? unsigned((*spp)[0]) : 1);
-        // PixelFormat::SetSamplesPerPixel asserts on any but 1, 3 and 4.
+        // PixelFormat::SetSamplesPerPixel asserts on any but 1, 3 and 4; the
+        // image reader takes the first value of a Samples per Pixel that
+        // holds several (DICOM allows one).
+        if (why.empty() && spp && spp->size() > 1)
+            why = fmt::format("Samples per Pixel (0028,0002) holds {} values where DICOM has one (GDCM's image reader takes the first, {}, "
+                              "and aborts on any but 1, 3 or 4)",
+                              spp->size(), (*spp)[0]);
         if (why.empty() && spp && spp->size() == 1 && (*spp)[0] != 1 && (*spp)[0] != 3 && (*spp)[0] != 4)
             why = fmt::format("Samples per Pixel (0028,0002) {}, which GDCM's image reader aborts on (it takes 1, 3 or 4)", (*spp)[0]);
         if (why.empty()) why = curveProblem(ds);
