@@ -297,7 +297,7 @@ Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, ui
     Hit h;
     h.hit = true;
     h.voxel = v + gRootOrigin;
-    h.t = t;
+    h.t = t == 0.0lf ? 0.0lf : t;  // +0.0, as DagWalk.h: which axis a tie of crossings at 0 comes from decides its sign
     h.entry = entry;
     h.faceAxis = faceAxis;
     h.faceSign = faceAxis < 0 ? 0 : (gD[faceAxis] > 0.0lf ? -1 : 1);

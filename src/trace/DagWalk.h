@@ -156,7 +156,10 @@ RayHit walkOctant(const encoding::CompactDag& dag, const TraceOptions& options, 
             if (((crossed >> a) & 1u) && (v[a] & within) == (R::negative(a) ? within : 0)) faceAxis = a;
         result.hit = true;
         for (int a = 0; a < 3; ++a) result.voxel[a] = v[a] + dag.origin[a];
-        result.t = t;
+        // A hit at t = 0 reports +0.0: a tie of crossings at 0 is +0 on an
+        // axis moving up and -0 on one moving down, and a hierarchical step
+        // may take the tie from another axis than a voxel step (Vulkan).
+        result.t = t == 0 ? 0.0 : t;
         result.attribute = attribute;
         result.faceAxis = int8_t(faceAxis);
         result.faceSign = faceAxis < 0 ? 0 : (R::negative(faceAxis) ? 1 : -1);
