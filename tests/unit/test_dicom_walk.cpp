@@ -157,6 +157,8 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                          {"dicom_icon_samples_per_pixel_abort",
                                                           "its Icon Image Sequence (0088,0200) has Samples per Pixel (0028,0002) 79, which GDCM's image reader aborts on"},
                                                          {"dicom_curve_element_abort", "curve group 5000 holds element (5000,0050), which GDCM's image reader aborts on"},
+                                                         {"dicom_overlays_in_and_out_of_pixels_abort",
+                                                          "overlay group 6020 keeps its Overlay Data and overlay group 601E does not (none, or no Rows x Columns"},
                                                          {"dicom_samples_per_pixel_values_abort",
                                                           "Samples per Pixel (0028,0002) holds 8 values where DICOM has one (GDCM's image reader takes the first, 21333"},
                                                          // refused by the walk

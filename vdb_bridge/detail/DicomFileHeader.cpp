@@ -136,6 +136,7 @@ std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned 
     // GetNumberOfOverlaysInternal asserts that there are at most 16.
     if (overlays.size() > 16)
         return fmt::format("{} overlay groups (60xx), more than the 16 GDCM's image reader takes (it aborts on more)", overlays.size());
+    int withData = -1, inPixels = -1;  // the first overlay group of each kind
     for (const uint16_t g : overlays) {
         unsigned rows = 0, columns = 0;
         bool data = false;
@@ -172,7 +173,17 @@ std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned 
             return fmt::format("overlay group {:04X} of {}x{} pixels (not a multiple of 8) lies in the pixel data's unused bits, which GDCM's image reader "
                                "aborts on",
                                g, rows, columns);
+        (data && pixels != 0 ? withData : inPixels) = g;
     }
+    // DoOverlays takes an overlay whose Overlay Data it did not keep (none,
+    // or no Rows x Columns to size it: Overlay::SetOverlay) to lie in the
+    // pixel data's unused bits; Pixmap::AreOverlaysInPixelData then asserts
+    // that all overlays do or none does. (GDCM may drop such an overlay
+    // first, for a Bit Position below Bits Stored: refused all the same.)
+    if (withData >= 0 && inPixels >= 0)
+        return fmt::format("overlay group {:04X} keeps its Overlay Data and overlay group {:04X} does not (none, or no Rows x Columns to hold it), "
+                           "so it lies in the pixel data's unused bits: GDCM's image reader aborts on the mix",
+                           withData, inPixels);
     return "";
 }
 
