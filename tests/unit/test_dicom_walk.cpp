@@ -159,6 +159,7 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                          {"dicom_curve_element_abort", "curve group 5000 holds element (5000,0050), which GDCM's image reader aborts on"},
                                                          {"dicom_overlays_in_and_out_of_pixels_abort",
                                                           "overlay group 6020 keeps its Overlay Data and overlay group 601E does not (none, or no Rows x Columns"},
+                                                         {"dicom_overlay_size_oom", "overlay group 600C of 47108x24580 pixels, which GDCM's image reader unpacks"},
                                                          {"dicom_samples_per_pixel_values_abort",
                                                           "Samples per Pixel (0028,0002) holds 8 values where DICOM has one (GDCM's image reader takes the first, 21333"},
                                                          // refused by the walk

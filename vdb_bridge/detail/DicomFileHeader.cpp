@@ -169,6 +169,13 @@ std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned 
         // sample (Overlay::GrabOverlayFromPixelData), asserting that its
         // pixels are a multiple of 8.
         const uint64_t pixels = uint64_t(rows) * columns;
+        // DoOverlays unpacks every overlay (Overlay::Decompress) at a byte a
+        // pixel into a string stream, whatever its Overlay Data holds: 65535 x
+        // 65535 would take 4 GB and more while it grows.
+        if (pixels > (uint64_t(1) << 26))
+            return fmt::format("overlay group {:04X} of {}x{} pixels, which GDCM's image reader unpacks at a byte a pixel ({} MB; vdbdag takes overlays "
+                               "of up to 2^26 pixels)",
+                               g, rows, columns, pixels >> 20);
         if ((!data || pixels == 0) && nativePixels && samplesPerPixel == 1 && (pixelBits == 8 || pixelBits == 16) && pixels % 8 != 0)
             return fmt::format("overlay group {:04X} of {}x{} pixels (not a multiple of 8) lies in the pixel data's unused bits, which GDCM's image reader "
                                "aborts on",
