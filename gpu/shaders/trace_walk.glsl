@@ -148,6 +148,9 @@ double entryTime(i64vec3 v, uint crossed, double tEnter) {
     return crossing(a, gD[a] > 0.0lf ? v[a] : v[a] + 1l);
 }
 
+// The crossing through which the ray leaves voxel c on axis a (inf if it never does).
+double exitTime(int a, int64_t c) { return gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? c + 1l : c); }
+
 int64_t clamp64(int64_t c, int64_t lo, int64_t hi) { return c < lo ? lo : (hi < c ? hi : c); }
 
 // DagWalk.h voxelAt: the one voxel of [lo, hi] whose [tIn, tOut) holds t
@@ -315,7 +318,6 @@ Hit makeHit(i64vec3 v, uint crossed, double t, uint64_t entry, uint lodLevel, ui
 bool voxelAtFloat(int a, float tF, float eT, int64_t lo, int64_t hi, out int64_t c, out float tOutF) {
     const bool up = gD[a] > 0.0lf;
     const float p = gOf[a] + tF * gDf[a];
-    c = lo;
     if (!(p > float(lo) - 1.0)) c = lo;
     else if (!(p < float(hi) + 2.0)) c = hi;
     else c = up ? int64_t(floor(p)) : int64_t(ceil(p)) - 1l;
@@ -379,7 +381,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             if (gD[a] != 0.0lf && crossing(a, gD[a] > 0.0lf ? v[a] : v[a] + 1l) == t) crossed |= 1u << a;
 
     dvec3 tNext;  // a vector, not an array: indexed by a varying axis below
-    for (int a = 0; a < 3; ++a) tNext[a] = gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? v[a] + 1l : v[a]);
+    for (int a = 0; a < 3; ++a) tNext[a] = exitTime(a, v[a]);
 
     // WALK_FP32: the floats of tNext and tExit; t and tNext then hold only
     // where a step ran in doubles (entryTime gives t at a hit). Rays with
@@ -435,6 +437,8 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
         uint hitLevel = 0u;
         bool enterLeaf = false;  // the descent reached a 4^3 leaf (at leafOffset, leafMirror, leafBase)
         uint64_t leafOffset = 0ul;
+        // The walk's time for the LOD cut-off, once per step (not per level).
+        const double tLod = lodScale > 0.0lf ? (tFresh ? t : entryTime(v, crossed, tEnter)) : 0.0lf;
         while (!inLeaf) {
             const uint s = L - depth;
             const uint header = innerWord(nodePos);
@@ -461,7 +465,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
                 leafBase = base;
                 break;
             }
-            if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * (tFresh ? t : entryTime(v, crossed, tEnter))) {
+            if (lodScale > 0.0lf && double(int64_t(1) << halfLog2) <= lodScale * tLod) {
                 hitEntry = base;
                 hitLevel = halfLog2;
                 occupied = true;
@@ -616,7 +620,7 @@ Hit walkRay(dvec3 origin, dvec3 direction, double tMin, double tMax, uint visitK
             if (!sure) {
                 next = v;
                 // The doubles of the state, for the step in doubles below.
-                for (int a = 0; a < 3; ++a) tNext[a] = gD[a] == 0.0lf ? infinity() : crossing(a, gD[a] > 0.0lf ? v[a] + 1l : v[a]);
+                for (int a = 0; a < 3; ++a) tNext[a] = exitTime(a, v[a]);
                 if (!tFresh) t = entryTime(v, crossed, tEnter);
                 tFresh = true;
             }

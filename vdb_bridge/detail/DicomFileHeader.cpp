@@ -136,7 +136,7 @@ std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned 
     // GetNumberOfOverlaysInternal asserts that there are at most 16.
     if (overlays.size() > 16)
         return fmt::format("{} overlay groups (60xx), more than the 16 GDCM's image reader takes (it aborts on more)", overlays.size());
-    int withData = -1, inPixels = -1;  // the first overlay group of each kind
+    int withData = -1, inPixels = -1;  // an overlay group of each kind (the last met)
     for (const uint16_t g : overlays) {
         unsigned rows = 0, columns = 0;
         bool data = false;
@@ -164,10 +164,6 @@ std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned 
             if (e == 0x0011) columns = bv->GetLength() >= 2 ? valueUs(*bv, 0) : uint8_t(s[0]);
             if (e == 0x3000) data = true;
         }
-        // An overlay without Overlay Data (or of no pixels): GDCM takes it
-        // from the unused bits of native pixel data of 8 or 16 bits of one
-        // sample (Overlay::GrabOverlayFromPixelData), asserting that its
-        // pixels are a multiple of 8.
         const uint64_t pixels = uint64_t(rows) * columns;
         // DoOverlays unpacks every overlay (Overlay::Decompress) at a byte a
         // pixel into a string stream, whatever its Overlay Data holds: 65535 x
@@ -176,6 +172,10 @@ std::string overlayProblem(const gdcm::DataSet& ds, bool nativePixels, unsigned 
             return fmt::format("overlay group {:04X} of {}x{} pixels, which GDCM's image reader unpacks at a byte a pixel ({} MB; vdbdag takes overlays "
                                "of up to 2^26 pixels)",
                                g, rows, columns, pixels >> 20);
+        // An overlay without Overlay Data (or of no pixels): GDCM takes it
+        // from the unused bits of native pixel data of 8 or 16 bits of one
+        // sample (Overlay::GrabOverlayFromPixelData), asserting that its
+        // pixels are a multiple of 8.
         if ((!data || pixels == 0) && nativePixels && samplesPerPixel == 1 && (pixelBits == 8 || pixelBits == 16) && pixels % 8 != 0)
             return fmt::format("overlay group {:04X} of {}x{} pixels (not a multiple of 8) lies in the pixel data's unused bits, which GDCM's image reader "
                                "aborts on",
