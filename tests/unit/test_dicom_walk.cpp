@@ -160,6 +160,8 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                          {"dicom_overlays_in_and_out_of_pixels_abort",
                                                           "overlay group 6020 keeps its Overlay Data and overlay group 601E does not (none, or no Rows x Columns"},
                                                          {"dicom_overlay_size_oom", "overlay group 600C of 47108x24580 pixels, which GDCM's image reader unpacks"},
+                                                         {"dicom_not_image_storage_abort",
+                                                          "its SOP Class UID is unknown, and GDCM's image reader would decode it as 1.2.840.10008.3.1.2.3.1"},
                                                          {"dicom_samples_per_pixel_values_abort",
                                                           "Samples per Pixel (0028,0002) holds 8 values where DICOM has one (GDCM's image reader takes the first, 21333"},
                                                          // refused by the walk

@@ -100,6 +100,26 @@ std::string nonImageClass(const std::string& sop) {
     return "";
 }
 
+// The SOP class GDCM's image reader decodes a file as, when that is no image
+// class (it asserts MediaStorage::IsImage then, PixmapReader::Read): a class
+// unknown in both the file meta header and the data set, under a transfer
+// syntax other than ACR-NEMA's, sends the reader to MediaStorage::SetFromFile,
+// which cuts a UID at its first space ("1.2.840.10008.3.1.2.3.1 .2" became
+// Detached Study Management; found by fuzz_scan_headers). "" when the reader
+// takes an image class or refuses the file itself.
+std::string imageReaderClassProblem(const gdcm::File& file) {
+    const gdcm::MediaStorage header = file.GetHeader().GetMediaStorage();
+    if (gdcm::MediaStorage::IsImage(header)) return "";
+    if (file.GetDataSet().GetMediaStorage() != gdcm::MediaStorage::MS_END) return "";  // GDCM reads it as an image class or refuses it
+    if (file.GetHeader().GetDataSetTransferSyntax() == gdcm::TransferSyntax::ImplicitVRBigEndianACRNEMA || file.GetHeader().IsEmpty())
+        return "";  // read as ACR-NEMA
+    gdcm::MediaStorage guess;
+    guess.SetFromFile(file);
+    if (guess == gdcm::MediaStorage::MS_END || gdcm::MediaStorage::IsImage(guess)) return "";
+    return fmt::format("its SOP Class UID is unknown, and GDCM's image reader would decode it as {} ({}), no image storage",
+                       guess.GetString() ? guess.GetString() : "?", gdcm::MediaStorage::GetMSString(guess) ? gdcm::MediaStorage::GetMSString(guess) : "?");
+}
+
 // What GDCM 3.0's image reader (PixmapReader::ReadImageInternal, which
 // vdbdag runs on a file whose pixel data it does not read itself: any but
 // native pixel data under a native transfer syntax) asserts (aborts) or
@@ -406,6 +426,7 @@ std::string readFile(const std::string& path, FileInfo& info, std::vector<Frame>
                               spp->size(), (*spp)[0]);
         if (why.empty() && spp && spp->size() == 1 && (*spp)[0] != 1 && (*spp)[0] != 3 && (*spp)[0] != 4)
             why = fmt::format("Samples per Pixel (0028,0002) {}, which GDCM's image reader aborts on (it takes 1, 3 or 4)", (*spp)[0]);
+        if (why.empty()) why = imageReaderClassProblem(file);
         if (why.empty()) why = curveProblem(ds);
         if (why.empty()) why = iconProblem(ds);
         if (!why.empty()) return "corrupt DICOM: " + why;
