@@ -236,7 +236,9 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
         std::vector<Brick> bricks;
         std::vector<V> values;
         PassStats stats;
+        bool integers = true;  // every value of the row an integer (float32 grids: integerLattice)
     };
+    bool integers = true;
     std::vector<Row> rowOut(static_cast<size_t>(rows));
     // Solid 8^3 blocks (SolidBlocks.h): each slab's uniform bricks, paired
     // with the slab below when the slab is the upper half of a block.
@@ -262,6 +264,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
                 if (mask) row.bricks.push_back({int32_t(bx * 4), int32_t(by * 4), int32_t(z0), mask});
                 if (th.solidBlocks) slabNow.note(cols, bx, by, mask, row.values);
             }
+            if constexpr (std::is_same_v<V, float>) row.integers = detail::integerLattice(row.values);
             if (byCubes) row.values.clear();  // read back cube by cube
         });
         if (th.solidBlocks) {
@@ -270,6 +273,7 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
         }
         for (Row& row : rowOut) {
             second.add(row.stats);
+            integers = integers && row.integers;
             if (byCubes) {
                 for (const Brick& b : row.bricks) scratch.add(b);
                 continue;
@@ -319,6 +323,8 @@ DenseImportResult importTyped(const DenseVolume& v, const Thresholds& th, ValueT
         }
     }
     describeGrid<V>(v, background, &th, &r, record);
+    if constexpr (std::is_same_v<V, float>)
+        if (integers && !record.rescale) record.rescale = ValueRescale{1, 0};
     if (byCubes) result.cubes.push_back(detail::makeDenseCubes<S, V>(v, rule, std::move(scratch), record));
     result.volume.grids.push_back(std::move(record));
     return result;

@@ -319,6 +319,62 @@ TEST(DenseSynthetic, GzipNrrdFloatsBitExact) {
     expectTransform(*readOnlyGrid(workDir() / "gzip_floats_import.vdb"), {0, 0, 0}, {{{1.25, 0, 0}, {0, 1.25, 0}, {0, 0, 0.75}}}, dims, "gzip");
 }
 
+// A float32 scan whose samples are all integers (a label map, a series
+// saved as float) has the lattice of slope 1 as its rescale hint, in memory
+// and cube by cube, and its values are coded as those integers: its file is
+// the size of the same samples stored as int16 (to 2 %), well under the same
+// floats with one sample off the integers, and comes back bit for bit
+// (OpenVDB's accessor against the samples written). A -0.0 among them, or a
+// half, and there is no hint.
+TEST(DenseSynthetic, FloatSamplesThatAreIntegersAreCodedAsIntegers) {
+    using namespace vdbdag;
+    const std::array<int, 3> dims{40, 36, 30};
+    const size_t n = size_t(dims[0]) * dims[1] * dims[2];
+    std::mt19937 rng(7);
+    std::vector<float> floats(n);
+    std::vector<int16_t> ints(n);
+    for (int z = 0, i = 0; z < dims[2]; ++z)
+        for (int y = 0; y < dims[1]; ++y)
+            for (int x = 0; x < dims[0]; ++x, ++i) {
+                ints[size_t(i)] = int16_t(800 + 400 * std::sin(x / 7.0) * std::cos(y / 5.0) + 10 * z + int(rng() % 17));
+                floats[size_t(i)] = float(ints[size_t(i)]);
+            }
+    const auto write = [&](const std::string& stem, const void* data, size_t bytes, const std::string& type) {
+        writeBytes(workDir() / (stem + ".raw"), data, bytes);
+        const std::string h = "NRRD0004\ntype: " + type + "\ndimension: 3\nsizes: 40 36 30\nendian: little\nencoding: raw\ndata file: " + stem + ".raw\n";
+        writeBytes(workDir() / (stem + ".nhdr"), h.data(), h.size());
+        return workDir() / (stem + ".nhdr");
+    };
+    const auto encodedSize = [&](const fs::path& in) {
+        const fs::path out = workDir() / (in.stem().string() + ".ssvdag");
+        const auto r = runCli("encode " + in.string() + " -o " + out.string() + " --force");
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return fs::file_size(out);
+    };
+    const fs::path integral = write("integer_floats", floats.data(), n * 4, "float");
+    for (const bool byCubes : {false, true}) {
+        bridge::DenseImportOptions options;
+        if (byCubes) options.cubesNear = workDir().string();
+        const bridge::DenseImportResult r = bridge::importDense(integral.string(), options);
+        const GridRecord& header = byCubes ? r.cubes.at(0)->header() : r.volume.grids.at(0);
+        EXPECT_EQ(header.rescale, std::optional<ValueRescale>(ValueRescale{1, 0})) << "by cubes " << byCubes;
+    }
+    expectBothRoutes(integral, "", fromFile(workDir() / "integer_floats.raw", 0, dims, "f32", false), "integer_floats");
+    const uint64_t asFloats = encodedSize(integral);
+    const uint64_t asInt16 = encodedSize(write("integer_int16", ints.data(), n * 2, "int16"));
+    EXPECT_LT(double(asFloats), 1.02 * double(asInt16)) << asFloats << " against " << asInt16;
+    for (const float odd : {-0.0f, 0.5f}) {
+        std::vector<float> off = floats;
+        off[n / 2] = odd;
+        const fs::path in = write(odd == 0 ? "negative_zero_floats" : "half_floats", off.data(), n * 4, "float");
+        EXPECT_FALSE(bridge::importDense(in.string(), {}).volume.grids.at(0).rescale.has_value()) << odd;
+        expectBothRoutes(in, "", fromFile(workDir() / (in.stem().string() + ".raw"), 0, dims, "f32", false), in.stem().string());
+        if (odd != 0) {
+            EXPECT_LT(double(asFloats), 0.95 * double(encodedSize(in))) << "the same floats with one half";
+        }
+    }
+}
+
 TEST(DenseSynthetic, MetaImageObliqueBigEndianAndInlineMha) {
     const std::array<int, 3> dims{7, 8, 6};
     std::vector<uint8_t> be;
