@@ -24,6 +24,7 @@
 #include "vdb_bridge/NrrdHeader.h"
 #include "vdb_bridge/detail/DenseBricks.h"
 #include "vdb_bridge/detail/HeaderFieldMeta.h"
+#include "vdb_bridge/detail/InflateCheckpoints.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/SolidBlocks.h"
 
@@ -390,6 +391,7 @@ DenseVolume describeDense(const std::string& path, const DenseImportOptions& opt
         case DenseFormat::None: throw Error(path + ": not a dense volume (expected .raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz, .hdr or DICOM)");
     }
     v.format = denseFormatOf(path);
+    v.resume = options.resume;
     toLps(v);
     if (!options.allowExternalData && v.dataPath != v.headerPath) checkDataFileLocation(v, v.dataNameInHeader);
     return v;
@@ -507,9 +509,11 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
                 checkImportLimits(describeDense(path, first), false, options, uint64_t(volumes));
             }
             DenseImportResult all;
+            const auto resume = std::make_shared<detail::InflateCheckpoints>();  // each volume's reader starts where the last one ended
             for (int64_t t = 0; t < volumes; ++t) {
                 DenseImportOptions one = options;
                 one.volume = t;
+                one.resume = resume;
                 DenseImportResult r = importDense(path, one);
                 if (t == 0) {
                     all.source = r.source;

@@ -53,6 +53,9 @@ struct DenseImportOptions {
     bool dropPatientTags = false;
     // NIfTI or NRRD: which volume of a 4-D file (`--volume N`, 0-based).
     std::optional<int64_t> volume;
+    // Set by importDense for the volumes of a 4-D file it reads in turn
+    // (DenseVolume::resume); leave it null.
+    std::shared_ptr<detail::InflateCheckpoints> resume;
     // A scalar scan's solid 8^3 blocks (all 512 samples kept, one value bit
     // for bit) become active tiles: one attribute entry each instead of 512
     // (detail/SolidBlocks.h). Off (`--no-tiles`): every voxel in its brick,

@@ -3,6 +3,7 @@
 // either header), in fixed 1 MiB input chunks, so memory stays at one slab.
 #include "vdb_bridge/DenseVolume.h"
 #include "vdb_bridge/DicomSeries.h"
+#include "vdb_bridge/detail/InflateCheckpoints.h"
 
 #include <algorithm>
 #include <cmath>
@@ -233,7 +234,15 @@ void DenseSampleStream::positionAt(uint64_t fileSize, uint64_t need) {
                         " bytes of samples the header describes");
         inflater_ = std::make_unique<Inflater>();
         if (inflateInit2(&inflater_->z, 15 + 32) != Z_OK) throw Error(where() + ": cannot start zlib");
-        skipDecoded(uint64_t(volume_.decodedSkip));
+        uint64_t skip = uint64_t(volume_.decodedSkip);
+        if (volume_.resume)
+            if (const auto at = volume_.resume->restore(skip, inflater_->z)) {  // where an earlier reader of the file left off
+                if (std::fseek(file_, long(at->filePosition), SEEK_SET) != 0) throw Error(where() + ": cannot seek to byte " + std::to_string(at->filePosition));
+                decoded_ = at->decoded;
+                skip -= at->decoded;
+            }
+        skipDecoded(skip);
+        keepPosition();
     }
 }
 
@@ -243,7 +252,18 @@ std::string DenseSampleStream::where() const {
 }
 
 DenseSampleStream::~DenseSampleStream() {
+    try {
+        keepPosition();  // where the next volume of a 4-D file starts
+    } catch (...) {
+    }
     if (file_) std::fclose(file_);
+}
+
+void DenseSampleStream::keepPosition() {
+    if (!volume_.resume || !inflater_ || inflater_->ended || !file_) return;
+    const long at = std::ftell(file_);
+    if (at < 0 || uint64_t(at) < inflater_->z.avail_in) return;
+    volume_.resume->save(decoded_, inflater_->z, uint64_t(at) - inflater_->z.avail_in);
 }
 
 void DenseSampleStream::readBytes(uint8_t* out, size_t n) {
@@ -277,6 +297,7 @@ void DenseSampleStream::readBytes(uint8_t* out, size_t n) {
         }
         left -= chunk;
     }
+    decoded_ += n;
 }
 
 void DenseSampleStream::skipDecoded(uint64_t n) {

@@ -17,6 +17,10 @@
 
 namespace vdbdag::bridge {
 
+namespace detail {
+class InflateCheckpoints;
+}
+
 enum class SampleType : uint8_t { U8, I8, U16, I16, U32, I32, F32, F64 };
 const char* sampleTypeName(SampleType type);  // "u8", ..., "f64"
 unsigned sampleBytes(SampleType type);
@@ -113,6 +117,10 @@ struct DenseVolume {
     // and how many the file holds; -1 and 1 for a 3-D scan. A decode to
     // NIfTI writes the grids of one series back as one 4-D file.
     int64_t volumeIndex = -1, volumeCount = 1;
+    // Where readers of a compressed data file may resume decoding it
+    // (detail/InflateCheckpoints.h): shared by the volumes of one 4-D file
+    // while importDense reads them in turn; null otherwise.
+    std::shared_ptr<detail::InflateCheckpoints> resume;
 
     uint64_t sampleCount() const { return uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]); }
     uint64_t sliceSamples() const { return uint64_t(dims[0]) * uint64_t(dims[1]); }
@@ -153,11 +161,13 @@ private:
     std::string where() const;  // "HEADER: data file DATA", or the file itself
     void positionAt(uint64_t fileSize, uint64_t need);  // the constructor's checks and seek, once the file is open
     void skipDecoded(uint64_t n);
+    void keepPosition();  // volume_.resume: where the decoding has come to
     DenseVolume volume_;
     std::FILE* file_ = nullptr;
     struct Inflater;
     std::unique_ptr<Inflater> inflater_;
     int64_t slicesRead_ = 0;
+    uint64_t decoded_ = 0;  // bytes of the compressed stream decoded so far
 };
 
 } // namespace vdbdag::bridge

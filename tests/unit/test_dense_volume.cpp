@@ -5,15 +5,20 @@
 // inputs). Counted in /proc/self/fd, in-process.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
+#include <zlib.h>
 
 #include "src/util/Error.h"
 #include "vdb_bridge/DenseVolume.h"
 #include "vdb_bridge/NrrdHeader.h"
+#include "vdb_bridge/detail/InflateCheckpoints.h"
 
 namespace fs = std::filesystem;
 using namespace vdbdag;
@@ -47,5 +52,53 @@ TEST(DenseVolume, ARefusedDataFileLeavesNoDescriptorOpen) {
         }
     }
     EXPECT_EQ(openDescriptors(), before);
+    fs::remove_all(dir);
+}
+
+// The volumes of a 4-D gzip NRRD read one after another, each reader
+// resuming the stream where the one before left it (InflateCheckpoints.h):
+// every volume's samples equal the ones written (a fresh decode from the
+// stream's start would give them too), whether read in order, again, or
+// out of order; in order, each reader after the first skips every byte
+// before its volume (resumedBytes).
+TEST(DenseVolume, AFourDGzipStreamResumesWhereTheLastVolumeEnded) {
+    const fs::path dir = fs::temp_directory_path() / ("vdbdag_dense_resume_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    constexpr int nx = 37, ny = 29, nz = 11, volumes = 9;
+    const size_t perVolume = size_t(nx) * ny * nz;
+    std::vector<uint16_t> samples(perVolume * volumes);
+    uint32_t state = 12345;
+    for (size_t i = 0; i < samples.size(); ++i) {
+        state = state * 1664525u + 1013904223u;
+        samples[i] = uint16_t(1000 + (i % 97) * 7 + (state >> 28));  // compressible, not constant
+    }
+    std::vector<uint8_t> gz(compressBound(uLong(samples.size() * 2)) + 64);
+    z_stream z{};
+    ASSERT_EQ(deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY), Z_OK);  // a gzip wrapper
+    z.next_in = reinterpret_cast<Bytef*>(samples.data());
+    z.avail_in = uInt(samples.size() * 2);
+    z.next_out = gz.data();
+    z.avail_out = uInt(gz.size());
+    ASSERT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
+    gz.resize(z.total_out);
+    deflateEnd(&z);
+    std::ofstream(dir / "series.raw.gz", std::ios::binary).write(reinterpret_cast<const char*>(gz.data()), std::streamsize(gz.size()));
+    std::ofstream(dir / "series.nhdr") << "NRRD0004\ntype: uint16\ndimension: 4\nsizes: " << nx << " " << ny << " " << nz << " " << volumes
+                                       << "\nspace directions: (1,0,0) (0,1,0) (0,0,1) none\nendian: little\nencoding: gzip\ndata file: series.raw.gz\n";
+    const auto resume = std::make_shared<detail::InflateCheckpoints>();
+    const auto check = [&](int t) {
+        DenseVolume v = readNrrdHeader((dir / "series.nhdr").string(), t);
+        ASSERT_EQ(v.volumeCount, volumes);
+        v.resume = resume;
+        std::vector<uint8_t> got;
+        openSliceReader(v)->readSlices(nz, got);
+        ASSERT_EQ(got.size(), perVolume * 2);
+        EXPECT_EQ(std::memcmp(got.data(), samples.data() + perVolume * size_t(t), got.size()), 0) << "volume " << t;
+    };
+    for (int t = 0; t < volumes; ++t) check(t);
+    uint64_t before = 0;
+    for (int t = 1; t < volumes; ++t) before += uint64_t(t) * perVolume * 2;
+    EXPECT_EQ(resume->resumedBytes(), before);  // each volume's reader began at its volume
+    for (const int t : {volumes - 1, 2, 0, 5, 5}) check(t);  // again, and out of order
     fs::remove_all(dir);
 }
