@@ -22,8 +22,10 @@ using namespace detail;
 
 // Generations 2's and 3's far neighbours (LeastSquaresPredictor.h) of sample
 // i at (x, y, z), each with the nearest near neighbour where the volume ends.
+// `ref`, `refBelow`: this slice and the one below of the reference volume
+// (IntCoderOptions::reference), or null.
 inline void farNeighbours(Neighbourhood& n, int64_t x, int64_t y, int64_t z, int64_t nx, int64_t ny, size_t i, const std::vector<int64_t>& cur,
-                          const std::vector<int64_t>& prev, const std::vector<int64_t>& prev2) {
+                          const std::vector<int64_t>& prev, const std::vector<int64_t>& prev2, const int32_t* ref, const int32_t* refBelow) {
     const size_t row = size_t(nx);
     const bool hx = x > 0, hy = y > 0, hz = z > 0, hE = x + 1 < nx, hS = y + 1 < ny;
     n.far[kWW] = x > 1 ? cur[i - 2] : n.W;
@@ -43,6 +45,13 @@ inline void farNeighbours(Neighbourhood& n, int64_t x, int64_t y, int64_t z, int
     n.far[kNWWW] = x > 2 && hy ? cur[i - row - 3] : n.far[kNWW];
     n.far[kNEEE] = x + 3 < nx && hy ? cur[i - row + 3] : n.far[kNEE];
     n.far[kNNN] = y > 2 ? cur[i - 3 * row] : n.far[kNN];
+    if (ref) {
+        const int64_t t = ref[i];
+        n.far[kNNN] = t;
+        n.far[kWWWW] = hx ? ref[i - 1] : t;
+        n.far[kNWWW] = hy ? ref[i - row] : t;
+        n.far[kNEEE] = refBelow ? refBelow[i] : t;
+    }
 }
 
 // The raster walk shared by both directions. `step(prediction, sample
@@ -60,7 +69,10 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
     // the compiler vectorises; W's part is added per sample.
     std::vector<uint64_t> rowErrors(size_t(nx) * kPredictors);
     std::vector<uint64_t> rowResiduals(static_cast<size_t>(nx));
+    const bool referenced = !options.reference.empty() && models.farActivity;  // generation 3 on: 24 taps
     for (int64_t z = 0; z < nz; ++z) {
+        const int32_t* ref = referenced ? options.reference.data() + size_t(z) * plane : nullptr;
+        const int32_t* refBelow = referenced && z > 0 ? ref - plane : nullptr;
         for (int64_t y = 0; y < ny; ++y) {
             for (int64_t x = 0; x < nx; ++x) {
                 const size_t i = size_t(y * nx + x);
@@ -93,7 +105,7 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
                 } else {
                     n.P = med(n.W, n.N, n.NW), n.PW = n.W, n.PN = n.N, n.PNW = n.NW;
                 }
-                farNeighbours(n, x, y, z, nx, ny, i, cur, prev, prev2);
+                farNeighbours(n, x, y, z, nx, ny, i, cur, prev, prev2, ref, refBelow);
                 n.rW = hx ? &curRec[i - 1] : nullptr;
                 n.rN = hy ? &curRec[i - size_t(nx)] : nullptr;
                 n.rP = hz ? &prevRec[i] : nullptr;
@@ -114,22 +126,24 @@ void walk(IntVolumeShape shape, const IntCoderOptions& options, Models& models, 
     }
 }
 
-void checkShape(IntVolumeShape shape) {
+void checkShape(IntVolumeShape shape, const IntCoderOptions& options) {
     if (shape.nx < 0 || shape.ny < 0 || shape.nz < 0) throw Error("value coder: a negative extent");
+    if (!options.reference.empty() && options.reference.size() != shape.count())
+        throw Error("value coder: a reference volume of " + std::to_string(options.reference.size()) + " samples for " + std::to_string(shape.count()));
 }
 
 } // namespace
 
 std::vector<uint8_t> encodeIntVolume(std::span<const int32_t> samples, IntVolumeShape shape, const IntCoderOptions& options,
                                      std::vector<int32_t>* reconstructed) {
-    checkShape(shape);
+    checkShape(shape, options);
     if (samples.size() != shape.count()) throw Error("value coder: " + std::to_string(samples.size()) + " samples for " + std::to_string(shape.count()));
     return encodeSamples(samples, options, reconstructed, [&](Models& models, auto&& step) { walk(shape, options, models, step); });
 }
 
 void decodeIntVolume(std::span<const uint8_t> bytes, IntVolumeShape shape, const IntCoderOptions& options, std::span<int32_t> out,
                      const std::string& what) {
-    checkShape(shape);
+    checkShape(shape, options);
     if (out.size() != shape.count()) throw Error(what + ": room for " + std::to_string(out.size()) + " samples, " + std::to_string(shape.count()) + " to decode");
     decodeSamples(bytes, options, out, what, [&](Models& models, auto&& step) { walk(shape, options, models, step); });
 }

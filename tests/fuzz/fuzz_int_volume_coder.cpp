@@ -7,7 +7,8 @@
 // layout's order rather than spatially, & 16 in raster blocks; with places and byte 5 & 0x40, the
 // entries are float32 bits for coding/FloatValueCoder, & 0x20 too vec3s,
 // any bits allowed and every bit kept), the sample range, near and the
-// model generation; the rest is (a) a stream to
+// model generation (byte 7 & 32, no bricks: a reference volume for the
+// raster coder, from the data); the rest is (a) a stream to
 // decode, which must throw vdbdag::Error or give samples inside the range,
 // never crash or read out of bounds, and (b) the samples of a volume to
 // encode, whose decode must give every sample back (within near).
@@ -81,6 +82,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         return bricks ? encodeBrickValues(samples, layout, o) : encodeIntVolume(samples, shape, o);
     };
     const uint64_t count = bricks ? layoutEntryCount(layout) : shape.count();
+    // The raster coder, byte 7 & 32: a reference volume (IntCoderOptions::reference) of
+    // samples from the data, in the range or not (a reference is any int32).
+    std::vector<int32_t> reference;
+    if (!bricks && (data[7] & 32)) {
+        reference.resize(count);
+        for (size_t i = 0; i < reference.size(); ++i)
+            if (!rest.empty()) std::memcpy(&reference[i], rest.data() + (i * 3) % rest.size(), std::min<size_t>(4, rest.size() - (i * 3) % rest.size()));
+        o.reference = reference;
+    }
     std::vector<int32_t> out(count);
     try {
         decode(rest, out);

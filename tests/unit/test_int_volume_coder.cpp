@@ -9,6 +9,7 @@
 // further).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -158,6 +159,51 @@ TEST(IntVolumeCoder, RangeCodingBesideTheWalkGivesTheSameBytes) {
     v[v.size() - 5] = 0;
     v[3] = -1101;  // found before the first hand-over
     EXPECT_THROW(encodeIntVolume(v, s, o), Error);
+}
+
+// IntCoderOptions::reference (a series' previous volume): every sample
+// comes back (lossless, and within near) over shapes whose edges lack the
+// reference's W, N or P; a volume that repeats the one before with a little
+// noise codes in well under half the bytes it takes alone (its noise is 1.5
+// bits a sample against the phantom's 6); an unrelated reference still
+// round-trips; generation 2 (19 taps) ignores it (the same bytes); a
+// reference of another size is refused.
+TEST(IntVolumeCoder, ThePreviousVolumeOfASeriesAsNeighbours) {
+    for (const IntVolumeShape s : {IntVolumeShape{23, 17, 9}, IntVolumeShape{1, 1, 1}, IntVolumeShape{40, 1, 1}, IntVolumeShape{1, 33, 7}}) {
+        const std::vector<int32_t> before = phantom(s, 3);
+        std::vector<int32_t> now = before;
+        std::mt19937 rng(5);
+        for (int32_t& v : now) v = std::clamp(v + int32_t(rng() % 3) - 1, -1100, 2600);
+        for (int32_t near : {0, 2}) {
+            IntCoderOptions o;
+            o.minValue = -1100, o.maxValue = 2600, o.near = near;
+            o.reference = before;
+            expectRoundTrip(now, s, o, "reference, " + std::to_string(s.nx) + "x" + std::to_string(s.ny) + "x" + std::to_string(s.nz));
+            const std::vector<int32_t> unrelated = phantom(s, 99);
+            o.reference = unrelated;
+            expectRoundTrip(now, s, o, "unrelated reference");
+        }
+    }
+    const IntVolumeShape s{48, 40, 16};
+    const std::vector<int32_t> before = phantom(s, 3);
+    std::vector<int32_t> now = before;
+    std::mt19937 rng(5);
+    for (int32_t& v : now) v += int32_t(rng() % 3) - 1;
+    IntCoderOptions o;
+    o.minValue = -1200, o.maxValue = 2700;
+    const size_t alone = encodeIntVolume(now, s, o).size();
+    o.reference = before;
+    const size_t referenced = encodeIntVolume(now, s, o).size();
+    EXPECT_LT(double(referenced), 0.5 * double(alone)) << referenced << " against " << alone << " alone";
+    o.model = 2;
+    const std::vector<uint8_t> second = encodeIntVolume(now, s, o);
+    o.reference = {};
+    EXPECT_EQ(encodeIntVolume(now, s, o), second);
+    o.model = kLatestIntModel;
+    o.reference = std::span<const int32_t>(before).first(before.size() - 1);
+    EXPECT_THROW(encodeIntVolume(now, s, o), Error);
+    std::vector<int32_t> out(now.size());
+    EXPECT_THROW(decodeIntVolume(second, s, o, out), Error);
 }
 
 } // namespace
