@@ -524,6 +524,7 @@ DenseImportResult importDense(const std::string& path, const DenseImportOptions&
                 for (GridRecord& g : r.volume.grids) all.volume.grids.push_back(std::move(g));
                 for (auto& c : r.cubes) all.cubes.push_back(std::move(c));
             }
+            all.source.resume.reset();  // the checkpoints serve this import only
             return all;
         }
     }

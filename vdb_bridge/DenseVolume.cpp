@@ -173,6 +173,7 @@ struct DenseSampleStream::Inflater {
     z_stream z{};
     std::vector<uint8_t> input = std::vector<uint8_t>(1u << 20);
     bool ended = false;
+    bool failed = false;  // a read threw: its state is no position to resume from
     ~Inflater() { inflateEnd(&z); }
 };
 
@@ -236,9 +237,8 @@ void DenseSampleStream::positionAt(uint64_t fileSize, uint64_t need) {
         if (inflateInit2(&inflater_->z, 15 + 32) != Z_OK) throw Error(where() + ": cannot start zlib");
         uint64_t skip = uint64_t(volume_.decodedSkip);
         if (volume_.resume)
-            if (const auto at = volume_.resume->restore(skip, inflater_->z)) {  // where an earlier reader of the file left off
+            if (const auto at = volume_.resume->restore(streamName(), skip, inflater_->z)) {  // where an earlier reader of the file left off
                 if (std::fseek(file_, long(at->filePosition), SEEK_SET) != 0) throw Error(where() + ": cannot seek to byte " + std::to_string(at->filePosition));
-                decoded_ = at->decoded;
                 skip -= at->decoded;
             }
         skipDecoded(skip);
@@ -260,11 +260,13 @@ DenseSampleStream::~DenseSampleStream() {
 }
 
 void DenseSampleStream::keepPosition() {
-    if (!volume_.resume || !inflater_ || inflater_->ended || !file_) return;
+    if (!volume_.resume || !inflater_ || inflater_->ended || inflater_->failed || !file_) return;
     const long at = std::ftell(file_);
     if (at < 0 || uint64_t(at) < inflater_->z.avail_in) return;
-    volume_.resume->save(decoded_, inflater_->z, uint64_t(at) - inflater_->z.avail_in);
+    volume_.resume->save(streamName(), inflater_->z, uint64_t(at) - inflater_->z.avail_in);
 }
+
+std::string DenseSampleStream::streamName() const { return volume_.dataPath + " at byte " + std::to_string(volume_.dataOffset); }
 
 void DenseSampleStream::readBytes(uint8_t* out, size_t n) {
     if (!inflater_) {
@@ -272,6 +274,7 @@ void DenseSampleStream::readBytes(uint8_t* out, size_t n) {
         return;
     }
     Inflater& inf = *inflater_;
+    inf.failed = true;  // until every byte is read: a reader that threw keeps no position
     inf.z.next_out = out;
     inf.z.avail_out = 0;
     size_t left = n;
@@ -297,7 +300,7 @@ void DenseSampleStream::readBytes(uint8_t* out, size_t n) {
         }
         left -= chunk;
     }
-    decoded_ += n;
+    inf.failed = false;
 }
 
 void DenseSampleStream::skipDecoded(uint64_t n) {

@@ -162,12 +162,12 @@ private:
     void positionAt(uint64_t fileSize, uint64_t need);  // the constructor's checks and seek, once the file is open
     void skipDecoded(uint64_t n);
     void keepPosition();  // volume_.resume: where the decoding has come to
+    std::string streamName() const;  // the compressed stream, for volume_.resume
     DenseVolume volume_;
     std::FILE* file_ = nullptr;
     struct Inflater;
     std::unique_ptr<Inflater> inflater_;
     int64_t slicesRead_ = 0;
-    uint64_t decoded_ = 0;  // bytes of the compressed stream decoded so far
 };
 
 } // namespace vdbdag::bridge

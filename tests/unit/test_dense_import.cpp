@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <random>
 
@@ -324,8 +325,9 @@ TEST(DenseSynthetic, GzipNrrdFloatsBitExact) {
 // and cube by cube, and its values are coded as those integers: its file is
 // the size of the same samples stored as int16 (to 2 %), well under the same
 // floats with one sample off the integers, and comes back bit for bit
-// (OpenVDB's accessor against the samples written). A -0.0 among them, or a
-// half, and there is no hint.
+// (OpenVDB's accessor against the samples written). A -0.0 among them, a
+// half, a NaN, an infinity or 2^31, and there is no hint (in memory or cube
+// by cube), every sample still back bit for bit.
 TEST(DenseSynthetic, FloatSamplesThatAreIntegersAreCodedAsIntegers) {
     using namespace vdbdag;
     const std::array<int, 3> dims{40, 36, 30};
@@ -363,13 +365,21 @@ TEST(DenseSynthetic, FloatSamplesThatAreIntegersAreCodedAsIntegers) {
     const uint64_t asFloats = encodedSize(integral);
     const uint64_t asInt16 = encodedSize(write("integer_int16", ints.data(), n * 2, "int16"));
     EXPECT_LT(double(asFloats), 1.02 * double(asInt16)) << asFloats << " against " << asInt16;
-    for (const float odd : {-0.0f, 0.5f}) {
+    const std::array<std::pair<float, const char*>, 5> odds{{{-0.0f, "negative_zero"},
+                                                            {0.5f, "half"},
+                                                            {std::numeric_limits<float>::quiet_NaN(), "nan"},
+                                                            {std::numeric_limits<float>::infinity(), "infinity"},
+                                                            {0x1p31f, "two_to_31"}}};
+    for (const auto& [odd, name] : odds) {
         std::vector<float> off = floats;
         off[n / 2] = odd;
-        const fs::path in = write(odd == 0 ? "negative_zero_floats" : "half_floats", off.data(), n * 4, "float");
-        EXPECT_FALSE(bridge::importDense(in.string(), {}).volume.grids.at(0).rescale.has_value()) << odd;
+        const fs::path in = write(std::string(name) + "_floats", off.data(), n * 4, "float");
+        EXPECT_FALSE(bridge::importDense(in.string(), {}).volume.grids.at(0).rescale.has_value()) << name;
+        bridge::DenseImportOptions cubes;
+        cubes.cubesNear = workDir().string();
+        EXPECT_FALSE(bridge::importDense(in.string(), cubes).cubes.at(0)->header().rescale.has_value()) << name << " by cubes";
         expectBothRoutes(in, "", fromFile(workDir() / (in.stem().string() + ".raw"), 0, dims, "f32", false), in.stem().string());
-        if (odd != 0) {
+        if (odd == 0.5f) {
             EXPECT_LT(double(asFloats), 0.95 * double(encodedSize(in))) << "the same floats with one half";
         }
     }

@@ -17,6 +17,7 @@
 
 #include "src/util/Error.h"
 #include "vdb_bridge/DenseVolume.h"
+#include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/NrrdHeader.h"
 #include "vdb_bridge/detail/InflateCheckpoints.h"
 
@@ -57,20 +58,21 @@ TEST(DenseVolume, ARefusedDataFileLeavesNoDescriptorOpen) {
 
 // The volumes of a 4-D gzip NRRD read one after another, each reader
 // resuming the stream where the one before left it (InflateCheckpoints.h):
-// every volume's samples equal the ones written (a fresh decode from the
-// stream's start would give them too), whether read in order, again, or
-// out of order; in order, each reader after the first skips every byte
-// before its volume (resumedBytes).
+// every volume's samples equal the ones written (2.2 MB of gzip, so the
+// readers cross the 1 MiB reads of the file), whether read in order, again,
+// out of order or after a reader gave up halfway; in order, each reader
+// after the first skips every byte before its volume (resumedBytes). The
+// import of the whole series (one grid a volume) gives every sample too.
 TEST(DenseVolume, AFourDGzipStreamResumesWhereTheLastVolumeEnded) {
     const fs::path dir = fs::temp_directory_path() / ("vdbdag_dense_resume_" + std::to_string(::getpid()));
     fs::create_directories(dir);
-    constexpr int nx = 37, ny = 29, nz = 11, volumes = 9;
+    constexpr int nx = 64, ny = 64, nz = 40, volumes = 9;
     const size_t perVolume = size_t(nx) * ny * nz;
     std::vector<uint16_t> samples(perVolume * volumes);
     uint32_t state = 12345;
     for (size_t i = 0; i < samples.size(); ++i) {
         state = state * 1664525u + 1013904223u;
-        samples[i] = uint16_t(1000 + (i % 97) * 7 + (state >> 28));  // compressible, not constant
+        samples[i] = uint16_t(state >> 20);  // 12 random bits: little for gzip to take
     }
     std::vector<uint8_t> gz(compressBound(uLong(samples.size() * 2)) + 64);
     z_stream z{};
@@ -82,12 +84,14 @@ TEST(DenseVolume, AFourDGzipStreamResumesWhereTheLastVolumeEnded) {
     ASSERT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
     gz.resize(z.total_out);
     deflateEnd(&z);
+    ASSERT_GT(gz.size(), size_t(2) << 20);
     std::ofstream(dir / "series.raw.gz", std::ios::binary).write(reinterpret_cast<const char*>(gz.data()), std::streamsize(gz.size()));
-    std::ofstream(dir / "series.nhdr") << "NRRD0004\ntype: uint16\ndimension: 4\nsizes: " << nx << " " << ny << " " << nz << " " << volumes
-                                       << "\nspace directions: (1,0,0) (0,1,0) (0,0,1) none\nendian: little\nencoding: gzip\ndata file: series.raw.gz\n";
+    const fs::path header = dir / "series.nhdr";
+    std::ofstream(header) << "NRRD0004\ntype: uint16\ndimension: 4\nsizes: " << nx << " " << ny << " " << nz << " " << volumes
+                          << "\nspace directions: (1,0,0) (0,1,0) (0,0,1) none\nendian: little\nencoding: gzip\ndata file: series.raw.gz\n";
     const auto resume = std::make_shared<detail::InflateCheckpoints>();
     const auto check = [&](int t) {
-        DenseVolume v = readNrrdHeader((dir / "series.nhdr").string(), t);
+        DenseVolume v = readNrrdHeader(header.string(), t);
         ASSERT_EQ(v.volumeCount, volumes);
         v.resume = resume;
         std::vector<uint8_t> got;
@@ -100,5 +104,30 @@ TEST(DenseVolume, AFourDGzipStreamResumesWhereTheLastVolumeEnded) {
     for (int t = 1; t < volumes; ++t) before += uint64_t(t) * perVolume * 2;
     EXPECT_EQ(resume->resumedBytes(), before);  // each volume's reader began at its volume
     for (const int t : {volumes - 1, 2, 0, 5, 5}) check(t);  // again, and out of order
+    {
+        DenseVolume v = readNrrdHeader(header.string(), 3);
+        v.resume = resume;
+        std::vector<uint8_t> part;
+        openSliceReader(v)->readSlices(nz / 2 + 1, part);  // a reader that stops halfway
+    }
+    for (const int t : {3, 4, 6}) check(t);
+    // The import: grid t holds volume t's samples (uint16 -> int32, every voxel active).
+    const bridge::DenseImportResult imported = bridge::importDense(header.string(), {});
+    ASSERT_EQ(imported.volume.grids.size(), size_t(volumes));
+    for (int t = 0; t < volumes; ++t) {
+        const GridRecord& g = imported.volume.grids[size_t(t)];
+        size_t at = 0, wrong = 0, seen = 0;
+        for (const Brick& b : g.topology.bricks)
+            for (int bit = 0; bit < 64; ++bit) {
+                if (!(b.mask >> bit & 1)) continue;
+                const size_t i = (size_t(b.z + (bit >> 4)) * ny + size_t(b.y + ((bit >> 2) & 3))) * nx + size_t(b.x + (bit & 3));
+                int32_t value;
+                std::memcpy(&value, g.values.bricks.data() + 4 * at++, 4);
+                wrong += value != samples[perVolume * size_t(t) + i];
+                ++seen;
+            }
+        EXPECT_EQ(seen, perVolume) << "volume " << t;
+        EXPECT_EQ(wrong, 0u) << "volume " << t;
+    }
     fs::remove_all(dir);
 }

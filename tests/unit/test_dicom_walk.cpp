@@ -161,7 +161,7 @@ TEST(DicomWalk, TheFuzzRegressionsAreRefusedBeforeGdcmAndCostNothing) {
                                                           "overlay group 6020 keeps its Overlay Data and overlay group 601E does not (none, or no Rows x Columns"},
                                                          {"dicom_overlay_size_oom", "overlay group 600C of 47108x24580 pixels, which GDCM's image reader unpacks"},
                                                          {"dicom_not_image_storage_abort",
-                                                          "its SOP Class UID is unknown, and GDCM's image reader would decode it as 1.2.840.10008.3.1.2.3.1"},
+                                                          "GDCM's image reader would take its SOP class for 1.2.840.10008.3.1.2.3.1"},
                                                          {"dicom_samples_per_pixel_values_abort",
                                                           "Samples per Pixel (0028,0002) holds 8 values where DICOM has one (GDCM's image reader takes the first, 21333"},
                                                          // refused by the walk
@@ -271,6 +271,54 @@ TEST(DicomRle, ForgedRleHeadersAreRefusedAndAValidOneDecodesByHand) {
     EXPECT_NE(r.err.find("an RLE header of 33554434 segments"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
     fs::remove_all(file.parent_path());
+}
+
+// The SOP class check of a file GDCM's image reader decodes (an RLE file:
+// the valid one of the test above), through the three ways
+// PixmapReader::Read goes when the file meta header's class is unknown: the
+// data set's class is CT, and the file reads, its pixels as by hand; both
+// unknown, and GDCM gives the file up itself (one line, no abort); the data
+// set's class one that a space cuts to a non-image class (Detached Study
+// Management, the fuzz finding dicom_not_image_storage_abort), refused by
+// the check naming it, where GDCM's reader asserted.
+TEST(DicomWalk, AnUnknownSopClassIsReadRefusedOrGivenUpAsGdcmWould) {
+    std::ifstream in(fs::path(VDBDAG_SOURCE_DIR) / "tests/fuzz/regressions/scan_headers/dicom_rle_segment_count_crash", std::ios::binary);
+    std::string valid = std::string((std::istreambuf_iterator<char>(in)), {}).substr(1);
+    const size_t fragment = valid.find(std::string("\xFE\xFF\x00\xE0\x64\x00\x00\x00", 8)) + 8;
+    ASSERT_LT(fragment, valid.size());
+    valid.replace(fragment, 4, std::string("\x02\x00\x00\x00", 4));  // two segments: the valid file
+    const std::string ct = "1.2.840.10008.5.1.4.1.1.2";
+    const auto withClasses = [&](const std::string& name, const std::string& meta, const std::string& dataSet) {
+        std::string s = valid;
+        EXPECT_EQ(s.substr(166, ct.size()), ct);  // (0002,0002) and (0008,0016)
+        EXPECT_EQ(s.substr(248, ct.size()), ct);
+        s.replace(166, ct.size(), meta);
+        s.replace(248, ct.size(), dataSet);
+        return write(name, s);
+    };
+    const std::string unknown = "1.2.840.10008.5.1.4.1.9.9";   // no class GDCM knows
+    const std::string cutToStudy = "1.2.840.10008.3.1.2.3.1 2";  // "1.2.840.10008.3.1.2.3.1" once cut at the space
+    ASSERT_EQ(unknown.size(), ct.size());
+    ASSERT_EQ(cutToStudy.size(), ct.size());
+    const DenseVolume v = describeDicomSeries(withClasses("meta_unknown.dcm", unknown, ct).string(), "");
+    std::vector<uint8_t> out;
+    openSliceReader(v)->readSlices(v.dims[2], out);
+    ASSERT_EQ(out.size(), 32u);
+    EXPECT_EQ(out[2 * 15] | out[2 * 15 + 1] << 8, 5 << 8 | 0xdc);  // the last pixel, as read by hand above
+    const std::pair<fs::path, std::string> refused[] = {
+        {withClasses("both_unknown.dcm", unknown, unknown), "GDCM cannot read it as a DICOM image"},
+        {withClasses("study_class.dcm", unknown, cutToStudy), "GDCM's image reader would take its SOP class for 1.2.840.10008.3.1.2.3.1"},
+    };
+    for (const auto& [file, why] : refused) {
+        try {
+            const DenseVolume w = describeDicomSeries(file.string(), "");
+            openSliceReader(w)->readSlices(w.dims[2], out);
+            ADD_FAILURE() << "not refused: " << file;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+        }
+    }
+    fs::remove_all(fs::temp_directory_path() / ("vdbdag_dicom_walk_" + std::to_string(::getpid())));
 }
 
 // An element of undefined length under an explicit VR GDCM reads it by:

@@ -101,22 +101,25 @@ std::string nonImageClass(const std::string& sop) {
 }
 
 // The SOP class GDCM's image reader decodes a file as, when that is no image
-// class (it asserts MediaStorage::IsImage then, PixmapReader::Read): a class
-// unknown in both the file meta header and the data set, under a transfer
-// syntax other than ACR-NEMA's, sends the reader to MediaStorage::SetFromFile,
-// which cuts a UID at its first space ("1.2.840.10008.3.1.2.3.1 .2" became
-// Detached Study Management; found by fuzz_scan_headers). "" when the reader
-// takes an image class or refuses the file itself.
+// class (it asserts MediaStorage::IsImage then, PixmapReader::Read): where
+// the file meta header's class is no image class (unknown, or known and
+// another kind) and the data set's is unknown or missing, under a transfer
+// syntax other than ACR-NEMA's, the reader guesses with
+// MediaStorage::SetFromFile, which cuts a UID at its first space
+// ("1.2.840.10008.3.1.2.3.1 .2" became Detached Study Management; found by
+// fuzz_scan_headers). "" when the reader takes an image class or refuses the
+// file itself (a DICOMDIR, a class both name alike).
 std::string imageReaderClassProblem(const gdcm::File& file) {
     const gdcm::MediaStorage header = file.GetHeader().GetMediaStorage();
     if (gdcm::MediaStorage::IsImage(header)) return "";
     if (file.GetDataSet().GetMediaStorage() != gdcm::MediaStorage::MS_END) return "";  // GDCM reads it as an image class or refuses it
+    if (header == gdcm::MediaStorage::MediaStorageDirectoryStorage) return "";     // GDCM refuses a DICOMDIR
     if (file.GetHeader().GetDataSetTransferSyntax() == gdcm::TransferSyntax::ImplicitVRBigEndianACRNEMA || file.GetHeader().IsEmpty())
         return "";  // read as ACR-NEMA
     gdcm::MediaStorage guess;
     guess.SetFromFile(file);
     if (guess == gdcm::MediaStorage::MS_END || gdcm::MediaStorage::IsImage(guess)) return "";
-    return fmt::format("its SOP Class UID is unknown, and GDCM's image reader would decode it as {} ({}), no image storage",
+    return fmt::format("GDCM's image reader would take its SOP class for {} ({}), which is no image storage (it aborts on such a file)",
                        guess.GetString() ? guess.GetString() : "?", gdcm::MediaStorage::GetMSString(guess) ? gdcm::MediaStorage::GetMSString(guess) : "?");
 }
 
