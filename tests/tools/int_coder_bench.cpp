@@ -5,6 +5,11 @@
 // raw), in one run:
 //
 //   vdbdag_int_coder_bench SCAN [--near N] [--repeats R] [--series N] [--volume N] [--dump RAW]
+//   vdbdag_int_coder_bench SCAN_4D --series-reference 1
+//
+// The second: each volume of a 4-D scan coded alone and with the volume
+// before it as the coder's reference (IntCoderOptions::reference): the
+// bytes of each way, summed, and every decode checked.
 //
 // `ours_model1_bytes`: the same volume coded with the previous model
 // generation (the blend of six, SamplePredictor.h), once, for the table's
@@ -18,6 +23,8 @@
 // report medians. One JSON object on stdout.
 #include <algorithm>
 #include <chrono>
+#include <climits>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -60,12 +67,53 @@ std::vector<int32_t> storedSamples(const vdbdag::bridge::DenseVolume& v) {
                 case SampleType::U16: { uint16_t x; std::memcpy(&x, p, 2); s = x; break; }
                 case SampleType::I16: { int16_t x; std::memcpy(&x, p, 2); s = x; break; }
                 case SampleType::I32: std::memcpy(&s, p, 4); break;
+                case SampleType::F32: {  // float samples that are all integers (a series saved as float)
+                    float x;
+                    std::memcpy(&x, p, 4);
+                    if (!(std::fabs(x) < 0x1p31f) || x != std::trunc(x))
+                        throw vdbdag::Error(v.headerPath + ": a float sample that is no integer (" + std::to_string(x) + "): the integer coder takes integers");
+                    s = int32_t(x);
+                    break;
+                }
                 default: throw vdbdag::Error(v.headerPath + ": " + vdbdag::bridge::sampleTypeName(v.type) + " samples: the integer coder takes 8- to 32-bit integers");
             }
             out.push_back(s);
         }
     }
     return out;
+}
+
+// --series-reference: each volume of a 4-D scan coded alone and with the
+// volume before it as its reference (IntCoderOptions::reference), lossless,
+// every decode checked. One JSON object.
+nlohmann::json seriesReport(const std::string& path, vdbdag::bridge::DenseImportOptions options) {
+    options.volume = 0;
+    const int64_t volumes = vdbdag::bridge::describeDense(path, options).volumeCount;
+    std::vector<std::vector<int32_t>> all;
+    int32_t lo = INT32_MAX, hi = INT32_MIN;
+    vdbdag::bridge::DenseVolume v;
+    for (int64_t t = 0; t < volumes; ++t) {
+        options.volume = t;
+        v = vdbdag::bridge::describeDense(path, options);
+        all.push_back(storedSamples(v));
+        for (const int32_t s : all.back()) lo = std::min(lo, s), hi = std::max(hi, s);
+    }
+    const vdbdag::coding::IntVolumeShape shape{v.dims[0], v.dims[1], v.dims[2]};
+    vdbdag::coding::IntCoderOptions o;
+    o.minValue = lo, o.maxValue = hi;
+    size_t alone = 0, referenced = 0, wrong = 0;
+    std::vector<int32_t> back(shape.count());
+    for (size_t t = 0; t < all.size(); ++t) {
+        vdbdag::coding::IntCoderOptions r = o;
+        alone += vdbdag::coding::encodeIntVolume(all[t], shape, o).size();
+        if (t > 0) r.reference = all[t - 1];
+        const std::vector<uint8_t> bytes = vdbdag::coding::encodeIntVolume(all[t], shape, r);
+        referenced += bytes.size();
+        vdbdag::coding::decodeIntVolume(bytes, shape, r, back);
+        wrong += back != all[t];
+    }
+    return {{"scan", path}, {"volumes", volumes}, {"dims", {shape.nx, shape.ny, shape.nz}}, {"alone_bytes", alone}, {"with_previous_bytes", referenced},
+            {"ratio", double(referenced) / double(alone)}, {"volumes_wrong", wrong}};
 }
 
 } // namespace
@@ -154,7 +202,7 @@ size_t jpeg2000Slice(const int32_t* slice, uint32_t nx, uint32_t ny, int bits, b
 
 int main(int argc, char** argv) {
     try {
-        if (argc < 2) throw vdbdag::Error("usage: vdbdag_int_coder_bench SCAN [--near N] [--repeats R] [--series N] [--volume N] [--dump RAW]");
+        if (argc < 2) throw vdbdag::Error("usage: vdbdag_int_coder_bench SCAN [--near N] [--repeats R] [--series N] [--volume N] [--dump RAW] | SCAN_4D --series-reference 1");
         const std::string path = argv[1];
         int near = 0, repeats = 3;
         std::string dump;  // --dump PATH: the stored samples as raw int32 (x fastest), then stop
@@ -167,6 +215,11 @@ int main(int argc, char** argv) {
             else if (flag == "--series") options.series = value;
             else if (flag == "--volume") options.volume = std::stoll(value);
             else if (flag == "--dump") dump = value;
+            else if (flag == "--series-reference" && value == "1") {
+                const nlohmann::json r = seriesReport(path, options);
+                std::printf("%s\n", r.dump().c_str());
+                return r["volumes_wrong"] == 0 ? 0 : 1;
+            }
             else throw vdbdag::Error("unknown option " + flag);
         }
         const vdbdag::bridge::DenseVolume v = vdbdag::bridge::describeDense(path, options);
