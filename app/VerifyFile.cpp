@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "app/EncodeFile.h"
 #include "app/MemoryBudget.h"
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/CubeEncoder.h"
@@ -125,10 +126,38 @@ Verified verifyNanoVdb(const VerifyRequest& opt) {
     return bridge::canReadVdbByCubes(asVdb.input) ? verifyByCubes(asVdb) : verifyWhole(asVdb);
 }
 
+// A scan: its grids as `encode` imports them go to a temporary .vdb in the
+// scratch folder (the import whole, in memory: 4 bytes a sample, and the
+// .vdb's copy while it is written). The .ssvdag compared with it, cube by
+// cube: --encoded, or what `encode` writes for the scan with the same
+// options (app::encodeFile, into the scratch folder: the same bytes).
+Verified verifyScan(const VerifyRequest& opt) {
+    const std::filesystem::path folder = opt.scratch.empty() ? std::filesystem::temp_directory_path() : std::filesystem::path(opt.scratch);
+    const std::string stem = (folder / std::filesystem::path(opt.input).filename()).string();
+    const RemovedAfterwards vdb(temporaryNameFor(stem, ".vdb"));
+    {
+        bridge::DenseImportOptions dense = opt.dense;
+        dense.cubesNear.clear();
+        bridge::exportVdb(bridge::importDense(opt.input, dense).volume, vdb.path);
+    }
+    VerifyRequest asVdb = opt;
+    asVdb.input = vdb.path;
+    if (!opt.encoded.empty()) return verifyEncoded(asVdb);
+    const RemovedAfterwards encoded(temporaryNameFor(stem, ".ssvdag"));
+    EncodeRequest request;
+    request.input = opt.input, request.output = encoded.path, request.force = true, request.dense = opt.dense;
+    request.noSymmetry = opt.noSymmetry, request.topologyOnly = opt.topologyOnly, request.memoryLimit = opt.memoryLimit, request.scratch = folder.string();
+    encodeFile(request);
+    asVdb.encoded = encoded.path;
+    return verifyEncoded(asVdb);
+}
+
 } // namespace
 
 VerifyResult verifyFile(const VerifyRequest& opt) {
-    const Verified verified = bridge::inputKindOf(opt.input) == bridge::InputKind::NanoVdb ? verifyNanoVdb(opt)
+    const bridge::InputKind kind = bridge::inputKindOf(opt.input);
+    const Verified verified = kind == bridge::InputKind::Dense     ? verifyScan(opt)
+                              : kind == bridge::InputKind::NanoVdb ? verifyNanoVdb(opt)
                               : !opt.encoded.empty()                   ? verifyEncoded(opt)
                               : bridge::canReadVdbByCubes(opt.input) ? verifyByCubes(opt)
                                                                      : verifyWhole(opt);

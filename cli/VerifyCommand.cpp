@@ -13,6 +13,7 @@
 #include "app/VerifyFile.h"
 #include "cli/ByteSize.h"
 #include "cli/Commands.h"
+#include "cli/DenseInputOptions.h"
 #include "cli/JsonReport.h"
 #include "cli/ReadLimitOptions.h"
 #include "cli/RunContext.h"
@@ -20,6 +21,7 @@
 #include "src/util/Error.h"
 #include "src/util/FramePattern.h"
 #include "src/util/Progress.h"
+#include "vdb_bridge/InputScene.h"
 
 namespace vdbdag::cli {
 namespace {
@@ -30,6 +32,7 @@ struct VerifyOptions {
     bool json = false, noSymmetry = false, topologyOnly = false;
     uint64_t memoryLimit = 0;
     ReadLimitOptions limits;  // what the .ssvdag file may expand to (a file from elsewhere, --encoded)
+    DenseInputOptions dense;  // a scan: read as `encode` reads it
 };
 
 // Verifies one input and prints (or, with `batch`, adds) its report;
@@ -39,6 +42,12 @@ bool verifyAndReport(const VerifyOptions& opt, std::optional<int64_t> frame, nlo
     request.input = opt.input, request.encoded = opt.encoded, request.frame = opt.frame, request.scratch = opt.scratch;
     request.noSymmetry = opt.noSymmetry, request.topologyOnly = opt.topologyOnly, request.memoryLimit = opt.memoryLimit;
     request.limits = opt.limits.limits(0);  // compared cube by cube: no copy of the whole
+    const app::DenseInputs dense = opt.dense.inputs();
+    dense.checkApplies(opt.input);
+    if (bridge::inputKindOf(opt.input) == bridge::InputKind::Dense) {
+        request.dense = dense.resolve(opt.input);
+        request.dense.showProgress = false;  // verify's own progress line
+    }
     app::VerifyResult verified = app::verifyFile(request);
     const bridge::CompareResult& result = verified.result;
     nlohmann::json& report = verified.report;
@@ -67,9 +76,10 @@ bool verifyAndReport(const VerifyOptions& opt, std::optional<int64_t> frame, nlo
 
 void addVerifyCommand(CLI::App& app, int& exitCode) {
     auto opt = std::make_shared<VerifyOptions>();
-    CLI::App* cmd = app.add_subcommand("verify", "Check that a .vdb file survives the round trip through .ssvdag bit for bit (or that an .ssvdag file holds it), region by region");
+    CLI::App* cmd = app.add_subcommand("verify", "Check that a .vdb file or a scan survives the round trip through .ssvdag bit for bit (or that an .ssvdag file holds it), region by region");
     cmd->add_option("input", opt->input,
-                    "input .vdb file (or a NanoVDB .nvdb, as its grids read through NanoVDB), or a frame pattern (smoke.####.vdb): each frame, "
+                    "input .vdb file (or a NanoVDB .nvdb, as its grids read through NanoVDB; or a scan: NIfTI, NRRD, MetaImage, raw or DICOM, "
+                    "as `encode` reads it with the same options), or a frame pattern (smoke.####.vdb): each frame, "
                     "against its frame of the sequence file --encoded names")
         ->required();
     cmd->add_flag("--no-symmetry", opt->noSymmetry, "verify the plain SVDAG encoding");
@@ -82,6 +92,7 @@ void addVerifyCommand(CLI::App& app, int& exitCode) {
         ->check(CLI::ExistingDirectory);
     cmd->add_flag("--json", opt->json, "print JSON");
     opt->limits.add(*cmd);
+    opt->dense.addTo(*cmd);
     cmd->callback([opt, &exitCode] {
         if (opt->json) setQuiet(true);
         // Frames: a pattern (smoke.####.vdb), each frame verified; with

@@ -172,6 +172,8 @@ DenseVolume readNrrdHeader(const std::string& path, std::optional<int64_t> volum
             if (!kinds.empty() && detail::lower(kinds[0]) == "rgb-color") v.colour = true;
         }
     }
+    if (!series && volume.value_or(0) != 0)  // as NIfTI's reader says it (a 3-D file was read as if asked for volume 0)
+        throw Error(path + ": --volume " + std::to_string(*volume) + " is out of range: the file holds 1 volume (0..0)");
     for (int a = 0; a < 3; ++a) v.dims[size_t(a)] = detail::parseInteger(sizes[first + size_t(a)], path + ": sizes");
 
     const std::string encoding = detail::lower(detail::trim(required("encoding")));
