@@ -12,6 +12,7 @@
 # Writes docs/sequences.md and docs/bench/sequences.jsonl.
 #   scripts/sequence_report.sh [FRAMES [DIM]]     (defaults: 48 frames, d=256)
 #   SEQUENCE_DIR=DIR scripts/sequence_report.sh  (frames already made there)
+#   APPEND=1 ...: the rows join those of the run before (both in the table)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 FRAMES=${1:-48}
@@ -20,7 +21,7 @@ VDBDAG=build/vdbdag
 OUT=docs/sequences.md
 JSONL=docs/bench/sequences.jsonl
 mkdir -p docs/bench
-: > "$JSONL"
+[ -n "${APPEND:-}" ] || : > "$JSONL"  # APPEND=1: add this cache's rows to the last run's
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 DIR=${SEQUENCE_DIR:-$TMP/frames}
