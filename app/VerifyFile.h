@@ -8,8 +8,10 @@
 // A scan (NIfTI, NRRD, MetaImage, raw, DICOM) is imported as `encode`
 // imports it with the same options (vdb_bridge/DenseImport.h: its samples
 // after any rescale, thresholds and tiles), into a temporary .vdb in the
-// scratch folder, which is then verified as a .vdb is: every sample of the
-// scan is compared through OpenVDB's accessors.
+// scratch folder, which is then verified as a .vdb is: every sample as the
+// import reads it is compared through OpenVDB's accessors (a fault of the
+// import itself would be on both sides; the scan readers have their own
+// tests against nibabel and pydicom).
 //
 // A .vdb with grid offsets goes the way `encode` takes it (region by
 // region, within the memory limit) into a temporary file in the scratch

@@ -46,7 +46,8 @@ bool verifyAndReport(const VerifyOptions& opt, std::optional<int64_t> frame, nlo
     dense.checkApplies(opt.input);
     if (bridge::inputKindOf(opt.input) == bridge::InputKind::Dense) {
         request.dense = dense.resolve(opt.input);
-        request.dense.showProgress = false;  // verify's own progress line
+        request.dense.showProgress = false;         // verify's own progress line
+        request.dense.limits = opt.limits.limits(1);  // --max-memory, --max-voxels: the import holds the samples once (as `import`)
     }
     app::VerifyResult verified = app::verifyFile(request);
     const bridge::CompareResult& result = verified.result;

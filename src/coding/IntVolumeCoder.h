@@ -81,7 +81,9 @@ struct IntCoderOptions {
     // them as it finds them: the 25 ASL volumes of mpld_asl.nii.gz
     // (64x64x24) cost 808,884 bytes coded alone and 564,350 each with the
     // one before as its reference (-30 %); volumes of independent noise
-    // around one mean, -2 %. Empty: none.
+    // around one mean, -2 %. Empty: none. Near-lossless (near > 0): the
+    // reference must be the previous volume as the decoder rebuilds it
+    // (encodeIntVolume's `reconstructed`), or the two drift apart.
     std::span<const int32_t> reference;
 };
 

@@ -228,7 +228,13 @@ inline Prediction predict(const Neighbourhood& n, int64_t minValue, int64_t maxV
         for (size_t k = 0; k < 7; ++k) out.x[k] = double(nearSeven[k] - n.W);
         const size_t far = size_t(out.fit->shape.taps - 7);
         for (size_t k = 0; k < far; ++k) out.x[7 + k] = double(n.far[k] - n.W);
-        out.blend = std::clamp(int64_t(std::nearbyint(out.fit->predict(out.x, double(n.W)))), minValue, maxValue);
+        // A prediction outside int64 (a fit whose weights a sudden jump in
+        // the samples or a series' reference multiplied: found by review,
+        // 2^64 from full-range int32 samples) is the range's minimum: what
+        // x86-64's conversion gave it (INT64_MIN, clamped), now defined, so
+        // that every machine decodes the same (ARM saturates instead).
+        const double rounded = std::nearbyint(out.fit->predict(out.x, double(n.W)));
+        out.blend = rounded >= -0x1p63 && rounded < 0x1p63 ? std::clamp(int64_t(rounded), minValue, maxValue) : minValue;
     }
     if (models.textureBias) {
         const int64_t b = out.blend;

@@ -385,43 +385,6 @@ TEST(DenseSynthetic, FloatSamplesThatAreIntegersAreCodedAsIntegers) {
     }
 }
 
-// `verify` takes a scan as `encode` reads it: a NRRD of int16 samples is
-// identical after the round trip (exit 0), and against the .ssvdag of the
-// same scan with one sample changed it DIFFERS (exit 1), naming one value;
-// a dense option verify passes to the import is checked as encode checks
-// it: --volume 2 of a 3-D NRRD is refused in one line (it was ignored).
-TEST(DenseSynthetic, VerifyTakesAScanAsEncodeReadsIt) {
-    const std::array<int, 3> dims{24, 20, 18};
-    const size_t n = size_t(dims[0]) * dims[1] * dims[2];
-    std::vector<int16_t> samples(n);
-    std::mt19937 rng(3);
-    for (size_t i = 0; i < n; ++i) samples[i] = int16_t(int(i % 301) - 150 + int(rng() % 7));
-    const auto write = [&](const std::string& stem, const std::vector<int16_t>& v) {
-        writeBytes(workDir() / (stem + ".raw"), v.data(), v.size() * 2);
-        const std::string h = "NRRD0004\ntype: int16\ndimension: 3\nsizes: 24 20 18\nendian: little\nencoding: raw\ndata file: " + stem + ".raw\n";
-        writeBytes(workDir() / (stem + ".nhdr"), h.data(), h.size());
-        return workDir() / (stem + ".nhdr");
-    };
-    const fs::path scan = write("verified", samples);
-    auto r = runCli("verify " + scan.string());
-    EXPECT_EQ(r.exitCode, 0) << r.out << r.err;
-    EXPECT_NE(r.out.find("identical after the round trip"), std::string::npos) << r.out;
-    std::vector<int16_t> changed = samples;
-    changed[n / 3] ^= 1;
-    const fs::path other = workDir() / "changed.ssvdag";
-    r = runCli("encode " + write("changed", changed).string() + " -o " + other.string() + " --force");
-    ASSERT_EQ(r.exitCode, 0) << r.err;
-    r = runCli("verify " + scan.string() + " --encoded " + other.string() + " --json");
-    EXPECT_EQ(r.exitCode, 1) << r.out << r.err;
-    const nlohmann::json report = nlohmann::json::parse(r.out);
-    EXPECT_FALSE(report["identical"].get<bool>());
-    ASSERT_EQ(report["values"].size(), 1u) << r.out;
-    EXPECT_EQ(report["values"][0]["active_values_differing"].get<uint64_t>(), 1u) << r.out;
-    r = runCli("verify " + scan.string() + " --volume 2");  // a 3-D NRRD: one volume (refused as NIfTI refuses it)
-    EXPECT_NE(r.exitCode, 0);
-    EXPECT_NE(r.err.find("verified.nhdr: --volume 2 is out of range: the file holds 1 volume"), std::string::npos) << r.err;
-}
-
 TEST(DenseSynthetic, MetaImageObliqueBigEndianAndInlineMha) {
     const std::array<int, 3> dims{7, 8, 6};
     std::vector<uint8_t> be;

@@ -206,5 +206,21 @@ TEST(IntVolumeCoder, ThePreviousVolumeOfASeriesAsNeighbours) {
     EXPECT_THROW(decodeIntVolume(second, s, o, out), Error);
 }
 
+// A prediction past int64 (found by review): a reference tap that mostly
+// differs by 1 from its W teaches the fit a weight near 1.4e9, then jumps by
+// 2^32 - 1, and the prediction is about 2^64. Converting that to int64 was
+// undefined (x86 gave INT64_MIN, ARM saturates: two machines would decode
+// differently); it is now the range's minimum, defined, and the samples
+// come back (UBSan in scripts/sanitize.sh runs this).
+TEST(IntVolumeCoder, APredictionPastInt64IsTheMinimumOnEveryMachine) {
+    const IntVolumeShape s{20000, 1, 1};
+    std::vector<int32_t> reference(s.count(), INT32_MIN), samples(s.count(), INT32_MIN);
+    for (size_t i = 0; i < 18000; i += 400) samples[i] = INT32_MAX, reference[i] = INT32_MIN + 1;
+    for (size_t i = 18050; i < s.count(); ++i) reference[i] = INT32_MAX;
+    IntCoderOptions o;
+    o.minValue = INT32_MIN, o.maxValue = INT32_MAX, o.reference = reference;
+    expectRoundTrip(samples, s, o, "a reference that jumps by 2^32 - 1");
+}
+
 } // namespace
 } // namespace vdbdag::coding
