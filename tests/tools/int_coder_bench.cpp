@@ -40,6 +40,7 @@
 #include "src/util/Error.h"
 #include "vdb_bridge/DenseImport.h"
 #include "vdb_bridge/DenseVolume.h"
+#include "vdb_bridge/detail/DenseBricks.h"
 
 #include "tests/tools/BenchTiming.h"
 
@@ -67,10 +68,10 @@ std::vector<int32_t> storedSamples(const vdbdag::bridge::DenseVolume& v) {
                 case SampleType::U16: { uint16_t x; std::memcpy(&x, p, 2); s = x; break; }
                 case SampleType::I16: { int16_t x; std::memcpy(&x, p, 2); s = x; break; }
                 case SampleType::I32: std::memcpy(&s, p, 4); break;
-                case SampleType::F32: {  // float samples that are all integers (a series saved as float)
+                case SampleType::F32: {  // float samples that are all integers (a series saved as float), as the import takes them
                     float x;
                     std::memcpy(&x, p, 4);
-                    if (!(std::fabs(x) < 0x1p31f) || x != std::trunc(x))
+                    if (!vdbdag::bridge::detail::onIntegerLattice(x))
                         throw vdbdag::Error(v.headerPath + ": a float sample that is no integer (" + std::to_string(x) + "): the integer coder takes integers");
                     s = int32_t(x);
                     break;

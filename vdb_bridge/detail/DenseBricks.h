@@ -59,9 +59,10 @@ struct PassStats {
 // floats' bits: mpld_asl.nii.gz, float32 of integers, 1,201,829 bytes coded
 // as floats. Only a hint: the coder checks every value, and no metadata
 // says it.
+inline bool onIntegerLattice(float f) { return std::fabs(f) < 0x1p31f && f == std::trunc(f) && !(f == 0 && std::signbit(f)); }
 inline bool integerLattice(std::span<const float> values) {
     bool all = true;
-    for (const float f : values) all &= std::fabs(f) < 0x1p31f && f == std::trunc(f) && !(f == 0 && std::signbit(f));
+    for (const float f : values) all &= onIntegerLattice(f);
     return all;
 }
 
