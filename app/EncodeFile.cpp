@@ -159,6 +159,14 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
     } catch (const Error& e) {
         throw Error(request.input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
     }
+    // A 4-D scan's volumes, each with the one before as its reference where
+    // that is smaller (lossless only: the pass takes exact grids alone).
+    pipeline::SeriesReferenceReport series;
+    if (dense && scene.grids.size() > 1 && request.keyEvery > 1 && team.isRoot()) {
+        phases.push_back({"coding the volumes against the one before", std::chrono::steady_clock::now()});
+        progress.setLabel("encode: coding the volumes against the one before");
+        series = pipeline::referenceSeries(scene, request.keyEvery);
+    }
     // Neither the input voxels nor the attribute arrays are written:
     // release them before the sections are built (a 512x512x999 scan
     // holds 1 GB in each).
@@ -197,6 +205,10 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
                           {"grid_count", scene.grids.size()}, {"grids", grids}, {"active_voxels", voxels}, {"seconds", seconds},
                           {"bits_per_active_voxel", voxels ? 8.0 * double(fileBytes) / double(voxels) : 0.0}};
     if (threshold.applied) report["threshold"] = thresholdJson(threshold);
+    if (series.referencedGrids)
+        report["series_reference"] = {{"key_every", request.keyEvery}, {"referenced_grids", series.referencedGrids},
+                                      {"referenced_windows", series.referencedWindows}, {"window_bytes_before", series.bytesBefore},
+                                      {"window_bytes_after", series.bytesAfter}};
     report["phases"] = nlohmann::json::array();
     for (size_t i = 0; i < phases.size(); ++i) {
         const auto end = i + 1 < phases.size() ? phases[i + 1].second : start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));

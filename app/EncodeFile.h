@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "src/pipeline/CubeEncoder.h"
+#include "src/pipeline/SeriesReference.h"
 #include "vdb_bridge/DenseImport.h"
 
 namespace vdbdag::app {
@@ -37,6 +38,10 @@ struct EncodeRequest {
     // How it is coded (the options of `vdbdag encode --help`).
     bool noSymmetry = false, noCompress = false, noPredict = false, svdagStats = false;
     int placementTrials = 1;
+    // A 4-D scan's volumes: a key volume every keyEvery, each other coded
+    // with the volume before as its reference where that is smaller
+    // (pipeline/SeriesReference.h; 1: every volume alone).
+    unsigned keyEvery = pipeline::kDefaultKeyEvery;
     double absError = 0, relError = 0;
     unsigned colourBits = 0, normalBits = 0;
     std::vector<std::string> colourGrids;

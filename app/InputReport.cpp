@@ -230,9 +230,13 @@ std::pair<nlohmann::json, std::string> describeInput(const InfoRequest& opt, con
         }
         report["format"] = "ssvdag";
         report["input_bytes"] = report["ssvdag_bytes"];
-        // The file's container version: 2 where a grid's inside is a signed fill (docs/FORMAT.md 3.1).
-        fileVersion = std::any_of(scene.grids.begin(), scene.grids.end(), [](const format::EncodedGrid& g) { return g.inactiveSignedFill; })
-                          ? format::kLatestFormatVersion
+        // The file's container version: 3 where a grid's values take an
+        // earlier grid's as their reference, 2 where a grid's inside is a
+        // signed fill (docs/FORMAT.md 3.1).
+        fileVersion = std::any_of(scene.grids.begin(), scene.grids.end(), [](const format::EncodedGrid& g) { return g.active.valueWindows.referenceDistance != 0; })
+                          ? 3u
+                      : std::any_of(scene.grids.begin(), scene.grids.end(), [](const format::EncodedGrid& g) { return g.inactiveSignedFill; })
+                          ? 2u
                           : format::kFormatVersion;
         for (size_t g = 0; g < scene.grids.size(); ++g) {
             const format::EncodedGrid& grid = scene.grids[g];

@@ -43,6 +43,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         bool force = false, noSymmetry = false, noCompress = false, noPredict = false, skipUnsupported = false, json = false, topologyOnly = false;
         bool svdagStats = false;
         int placementTrials = 1;
+        unsigned keyEvery = vdbdag::pipeline::kDefaultKeyEvery;
         uint64_t memoryLimit = 0;
         std::string scratch;
         unsigned threads = 0;
@@ -69,6 +70,11 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
                   "also reduce each layer without symmetry and store the plain SVDAG's node counts, which `info` shows beside the SVO's and "
                   "SSVDAG's (a second reduction; `info IN.vdb` computes them anyway)");
     cmd->add_option("--placement-trials", opt->placementTrials, "root placements to try, keeping the one whose file is smallest; each codes the values again (1-64)")->check(CLI::Range(1, 64));
+    cmd->add_option("--key-every", opt->keyEvery,
+                    "a 4-D scan (one grid a volume): a key volume every N, coded alone; each other volume's values may take the volume before "
+                    "as their reference, where that is smaller (lossless only); a reader decodes at most N - 1 other volumes to reach one "
+                    "(1: every volume alone)")
+        ->check(CLI::Range(1u, 256u));
     cmd->add_flag("--skip-unsupported", opt->skipUnsupported, "skip grids of unsupported types (e.g. PointDataGrid) instead of failing");
     cmd->add_flag("--topology-only", opt->topologyOnly, "geometry only: active topology as a mask, no values (decodes to MaskGrids)");
     auto* abs = cmd->add_option("--abs-error", opt->absError, "lossy: every float/double active value within this absolute error; an int32/int64 value within its integer part (JPEG-LS NEAR)")->check(finiteNumber())->check(CLI::PositiveNumber);
@@ -97,7 +103,7 @@ void addEncodeCommand(CLI::App& app, int& exitCode) {
         app::EncodeRequest& c = request.coding;
         c.force = opt->force, c.grids = opt->grids, c.skipUnsupported = opt->skipUnsupported, c.topologyOnly = opt->topologyOnly;
         c.noSymmetry = opt->noSymmetry, c.noCompress = opt->noCompress, c.noPredict = opt->noPredict, c.svdagStats = opt->svdagStats;
-        c.placementTrials = opt->placementTrials, c.absError = opt->absError, c.relError = opt->relError;
+        c.placementTrials = opt->placementTrials, c.keyEvery = opt->keyEvery, c.absError = opt->absError, c.relError = opt->relError;
         c.colourBits = opt->colourBits, c.normalBits = opt->normalBits, c.colourGrids = opt->colourGrids, c.normalGrid = opt->normalGrid;
         c.memoryLimit = opt->memoryLimit, c.scratch = opt->scratch, c.threads = opt->threads;
         app::EncodeInputsHooks hooks;

@@ -140,6 +140,7 @@ py::object encode(const py::object& src, const py::object& dst, const py::kwargs
         {"no_predict", flag(c.noPredict)},
         {"svdag_stats", flag(c.svdagStats)},
         {"placement_trials", [&c](const py::handle& h) { c.placementTrials = inRange<int>(h, 1, 64, "placement_trials"); }},
+        {"key_every", [&c](const py::handle& h) { c.keyEvery = inRange<unsigned>(h, 1, 256, "key_every"); }},
         {"abs_error", [&c](const py::handle& h) { c.absError = finite(h, "abs_error"); }},
         {"rel_error", [&c](const py::handle& h) { c.relError = finite(h, "rel_error"); }},
         {"colour_bits", colourBits},

@@ -20,10 +20,29 @@ int modelOf(std::span<const coding::BrickPlace> places, coding::BrickOrder order
     if (spatial < 1 || spatial > coding::kLatestIntModel) throw Error("internal error: model generation " + std::to_string(spatial));
     return !places.empty() && order != coding::BrickOrder::Attribute ? spatial : 0;
 }
+// A reference's entries as the coder sees the entries: (t - lo) / step,
+// rounded down (an entry off the step's lattice is a tap all the same).
+std::vector<int32_t> referenceTaps(std::span<const int32_t> reference, int32_t lo, uint64_t step) {
+    std::vector<int32_t> taps(reference.begin(), reference.end());
+    if (step > 1)
+        for (int32_t& t : taps) {
+            const int64_t d = int64_t(t) - lo, s = int64_t(step);
+            t = int32_t(d >= 0 ? d / s : -((-d + s - 1) / s));
+        }
+    return taps;
+}
+void checkReference(std::span<const int32_t> reference, bool labels, std::span<const coding::BrickPlace> places, int model, size_t entries,
+                    const std::string& what) {
+    if (reference.empty()) return;
+    if (labels || places.empty() || model < 3) throw Error(what + ": internal error: a reference needs a placed walk of generation 3 or later");
+    if (reference.size() != entries)
+        throw Error(what + ": a reference of " + std::to_string(reference.size()) + " entries for " + std::to_string(entries));
+}
 } // namespace
 
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                          bool labels, coding::BrickOrder order, int model, int labelModel, bool tileNeighbours, bool codeAside) {
+                                          bool labels, coding::BrickOrder order, int model, int labelModel, bool tileNeighbours, bool codeAside,
+                                          std::span<const int32_t> reference) {
     if (labels && places.empty()) throw Error("internal error: labels are coded with their bricks' places");
     if (values.size() % 4) throw Error("internal error: a context-coded channel holds int32 entries");
     std::vector<int32_t> entries(values.size() / 4);
@@ -46,6 +65,9 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
     options.model = modelOf(places, order, model);
     options.tileNeighbours = tileNeighbours;
     options.codeAside = codeAside;
+    checkReference(reference, labels, places, options.model, entries.size(), "value coder");
+    const std::vector<int32_t> taps = referenceTaps(reference, lo, step);
+    options.reference = taps;
     const std::vector<uint8_t> stream =
         labels           ? coding::encodePlacedLabels(entries, layout, places, order, int32_t(options.minValue), int32_t(options.maxValue), labelModel)
         : places.empty() ? coding::encodeBrickValues(entries, layout, options)
@@ -64,7 +86,7 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
 
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
                                           std::span<const coding::BrickPlace> places, bool labels, coding::BrickOrder order, int model,
-                                          int labelModel, bool tileNeighbours) {
+                                          int labelModel, bool tileNeighbours, std::span<const int32_t> reference) {
     format::ByteReader r(payload, what);
     const uint8_t valueSize = r.get<uint8_t>();
     if (valueSize != 4) r.fail("a context-coded channel of " + std::to_string(valueSize) + "-byte values (4 expected)");
@@ -86,6 +108,9 @@ std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std:
         r.fail("holds " + std::to_string(n) + " entries, its bricks " + std::to_string(coding::layoutEntryCount(layout)) + ", expected " + std::to_string(entries));
     std::vector<int32_t> decoded(static_cast<size_t>(entries));
     if (labels && (near || places.empty())) r.fail("labels coded near-lossless or without places");
+    checkReference(reference, labels, places, options.model, decoded.size(), what);
+    const std::vector<int32_t> taps = referenceTaps(reference, lo, step);
+    options.reference = taps;
     if (labels)
         coding::decodePlacedLabels(payload.subspan(kHeaderBytes), layout, places, order, int32_t(options.minValue), int32_t(options.maxValue), decoded, what,
                                    labelModel);

@@ -36,10 +36,15 @@ namespace vdbdag::attributes {
 // integers' placed walk of generation 4 with tiles as neighbours.
 // `model`: the generation in spatial order (ignored otherwise).
 // `codeAside`: IntCoderOptions::codeAside (speed only).
+// `reference` (codings 21 and 22: a placed walk of generation 3 or 4, not
+// labels): a series' previous volume, one entry per entry of `values` in
+// the same order, as IntCoderOptions::reference; the coder sees each as
+// the entries are seen, (t - minimum) / step rounded down.
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
                                           coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel,
-                                          int labelModel = 1, bool tileNeighbours = false, bool codeAside = false);
+                                          int labelModel = 1, bool tileNeighbours = false, bool codeAside = false,
+                                          std::span<const int32_t> reference = {});
 
 // Inverse (`places` given exactly when the payload was coded with them);
 // validates the payload against `layout` and `entries` (throws
@@ -47,6 +52,6 @@ std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::
 std::vector<uint8_t> decodeContextChannel(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
                                           coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel,
-                                          int labelModel = 1, bool tileNeighbours = false);
+                                          int labelModel = 1, bool tileNeighbours = false, std::span<const int32_t> reference = {});
 
 } // namespace vdbdag::attributes

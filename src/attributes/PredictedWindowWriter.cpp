@@ -237,7 +237,87 @@ std::vector<uint8_t> codeWindow(std::span<const uint8_t> values, std::span<const
     return raw;
 }
 
+// A window's raw bytes as stored: one zstd frame where that is smaller.
+std::vector<uint8_t> storedWindow(std::vector<uint8_t>&& raw) {
+    std::vector<uint8_t> stored;
+    if (zstdMayShrink(raw)) stored = format::zstdCompressIfSmaller(raw, {raw.size() <= kSmallWindowBytes ? 9 : 3, /*checksum*/ true, 0});
+    if (stored.empty()) stored = std::move(raw);
+    return stored;
+}
+
 } // namespace
+
+std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const uint8_t> payload, const ReferenceWindow& reference, uint32_t valueSize,
+                                                              std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
+                                                              const std::string& what, uint64_t& referenced, std::vector<std::vector<uint8_t>>* decoded) {
+    referenced = 0;
+    const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
+    if (decoded) decoded->assign(dir.windows.size(), {});
+    if (valueSize != 4 || places.size() != layout.size()) return std::nullopt;
+    // Each window of the walks that take a reference (codings 15, 16, 19,
+    // 20: 15 and 16 are 19 and 20 on a layout without tiles) coded again
+    // with it, in parallel; the smaller kept.
+    std::vector<std::vector<uint8_t>> stored(dir.windows.size());
+    std::vector<uint64_t> raws(dir.windows.size());
+    tbb::parallel_for(size_t(0), dir.windows.size(), [&](size_t k) {
+        const WindowDirectory::Window& e = dir.windows[k];
+        const std::string where = what + " window " + std::to_string(k);
+        const uint8_t coding = windowRawBytes(payload, e, where).at(0);
+        const bool integers = coding == detail::kTiledContextCoding || coding == detail::kBandedContextCoding;
+        const bool lattice = coding == detail::kTiledRescaledFloatCoding || coding == detail::kBandedRescaledFloatCoding;
+        if (!integers && !lattice) {
+            if (decoded) (*decoded)[k] = decodePredictedWindow(payload, dir, k, layout, where, places);
+            return;
+        }
+        std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, where, places);
+        const std::vector<uint8_t> t = reference(k);
+        if (t.size() != values.size()) throw Error(where + ": internal error: its reference window holds " + std::to_string(t.size()) + " bytes, it " + std::to_string(values.size()));
+        const auto keep = [&] {
+            if (decoded) (*decoded)[k] = std::move(values);
+        };
+        const std::span<const uint64_t> bricks = layout.subspan(size_t(e.firstBrick), size_t(e.bricks));
+        const auto placesHere = places.subspan(size_t(e.firstBrick), size_t(e.bricks));
+        std::vector<uint8_t> raw;
+        if (integers) {
+            std::vector<int32_t> taps(t.size() / 4);
+            std::memcpy(taps.data(), t.data(), t.size());
+            raw = encodeContextChannel(values, bricks, placesHere, false, coding::spatialOrderOf(4), 4, 1, true, false, taps);
+            raw.insert(raw.begin(), detail::kReferencedContextCoding);
+        } else {
+            const std::vector<uint8_t> own = windowRawBytes(payload, e, where);
+            format::ByteReader r(std::span<const uint8_t>(own).subspan(1), where);
+            ValueRescale rescale;
+            rescale.slope = r.get<double>();  // the window's own lattice (RescaledFloats.h)
+            rescale.intercept = r.get<double>();
+            std::optional<std::vector<uint8_t>> coded = encodeRescaledFloats(values, bricks, placesHere, rescale, 4, true, false, t);
+            if (!coded) return keep();
+            raw = std::move(*coded);
+            raw.insert(raw.begin(), detail::kReferencedRescaledFloatCoding);
+        }
+        const uint64_t rawSize = raw.size();
+        std::vector<uint8_t> candidate = storedWindow(std::move(raw));
+        if (candidate.size() < e.stored) {
+            stored[k] = std::move(candidate);
+            raws[k] = rawSize;
+        }
+        keep();
+    });
+    format::ByteWriter out;
+    out.putBytes(payload.first(kHeaderBytes));
+    format::ByteWriter directory;
+    for (size_t k = 0; k < dir.windows.size(); ++k) {
+        const WindowDirectory::Window& e = dir.windows[k];
+        referenced += !stored[k].empty();
+        if (stored[k].empty()) out.putBytes(payload.subspan(size_t(e.offset), size_t(e.stored)));
+        else out.putBytes(stored[k]);
+        directory.put<uint64_t>(stored[k].empty() ? e.stored : stored[k].size());
+        directory.put<uint64_t>(stored[k].empty() ? e.raw : raws[k]);
+        directory.put<uint64_t>(e.entries);
+    }
+    if (referenced == 0) return std::nullopt;
+    out.putBytes(directory.bytes());
+    return out.take();
+}
 
 PredictedWindowWriter::PredictedWindowWriter(uint32_t valueSize, unsigned parallel, const std::string& spillNear, uint64_t spillInMemory,
                                              std::optional<FloatChannel> floats)
@@ -334,8 +414,7 @@ void PredictedWindowWriter::codePending() {
         std::vector<uint64_t>().swap(pending_[i].layout);
         std::vector<coding::BrickPlace>().swap(pending_[i].places);
         rawBytes[i] = raw.size();
-        if (zstdMayShrink(raw)) stored[i] = format::zstdCompressIfSmaller(raw, {raw.size() <= kSmallWindowBytes ? 9 : 3, /*checksum*/ true, 0});
-        if (stored[i].empty()) stored[i] = std::move(raw);
+        stored[i] = storedWindow(std::move(raw));
     });
     for (size_t i = 0; i < pending_.size(); ++i) {
         appendWindow(payload_, spill_.get(), stored[i]);

@@ -67,7 +67,8 @@ const char* predictedCodingName(uint8_t coding) {
                                         "rescaled floats", "context-coded", "labels", "predicted floats", "predicted vectors",
                                         "fitted context-coded", "fitted rescaled floats", "float integers", "wide fitted context-coded",
                                         "wide fitted rescaled floats", "banded context-coded", "banded rescaled floats", "shaped labels", "tiled labels",
-                                        "tiled banded context-coded", "tiled banded rescaled floats"};
+                                        "tiled banded context-coded", "tiled banded rescaled floats", "referenced context-coded",
+                                        "referenced rescaled floats"};
     static_assert(std::size(names) == detail::kCodingCount);
     return coding < std::size(names) ? names[coding] : "unknown";
 }
@@ -136,12 +137,56 @@ WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, u
     return dir;
 }
 
+WindowReference::WindowReference(std::vector<uint8_t> bytes, uint32_t valueSize, std::span<const uint64_t> layout,
+                                 std::shared_ptr<const WindowReference> nextReference, std::string name)
+    : payload(std::move(bytes)), next(std::move(nextReference)), depth(next ? next->depth + 1 : 1), what(std::move(name)) {
+    if (depth > kMaxReferenceChain) throw Error(what + ": a chain of more than " + std::to_string(kMaxReferenceChain) + " grids, each the reference of the next");
+    directory = readPredictedWindowDirectory(payload, valueSize, layout, what);
+    offered_.resize(directory.windows.size());
+}
+
+std::vector<uint8_t> WindowReference::window(size_t k, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) const {
+    {
+        std::lock_guard lock(mutex_);
+        if (k >= offered_.size()) throw Error(what + ": has no window " + std::to_string(k));
+        if (!offered_[k].empty()) return std::move(offered_[k]);  // handed out once
+    }
+    std::vector<uint8_t> values = decodePredictedWindow(payload, directory, k, layout, what, places, referenceWindows(next, layout, places));
+    if (values.size() != directory.windows[k].entries * directory.valueSize) throw Error(what + " window " + std::to_string(k) + ": decoded to the wrong size");
+    return values;
+}
+
+void WindowReference::offer(size_t k, std::span<const uint8_t> values) const {
+    std::lock_guard lock(mutex_);
+    if (k < offered_.size() && values.size() == directory.windows[k].entries * directory.valueSize) offered_[k].assign(values.begin(), values.end());
+}
+
+ReferenceWindow referenceWindows(const std::shared_ptr<const WindowReference>& reference, std::span<const uint64_t> layout,
+                                 std::span<const coding::BrickPlace> places) {
+    if (!reference) return {};
+    return [reference, layout, places](size_t k) { return reference->window(k, layout, places); };
+}
+
 std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, const WindowDirectory& dir, size_t k, std::span<const uint64_t> layout,
-                                           const std::string& what, std::span<const coding::BrickPlace> places) {
+                                           const std::string& what, std::span<const coding::BrickPlace> places, const ReferenceWindow& reference) {
     const WindowDirectory::Window& e = dir.windows.at(k);
     const std::string where = what + " window " + std::to_string(k);
     const std::vector<uint8_t> raw = windowRawBytes(payload, e, where);
     const std::span<const uint8_t> body = std::span<const uint8_t>(raw).subspan(1);
+    if (raw[0] == detail::kReferencedContextCoding || raw[0] == detail::kReferencedRescaledFloatCoding) {
+        // Codings 19 and 20 with the reference's window k as neighbours.
+        if (!reference) throw Error(where + ": is coded with a series' reference, and its layer names none");
+        if (dir.valueSize != 4) throw Error(where + ": a referenced window of " + std::to_string(dir.valueSize) + "-byte values (4 expected)");
+        if (places.size() != layout.size()) throw Error(where + ": internal error: the window needs its bricks' places");
+        const std::vector<uint8_t> t = reference(k);
+        if (t.size() != e.entries * 4) throw Error(where + ": its reference window holds " + std::to_string(t.size() / 4) + " entries, expected " + std::to_string(e.entries));
+        const std::span<const uint64_t> bricks = layout.subspan(size_t(e.firstBrick), size_t(e.bricks));
+        const auto placesHere = places.subspan(size_t(e.firstBrick), size_t(e.bricks));
+        if (raw[0] == detail::kReferencedRescaledFloatCoding) return decodeRescaledFloats(body, bricks, e.entries, where, placesHere, 4, true, t);
+        std::vector<int32_t> taps(t.size() / 4);
+        std::memcpy(taps.data(), t.data(), t.size());
+        return decodeContextChannel(body, bricks, e.entries, where, placesHere, false, coding::spatialOrderOf(4), 4, 1, true, taps);
+    }
     if (raw[0] == detail::kPaletteCoding) {
         const PaletteChannel c = deserializePalette(body, where);
         if (c.valueSize != dir.valueSize || c.entryCount != e.entries)
@@ -203,7 +248,8 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
 }
 
 std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            const std::string& what, std::span<const coding::BrickPlace> places, const ParallelFor& parallel) {
+                                            const std::string& what, std::span<const coding::BrickPlace> places, const ParallelFor& parallel,
+                                            const ReferenceWindow& reference, const WindowReference* offerTo) {
     const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
     std::vector<uint8_t> out(size_t(dir.entries * valueSize));  // entries matched the DAG's layout
     // The windows through `parallel` (in any order, each into its place: the
@@ -212,9 +258,10 @@ std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, ui
     std::vector<std::exception_ptr> failed(dir.windows.size());
     const auto one = [&](size_t k) {
         try {
-            const std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, what, places);
+            const std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, what, places, reference);
             if (values.size() != dir.windows[k].entries * valueSize) throw Error(what + " window " + std::to_string(k) + ": decoded to the wrong size");
             std::memcpy(out.data() + dir.windows[k].firstEntry * valueSize, values.data(), values.size());
+            if (offerTo) offerTo->offer(k, values);
         } catch (...) {
             failed[k] = std::current_exception();
         }

@@ -41,8 +41,9 @@
 // payload with the labels coded by label model generation 2 and the bricks
 // visited in raster order inside 32^3 blocks, coding/LabelCoder.h; 18: the
 // same with label model generation 3, tiles as neighbours; 19: coding 15
-// with tiles as neighbours; 20: coding 16 with tiles as neighbours) then
-// that payload;
+// with tiles as neighbours; 20: coding 16 with tiles as neighbours; 21 and
+// 22: codings 19 and 20 with a series' reference, the same window of an
+// earlier grid (WindowReference, below)) then that payload;
 // stored == raw: as they are, else one zstd frame of them that declares the
 // raw size and carries zstd's checksum.
 #pragma once
@@ -51,6 +52,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -70,7 +72,7 @@ inline constexpr uint8_t kPaletteCoding = 0, kPredictedCoding = 1, kContextCodin
                          kFittedContextCoding = 10, kFittedRescaledFloatCoding = 11, kFloatIntegerCoding = 12, kWideContextCoding = 13,
                          kWideRescaledFloatCoding = 14, kBandedContextCoding = 15, kBandedRescaledFloatCoding = 16, kShapedLabelCoding = 17,
                          kTiledLabelCoding = 18, kTiledContextCoding = 19, kTiledRescaledFloatCoding = 20,
-                         kCodingCount = 21;
+                         kReferencedContextCoding = 21, kReferencedRescaledFloatCoding = 22, kCodingCount = 23;
 // Entries of a brick instance of the attribute layout (a solid node: 1).
 inline uint64_t layoutEntries(uint64_t mask) { return mask ? uint64_t(std::popcount(mask)) : 1; }
 } // namespace detail
@@ -132,6 +134,50 @@ private:
     ValueRange range_;
 };
 
+// A series' reference (codings 21 and 22; FORMAT.md 8.6): a layer whose
+// grid's DAG is an earlier grid's, entry for entry, may code a window with
+// that grid's same window (the same entries: a 4-D scan's previous volume)
+// as four more neighbours of each voxel (coding/IntVolumeCoder.h's
+// IntCoderOptions::reference). Window k then needs the reference's window
+// k decoded first, and that one its own reference's: `next`.
+//
+// So that a decode of a whole series in order decodes each window once and
+// holds at most a volume's windows more: a decode of the reference grid's
+// own window k offers it (`offer`, ValueWindowsPayload::referencedBy), and
+// the grid that refers to it takes it from there (`window`: an offered
+// window is handed out once, then forgotten). A window not offered is
+// decoded again from the payload (and its own chain).
+// A reader refuses a chain longer than kMaxReferenceChain grids (the
+// decode of a window recurses along it; the encoder's key grids keep it
+// shorter: --key-every at most 256).
+inline constexpr unsigned kMaxReferenceChain = 255;
+struct WindowReference {
+    std::vector<uint8_t> payload;                 // the earlier grid's PredictedWindows payload
+    WindowDirectory directory;                    // its directory (the same windows as the layer's)
+    std::shared_ptr<const WindowReference> next;  // its own reference, or null
+    unsigned depth = 1;                           // the grids of the chain: 1 + next's
+    std::string what;                             // names it in errors
+    // Window k's entries (as decodePredictedWindow gives them): the one
+    // offered, or decoded.
+    std::vector<uint8_t> window(size_t k, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places) const;
+    // The reference grid's own decode of its window k hands it on.
+    void offer(size_t k, std::span<const uint8_t> values) const;
+    WindowReference() = default;
+    WindowReference(std::vector<uint8_t> bytes, uint32_t valueSize, std::span<const uint64_t> layout, std::shared_ptr<const WindowReference> next,
+                    std::string what);
+
+private:
+    mutable std::mutex mutex_;
+    mutable std::vector<std::vector<uint8_t>> offered_;
+};
+// The entries of the reference's window k, asked for only by the windows
+// whose coding reads it.
+using ReferenceWindow = std::function<std::vector<uint8_t>(size_t window)>;
+// `reference`'s window, over the layer's `layout` and `places` (which must
+// outlive the function); an empty function for a null reference.
+ReferenceWindow referenceWindows(const std::shared_ptr<const WindowReference>& reference, std::span<const uint64_t> layout,
+                                 std::span<const coding::BrickPlace> places);
+
 // How many windows use each coding (index: the coding byte, 0..9), read
 // from each window's first byte only (a compressed window's start is
 // inflated, nothing more); the directory is checked as for decoding. And
@@ -163,14 +209,31 @@ std::vector<uint8_t> encodePredictedWindows(std::span<const uint8_t> values, uin
 // (the DAG's attributeLayout) and throws vdbdag::Error starting with `what`.
 // `places` (encoding::attributePlaces) are needed by codings 3-8. The
 // windows are decoded through `parallel` when given.
+// `reference`: the entries of the reference's windows (codings 21, 22),
+// which a window of either coding without it refuses; `offerTo`: the
+// reference of the grid that refers to this one (its referencedBy), which
+// each decoded window is offered to.
 std::vector<uint8_t> decodePredictedWindows(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
-                                            const std::string& what, std::span<const coding::BrickPlace> places, const ParallelFor& parallel = {});
+                                            const std::string& what, std::span<const coding::BrickPlace> places, const ParallelFor& parallel = {},
+                                            const ReferenceWindow& reference = {}, const WindowReference* offerTo = nullptr);
 
 // Window by window (WindowCursor.h): the directory, checked against
 // `layout` as decodePredictedWindows checks it, and window k's entries.
 WindowDirectory readPredictedWindowDirectory(std::span<const uint8_t> payload, uint32_t valueSize, std::span<const uint64_t> layout,
                                              const std::string& what);
 std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, const WindowDirectory& dir, size_t k, std::span<const uint64_t> layout,
-                                           const std::string& what, std::span<const coding::BrickPlace> places);
+                                           const std::string& what, std::span<const coding::BrickPlace> places, const ReferenceWindow& reference = {});
+
+// A series' reference chosen for a layer's windows (the encoder's pass,
+// pipeline/SeriesReference.h): each window of coding 15, 16, 19 or 20
+// (`payload`'s windows need no reference) coded again with `reference(k)`,
+// the reference grid's window k (a grid of the same DAG), as its reference
+// (codings 21 and 22), kept where that is smaller. Returns the new payload,
+// or nothing when no window gained; `referenced` counts the windows that
+// did; `decoded` (if given) receives each window's entries.
+std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const uint8_t> payload, const ReferenceWindow& reference, uint32_t valueSize,
+                                                              std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
+                                                              const std::string& what, uint64_t& referenced,
+                                                              std::vector<std::vector<uint8_t>>* decoded = nullptr);
 
 } // namespace vdbdag::attributes

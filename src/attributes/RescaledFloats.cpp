@@ -1,6 +1,7 @@
 // See RescaledFloats.h.
 #include "src/attributes/RescaledFloats.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -28,9 +29,20 @@ std::optional<int32_t> latticeIndex(float v, const ValueRescale& r) {
 
 } // namespace
 
+std::vector<int32_t> referenceIntegers(std::span<const uint8_t> reference, const ValueRescale& rescale) {
+    std::vector<int32_t> out(reference.size() / 4);
+    for (size_t i = 0; i < out.size(); ++i) {
+        float v;
+        std::memcpy(&v, reference.data() + 4 * i, 4);
+        const double q = std::nearbyint((double(v) - rescale.intercept) / rescale.slope);
+        out[i] = q != q ? 0 : int32_t(std::clamp(q, double(INT32_MIN) + 1, double(INT32_MAX) - 1));
+    }
+    return out;
+}
+
 std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                                          std::span<const coding::BrickPlace> places, const ValueRescale& rescale, int model,
-                                                         bool tileNeighbours, bool codeAside) {
+                                                         bool tileNeighbours, bool codeAside, std::span<const uint8_t> reference) {
     if (values.size() % 4) throw Error("internal error: rescaled floats are 4-byte entries");
     if (!std::isfinite(rescale.slope) || rescale.slope == 0 || !std::isfinite(rescale.intercept)) return std::nullopt;
     const size_t n = values.size() / 4;
@@ -50,7 +62,7 @@ std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t
     }
     const std::vector<uint8_t> coded = encodeContextChannel(
         std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(integers.data()), integers.size() * 4), layout, places, false,
-        coding::spatialOrderOf(model), model, 1, tileNeighbours, codeAside);
+        coding::spatialOrderOf(model), model, 1, tileNeighbours, codeAside, reference.empty() ? std::vector<int32_t>{} : referenceIntegers(reference, rescale));
     format::ByteWriter w;
     w.bytes().reserve(kHeaderBytes + 8 * exceptions.size() + coded.size());
     w.put(rescale.slope);
@@ -65,7 +77,7 @@ std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t
 }
 
 std::vector<uint8_t> decodeRescaledFloats(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places, int model, bool tileNeighbours) {
+                                          std::span<const coding::BrickPlace> places, int model, bool tileNeighbours, std::span<const uint8_t> reference) {
     format::ByteReader r(payload, what);
     ValueRescale rescale;
     rescale.slope = r.get<double>();
@@ -81,7 +93,8 @@ std::vector<uint8_t> decodeRescaledFloats(std::span<const uint8_t> payload, std:
             r.fail("its exceptions are not in increasing entry order inside the window");
     }
     std::vector<uint8_t> out =
-        decodeContextChannel(payload.subspan(r.position()), layout, entries, what, places, false, coding::spatialOrderOf(model), model, 1, tileNeighbours);
+        decodeContextChannel(payload.subspan(r.position()), layout, entries, what, places, false, coding::spatialOrderOf(model), model, 1, tileNeighbours,
+                             reference.empty() ? std::vector<int32_t>{} : referenceIntegers(reference, rescale));
     for (size_t i = 0; i + 4 <= out.size(); i += 4) {
         int32_t k;
         std::memcpy(&k, out.data() + i, 4);

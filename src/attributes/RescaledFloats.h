@@ -46,11 +46,22 @@ inline float rescaledFloat(int64_t k, const ValueRescale& r) {
 // `codeAside`: coding/IntVolumeCoder.h's IntCoderOptions::codeAside (speed only).
 std::optional<std::vector<uint8_t>> encodeRescaledFloats(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                                          std::span<const coding::BrickPlace> places, const ValueRescale& rescale,
-                                                         int model = coding::kLatestIntModel, bool tileNeighbours = false, bool codeAside = false);
+                                                         int model = coding::kLatestIntModel, bool tileNeighbours = false, bool codeAside = false,
+                                                         std::span<const uint8_t> reference = {});
 
 // Inverse; validates the payload against `layout` and `entries` (throws
 // vdbdag::Error starting with `what`).
 std::vector<uint8_t> decodeRescaledFloats(std::span<const uint8_t> payload, std::span<const uint64_t> layout, uint64_t entries, const std::string& what,
-                                          std::span<const coding::BrickPlace> places, int model, bool tileNeighbours = false);
+                                          std::span<const coding::BrickPlace> places, int model, bool tileNeighbours = false,
+                                          std::span<const uint8_t> reference = {});
+
+// `reference` (coding 22): a series' previous volume, float32 entries in
+// the same order as the window's, whose integers on this window's lattice
+// (referenceIntegers) are the coder's reference (ContextChannel.h).
+// The integer of a reference entry: (v - intercept) / slope rounded to the
+// nearest (ties to even) and kept inside int32 less one at each end; 0 for
+// NaN. IEEE doubles, a subtraction then a division: the same bits on every
+// machine.
+std::vector<int32_t> referenceIntegers(std::span<const uint8_t> reference, const ValueRescale& rescale);
 
 } // namespace vdbdag::attributes

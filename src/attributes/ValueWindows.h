@@ -47,8 +47,19 @@ inline constexpr uint64_t kValueWindowEntries = uint64_t(1) << 22;
 
 // A coded payload, in memory or (an encoder in bounded memory) the whole of
 // a scratch file.
+struct WindowReference;  // PredictedWindows.h
+
 struct ValueWindowsPayload {
     std::vector<uint8_t> bytes;
+    // A predicted payload whose windows may read those of an earlier grid
+    // of the file (codings 21, 22; section ValueReference, FORMAT.md 8.6):
+    // how many grids back it is (0: none), and, in a scene read from a
+    // file, its windows (set by the reader).
+    uint32_t referenceDistance = 0;
+    std::shared_ptr<const WindowReference> reference;
+    // The reference of the grid that refers to this one, if read: each
+    // window decoded in order is offered to it (WindowReference::offer).
+    std::shared_ptr<const WindowReference> referencedBy;
     // The range of the values coded, when the writer was asked to keep it
     // (trackRange): an encoder's Summary section (docs/FORMAT.md 10.1).
     std::optional<ValueRange> range;

@@ -10,8 +10,16 @@
 namespace vdbdag::attributes {
 
 WindowCursor::WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what,
-                           std::span<const coding::BrickPlace> places, unsigned ahead)
-    : payload_(payload), predicted_(predicted), layout_(layout), places_(places), what_(std::move(what)), ahead_(ahead) {
+                           std::span<const coding::BrickPlace> places, unsigned ahead, ReferenceWindow reference,
+                           std::shared_ptr<const WindowReference> offerTo)
+    : payload_(payload),
+      predicted_(predicted),
+      layout_(layout),
+      places_(places),
+      reference_(std::move(reference)),
+      offerTo_(std::move(offerTo)),
+      what_(std::move(what)),
+      ahead_(ahead) {
     dir_ = predicted ? readPredictedWindowDirectory(payload, valueSize, layout, what_) : readValueWindowDirectory(payload, what_);
     if (dir_.valueSize != valueSize)
         throw Error(what_ + ": holds " + std::to_string(dir_.valueSize) + "-byte values, expected " + std::to_string(valueSize));
@@ -24,7 +32,10 @@ WindowCursor::~WindowCursor() {
 }
 
 std::vector<uint8_t> WindowCursor::decode(size_t k) const {
-    return predicted_ ? decodePredictedWindow(payload_, dir_, k, layout_, what_, places_) : decodeValueWindow(payload_, dir_, k, what_).decodeAll();
+    if (!predicted_) return decodeValueWindow(payload_, dir_, k, what_).decodeAll();
+    std::vector<uint8_t> values = decodePredictedWindow(payload_, dir_, k, layout_, what_, places_, reference_);
+    if (offerTo_) offerTo_->offer(k, values);
+    return values;
 }
 
 // Windows are read in order (0, 1, ...): window k is the first pending one.

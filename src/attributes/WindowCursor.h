@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "src/attributes/PredictedWindows.h"
 #include "src/attributes/ValueWindows.h"
 
 namespace vdbdag::attributes {
@@ -26,7 +27,8 @@ public:
     // thread of its own (0: none; the cursor then holds one decoded window,
     // else up to 1 + ahead).
     WindowCursor(std::span<const uint8_t> payload, bool predicted, uint32_t valueSize, std::span<const uint64_t> layout, std::string what,
-                 std::span<const coding::BrickPlace> places, unsigned ahead = 0);
+                 std::span<const coding::BrickPlace> places, unsigned ahead = 0, ReferenceWindow reference = {},
+                 std::shared_ptr<const WindowReference> offerTo = nullptr);
     WindowCursor(const WindowCursor&) = delete;
     WindowCursor& operator=(const WindowCursor&) = delete;
     ~WindowCursor();
@@ -41,6 +43,8 @@ private:
     bool predicted_;
     std::span<const uint64_t> layout_;
     std::span<const coding::BrickPlace> places_;
+    ReferenceWindow reference_;  // a series' reference (PredictedWindows.h), or empty
+    std::shared_ptr<const WindowReference> offerTo_;  // the reference each decoded window is offered to (a series' next grid's), or null
     std::string what_;
     WindowDirectory dir_;
     size_t window_ = 0;            // the window in `values_`

@@ -5,6 +5,7 @@
 #include <array>
 #include <bit>
 #include <memory>
+#include <type_traits>
 
 #include "src/coding/CodingLoop.h"
 #include "src/coding/PlacedWalk.h"
@@ -103,16 +104,31 @@ struct CompactRecord {
     }
 };
 
+// A voxel's record in a walk with a series' reference (IntCoderOptions::
+// reference): also the reference's entry at the voxel, which its later
+// neighbours read as TW, TN and TP. A tile beside a brick stands in with
+// its record Rec{}: a reference of 0 there.
+struct ReferencedRecord : CompactRecord {
+    int32_t t = 0;
+};
+
 // Generation 2 (kReach Wide) also finds the far neighbours, generation 3
 // (Widest) five more, with the raster walk's substitutes (IntVolumeCoder.cpp)
-// where a neighbour's brick is not visited yet.
-template <Reach kReach, bool kTiles, typename Step>
+// where a neighbour's brick is not visited yet. With a reference (kRef,
+// generations 3 and 4), the reference's entry at the voxel (T) and at W, N
+// and P (TW, TN, TP; T where that neighbour is not visited) take the taps
+// of NNN, WWWW, NWWW and NEEE, as the raster walk's reference does.
+template <Reach kReach, bool kTiles, bool kRef = false, typename Step>
 void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
                 Models& models, Step&& step) {
+    static_assert(!kRef || kReach == Reach::Widest, "a reference takes generation 3's far taps");
+    using Rec = std::conditional_t<kRef, ReferencedRecord, CompactRecord>;
+    if (kRef && options.reference.size() != entries)
+        throw Error("value coder: a reference of " + std::to_string(options.reference.size()) + " entries for " + std::to_string(entries));
     int64_t last = 0;  // the previous entry visited, and its record
     SampleRecord lastRec{};
-    using Nb = PlacedNeighbours<CompactRecord>;
-    walkPlacedBricks<CompactRecord, kReach, kTiles>(
+    using Nb = PlacedNeighbours<Rec>;
+    walkPlacedBricks<Rec, kReach, kTiles>(
         layout, places, entries, order,
         [&](uint64_t entry, auto&&...) {  // a tile: one entry, predicted by the entry before (kTiles: its value a neighbour's)
             Neighbourhood n;
@@ -124,8 +140,8 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             learn(pr, last, lastRec);
             return int32_t(last);
         },
-        [&](const Nb& nb, uint64_t entry, int32_t& value, CompactRecord& rec) {
-            const auto v = [&](Nb::Which k) { return int64_t(nb.value(k)); };
+        [&](const Nb& nb, uint64_t entry, int32_t& value, Rec& rec) {
+            const auto v = [&](typename Nb::Which k) { return int64_t(nb.value(k)); };
             const bool hW = nb.has(Nb::W), hN = nb.has(Nb::N), hP = nb.has(Nb::P);
             Neighbourhood n;
             n.W = hW ? v(Nb::W) : hN ? v(Nb::N) : hP ? v(Nb::P) : last;
@@ -141,7 +157,7 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
                 n.P = med(n.W, n.N, n.NW), n.PW = n.W, n.PN = n.N, n.PNW = n.NW;
             }
             if constexpr (kReach >= Reach::Wide) {
-                const auto o = [&](Nb::Which k, int64_t substitute) { return nb.has(k) ? v(k) : substitute; };
+                const auto o = [&](typename Nb::Which k, int64_t substitute) { return nb.has(k) ? v(k) : substitute; };
                 n.far[kWW] = o(Nb::WW, n.W), n.far[kNN] = o(Nb::NN, n.N), n.far[kPP] = o(Nb::PP, n.P);
                 n.far[kPE] = o(Nb::PE, n.P), n.far[kPS] = o(Nb::PS, n.P), n.far[kPNE] = o(Nb::PNE, n.PN), n.far[kPSW] = o(Nb::PSW, n.PW);
                 n.far[kPSE] = o(Nb::PSE, n.far[kPS]), n.far[kNWW] = o(Nb::NWW, n.NW), n.far[kNNE] = o(Nb::NNE, n.far[kNN]);
@@ -149,8 +165,16 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
                 if constexpr (kReach == Reach::Widest) {
                     n.far[kWWW] = o(Nb::WWW, n.far[kWW]), n.far[kWWWW] = o(Nb::WWWW, n.far[kWWW]), n.far[kNWWW] = o(Nb::NWWW, n.far[kNWW]);
                     n.far[kNEEE] = o(Nb::NEEE, n.far[kNEE]), n.far[kNNN] = o(Nb::NNN, n.far[kNN]);
-                    for (const Nb::Which k : {Nb::WW, Nb::NN, Nb::NEE})
+                    for (const typename Nb::Which k : {Nb::WW, Nb::NN, Nb::NEE})
                         if (nb.has(k)) n.residualsFar += nb.rec(k).residual;
+                    if constexpr (kRef) {
+                        const int32_t t = options.reference[size_t(entry)];
+                        rec.t = t;
+                        n.far[kNNN] = t;
+                        n.far[kWWWW] = hW ? nb.rec(Nb::W).t : t;
+                        n.far[kNWWW] = hN ? nb.rec(Nb::N).t : t;
+                        n.far[kNEEE] = hP ? nb.rec(Nb::P).t : t;
+                    }
                 }
             } else {
                 n.far.fill(n.W);
@@ -162,9 +186,9 @@ void walkPlaced(std::span<const uint64_t> layout, std::span<const BrickPlace> pl
             n.rW = hW ? &rW : (!hN && !hP) ? &lastRec : nullptr;
             n.rN = hN ? &rN : nullptr;
             n.rP = hP ? &rP : nullptr;
-            const auto add = [&](Nb::Which k, unsigned times) {
+            const auto add = [&](typename Nb::Which k, unsigned times) {
                 if (!nb.has(k)) return;
-                const CompactRecord& r = nb.rec(k);
+                const CompactRecord& r = nb.rec(k);  // (a ReferencedRecord's base)
                 if constexpr (kReach < Reach::Wide)  // generations 2 and 3 have no blend to weigh
                     for (size_t j = 0; j < size_t(kPredictors); ++j) n.errorsAbove[j] += times * uint64_t(r.err[j]);
                 n.residualsAbove += times * uint64_t(r.residual);
@@ -185,7 +209,11 @@ template <typename Step>
 void walkPlacedAny(std::span<const uint64_t> layout, std::span<const BrickPlace> places, uint64_t entries, BrickOrder order, const IntCoderOptions& options,
                    Models& models, Step&& step) {
     if (options.tileNeighbours && options.model != 4) throw Error("internal error: tiles as neighbours are model generation 4's");
-    if (options.tileNeighbours) walkPlaced<Reach::Widest, true>(layout, places, entries, order, options, models, step);
+    if (!options.reference.empty() && options.model < 3) throw Error("internal error: a series' reference needs model generation 3 or later");
+    if (!options.reference.empty()) {
+        if (options.tileNeighbours) walkPlaced<Reach::Widest, true, true>(layout, places, entries, order, options, models, step);
+        else walkPlaced<Reach::Widest, false, true>(layout, places, entries, order, options, models, step);
+    } else if (options.tileNeighbours) walkPlaced<Reach::Widest, true>(layout, places, entries, order, options, models, step);
     else if (options.model >= 3) walkPlaced<Reach::Widest, false>(layout, places, entries, order, options, models, step);
     else if (options.model == 2) walkPlaced<Reach::Wide, false>(layout, places, entries, order, options, models, step);
     else walkPlaced<Reach::Near, false>(layout, places, entries, order, options, models, step);

@@ -72,10 +72,12 @@ struct IntCoderOptions {
     // of its own beside the walk (CodeAside.h; the same
     // bytes). For an encoder that may use one more thread than it runs on.
     bool codeAside = false;
-    // The raster coder only (encodeIntVolume, decodeIntVolume), generations
-    // 3 and 4: the volume before this one in a series (a 4-D scan's volume
-    // t - 1; shape.count() samples, raster order), which encoder and decoder
-    // both hold. Its samples at the same (x, y, z) and one step back along
+    // Generations 3 and 4, the raster coder (encodeIntVolume, decodeIntVolume)
+    // and the placed walk (BrickValueCoder.h's encodePlacedBrickValues;
+    // window codings 21 and 22): the volume before this one in a series (a
+    // 4-D scan's volume t - 1; shape.count() samples in raster order, or the
+    // entries of the same layout in the same order), which encoder and
+    // decoder both hold. Its samples at the same (x, y, z) and one step back along
     // x, y and z are four neighbours of the least-squares fit, in place of
     // WWWW, NWWW, NEEE and NNN (LeastSquaresPredictor.h). The fit weighs
     // them as it finds them: the 25 ASL volumes of mpld_asl.nii.gz

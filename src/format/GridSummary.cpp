@@ -55,7 +55,8 @@ GridSummary computedSummary(const EncodedGrid& grid, const encoding::DecodedSize
     }
     const std::vector<uint64_t> layout = encoding::attributeLayout(grid.active.dag);
     const std::vector<coding::BrickPlace> places = encoding::attributePlaces(grid.active.dag, vs);
-    attributes::WindowCursor cursor(bytes, true, vs, layout, what, places);
+    attributes::WindowCursor cursor(bytes, true, vs, layout, what, places, 0, attributes::referenceWindows(windows.reference, layout, places),
+                                    windows.referencedBy);
     constexpr uint64_t kChunk = uint64_t(1) << 16;
     std::vector<uint8_t> chunk;
     for (uint64_t done = 0; done < cursor.entries();) {

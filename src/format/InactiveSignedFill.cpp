@@ -22,9 +22,13 @@ std::vector<uint8_t> activeValues(const EncodedGrid& grid, uint32_t vs, const at
     if (!layer.attributes.empty()) return layer.attributes;
     if (layer.values.entryCount) return layer.values.decodeAll();
     if (layer.valueWindows.empty()) return {};
-    if (layer.valueWindows.predicted)
-        return attributes::decodePredictedWindows(layer.valueWindows.load(), vs, encoding::attributeLayout(layer.dag), what + " predicted windows",
-                                                  encoding::attributePlaces(layer.dag, vs), parallel);
+    if (layer.valueWindows.predicted) {
+        const std::vector<uint64_t> layout = encoding::attributeLayout(layer.dag);
+        const std::vector<coding::BrickPlace> places = encoding::attributePlaces(layer.dag, vs);
+        return attributes::decodePredictedWindows(layer.valueWindows.load(), vs, layout, what + " predicted windows", places, parallel,
+                                                  attributes::referenceWindows(layer.valueWindows.reference, layout, places),
+                                                  layer.valueWindows.referencedBy.get());
+    }
     return attributes::decodeValueWindows(layer.valueWindows.load(), what + " value windows").decodeAll();
 }
 

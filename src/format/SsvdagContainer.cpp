@@ -257,6 +257,7 @@ const char* sectionKindName(SectionKind kind) {
         case SectionKind::InactiveValueWindows: return "InactiveValueWindows";
         case SectionKind::PredictedWindows: return "PredictedWindows";
         case SectionKind::InactivePredictedWindows: return "InactivePredictedWindows";
+        case SectionKind::ValueReference: return "ValueReference";
     }
     return "unknown";
 }
@@ -264,9 +265,12 @@ const char* sectionKindName(SectionKind kind) {
 bool isKnownKind(SectionKind kind) { return std::strcmp(sectionKindName(kind), "unknown") != 0; }
 
 uint32_t formatVersionOf(std::span<const Section> sections) {
-    for (const Section& s : sections)
-        if (s.kind == SectionKind::InactiveSignedFill) return kLatestFormatVersion;
-    return kFormatVersion;
+    uint32_t version = kFormatVersion;
+    for (const Section& s : sections) {
+        if (s.kind == SectionKind::ValueReference) return 3;
+        if (s.kind == SectionKind::InactiveSignedFill) version = 2;
+    }
+    return version;
 }
 
 bool isPrecompressed(SectionKind kind) {

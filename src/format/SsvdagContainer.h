@@ -23,7 +23,7 @@ namespace vdbdag::format {
 // (one whose absence would change what that reader decodes): then as
 // version 2, which readers before it refuse. This build reads both.
 inline constexpr uint32_t kFormatVersion = 1;
-inline constexpr uint32_t kLatestFormatVersion = 2;
+inline constexpr uint32_t kLatestFormatVersion = 3;
 
 // Section kinds. A file holds a section only when the scene needs it
 // (../shared/DESIGN.md invariant 3). Unknown kinds are rejected by readers that need
@@ -56,6 +56,7 @@ enum class SectionKind : uint32_t {
     SameAs = 25,         // sequence files: this grid's section of a kind holds the bytes of an earlier grid's (a grid that does not change between frames)
     Summary = 26,        // per grid: what `info` prints that the DAG and values would otherwise give (index box, solid nodes, value range)
     InactiveSignedFill = 27,  // per grid (version 2): the inactive layer is OpenVDB's signed flood fill of the active values, made again by the reader (no Inactive* sections)
+    ValueReference = 28,      // per grid (version 3): its active predicted windows of codings 21 and 22 read an earlier grid's same windows (a 4-D scan's previous volume)
 };
 
 const char* sectionKindName(SectionKind kind);  // "unknown" for a kind this build does not know
@@ -77,8 +78,8 @@ struct Section {
     std::shared_ptr<const struct StoredPayload> stored = nullptr;
 };
 
-// The version a file of these sections is written as (kFormatVersion, or
-// kLatestFormatVersion with an InactiveSignedFill section).
+// The version a file of these sections is written as (kFormatVersion; 2
+// with an InactiveSignedFill section; 3 with a ValueReference section).
 uint32_t formatVersionOf(std::span<const Section> sections);
 
 // Where a section lies in an .ssvdag file, as its table says.

@@ -182,6 +182,14 @@ void putLayer(std::vector<Section>& sections, uint32_t g, const LayerKinds& kind
         releaseIf(dag.inner, take);
         if (!dag.leaves.empty()) sections.push_back({kinds.leaves, g, rawBytes(dag.leaves)});
         releaseIf(dag.leaves, take);
+        if (valueSize && windows.referenceDistance && !predicted.empty()) throw Error("internal error: a reference for values not in windows");
+        if (valueSize && windows.referenceDistance) {  // FORMAT.md 8.6
+            if (kinds.predictedWindows != SectionKind::PredictedWindows || !windows.predicted)
+                throw Error("internal error: a series' reference for an inactive layer or palette windows");
+            ByteWriter w;
+            w.put<uint32_t>(windows.referenceDistance);
+            sections.push_back({SectionKind::ValueReference, g, w.take()});
+        }
         if (valueSize && !predicted.empty()) sections.push_back({kinds.predicted, g, takeOrCopy(predicted, take)});
         else if (valueSize && windows.file) sections.push_back({windowKind, g, {}, take ? std::move(windows.file) : windows.file});
         else if (valueSize && !windows.empty()) sections.push_back({windowKind, g, takeOrCopy(windows.bytes, take)});
@@ -350,9 +358,18 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     const GridRange range = options.frame ? frameGrids(frames, gridCount, *options.frame, sourceName)
                             : options.grid ? GridRange{*options.grid, *options.grid + 1}
                                            : GridRange{0, gridCount};
-    const uint32_t first = range.first, end = range.end;
+    uint32_t first = range.first;
+    const uint32_t end = range.end;
     if (end - first > sections.size()) throw Error(sourceName + ": FileInfo claims " + std::to_string(gridCount) + " grids, more than its sections can hold");
 
+    // A ValueReference payload (FORMAT.md 8.6): u32 distance, >= 1.
+    const auto referenceDistanceOf = [&](const Section& s) {
+        ByteReader r(s.data, sourceName + ": grid " + std::to_string(s.grid) + " ValueReference");
+        const uint32_t distance = r.get<uint32_t>();
+        r.expectEnd();
+        if (distance == 0) r.fail("names the grid itself");
+        return distance;
+    };
     auto find = [&](uint32_t g, SectionKind kind, bool required) -> Section* {
         auto it = byGrid.find({g, kind});
         if (it == byGrid.end()) {
@@ -362,6 +379,15 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
         return it->second;
     };
 
+    // One grid asked for whose values take an earlier grid's as their
+    // reference (FORMAT.md 8.6): the grids of its chain are read too, back
+    // to its key grid, and dropped once it is read.
+    if (options.grid && !options.referencesByCaller)
+        while (Section* ref = find(first, SectionKind::ValueReference, false)) {
+            const uint32_t distance = referenceDistanceOf(*ref);
+            if (distance > first) throw Error(sourceName + ": grid " + std::to_string(first) + " ValueReference: names a grid before the first");
+            first -= distance;
+        }
     SsvdagScene scene;
     if (fileMetadata) scene.fileMetadata = std::move(fileMetadata->data);
     {
@@ -472,6 +498,8 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             Section* predictedWindowSection = find(g, kinds.predictedWindows, false);
             if (int(predictedSection != nullptr) + int(windowSection != nullptr) + int(paletteSection != nullptr) + int(predictedWindowSection != nullptr) > 1)
                 throw Error(what + ": the " + layer + " values are stored twice (more than one of Values, ValueWindows, PredictedValues, PredictedWindows)");
+            if (kinds.predictedWindows == SectionKind::PredictedWindows && find(g, SectionKind::ValueReference, false) && !predictedWindowSection)
+                throw Error(what + ": a ValueReference section for " + layer + " values not in predicted windows");
             if ((predictedSection || windowSection || predictedWindowSection) && (!vs || dag.empty()))
                 throw Error(what + ": unexpected " + layer + " values section for a grid without values");
             if (predictedSection || predictedWindowSection) {
@@ -482,15 +510,54 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                 if (predictedSection) {
                     predicted = std::move(predictedSection->data);
                     attributes = attributes::decodePredicted(predicted, vs, encoding::attributeLayout(dag), what + " " + layer + " values");
+                }
+                // A series' reference (FORMAT.md 8.6): an earlier grid of this read, whose windows this layer's may read.
+                attributes::ReferenceWindow referenceWindow;
+                Section* ref = kinds.predictedWindows == SectionKind::PredictedWindows ? find(g, SectionKind::ValueReference, false) : nullptr;
+                if (ref && options.grid && options.referencesByCaller) {
+                    if (!options.keepValueWindows) throw Error("internal error: a grid's reference left to a caller that decodes its values now");
+                    ref = nullptr;  // the caller's (its referenceDistance is set below)
+                }
+                if (ref) {
+                    ByteReader r(ref->data, what + " ValueReference");
+                    const uint32_t distance = referenceDistanceOf(*ref);
+                    if (!predictedWindowSection) r.fail("names a reference for values not in predicted windows");
+                    if (distance == 0 || distance > g - first) r.fail("names grid " + std::to_string(int64_t(g) - distance) + ", not an earlier grid of this read");
+                    EncodedGrid& earlier = scene.grids[g - first - distance];
+                    EncodedLayer& other = earlier.active;
+                    const auto same = [](const encoding::CompactDag& a, const encoding::CompactDag& b) {
+                        return a.origin == b.origin && a.log2Size == b.log2Size && a.rootReflection == b.rootReflection && a.levelStart == b.levelStart &&
+                               a.offsetWords == b.offsetWords && a.inner == b.inner && a.leaves == b.leaves;
+                    };
+                    if (earlier.record.valueType != grid.record.valueType || !other.valueWindows.predicted || other.valueWindows.empty() || !same(other.dag, dag))
+                        r.fail("names grid " + std::to_string(g - distance) + ", whose active voxels or values are not this grid's kind (the same DAG, type and predicted windows)");
+                    windows.referenceDistance = distance;
+                    windows.reference = std::make_shared<const attributes::WindowReference>(
+                        other.valueWindows.load(), vs, encoding::attributeLayout(dag), other.valueWindows.reference,
+                        what + " (the reference of grid " + std::to_string(g) + ") grid " + std::to_string(g - distance) + " active predicted windows");
+                    if (!other.valueWindows.referencedBy) other.valueWindows.referencedBy = windows.reference;
+                    if (!other.attributes.empty() && !options.keepValueWindows) {  // decoded already: its windows sliced from it
+                        const std::vector<uint8_t>& decoded = other.attributes;
+                        const attributes::WindowDirectory& d = windows.reference->directory;
+                        referenceWindow = [&decoded, &d, vs](size_t k) {
+                            const attributes::WindowDirectory::Window& e = d.windows.at(k);
+                            return std::vector<uint8_t>(decoded.begin() + ptrdiff_t(e.firstEntry * vs), decoded.begin() + ptrdiff_t((e.firstEntry + e.entries) * vs));
+                        };
+                    }
+                }
+                if (predictedSection) {
+                    // decoded above
                 } else if (options.keepValueWindows) {
                     windows.bytes = std::move(predictedWindowSection->data);
                     windows.predicted = true;
                     attributes::readPredictedWindowDirectory(windows.bytes, vs, encoding::attributeLayout(dag), what + " " + layer + " predicted windows");
                     return;
                 } else {
-                    attributes = attributes::decodePredictedWindows(predictedWindowSection->data, vs, encoding::attributeLayout(dag),
-                                                                    what + " " + layer + " predicted windows", encoding::attributePlaces(dag, vs),
-                                                                    options.parallel);
+                    const std::vector<uint64_t> layoutHere = encoding::attributeLayout(dag);
+                    const std::vector<coding::BrickPlace> placesHere = encoding::attributePlaces(dag, vs);
+                    if (!referenceWindow) referenceWindow = attributes::referenceWindows(windows.reference, layoutHere, placesHere);
+                    attributes = attributes::decodePredictedWindows(predictedWindowSection->data, vs, layoutHere, what + " " + layer + " predicted windows",
+                                                                    placesHere, options.parallel, referenceWindow);
                     windows.bytes = std::move(predictedWindowSection->data);  // kept as it is: a rewrite stores it again
                     windows.predicted = true;
                 }
@@ -513,6 +580,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             }
         };
         const encoding::DecodedSize activeSize = readLayerDag(kActive, grid.active, "active");
+        if (Section* ref = find(g, SectionKind::ValueReference, false)) grid.active.valueWindows.referenceDistance = referenceDistanceOf(*ref);
         if (Section* fill = find(g, SectionKind::InactiveSignedFill, false)) {
             ByteReader r(fill->data, what + " InactiveSignedFill");
             if (r.get<uint8_t>() != 0) r.fail("an unknown fill");
@@ -580,6 +648,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     }
     for (const auto& [key, section] : byGrid)
         if (key.first >= gridCount) throw Error(sourceName + ": section for grid " + std::to_string(key.first) + " but the file has " + std::to_string(gridCount) + " grids");
+    if (options.grid && first < range.first) scene.grids.erase(scene.grids.begin(), scene.grids.begin() + ptrdiff_t(range.first - first));  // its chain
     return scene;
 }
 
@@ -623,7 +692,18 @@ SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
     const FrameList list = readFrameList(path);
     if (options.grid && *options.grid >= list.gridCount)
         throw Error(path + ": has " + std::to_string(list.gridCount) + " grid(s); grid " + std::to_string(*options.grid) + " asked for");
-    const GridRange range = options.frame ? frameGrids(list.frames, list.gridCount, *options.frame, path) : GridRange{*options.grid, *options.grid + 1};
+    GridRange range = options.frame ? frameGrids(list.frames, list.gridCount, *options.frame, path) : GridRange{*options.grid, *options.grid + 1};
+    if (options.grid && !options.referencesByCaller) {  // and the grids its values' reference chain goes back to (FORMAT.md 8.6)
+        std::map<uint32_t, uint32_t> distance;
+        for (const Section& s : readContainerFile(path, false, options.limits, [&](SectionKind kind, uint32_t grid) {
+                 return kind == SectionKind::ValueReference && grid <= *options.grid;
+             })) {
+            ByteReader r(s.data, path + ": grid " + std::to_string(s.grid) + " ValueReference");
+            distance[s.grid] = r.get<uint32_t>();
+        }
+        for (auto it = distance.find(range.first); it != distance.end() && it->second > 0 && it->second <= range.first; it = distance.find(range.first))
+            range.first -= it->second;  // (sectionsToScene checks each)
+    }
     const uint32_t first = range.first, end = range.end;  // (named, for the lambdas)
     const auto keep = [first, end](SectionKind kind, uint32_t grid) {
         switch (kind) {

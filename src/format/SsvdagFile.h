@@ -135,8 +135,13 @@ struct ReadOptions {
     std::optional<uint32_t> frame;
     // Read one grid (its index in the file) and only its sections: the
     // scene's grids are that one (the reader library's first use of a grid).
-    // Not with `frame`.
+    // Not with `frame`. A grid whose values take an earlier grid's as their
+    // reference (FORMAT.md 8.6) is read with its chain (those grids read
+    // too, then dropped), unless `referencesByCaller`: then its layer's
+    // referenceDistance is set and its `reference` left empty, for a caller
+    // that holds the earlier grids itself (the reader library).
     std::optional<uint32_t> grid;
+    bool referencesByCaller = false;
     // The grids' headers only (`info` of a file with Summary sections): each
     // layer's DagLevels (origin, size, levels; no inner words or leaves),
     // no values, no normals. The sections given may lack the rest.

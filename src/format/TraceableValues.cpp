@@ -18,9 +18,11 @@ attributes::PaletteChannel traceableValues(const EncodedGrid& grid, bool inactiv
     if (!windows.empty() && windows.predicted) {
         const encoding::CompactDag& dag = layer.dag;
         const uint32_t vs = valueSize(grid.record.valueType);
-        return attributes::compressPalette(attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(dag),
-                                                                              "grid '" + grid.record.name + "' predicted windows",
-                                                                              encoding::attributePlaces(dag, vs)),
+        const std::vector<uint64_t> layout = encoding::attributeLayout(dag);
+        const std::vector<coding::BrickPlace> places = encoding::attributePlaces(dag, vs);
+        return attributes::compressPalette(attributes::decodePredictedWindows(windows.load(), vs, layout, "grid '" + grid.record.name + "' predicted windows",
+                                                                              places, {}, attributes::referenceWindows(windows.reference, layout, places),
+                                                                              windows.referencedBy.get()),
                                            vs);
     }
     if (!windows.empty()) return attributes::decodeValueWindows(windows.load(), "grid '" + grid.record.name + "' value windows");

@@ -28,8 +28,11 @@ const std::vector<uint8_t>& attributesOf(const format::EncodedGrid& grid, bool i
     if (windows.predicted) {
         const encoding::CompactDag& dag = layer.dag;
         const uint32_t vs = valueSize(grid.record.valueType);
-        store = attributes::decodePredictedWindows(windows.load(), vs, encoding::attributeLayout(dag), "grid '" + grid.record.name + "' predicted windows",
-                                                   encoding::attributePlaces(dag, vs), util::tbbParallelFor());
+        const std::vector<uint64_t> layout = encoding::attributeLayout(dag);
+        const std::vector<coding::BrickPlace> places = encoding::attributePlaces(dag, vs);
+        store = attributes::decodePredictedWindows(windows.load(), vs, layout, "grid '" + grid.record.name + "' predicted windows", places,
+                                                   util::tbbParallelFor(), attributes::referenceWindows(windows.reference, layout, places),
+                                                   windows.referencedBy.get());
     }
     else
         store = format::traceableValues(grid, inactive).decodeAll();

@@ -32,7 +32,8 @@ void scatterLayerByCubes(const format::EncodedGrid& grid, bool inactive, unsigne
         // ahead: each holds up to a window's decoded entries, 16 MB).
         const size_t threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
         cursor.emplace(windows.bytes, windows.predicted, vs, layout, "grid '" + grid.record.name + "' value windows", places,
-                       unsigned(std::clamp<size_t>(threads, 1, 8) - 1));
+                       unsigned(std::clamp<size_t>(threads, 1, 8) - 1), attributes::referenceWindows(windows.reference, layout, places),
+                       windows.referencedBy);
         if (cursor->entries() != entries) throw Error("grid '" + grid.record.name + "': its value windows do not match its DAG");
     } else if (vs && attributes.size() != entries * vs) {
         throw Error("grid '" + grid.record.name + "': its values do not match its DAG");

@@ -26,6 +26,7 @@ void GridData::load() const {
         options.keepValueWindows = true;
         options.limits = limits;
         options.grid = index;
+        options.referencesByCaller = true;  // Layer::referenceGrid
         format::SsvdagScene scene = format::readSceneFile(path, options);
         if (scene.grids.size() != 1) throw Error(path + ": grid " + std::to_string(index) + " could not be read alone");
         format::EncodedGrid& from = scene.grids[0];
@@ -77,6 +78,33 @@ void Layer::load() const {
     });
 }
 
+void Layer::decodeWindow(size_t k) const {
+    Windows& w = *windows_;
+    std::call_once(w.decoded[k], [&] {
+        // A series' reference (FORMAT.md 8.6): the grid before's own layer
+        // (opened by headers), else the chain the grid's read built.
+        attributes::ReferenceWindow reference;
+        if (referenceGrid)
+            reference = [this](size_t r) {
+                referenceGrid->load();
+                return referenceGrid->active.window(r);
+            };
+        else
+            reference = attributes::referenceWindows(grid->layer(inactive).valueWindows.reference, w.layout, w.places);
+        std::vector<uint8_t> decoded = attributes::decodePredictedWindow(w.payload, w.directory, k, w.layout, what + " predicted windows", w.places, reference);
+        if (decoded.size() != w.directory.windows[k].entries * valueSize(grid->record.valueType))
+            throw Error(what + " predicted windows window " + std::to_string(k) + ": decoded to the wrong size");
+        w.values[k] = std::move(decoded);
+    });
+}
+
+std::vector<uint8_t> Layer::window(size_t k) const {
+    load();
+    if (!windows_ || k >= windows_->directory.windows.size()) throw Error(what + ": has no predicted window " + std::to_string(k) + " for a grid that takes it as reference");
+    decodeWindow(k);
+    return windows_->values[k];
+}
+
 void Layer::values(uint64_t first, uint64_t count, uint8_t* out, size_t& hint) const {
     load();
     const unsigned vs = valueSize(grid->record.valueType);
@@ -97,11 +125,7 @@ void Layer::values(uint64_t first, uint64_t count, uint8_t* out, size_t& hint) c
                     throw Error(what + ": value entry " + std::to_string(first) + " is past the channel's end");
                 hint = k;
             }
-            std::call_once(w.decoded[k], [&] {
-                std::vector<uint8_t> decoded = attributes::decodePredictedWindow(w.payload, w.directory, k, w.layout, what + " predicted windows", w.places);
-                if (decoded.size() != list[k].entries * vs) throw Error(what + " predicted windows window " + std::to_string(k) + ": decoded to the wrong size");
-                w.values[k] = std::move(decoded);
-            });
+            decodeWindow(k);
             const uint64_t at = first - list[k].firstEntry, n = std::min(count, list[k].entries - at);
             std::memcpy(out, w.values[k].data() + at * vs, n * vs);
             out += n * vs, first += n, count -= n;
@@ -164,6 +188,10 @@ std::shared_ptr<FileData> FileData::read(const std::string& path, const OpenLimi
         data->inactive.inactive = true;
         data->inactive.what = what + " inactive values";
         data->lazy = lazy;
+        if (const uint32_t d = data->grid.active.valueWindows.referenceDistance; lazy && d) {  // FORMAT.md 8.6
+            if (d > file->data.size()) throw Error(what + ": its values take grid -" + std::to_string(d - file->data.size()) + " as their reference");
+            data->active.referenceGrid = file->data[file->data.size() - d].get();
+        }
         data->path = path;
         data->index = uint32_t(file->grids.size());
         data->limits = options.limits;

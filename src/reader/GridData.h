@@ -17,6 +17,8 @@
 
 namespace vdbdag::detail {
 
+struct GridData;
+
 // One layer (active or inactive) of a grid: its DAG and its values.
 struct Layer {
     const encoding::CompactDag* dag = nullptr;
@@ -42,13 +44,22 @@ struct Layer {
     // The values of `count` consecutive entries from `first`.
     void values(uint64_t first, uint64_t count, uint8_t* out, size_t& hint) const;
 
+    // Predicted window k's entries (decoded once, as values() decodes it).
+    std::vector<uint8_t> window(size_t k) const;
+
     // Set by the file reader; the channel is built from them once.
     const format::EncodedGrid* grid = nullptr;
     bool inactive = false;
     std::string what;  // "FILE: grid 'NAME'"
+    // The grid whose active windows this (active) layer's take as their
+    // reference (a 4-D scan's volume before: FORMAT.md 8.6), when the file
+    // was opened by its headers: its windows, decoded once by its own
+    // layer, serve every grid that reads them.
+    const GridData* referenceGrid = nullptr;
 
 private:
     void load() const;
+    void decodeWindow(size_t k) const;  // predicted window k, once
     mutable std::once_flag loaded_;
     mutable bool palette_ = false;
     mutable attributes::PaletteChannel channel_;  // palette windows, or a palette of an older file

@@ -7,8 +7,10 @@
 // layout's order rather than spatially, & 16 in raster blocks; with places and byte 5 & 0x40, the
 // entries are float32 bits for coding/FloatValueCoder, & 0x20 too vec3s,
 // any bits allowed and every bit kept), the sample range, near and the
-// model generation (byte 7 & 32, no bricks: a reference volume for the
-// raster coder, from the data); the rest is (a) a stream to
+// model generation (byte 7 & 32: a reference volume from the data for the
+// raster coder, or for the placed walk of generation 3 or 4, not labels;
+// byte 7 & 64, generation 4 placed in spatial order: tiles as
+// neighbours); the rest is (a) a stream to
 // decode, which must throw vdbdag::Error or give samples inside the range,
 // never crash or read out of bounds, and (b) the samples of a volume to
 // encode, whose decode must give every sample back (within near).
@@ -70,6 +72,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const int labelModel = data[4] & 8 ? 2 : 1;
     // byte 7 & 8: the layout's brick order; & 16, raster blocks
     const BrickOrder order = data[7] & 8 ? BrickOrder::Attribute : data[7] & 16 ? BrickOrder::Raster : BrickOrder::Spatial;
+    o.tileNeighbours = !places.empty() && !labels && o.model == 4 && (data[7] & 64) && order != BrickOrder::Attribute;
     const auto decode = [&](std::span<const uint8_t> stream, std::vector<int32_t>& out) {
         if (labels) decodePlacedLabels(stream, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue), out, "fuzz", labelModel);
         else if (!places.empty()) decodePlacedBrickValues(stream, layout, places, order, o, out, "fuzz");
@@ -82,10 +85,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         return bricks ? encodeBrickValues(samples, layout, o) : encodeIntVolume(samples, shape, o);
     };
     const uint64_t count = bricks ? layoutEntryCount(layout) : shape.count();
-    // The raster coder, byte 7 & 32: a reference volume (IntCoderOptions::reference) of
-    // samples from the data, in the range or not (a reference is any int32).
+    // Byte 7 & 32: a reference volume (IntCoderOptions::reference) of
+    // samples from the data, in the range or not (a reference is any int32),
+    // for the raster coder or the placed walk of generation 3 or 4.
     std::vector<int32_t> reference;
-    if (!bricks && (data[7] & 32)) {
+    if ((data[7] & 32) && (!bricks || (!places.empty() && !labels && o.model >= 3))) {
         reference.resize(count);
         for (size_t i = 0; i < reference.size(); ++i)
             if (!rest.empty()) std::memcpy(&reference[i], rest.data() + (i * 3) % rest.size(), std::min<size_t>(4, rest.size() - (i * 3) % rest.size()));

@@ -13,6 +13,7 @@
 #include "src/attributes/RescaledFloats.h"
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
+#include "src/pipeline/SeriesReference.h"
 #include "tests/tools/ForgedDicom.h"
 #include "tests/tools/ForgedScenes.h"
 
@@ -75,6 +76,20 @@ int main(int argc, char** argv) {
             std::memcpy(values->data() + at, &f, 4);
         }
     scene.grids.push_back(pipeline::encodeGrid(rescaled));
+    // The next volume of a series: the same voxels, each integer moved by
+    // at most 2; the pass below codes it against the one before
+    // (ValueReference, coding 22: docs/FORMAT.md 8.6).
+    GridRecord next = rescaled;
+    next.name = "rescaled_t1";
+    for (auto* values : {&next.values.bricks, &next.values.tiles})
+        for (size_t at = 0; at + 4 <= values->size(); at += 4) {
+            float f;
+            std::memcpy(&f, values->data() + at, 4);
+            const int64_t k = std::llround((double(f) - next.rescale->intercept) / next.rescale->slope) + int64_t(at / 4 % 5) - 2;
+            f = attributes::rescaledFloat(k, *next.rescale);
+            std::memcpy(values->data() + at, &f, 4);
+        }
+    scene.grids.push_back(pipeline::encodeGrid(next));
     // Labels: a 24x16x8 box in three regions split by planes, most entries
     // repeating the one before, its two uniform 8^3 blocks (x < 8) tiles as
     // a scan's import makes them: a PredictedWindows section whose window is
@@ -107,6 +122,7 @@ int main(int argc, char** argv) {
                 }
         scene.grids.push_back(pipeline::encodeGrid(half));
     }
+    if (pipeline::referenceSeries(scene).referencedGrids != 1) std::fprintf(stderr, "make_seed_corpus: the series' second volume took no reference\n");
     int n = 0;
     for (bool compress : {true, false}) {
         format::ContainerOptions options;

@@ -416,7 +416,7 @@ TEST(Container, OverlapsGapsAndOutOfBoundsOffsetsAreRejected) {
         {[&](auto& b) { store<uint32_t>(b, entryAt(0) + kReservedAt, 1); }, "non-zero reserved field"},
         {[&](auto& b) { b.push_back(0); }, "1 unexpected bytes after the last section"},
         {[&](auto& b) { store<uint32_t>(b, 12, 0xFFFFFFFFu); }, "truncated: the table of 4294967295 sections"},
-        {[&](auto& b) { store<uint32_t>(b, 8, 7); }, "unsupported format version 7 (this vdbdag reads versions 1 to 2)"},
+        {[&](auto& b) { store<uint32_t>(b, 8, 7); }, "unsupported format version 7 (this vdbdag reads versions 1 to 3)"},
     };
     for (const Case& c : cases) {
         auto bad = good;
