@@ -137,6 +137,7 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
 
     format::SsvdagScene scene;
     const auto onGrid = [&](size_t i, size_t) { gridName = gridNames[i]; };
+    pipeline::SeriesReferenceReport series;
     try {
         // A grid read whole (a small scan, an OpenVDB stream) is encoded
         // in memory, which costs least (the same bytes), except under
@@ -156,16 +157,16 @@ EncodeResult encodeFile(const EncodeRequest& request, const EncodeHooks& hooks) 
         } else {
             scene = pipeline::encodeVolumeReleasing(imported.volume, encodeOptions, onGrid);
         }
+        // A 4-D scan's volumes, each with the one before as its reference
+        // where that is smaller (lossless only: the pass takes exact grids
+        // alone), keeping decoded windows within a quarter of the memory limit.
+        if (dense && scene.grids.size() > 1 && request.keyEvery > 1 && team.isRoot()) {
+            phases.push_back({"coding the volumes against the one before", std::chrono::steady_clock::now()});
+            progress.setLabel("encode: coding the volumes against the one before");
+            series = pipeline::referenceSeries(scene, request.keyEvery, (request.memoryLimit ? request.memoryLimit : defaultMemoryLimit()) / 4);
+        }
     } catch (const Error& e) {
         throw Error(request.input + ": " + e.what());  // e.g. a colour grid holding NaN: name the file too
-    }
-    // A 4-D scan's volumes, each with the one before as its reference where
-    // that is smaller (lossless only: the pass takes exact grids alone).
-    pipeline::SeriesReferenceReport series;
-    if (dense && scene.grids.size() > 1 && request.keyEvery > 1 && team.isRoot()) {
-        phases.push_back({"coding the volumes against the one before", std::chrono::steady_clock::now()});
-        progress.setLabel("encode: coding the volumes against the one before");
-        series = pipeline::referenceSeries(scene, request.keyEvery);
     }
     // Neither the input voxels nor the attribute arrays are written:
     // release them before the sections are built (a 512x512x999 scan

@@ -39,7 +39,8 @@ namespace vdbdag::attributes {
 // `reference` (codings 21 and 22: a placed walk of generation 3 or 4, not
 // labels): a series' previous volume, one entry per entry of `values` in
 // the same order, as IntCoderOptions::reference; the coder sees each as
-// the entries are seen, (t - minimum) / step rounded down.
+// the entries are seen: t where the step is 1, else (t - minimum) / step
+// rounded down.
 std::vector<uint8_t> encodeContextChannel(std::span<const uint8_t> values, std::span<const uint64_t> layout,
                                           std::span<const coding::BrickPlace> places = {}, bool labels = false,
                                           coding::BrickOrder order = coding::BrickOrder::Spatial, int model = coding::kLatestIntModel,

@@ -382,12 +382,21 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     // One grid asked for whose values take an earlier grid's as their
     // reference (FORMAT.md 8.6): the grids of its chain are read too, back
     // to its key grid, and dropped once it is read.
-    if (options.grid && !options.referencesByCaller)
+    if (options.grid && !options.referencesByCaller) {
+        unsigned hops = 0;
         while (Section* ref = find(first, SectionKind::ValueReference, false)) {
             const uint32_t distance = referenceDistanceOf(*ref);
             if (distance > first) throw Error(sourceName + ": grid " + std::to_string(first) + " ValueReference: names a grid before the first");
+            if (++hops > attributes::kMaxReferenceChain)
+                throw Error(sourceName + ": grid " + std::to_string(end - 1) + " takes its values' reference through more than " +
+                            std::to_string(attributes::kMaxReferenceChain) + " grids");
             first -= distance;
         }
+        if (end - first > sections.size()) throw Error(sourceName + ": grid " + std::to_string(end - 1) + "'s reference chain claims more grids than its sections can hold");
+    }
+    // Each grid whose windows other grids of this read take as their
+    // reference: its windows once (a WindowReference), shared by them.
+    std::map<uint32_t, std::shared_ptr<const attributes::WindowReference>> referenceOf;
     SsvdagScene scene;
     if (fileMetadata) scene.fileMetadata = std::move(fileMetadata->data);
     {
@@ -532,10 +541,23 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                     if (earlier.record.valueType != grid.record.valueType || !other.valueWindows.predicted || other.valueWindows.empty() || !same(other.dag, dag))
                         r.fail("names grid " + std::to_string(g - distance) + ", whose active voxels or values are not this grid's kind (the same DAG, type and predicted windows)");
                     windows.referenceDistance = distance;
-                    windows.reference = std::make_shared<const attributes::WindowReference>(
-                        other.valueWindows.load(), vs, encoding::attributeLayout(dag), other.valueWindows.reference,
-                        what + " (the reference of grid " + std::to_string(g) + ") grid " + std::to_string(g - distance) + " active predicted windows");
-                    if (!other.valueWindows.referencedBy) other.valueWindows.referencedBy = windows.reference;
+                    std::shared_ptr<const attributes::WindowReference>& node = referenceOf[g - distance];
+                    if (!node) {  // its payload once more: counted as what the read takes
+                        expanded = saturatingAdd(expanded, other.valueWindows.size());
+                        checkMemory(options.limits, expanded, what, "its sections and decoded values");
+                        node = std::make_shared<const attributes::WindowReference>(
+                            other.valueWindows.load(), vs, encoding::attributeLayout(dag), other.valueWindows.reference,
+                            sourceName + ": grid " + std::to_string(g - distance) + " active predicted windows (a reference)");
+                    }
+                    windows.reference = node;
+                    if (!other.valueWindows.referencedBy) other.valueWindows.referencedBy = node;
+                    {  // the same windows (a float volume with fractions is cut in smaller ones than one of integers)
+                        const attributes::WindowDirectory own =
+                            attributes::readPredictedWindowDirectory(predictedWindowSection->data, vs, encoding::attributeLayout(dag), what + " " + layer + " predicted windows");
+                        bool same = own.windows.size() == node->directory.windows.size();
+                        for (size_t k = 0; same && k < own.windows.size(); ++k) same = own.windows[k].entries == node->directory.windows[k].entries;
+                        if (!same) r.fail("names grid " + std::to_string(g - distance) + ", whose values are cut into other windows");
+                    }
                     if (!other.attributes.empty() && !options.keepValueWindows) {  // decoded already: its windows sliced from it
                         const std::vector<uint8_t>& decoded = other.attributes;
                         const attributes::WindowDirectory& d = windows.reference->directory;
@@ -701,7 +723,9 @@ SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
             ByteReader r(s.data, path + ": grid " + std::to_string(s.grid) + " ValueReference");
             distance[s.grid] = r.get<uint32_t>();
         }
-        for (auto it = distance.find(range.first); it != distance.end() && it->second > 0 && it->second <= range.first; it = distance.find(range.first))
+        unsigned hops = 0;
+        for (auto it = distance.find(range.first); it != distance.end() && it->second > 0 && it->second <= range.first && hops++ <= attributes::kMaxReferenceChain;
+             it = distance.find(range.first))
             range.first -= it->second;  // (sectionsToScene checks each)
     }
     const uint32_t first = range.first, end = range.end;  // (named, for the lambdas)

@@ -34,8 +34,10 @@ struct SeriesReferenceReport {
 };
 
 // Codes every eligible grid of `scene` against the one before (above);
-// `keyEvery` 1 (none is referenced) to kMaxReferenceChain + 1. Throws vdbdag::Error on an
-// internal inconsistency only.
-SeriesReferenceReport referenceSeries(format::SsvdagScene& scene, unsigned keyEvery = kDefaultKeyEvery);
+// `keyEvery` 1 (none is referenced) to kMaxReferenceChain + 1. A grid's
+// decoded windows are kept for the next grid when they take at most
+// `keepBytes` (else that grid decodes them again: the same bytes either
+// way). Throws vdbdag::Error on an internal inconsistency only.
+SeriesReferenceReport referenceSeries(format::SsvdagScene& scene, unsigned keyEvery = kDefaultKeyEvery, uint64_t keepBytes = uint64_t(256) << 20);
 
 } // namespace vdbdag::pipeline

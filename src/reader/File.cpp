@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <fstream>
 
 #include "src/attributes/PredictedWindows.h"
 #include "src/attributes/ValueWindows.h"
@@ -15,7 +16,7 @@
 
 namespace vdbdag {
 
-int readableFormatVersion() { return int(format::kFormatVersion); }
+int readableFormatVersion() { return int(format::kLatestFormatVersion); }
 
 namespace detail {
 
@@ -63,6 +64,20 @@ void Layer::load() const {
             w->layout = encoding::attributeLayout(*dag);
             w->places = encoding::attributePlaces(*dag, vs);
             w->directory = attributes::readPredictedWindowDirectory(w->payload, vs, w->layout, what + " predicted windows");
+            if (referenceGrid) {  // the same DAG and windows as the grid it takes its reference from (FORMAT.md 8.6)
+                referenceGrid->load();
+                const encoding::CompactDag& a = *dag;
+                const encoding::CompactDag& b = referenceGrid->grid.active.dag;
+                const bool sameDag = a.origin == b.origin && a.log2Size == b.log2Size && a.rootReflection == b.rootReflection && a.levelStart == b.levelStart &&
+                                     a.offsetWords == b.offsetWords && a.inner == b.inner && a.leaves == b.leaves;
+                const attributes::ValueWindowsPayload& theirs = referenceGrid->grid.active.valueWindows;
+                if (!sameDag || !theirs.predicted || theirs.empty())
+                    throw Error(what + ": takes its values' reference from a grid whose active voxels or values are not this grid's kind");
+                const attributes::WindowDirectory other = attributes::readPredictedWindowDirectory(theirs.load(), vs, w->layout, what + " (its reference's windows)");
+                bool same = other.windows.size() == w->directory.windows.size();
+                for (size_t k = 0; same && k < other.windows.size(); ++k) same = other.windows[k].entries == w->directory.windows[k].entries;
+                if (!same) throw Error(what + ": takes its values' reference from a grid whose values are cut into other windows");
+            }
             w->decoded = std::make_unique<std::once_flag[]>(w->directory.windows.size());
             w->values = std::make_unique<std::vector<uint8_t>[]>(w->directory.windows.size());
             windows_ = std::move(w);
@@ -169,6 +184,12 @@ std::shared_ptr<FileData> FileData::read(const std::string& path, const OpenLimi
     auto file = std::make_shared<FileData>();
     file->path = path;
     file->sequence = !scene.frames.empty();
+    {  // the container's version, from its header (the read above checked it)
+        std::ifstream in(path, std::ios::binary);
+        uint8_t head[12] = {};
+        in.read(reinterpret_cast<char*>(head), sizeof head);
+        std::memcpy(&file->formatVersion, head + 8, 4);
+    }
     for (const format::SceneFrame& f : scene.frames) file->frames.push_back({f.number, f.firstGrid, f.gridCount});
     if (scene.frames.empty()) file->frames.push_back({0, 0, scene.grids.size()});
     for (format::EncodedGrid& g : scene.grids) {
@@ -188,9 +209,19 @@ std::shared_ptr<FileData> FileData::read(const std::string& path, const OpenLimi
         data->inactive.inactive = true;
         data->inactive.what = what + " inactive values";
         data->lazy = lazy;
-        if (const uint32_t d = data->grid.active.valueWindows.referenceDistance; lazy && d) {  // FORMAT.md 8.6
-            if (d > file->data.size()) throw Error(what + ": its values take grid -" + std::to_string(d - file->data.size()) + " as their reference");
-            data->active.referenceGrid = file->data[file->data.size() - d].get();
+        if (const uint32_t d = data->grid.active.valueWindows.referenceDistance; lazy && d) {  // FORMAT.md 8.6, checked as the scene reader checks it
+            const size_t g = file->data.size();
+            size_t frameFirst = 0;
+            for (const Frame& f : file->frames)
+                if (f.firstGrid <= g) frameFirst = f.firstGrid;
+            if (d > g - frameFirst) throw Error(what + ": its values take grid " + std::to_string(int64_t(g) - d) + ", not an earlier grid of its frame, as their reference");
+            const GridData* reference = file->data[g - d].get();
+            if (reference->grid.record.valueType != data->grid.record.valueType)
+                throw Error(what + ": its values take grid " + std::to_string(g - d) + ", of another value type, as their reference");
+            data->referenceDepth = reference->referenceDepth + 1;
+            if (data->referenceDepth > attributes::kMaxReferenceChain)
+                throw Error(what + ": takes its values' reference through more than " + std::to_string(attributes::kMaxReferenceChain) + " grids");
+            data->active.referenceGrid = reference;
         }
         data->path = path;
         data->index = uint32_t(file->grids.size());
@@ -233,7 +264,7 @@ const Grid& File::grid(const std::string& name, int64_t frame) const {
     throw Error(data_->path + ": has no frame " + std::to_string(frame));
 }
 
-uint32_t File::formatVersion() const { return format::kFormatVersion; }
+uint32_t File::formatVersion() const { return data_->formatVersion; }
 const std::string& File::path() const { return data_->path; }
 
 const std::string& Grid::name() const { return data_->grid.record.name; }

@@ -90,6 +90,7 @@ struct GridData {
     // normals and reports) the first time the grid is walked, under the
     // limits the file was opened with. Otherwise everything is read on open.
     bool lazy = false;
+    unsigned referenceDepth = 0;  // grids of its values' reference chain (FORMAT.md 8.6), checked on open
     std::string path;
     uint32_t index = 0;
     format::ReadLimits limits;
@@ -101,6 +102,7 @@ private:
 
 struct FileData {
     std::string path;
+    uint32_t formatVersion = 1;  // the container header's (docs/FORMAT.md 3.1)
     std::vector<std::unique_ptr<GridData>> data;
     std::vector<Grid> grids;
     std::vector<Frame> frames;

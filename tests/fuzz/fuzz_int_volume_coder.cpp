@@ -73,6 +73,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     // byte 7 & 8: the layout's brick order; & 16, raster blocks
     const BrickOrder order = data[7] & 8 ? BrickOrder::Attribute : data[7] & 16 ? BrickOrder::Raster : BrickOrder::Spatial;
     o.tileNeighbours = !places.empty() && !labels && o.model == 4 && (data[7] & 64) && order != BrickOrder::Attribute;
+    if (o.tileNeighbours)  // tiles as a DAG lays them out: aligned to their size (8, 16 or 32), apart from the bricks and each other
+        for (unsigned b = 0; b < layout.size(); ++b)
+            if (layout[b] == 0) places[b] = {int32_t(32 * (b + 1)), 0, 0, 3 + uint32_t(data[(b % 6) + 1] % 3)};
     const auto decode = [&](std::span<const uint8_t> stream, std::vector<int32_t>& out) {
         if (labels) decodePlacedLabels(stream, layout, places, order, int32_t(o.minValue), int32_t(o.maxValue), out, "fuzz", labelModel);
         else if (!places.empty()) decodePlacedBrickValues(stream, layout, places, order, o, out, "fuzz");

@@ -125,6 +125,7 @@ TEST(SeriesReference, EachVolumeTakesTheOneBeforeAndReadsBackAlone) {
         EXPECT_EQ(referencing, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 9, 10}));
         const vdbdag::File file = vdbdag::File::open(keyed.string());
         ASSERT_EQ(file.gridCount(), size_t(kVolumes));
+        EXPECT_EQ(file.formatVersion(), 3u);
         for (const int t : {10, 7, 3, 8, 0, 1, 2, 4, 5, 6, 9}) {
             const std::vector<float> got = readVolume(file, t, floats);
             EXPECT_EQ(std::memcmp(got.data(), samples.data() + size_t(t) * kPerVolume, kPerVolume * 4), 0) << "volume " << t;
@@ -169,9 +170,9 @@ TEST(SeriesReference, EachVolumeTakesTheOneBeforeAndReadsBackAlone) {
 
 // What a reader refuses, each in one line naming the file: a referenced
 // window whose grid names no reference (its ValueReference dropped), a
-// reference past the first grid or to the grid itself (also on grid 0), a
-// reference to a grid whose DAG differs; and a chain longer than
-// kMaxReferenceChain.
+// reference past the first grid or to the grid itself (also on grid 0;
+// the reader library too, on open), a reference to a grid whose DAG
+// differs; and a chain longer than kMaxReferenceChain.
 TEST(SeriesReference, ForgedReferencesAreRefused) {
     namespace format = vdbdag::format;
     const fs::path scan = writeSeries("forged", seriesSamples(), false);
@@ -206,6 +207,18 @@ TEST(SeriesReference, ForgedReferencesAreRefused) {
         for (auto& s : forged)
             if (s.kind == format::SectionKind::ValueReference && s.grid == 2) s.data = distance(d);
         refuse(forged, d == 0 ? "names the grid itself" : "not an earlier grid of this read");
+        // The reader library, which opens a file by its headers, refuses it too, on open.
+        const fs::path file = workDir() / "forged_reference.ssvdag";
+        const std::vector<uint8_t> bytes = format::writeContainer(forged);
+        std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        try {
+            (void)vdbdag::File::open(file.string());
+            ADD_FAILURE() << "opened a file whose grid 2 takes its reference from grid " << int(2 - int(d));
+        } catch (const vdbdag::Error& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find(d == 0 ? "names the grid itself" : "not an earlier grid of its frame"), std::string::npos) << what;
+            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        }
     }
     {  // grid 1's reference made grid 0 with another DAG: grid 0's DAG sections taken from a one-volume scan
         const fs::path other = workDir() / "other.nhdr";
