@@ -247,12 +247,11 @@ std::vector<uint8_t> storedWindow(std::vector<uint8_t>&& raw) {
 
 } // namespace
 
-std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const uint8_t> payload, const ReferenceWindow& reference, uint32_t valueSize,
-                                                              std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                                              const std::string& what, uint64_t& referenced, std::vector<std::vector<uint8_t>>* decoded) {
+std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const uint8_t> payload, const ReferenceWindow& own, const ReferenceWindow& reference,
+                                                              uint32_t valueSize, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
+                                                              const std::string& what, uint64_t& referenced) {
     referenced = 0;
     const WindowDirectory dir = readPredictedWindowDirectory(payload, valueSize, layout, what);
-    if (decoded) decoded->assign(dir.windows.size(), {});
     if (valueSize != 4 || places.size() != layout.size()) return std::nullopt;
     // Each window of the walks that take a reference (codings 15, 16, 19,
     // 20: 15 and 16 are 19 and 20 on a layout without tiles) coded again
@@ -265,16 +264,10 @@ std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const ui
         const uint8_t coding = windowRawBytes(payload, e, where).at(0);
         const bool integers = coding == detail::kTiledContextCoding || coding == detail::kBandedContextCoding;
         const bool lattice = coding == detail::kTiledRescaledFloatCoding || coding == detail::kBandedRescaledFloatCoding;
-        if (!integers && !lattice) {
-            if (decoded) (*decoded)[k] = decodePredictedWindow(payload, dir, k, layout, where, places);
-            return;
-        }
-        std::vector<uint8_t> values = decodePredictedWindow(payload, dir, k, layout, where, places);
-        const auto keep = [&] {
-            if (decoded) (*decoded)[k] = std::move(values);
-        };
+        if (!integers && !lattice) return;
+        const std::vector<uint8_t> values = own(k);
         const std::vector<uint8_t> t = reference(k);
-        if (t.size() != values.size()) return keep();  // windows cut otherwise: this one stays as it is
+        if (t.size() != values.size() || values.size() != e.entries * 4) return;  // windows cut otherwise: this one stays as it is
         const std::span<const uint64_t> bricks = layout.subspan(size_t(e.firstBrick), size_t(e.bricks));
         const auto placesHere = places.subspan(size_t(e.firstBrick), size_t(e.bricks));
         std::vector<uint8_t> raw;
@@ -290,7 +283,7 @@ std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const ui
             rescale.slope = r.get<double>();  // the window's own lattice (RescaledFloats.h)
             rescale.intercept = r.get<double>();
             std::optional<std::vector<uint8_t>> coded = encodeRescaledFloats(values, bricks, placesHere, rescale, 4, true, false, t);
-            if (!coded) return keep();
+            if (!coded) return;
             raw = std::move(*coded);
             raw.insert(raw.begin(), detail::kReferencedRescaledFloatCoding);
         }
@@ -300,7 +293,6 @@ std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const ui
             stored[k] = std::move(candidate);
             raws[k] = rawSize;
         }
-        keep();
     });
     format::ByteWriter out;
     out.putBytes(payload.first(kHeaderBytes));

@@ -226,14 +226,13 @@ std::vector<uint8_t> decodePredictedWindow(std::span<const uint8_t> payload, con
 
 // A series' reference chosen for a layer's windows (the encoder's pass,
 // pipeline/SeriesReference.h): each window of coding 15, 16, 19 or 20
-// (`payload`'s windows need no reference) coded again with `reference(k)`,
-// the reference grid's window k (a grid of the same DAG), as its reference
-// (codings 21 and 22), kept where that is smaller. Returns the new payload,
-// or nothing when no window gained; `referenced` counts the windows that
-// did; `decoded` (if given) receives each window's entries.
-std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const uint8_t> payload, const ReferenceWindow& reference, uint32_t valueSize,
-                                                              std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
-                                                              const std::string& what, uint64_t& referenced,
-                                                              std::vector<std::vector<uint8_t>>* decoded = nullptr);
+// (`payload`'s windows need no reference; `own(k)`, window k's entries as
+// they decode) coded again with `reference(k)`, the reference grid's
+// window k (a grid of the same DAG), as its reference (codings 21 and 22),
+// kept where that is smaller. Returns the new payload, or nothing when no
+// window gained; `referenced` counts the windows that did.
+std::optional<std::vector<uint8_t>> referencePredictedWindows(std::span<const uint8_t> payload, const ReferenceWindow& own, const ReferenceWindow& reference,
+                                                              uint32_t valueSize, std::span<const uint64_t> layout, std::span<const coding::BrickPlace> places,
+                                                              const std::string& what, uint64_t& referenced);
 
 } // namespace vdbdag::attributes
