@@ -256,6 +256,64 @@ TEST(BrickValueCoder, TilesAreNeighboursInCoding19) {
     EXPECT_EQ(attributes::decodePredictedWindows(windows, 4, c.layout, "test", c.places), raw);
 }
 
+// A series' reference (IntCoderOptions::reference in the placed walk;
+// window codings 21 and 22, FORMAT.md 8.6): a volume of rough texture and
+// the next one, the same texture moved by at most 2 per voxel, over the
+// same 32^3 box of mirrored bricks and zero tiles. With the first as its
+// reference the second codes under 0.6 times its size alone; every entry
+// comes back (within near); a reference of the wrong length is refused.
+// In windows: the pass's re-coding stores coding 21, which decodes with the
+// reference's windows and is refused without them.
+TEST(BrickValueCoder, ASeriesReferenceTakesTheVolumeBeforeAsNeighbours) {
+    const auto texture = [](int X, int Y, int Z) { return int32_t((uint32_t(X) * 73856093u ^ uint32_t(Y) * 19349663u ^ uint32_t(Z) * 83492791u) % 20000); };
+    std::mt19937 rngA(21), rngB(21);  // the same mirrors: the same layout and places
+    const PlacedChannel a = placedBlockBox(rngA, [&](int X, int Y, int Z) { return X < 8 ? 0 : 100 + texture(X, Y, Z); });
+    const PlacedChannel b = placedBlockBox(rngB, [&](int X, int Y, int Z) { return X < 8 ? 0 : 100 + texture(X, Y, Z) + int32_t((X + 2 * Y + 3 * Z) % 5) - 2; });
+    ASSERT_EQ(a.layout, b.layout);
+    for (int32_t near : {0, 2}) {
+        IntCoderOptions o;
+        o.minValue = 0, o.maxValue = 30000, o.near = near, o.model = 4, o.tileNeighbours = true;
+        const size_t alone = encodePlacedBrickValues(b.entries, b.layout, b.places, BrickOrder::Raster, o).size();
+        o.reference = a.entries;
+        std::vector<int32_t> reconstructed;
+        const std::vector<uint8_t> bytes = encodePlacedBrickValues(b.entries, b.layout, b.places, BrickOrder::Raster, o, &reconstructed);
+        if (near == 0) EXPECT_LT(double(bytes.size()), 0.6 * double(alone)) << bytes.size() << " against " << alone;
+        std::vector<int32_t> back(b.entries.size());
+        decodePlacedBrickValues(bytes, b.layout, b.places, BrickOrder::Raster, o, back, "referenced");
+        EXPECT_EQ(back, reconstructed);
+        size_t outside = 0;
+        for (size_t i = 0; i < back.size(); ++i) outside += std::abs(int64_t(back[i]) - b.entries[i]) > near;
+        EXPECT_EQ(outside, 0u) << "near " << near;
+        const std::vector<int32_t> shorter(a.entries.begin(), a.entries.end() - 1);
+        o.reference = shorter;
+        EXPECT_THROW(decodePlacedBrickValues(bytes, b.layout, b.places, BrickOrder::Raster, o, back, "short"), Error);
+    }
+    const auto raw = [](const std::vector<int32_t>& v) {
+        std::vector<uint8_t> out(v.size() * 4);
+        std::memcpy(out.data(), v.data(), out.size());
+        return out;
+    };
+    const std::vector<uint8_t> windowsA = attributes::encodePredictedWindows(raw(a.entries), 4, a.layout, a.places);
+    const std::vector<uint8_t> windowsB = attributes::encodePredictedWindows(raw(b.entries), 4, b.layout, b.places);
+    const auto whole = [&](const std::vector<int32_t>& v) { return [all = raw(v)](size_t) { return all; }; };  // one window each
+    uint64_t referenced = 0;
+    const std::optional<std::vector<uint8_t>> coded =
+        attributes::referencePredictedWindows(windowsB, whole(b.entries), whole(a.entries), 4, b.layout, b.places, "test", referenced);
+    ASSERT_TRUE(coded);
+    EXPECT_EQ(referenced, 1u);
+    EXPECT_LT(coded->size(), windowsB.size());
+    const attributes::WindowDirectory dir = attributes::readPredictedWindowDirectory(*coded, 4, b.layout, "test");
+    ASSERT_EQ(dir.windows.size(), 1u);
+    const std::vector<uint8_t> first = dir.windows[0].stored == dir.windows[0].raw
+                                           ? std::vector<uint8_t>{(*coded)[size_t(dir.windows[0].offset)]}
+                                           : format::zstdFirstBytes(std::span<const uint8_t>(*coded).subspan(size_t(dir.windows[0].offset), size_t(dir.windows[0].stored)), 1, "test");
+    EXPECT_EQ(first.at(0), attributes::detail::kReferencedContextCoding);
+    const auto reference = std::make_shared<const attributes::WindowReference>(windowsA, 4, a.layout, nullptr, "reference");
+    EXPECT_EQ(attributes::decodePredictedWindows(*coded, 4, b.layout, "test", b.places, {}, attributes::referenceWindows(reference, a.layout, a.places)),
+              raw(b.entries));
+    EXPECT_THROW(attributes::decodePredictedWindows(*coded, 4, b.layout, "test", b.places), Error);
+}
+
 TEST(BrickValueCoder, PlacesThatAreNoBricksAreRefused) {
     PlacedChannel c = placedField(4, true);
     IntCoderOptions o;
