@@ -170,6 +170,14 @@ private:
     mutable std::mutex mutex_;
     mutable std::vector<std::vector<uint8_t>> offered_;
 };
+// Whether two directories over one layout cut it into the same windows
+// (the same entries in each), as a referring grid's and its reference's must.
+inline bool sameWindowCuts(const WindowDirectory& a, const WindowDirectory& b) {
+    if (a.windows.size() != b.windows.size()) return false;
+    for (size_t k = 0; k < a.windows.size(); ++k)
+        if (a.windows[k].entries != b.windows[k].entries) return false;
+    return true;
+}
 // The entries of the reference's window k, asked for only by the windows
 // whose coding reads it.
 using ReferenceWindow = std::function<std::vector<uint8_t>(size_t window)>;

@@ -31,6 +31,8 @@ struct CompactDag {
     size_t innerLevelCount() const { return levelStart.size(); }
     uint64_t levelEnd(size_t i) const { return i + 1 < levelStart.size() ? levelStart[i + 1] : inner.size(); }
     uint64_t byteSize() const { return inner.size() * 2 + leaves.size() * 8 + levelStart.size() * 8; }
+    // The same DAG, word for word (a 4-D scan's volumes: the same voxels).
+    bool operator==(const CompactDag&) const = default;
 };
 
 // Lays out `dag` with the nodes of each level ordered by reference count

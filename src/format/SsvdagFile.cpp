@@ -534,11 +534,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                     if (distance == 0 || distance > g - first) r.fail("names grid " + std::to_string(int64_t(g) - distance) + ", not an earlier grid of this read");
                     EncodedGrid& earlier = scene.grids[g - first - distance];
                     EncodedLayer& other = earlier.active;
-                    const auto same = [](const encoding::CompactDag& a, const encoding::CompactDag& b) {
-                        return a.origin == b.origin && a.log2Size == b.log2Size && a.rootReflection == b.rootReflection && a.levelStart == b.levelStart &&
-                               a.offsetWords == b.offsetWords && a.inner == b.inner && a.leaves == b.leaves;
-                    };
-                    if (earlier.record.valueType != grid.record.valueType || !other.valueWindows.predicted || other.valueWindows.empty() || !same(other.dag, dag))
+                    if (earlier.record.valueType != grid.record.valueType || !other.valueWindows.predicted || other.valueWindows.empty() || other.dag != dag)
                         r.fail("names grid " + std::to_string(g - distance) + ", whose active voxels or values are not this grid's kind (the same DAG, type and predicted windows)");
                     windows.referenceDistance = distance;
                     std::shared_ptr<const attributes::WindowReference>& node = referenceOf[g - distance];
@@ -554,9 +550,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                     {  // the same windows (a float volume with fractions is cut in smaller ones than one of integers)
                         const attributes::WindowDirectory own =
                             attributes::readPredictedWindowDirectory(predictedWindowSection->data, vs, encoding::attributeLayout(dag), what + " " + layer + " predicted windows");
-                        bool same = own.windows.size() == node->directory.windows.size();
-                        for (size_t k = 0; same && k < own.windows.size(); ++k) same = own.windows[k].entries == node->directory.windows[k].entries;
-                        if (!same) r.fail("names grid " + std::to_string(g - distance) + ", whose values are cut into other windows");
+                        if (!attributes::sameWindowCuts(own, node->directory)) r.fail("names grid " + std::to_string(g - distance) + ", whose values are cut into other windows");
                     }
                     if (!other.attributes.empty() && !options.keepValueWindows) {  // decoded already: its windows sliced from it
                         const std::vector<uint8_t>& decoded = other.attributes;

@@ -15,11 +15,6 @@
 namespace vdbdag::pipeline {
 namespace {
 
-bool sameDag(const encoding::CompactDag& a, const encoding::CompactDag& b) {
-    return a.origin == b.origin && a.log2Size == b.log2Size && a.rootReflection == b.rootReflection && a.levelStart == b.levelStart &&
-           a.offsetWords == b.offsetWords && a.inner == b.inner && a.leaves == b.leaves;
-}
-
 // Whether grid `g`'s active values may refer to grid `r`'s (and the
 // windows' cuts agree: sameWindows). A grid whose inside is a signed fill
 // is left alone (a reader that keeps windows rebuilds its layers).
@@ -29,19 +24,15 @@ bool mayRefer(const format::EncodedGrid& g, const format::EncodedGrid& r) {
     return g.record.valueType == r.record.valueType && valueSize(g.record.valueType) == 4 && !a.dag.empty() && a.valueWindows.predicted &&
            !g.inactiveSignedFill && !r.inactiveSignedFill &&
            b.valueWindows.predicted && !a.valueWindows.empty() && !b.valueWindows.empty() && a.valueWindows.referenceDistance == 0 &&
-           g.lossy.tolerance.mode == attributes::ScalarTolerance::Mode::Exact && r.lossy.tolerance.mode == attributes::ScalarTolerance::Mode::Exact && sameDag(a.dag, b.dag);
+           g.lossy.tolerance.mode == attributes::ScalarTolerance::Mode::Exact && r.lossy.tolerance.mode == attributes::ScalarTolerance::Mode::Exact && a.dag == b.dag;
 }
 
 // Whether two payloads over the same layout cut it into the same windows: a
 // float volume of integers has windows of 2^22 entries, one with any
 // fraction 2^20 (PredictedWindows.h).
 bool sameWindows(std::span<const uint8_t> a, std::span<const uint8_t> b, uint32_t vs, std::span<const uint64_t> layout) {
-    const attributes::WindowDirectory da = attributes::readPredictedWindowDirectory(a, vs, layout, "a volume's predicted windows");
-    const attributes::WindowDirectory db = attributes::readPredictedWindowDirectory(b, vs, layout, "a volume's predicted windows");
-    if (da.windows.size() != db.windows.size()) return false;
-    for (size_t k = 0; k < da.windows.size(); ++k)
-        if (da.windows[k].entries != db.windows[k].entries) return false;
-    return true;
+    return attributes::sameWindowCuts(attributes::readPredictedWindowDirectory(a, vs, layout, "a volume's predicted windows"),
+                                      attributes::readPredictedWindowDirectory(b, vs, layout, "a volume's predicted windows"));
 }
 
 } // namespace

@@ -66,17 +66,11 @@ void Layer::load() const {
             w->directory = attributes::readPredictedWindowDirectory(w->payload, vs, w->layout, what + " predicted windows");
             if (referenceGrid) {  // the same DAG and windows as the grid it takes its reference from (FORMAT.md 8.6)
                 referenceGrid->load();
-                const encoding::CompactDag& a = *dag;
-                const encoding::CompactDag& b = referenceGrid->grid.active.dag;
-                const bool sameDag = a.origin == b.origin && a.log2Size == b.log2Size && a.rootReflection == b.rootReflection && a.levelStart == b.levelStart &&
-                                     a.offsetWords == b.offsetWords && a.inner == b.inner && a.leaves == b.leaves;
                 const attributes::ValueWindowsPayload& theirs = referenceGrid->grid.active.valueWindows;
-                if (!sameDag || !theirs.predicted || theirs.empty())
+                if (*dag != referenceGrid->grid.active.dag || !theirs.predicted || theirs.empty())
                     throw Error(what + ": takes its values' reference from a grid whose active voxels or values are not this grid's kind");
-                const attributes::WindowDirectory other = attributes::readPredictedWindowDirectory(theirs.load(), vs, w->layout, what + " (its reference's windows)");
-                bool same = other.windows.size() == w->directory.windows.size();
-                for (size_t k = 0; same && k < other.windows.size(); ++k) same = other.windows[k].entries == w->directory.windows[k].entries;
-                if (!same) throw Error(what + ": takes its values' reference from a grid whose values are cut into other windows");
+                if (!attributes::sameWindowCuts(attributes::readPredictedWindowDirectory(theirs.load(), vs, w->layout, what + " (its reference's windows)"), w->directory))
+                    throw Error(what + ": takes its values' reference from a grid whose values are cut into other windows");
             }
             w->decoded = std::make_unique<std::once_flag[]>(w->directory.windows.size());
             w->values = std::make_unique<std::vector<uint8_t>[]>(w->directory.windows.size());
