@@ -9,7 +9,7 @@
 set(VDBDAG_READER_SOURCES
     src/reader/Accessor.cpp src/reader/File.cpp
     src/format/ByteIO.cpp src/format/DagBounds.cpp src/format/ReadLimits.cpp src/format/SsvdagContainer.cpp
-    src/format/SsvdagFile.cpp src/format/FrameSequence.cpp src/format/ZstdFrame.cpp
+    src/format/SsvdagFile.cpp src/format/ValueReference.cpp src/format/FrameSequence.cpp src/format/ZstdFrame.cpp
     src/encoding/AttributeLayout.cpp src/encoding/CompactDag.cpp src/encoding/DagStructure.cpp
     src/attributes/NormalChannel.cpp src/attributes/OctahedralNormal.cpp src/attributes/PaletteChannel.cpp
     src/attributes/ContextChannel.cpp src/attributes/PredictedChannel.cpp src/attributes/PredictedWindows.cpp src/attributes/RescaledFloats.cpp src/coding/BrickValueCoder.cpp src/coding/LeastSquaresKernels.cpp src/coding/FloatValueCoder.cpp src/coding/FloatIntegerCoder.cpp src/coding/LabelCoder.cpp

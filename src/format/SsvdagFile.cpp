@@ -49,6 +49,7 @@
 #include "src/format/DagBounds.h"
 #include "src/format/FrameSequence.h"
 #include "src/format/InactiveSignedFill.h"
+#include "src/format/ValueReference.h"
 #include "src/encoding/AttributeLayout.h"
 #include "src/util/Error.h"
 
@@ -362,14 +363,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     const uint32_t end = range.end;
     if (end - first > sections.size()) throw Error(sourceName + ": FileInfo claims " + std::to_string(gridCount) + " grids, more than its sections can hold");
 
-    // A ValueReference payload (FORMAT.md 8.6): u32 distance, >= 1.
-    const auto referenceDistanceOf = [&](const Section& s) {
-        ByteReader r(s.data, sourceName + ": grid " + std::to_string(s.grid) + " ValueReference");
-        const uint32_t distance = r.get<uint32_t>();
-        r.expectEnd();
-        if (distance == 0) r.fail("names the grid itself");
-        return distance;
-    };
+    const auto referenceDistanceOf = [&](const Section& s) { return parseValueReference(s, sourceName); };
     auto find = [&](uint32_t g, SectionKind kind, bool required) -> Section* {
         auto it = byGrid.find({g, kind});
         if (it == byGrid.end()) {
@@ -383,20 +377,10 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     // reference (FORMAT.md 8.6): the grids of its chain are read too, back
     // to its key grid, and dropped once it is read.
     if (options.grid && !options.referencesByCaller) {
-        unsigned hops = 0;
-        while (Section* ref = find(first, SectionKind::ValueReference, false)) {
-            const uint32_t distance = referenceDistanceOf(*ref);
-            if (distance > first) throw Error(sourceName + ": grid " + std::to_string(first) + " ValueReference: names a grid before the first");
-            if (++hops > attributes::kMaxReferenceChain)
-                throw Error(sourceName + ": grid " + std::to_string(end - 1) + " takes its values' reference through more than " +
-                            std::to_string(attributes::kMaxReferenceChain) + " grids");
-            first -= distance;
-        }
+        first = referenceChainStart(first, [&](uint32_t g) -> const Section* { return find(g, SectionKind::ValueReference, false); }, sourceName);
         if (end - first > sections.size()) throw Error(sourceName + ": grid " + std::to_string(end - 1) + "'s reference chain claims more grids than its sections can hold");
     }
-    // Each grid whose windows other grids of this read take as their
-    // reference: its windows once (a WindowReference), shared by them.
-    std::map<uint32_t, std::shared_ptr<const attributes::WindowReference>> referenceOf;
+
     SsvdagScene scene;
     if (fileMetadata) scene.fileMetadata = std::move(fileMetadata->data);
     {
@@ -415,6 +399,9 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             throw Error(sourceName + ": FrameMetadata for grid " + std::to_string(frameMetadata.begin()->first) + ", which does not begin a frame");
     }
     uint64_t expanded = 0;  // bytes the sections and what is decoded from them take
+    ReferenceReads references;  // grids other grids take their values' reference from (FORMAT.md 8.6)
+    references.expanded = &expanded;
+    references.limits = &options.limits;
     for (const Section& s : sections) expanded = saturatingAdd(expanded, s.data.size());
     scene.grids.resize(end - first);
     for (uint32_t g = first; g < end; ++g) {
@@ -528,38 +515,9 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
                     ref = nullptr;  // the caller's (its referenceDistance is set below)
                 }
                 if (ref) {
-                    ByteReader r(ref->data, what + " ValueReference");
-                    const uint32_t distance = referenceDistanceOf(*ref);
-                    if (!predictedWindowSection) r.fail("names a reference for values not in predicted windows");
-                    if (distance == 0 || distance > g - first) r.fail("names grid " + std::to_string(int64_t(g) - distance) + ", not an earlier grid of this read");
-                    EncodedGrid& earlier = scene.grids[g - first - distance];
-                    EncodedLayer& other = earlier.active;
-                    if (earlier.record.valueType != grid.record.valueType || !other.valueWindows.predicted || other.valueWindows.empty() || other.dag != dag)
-                        r.fail("names grid " + std::to_string(g - distance) + ", whose active voxels or values are not this grid's kind (the same DAG, type and predicted windows)");
-                    windows.referenceDistance = distance;
-                    std::shared_ptr<const attributes::WindowReference>& node = referenceOf[g - distance];
-                    if (!node) {  // its payload once more: counted as what the read takes
-                        expanded = saturatingAdd(expanded, other.valueWindows.size());
-                        checkMemory(options.limits, expanded, what, "its sections and decoded values");
-                        node = std::make_shared<const attributes::WindowReference>(
-                            other.valueWindows.load(), vs, encoding::attributeLayout(dag), other.valueWindows.reference,
-                            sourceName + ": grid " + std::to_string(g - distance) + " active predicted windows (a reference)");
-                    }
-                    windows.reference = node;
-                    if (!other.valueWindows.referencedBy) other.valueWindows.referencedBy = node;
-                    {  // the same windows (a float volume with fractions is cut in smaller ones than one of integers)
-                        const attributes::WindowDirectory own =
-                            attributes::readPredictedWindowDirectory(predictedWindowSection->data, vs, encoding::attributeLayout(dag), what + " " + layer + " predicted windows");
-                        if (!attributes::sameWindowCuts(own, node->directory)) r.fail("names grid " + std::to_string(g - distance) + ", whose values are cut into other windows");
-                    }
-                    if (!other.attributes.empty() && !options.keepValueWindows) {  // decoded already: its windows sliced from it
-                        const std::vector<uint8_t>& decoded = other.attributes;
-                        const attributes::WindowDirectory& d = windows.reference->directory;
-                        referenceWindow = [&decoded, &d, vs](size_t k) {
-                            const attributes::WindowDirectory::Window& e = d.windows.at(k);
-                            return std::vector<uint8_t>(decoded.begin() + ptrdiff_t(e.firstEntry * vs), decoded.begin() + ptrdiff_t((e.firstEntry + e.entries) * vs));
-                        };
-                    }
+                    if (!predictedWindowSection) throw Error(what + ": a ValueReference section for values not in predicted windows");
+                    referenceWindow = readValueReference(*ref, g, first, scene, into, predictedWindowSection->data, vs, !options.keepValueWindows, references,
+                                                         what, sourceName);
                 }
                 if (predictedSection) {
                     // decoded above
@@ -709,19 +667,7 @@ SsvdagScene readSceneFile(const std::string& path, const ReadOptions& options) {
     if (options.grid && *options.grid >= list.gridCount)
         throw Error(path + ": has " + std::to_string(list.gridCount) + " grid(s); grid " + std::to_string(*options.grid) + " asked for");
     GridRange range = options.frame ? frameGrids(list.frames, list.gridCount, *options.frame, path) : GridRange{*options.grid, *options.grid + 1};
-    if (options.grid && !options.referencesByCaller) {  // and the grids its values' reference chain goes back to (FORMAT.md 8.6)
-        std::map<uint32_t, uint32_t> distance;
-        for (const Section& s : readContainerFile(path, false, options.limits, [&](SectionKind kind, uint32_t grid) {
-                 return kind == SectionKind::ValueReference && grid <= *options.grid;
-             })) {
-            ByteReader r(s.data, path + ": grid " + std::to_string(s.grid) + " ValueReference");
-            distance[s.grid] = r.get<uint32_t>();
-        }
-        unsigned hops = 0;
-        for (auto it = distance.find(range.first); it != distance.end() && it->second > 0 && it->second <= range.first && hops++ <= attributes::kMaxReferenceChain;
-             it = distance.find(range.first))
-            range.first -= it->second;  // (sectionsToScene checks each)
-    }
+    if (options.grid && !options.referencesByCaller) range.first = referenceChainStart(path, *options.grid, options.limits);  // and its values' reference chain (FORMAT.md 8.6)
     const uint32_t first = range.first, end = range.end;  // (named, for the lambdas)
     const auto keep = [first, end](SectionKind kind, uint32_t grid) {
         switch (kind) {
