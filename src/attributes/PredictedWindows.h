@@ -181,6 +181,15 @@ inline bool sameWindowCuts(const WindowDirectory& a, const WindowDirectory& b) {
 // The entries of the reference's window k, asked for only by the windows
 // whose coding reads it.
 using ReferenceWindow = std::function<std::vector<uint8_t>(size_t window)>;
+// The windows of a layer decoded whole (`entries` in attribute order, cut
+// as `dir` says; both must outlive the function).
+inline ReferenceWindow windowsOf(const std::vector<uint8_t>& entries, const WindowDirectory& dir) {
+    return [&entries, &dir](size_t k) {
+        const WindowDirectory::Window& e = dir.windows.at(k);
+        const uint64_t vs = dir.valueSize;
+        return std::vector<uint8_t>(entries.begin() + ptrdiff_t(e.firstEntry * vs), entries.begin() + ptrdiff_t((e.firstEntry + e.entries) * vs));
+    };
+}
 // `reference`'s window, over the layer's `layout` and `places` (which must
 // outlive the function); an empty function for a null reference.
 ReferenceWindow referenceWindows(const std::shared_ptr<const WindowReference>& reference, std::span<const uint64_t> layout,

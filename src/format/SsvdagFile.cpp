@@ -363,7 +363,6 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
     const uint32_t end = range.end;
     if (end - first > sections.size()) throw Error(sourceName + ": FileInfo claims " + std::to_string(gridCount) + " grids, more than its sections can hold");
 
-    const auto referenceDistanceOf = [&](const Section& s) { return parseValueReference(s, sourceName); };
     auto find = [&](uint32_t g, SectionKind kind, bool required) -> Section* {
         auto it = byGrid.find({g, kind});
         if (it == byGrid.end()) {
@@ -554,7 +553,7 @@ SsvdagScene sectionsToScene(std::vector<Section> sections, const std::string& so
             }
         };
         const encoding::DecodedSize activeSize = readLayerDag(kActive, grid.active, "active");
-        if (Section* ref = find(g, SectionKind::ValueReference, false)) grid.active.valueWindows.referenceDistance = referenceDistanceOf(*ref);
+        if (Section* ref = find(g, SectionKind::ValueReference, false)) grid.active.valueWindows.referenceDistance = parseValueReference(*ref, sourceName);
         if (Section* fill = find(g, SectionKind::InactiveSignedFill, false)) {
             ByteReader r(fill->data, what + " InactiveSignedFill");
             if (r.get<uint8_t>() != 0) r.fail("an unknown fill");

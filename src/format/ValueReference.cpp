@@ -44,13 +44,7 @@ attributes::ReferenceWindow readValueReference(const Section& section, uint32_t 
     if (!attributes::sameWindowCuts(attributes::readPredictedWindowDirectory(payload, vs, layout, what + " active predicted windows"), node->directory))
         r.fail("names grid " + std::to_string(g - distance) + ", whose values are cut into other windows");
     if (other.attributes.empty() || !decodedNow) return {};
-    // Decoded already: its windows sliced from it (used only during the decode that follows).
-    const std::vector<uint8_t>& decoded = other.attributes;
-    const attributes::WindowDirectory& d = node->directory;
-    return [&decoded, &d, vs](size_t k) {
-        const attributes::WindowDirectory::Window& e = d.windows.at(k);
-        return std::vector<uint8_t>(decoded.begin() + ptrdiff_t(e.firstEntry * vs), decoded.begin() + ptrdiff_t((e.firstEntry + e.entries) * vs));
-    };
+    return attributes::windowsOf(other.attributes, node->directory);  // decoded already (used only during the decode that follows)
 }
 
 uint32_t referenceChainStart(uint32_t grid, const std::function<const Section*(uint32_t)>& referenceOf, const std::string& sourceName) {
@@ -68,17 +62,13 @@ uint32_t referenceChainStart(uint32_t grid, const std::function<const Section*(u
 }
 
 uint32_t referenceChainStart(const std::string& path, uint32_t grid, const ReadLimits& limits) {
-    std::map<uint32_t, uint32_t> distance;
-    for (const Section& s : readContainerFile(path, false, limits, [&](SectionKind kind, uint32_t g) { return kind == SectionKind::ValueReference && g <= grid; })) {
-        ByteReader r(s.data, path + ": grid " + std::to_string(s.grid) + " ValueReference");
-        distance[s.grid] = r.get<uint32_t>();
-    }
-    uint32_t first = grid;
-    unsigned hops = 0;
-    for (auto it = distance.find(first); it != distance.end() && it->second > 0 && it->second <= first && hops++ <= attributes::kMaxReferenceChain;
-         it = distance.find(first))
-        first -= it->second;  // (the scene reader checks each)
-    return first;
+    std::map<uint32_t, Section> byGrid;
+    for (Section& s : readContainerFile(path, false, limits, [&](SectionKind kind, uint32_t g) { return kind == SectionKind::ValueReference && g <= grid; }))
+        byGrid[s.grid] = std::move(s);
+    return referenceChainStart(grid, [&](uint32_t g) -> const Section* {
+        const auto it = byGrid.find(g);
+        return it == byGrid.end() ? nullptr : &it->second;
+    }, path);
 }
 
 } // namespace vdbdag::format

@@ -97,14 +97,8 @@ SeriesReferenceReport referenceSeries(format::SsvdagScene& scene, unsigned keyEv
             const std::vector<uint64_t> layout = encoding::attributeLayout(grid.active.dag);
             const std::vector<coding::BrickPlace> places = encoding::attributePlaces(grid.active.dag, vs);
             const attributes::WindowDirectory dir = attributes::readPredictedWindowDirectory(payload[g], vs, layout, "grid '" + grid.record.name + "'");
-            // Window k of a decoded grid (the two grids' windows hold the same entries: sameWindows).
-            const auto windowOf = [&](const std::vector<uint8_t>& all) {
-                return [&all, &dir, vs](size_t k) {
-                    const attributes::WindowDirectory::Window& e = dir.windows.at(k);
-                    return std::vector<uint8_t>(all.begin() + ptrdiff_t(e.firstEntry * vs), all.begin() + ptrdiff_t((e.firstEntry + e.entries) * vs));
-                };
-            };
-            coded[g - g0] = attributes::referencePredictedWindows(payload[g], windowOf(decodedOf(g)), windowOf(decodedOf(g - 1)), vs, layout, places,
+            // Both grids' windows cut as `dir` (sameWindows).
+            coded[g - g0] = attributes::referencePredictedWindows(payload[g], attributes::windowsOf(decodedOf(g), dir), attributes::windowsOf(decodedOf(g - 1), dir), vs, layout, places,
                                                                   "grid '" + grid.record.name + "' predicted windows", referenced[g - g0]);
         });
         for (size_t g = g0; g < g1; ++g) {

@@ -66,10 +66,11 @@ void Layer::load() const {
             w->directory = attributes::readPredictedWindowDirectory(w->payload, vs, w->layout, what + " predicted windows");
             if (referenceGrid) {  // the same DAG and windows as the grid it takes its reference from (FORMAT.md 8.6)
                 referenceGrid->load();
-                const attributes::ValueWindowsPayload& theirs = referenceGrid->grid.active.valueWindows;
-                if (*dag != referenceGrid->grid.active.dag || !theirs.predicted || theirs.empty())
+                const Layer& theirs = referenceGrid->active;
+                theirs.load();
+                if (*dag != *theirs.dag || !theirs.windows_)
                     throw Error(what + ": takes its values' reference from a grid whose active voxels or values are not this grid's kind");
-                if (!attributes::sameWindowCuts(attributes::readPredictedWindowDirectory(theirs.load(), vs, w->layout, what + " (its reference's windows)"), w->directory))
+                if (!attributes::sameWindowCuts(theirs.windows_->directory, w->directory))
                     throw Error(what + ": takes its values' reference from a grid whose values are cut into other windows");
             }
             w->decoded = std::make_unique<std::once_flag[]>(w->directory.windows.size());
