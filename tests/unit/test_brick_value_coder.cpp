@@ -277,7 +277,9 @@ TEST(BrickValueCoder, ASeriesReferenceTakesTheVolumeBeforeAsNeighbours) {
         o.reference = a.entries;
         std::vector<int32_t> reconstructed;
         const std::vector<uint8_t> bytes = encodePlacedBrickValues(b.entries, b.layout, b.places, BrickOrder::Raster, o, &reconstructed);
-        if (near == 0) EXPECT_LT(double(bytes.size()), 0.6 * double(alone)) << bytes.size() << " against " << alone;
+        if (near == 0) {
+            EXPECT_LT(double(bytes.size()), 0.6 * double(alone)) << bytes.size() << " against " << alone;
+        }
         std::vector<int32_t> back(b.entries.size());
         decodePlacedBrickValues(bytes, b.layout, b.places, BrickOrder::Raster, o, back, "referenced");
         EXPECT_EQ(back, reconstructed);
