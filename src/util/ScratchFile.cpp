@@ -2,9 +2,11 @@
 #include "src/util/ScratchFile.h"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +14,23 @@
 #include "src/util/Error.h"
 
 namespace vdbdag {
+
+namespace {
+
+// Asks the kernel to back the 2 MiB-aligned part of [p, p + size) with
+// transparent huge pages: one page fault a 2 MiB page instead of 512.
+void adviseHugePages(void* p, size_t size) {
+#ifdef MADV_HUGEPAGE
+    constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+    const uintptr_t begin = (reinterpret_cast<uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+    const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + size) & ~(kHuge - 1);
+    if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);  // advice: its failure changes nothing
+#else
+    (void)p, (void)size;
+#endif
+}
+
+} // namespace
 
 ScratchFile::ScratchFile(const std::string& near, uint64_t keepInMemory) : near_(near), keep_(keepInMemory) {
     if (keep_ == 0) openFile();  // fail early (a folder that cannot be written) when the file is certain
@@ -41,7 +60,10 @@ void ScratchFile::check(uint64_t offset, size_t size, const char* what) const {
 uint64_t ScratchFile::append(const void* data, size_t size) {
     const uint64_t at = size_;
     if (!spilled_ && size <= keep_ - inMemory_) {
-        while (uint64_t(chunks_.size()) * kChunk < at + size) chunks_.emplace_back(new uint8_t[kChunk]);  // not zeroed: written before read
+        while (uint64_t(chunks_.size()) * kChunk < at + size) {
+            chunks_.emplace_back(new uint8_t[kChunk]);  // not zeroed: written before read
+            adviseHugePages(chunks_.back().get(), kChunk);
+        }
         toMemory(at, data, size);
         inMemory_ += size;
     } else {
