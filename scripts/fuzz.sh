@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang (ASan + UBSan, UBSan fatal) and runs
-# each for N seconds (default 120) from a generated seed corpus:
+# each for N seconds (default 120), JOBS (default 2) at a time, from a generated seed corpus:
 #   fuzz_ssvdag_reader    whole files: container (magic, table, bounds,
 #                         checksums, zstd; also with checksums patched so
 #                         mutations reach the structural checks), then the
@@ -59,16 +59,29 @@ for d in tests/fuzz/regressions/*/; do
   cp "$d"* "build-fuzz/corpus_$name/"
 done
 
-status=0
-for target in "${TARGETS[@]}"; do
-  corpus=build-fuzz/corpus_${target#fuzz_ssvdag_}
+# The targets run JOBS at a time (each fuzzer is one process on one core),
+# each into its own log; the summaries print in the targets' order.
+run_target() {  # TARGET: its exit status in build-fuzz/TARGET.status
+  local target=$1 corpus=build-fuzz/corpus_${1#fuzz_ssvdag_} rc=0
   [ "$target" = fuzz_scan_headers ] && corpus=build-fuzz/corpus_scan_headers
   [ "$target" = fuzz_int_volume_coder ] && corpus=build-fuzz/corpus_int_volume_coder && mkdir -p "$corpus"
-  limit=(-max_total_time="$SECONDS_TO_RUN")
+  local limit=(-max_total_time="$SECONDS_TO_RUN")
   [ -n "${FUZZ_RUNS:-}" ] && limit=(-runs="$FUZZ_RUNS" -seed=1)
-  echo "== $target: ${limit[*]} from $(ls "$corpus" | wc -l) corpus files"
-  if ! build-fuzz/"$target" "${limit[@]}" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
-        -print_final_stats=1 -artifact_prefix=build-fuzz/artifacts/"$target"- "$corpus" > build-fuzz/"$target".log 2>&1; then
+  echo "== $target: ${limit[*]} from $(ls "$corpus" | wc -l) corpus files" > build-fuzz/"$target".head
+  build-fuzz/"$target" "${limit[@]}" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
+      -print_final_stats=1 -artifact_prefix=build-fuzz/artifacts/"$target"- "$corpus" > build-fuzz/"$target".log 2>&1 || rc=$?
+  echo "$rc" > build-fuzz/"$target".status
+}
+for target in "${TARGETS[@]}"; do
+  rm -f build-fuzz/"$target".status
+  while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n || true; done
+  run_target "$target" &
+done
+wait
+status=0
+for target in "${TARGETS[@]}"; do
+  cat build-fuzz/"$target".head
+  if [ "$(cat build-fuzz/"$target".status 2>/dev/null || echo 1)" != 0 ]; then
     status=1
     echo "!! $target found a problem; see build-fuzz/$target.log and build-fuzz/artifacts/"
   fi

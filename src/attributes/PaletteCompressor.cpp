@@ -522,6 +522,44 @@ private:
     std::unordered_multimap<uint64_t, std::pair<uint32_t, uint32_t>> offsets_;  // hash -> (offset, size)
 };
 
+// Sorts the distinct ids in `order` by their values read as little-endian
+// unsigned integers (the material array's order) and writes those values, in
+// that order, to `materials`. Values of up to 16 bytes are sorted as (key, id)
+// pairs: neither the sort nor the copy then reads `first` or the values at
+// random, which was most of the cost. No two ids share a value, so every sort
+// gives the one order.
+void sortMaterials(std::vector<uint32_t>& order, const uint8_t* base, const std::vector<uint64_t>& first, uint32_t valueSize,
+                   std::vector<uint8_t>& materials) {
+    materials.resize(order.size() * valueSize);
+    if (valueSize <= 16) {
+        struct Keyed {
+            uint64_t high, low;  // the value's bytes 8-15 and 0-7, little-endian
+            uint32_t id;
+        };
+        std::vector<Keyed> keyed(order.size());
+        for (size_t i = 0; i < order.size(); ++i) {  // ids ascending: `first` and the values read forwards
+            const uint8_t* v = base + first[order[i]] * valueSize;
+            Keyed k{0, 0, order[i]};
+            for (uint32_t b = 0; b < valueSize; ++b) (b < 8 ? k.low : k.high) |= uint64_t(v[b]) << (8 * (b & 7));
+            keyed[i] = k;
+        }
+        std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) { return a.high != b.high ? a.high < b.high : a.low < b.low; });
+        for (size_t i = 0; i < order.size(); ++i) {
+            order[i] = keyed[i].id;
+            for (uint32_t b = 0; b < valueSize; ++b) materials[i * valueSize + b] = uint8_t((b < 8 ? keyed[i].low : keyed[i].high) >> (8 * (b & 7)));
+        }
+        return;
+    }
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        const uint8_t* x = base + first[a] * valueSize;
+        const uint8_t* y = base + first[b] * valueSize;
+        for (uint32_t k = valueSize; k-- > 0;)
+            if (x[k] != y[k]) return x[k] < y[k];
+        return false;
+    });
+    for (size_t i = 0; i < order.size(); ++i) std::memcpy(&materials[i * valueSize], base + first[order[i]] * valueSize, valueSize);
+}
+
 } // namespace
 
 PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSize) {
@@ -548,19 +586,8 @@ PaletteChannel compressPalette(std::span<const uint8_t> values, uint32_t valueSi
         std::vector<uint32_t> order;
         for (uint32_t id = 0; id < used.size(); ++id)
             if (used[id]) order.push_back(id);
-        const uint8_t* base = values.data();
-        std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-            const uint8_t* x = base + first[a] * valueSize;
-            const uint8_t* y = base + first[b] * valueSize;
-            for (uint32_t k = valueSize; k-- > 0;)
-                if (x[k] != y[k]) return x[k] < y[k];
-            return false;
-        });
-        out.materials.resize(order.size() * valueSize);
-        for (uint32_t m = 0; m < order.size(); ++m) {
-            material[order[m]] = m;
-            std::memcpy(&out.materials[size_t(m) * valueSize], base + first[order[m]] * valueSize, valueSize);
-        }
+        sortMaterials(order, values.data(), first, valueSize, out.materials);
+        for (uint32_t m = 0; m < order.size(); ++m) material[order[m]] = m;
     }
     PaletteTable paletteAt;                                        // shared palettes
     std::vector<uint32_t> local(first.size(), 0);
