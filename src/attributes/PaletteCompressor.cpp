@@ -524,15 +524,15 @@ private:
 
 // Sorts the distinct ids in `order` by their values read as little-endian
 // unsigned integers (the material array's order) and writes those values, in
-// that order, to `materials`. Values of up to 16 bytes are sorted as (key, id)
-// pairs: neither the sort nor the copy then reads `first` or the values at
-// random, which was most of the cost. The pairs take 8 bytes a distinct value
-// of up to 4 bytes, 24 beyond (as long as the sort). No two ids share a value,
-// so every sort gives the one order.
+// that order, to `materials`. Values of up to 4 bytes (float, int32, colour
+// and normal codes) are sorted as one uint64 each, key << 32 | id: neither the
+// sort nor the copy then reads `first` or the values at random, which was most
+// of the cost; wider values through their ids. No two ids share a value, so
+// every sort gives the one order.
 void sortMaterials(std::vector<uint32_t>& order, const uint8_t* base, const std::vector<uint64_t>& first, uint32_t valueSize,
                    std::vector<uint8_t>& materials) {
     materials.resize(order.size() * valueSize);
-    if (valueSize <= 4) {  // the most common (float, int32, colour and normal codes): key and id in 8 bytes
+    if (valueSize <= 4) {
         std::vector<uint64_t> keyed(order.size());
         for (size_t i = 0; i < order.size(); ++i) {
             const uint8_t* v = base + first[order[i]] * valueSize;
@@ -544,25 +544,6 @@ void sortMaterials(std::vector<uint32_t>& order, const uint8_t* base, const std:
         for (size_t i = 0; i < order.size(); ++i) {
             order[i] = uint32_t(keyed[i]);
             for (uint32_t b = 0; b < valueSize; ++b) materials[i * valueSize + b] = uint8_t(keyed[i] >> (32 + 8 * b));
-        }
-        return;
-    }
-    if (valueSize <= 16) {  // (key, id) in 24 bytes
-        struct Keyed {
-            uint64_t high, low;  // the value's bytes 8-15 and 0-7, little-endian
-            uint32_t id;
-        };
-        std::vector<Keyed> keyed(order.size());
-        for (size_t i = 0; i < order.size(); ++i) {  // ids ascending: `first` and the values read forwards
-            const uint8_t* v = base + first[order[i]] * valueSize;
-            Keyed k{0, 0, order[i]};
-            for (uint32_t b = 0; b < valueSize; ++b) (b < 8 ? k.low : k.high) |= uint64_t(v[b]) << (8 * (b & 7));
-            keyed[i] = k;
-        }
-        std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) { return a.high != b.high ? a.high < b.high : a.low < b.low; });
-        for (size_t i = 0; i < order.size(); ++i) {
-            order[i] = keyed[i].id;
-            for (uint32_t b = 0; b < valueSize; ++b) materials[i * valueSize + b] = uint8_t((b < 8 ? keyed[i].low : keyed[i].high) >> (8 * (b & 7)));
         }
         return;
     }
