@@ -23,7 +23,7 @@ PACKAGES=(
   libcli11-dev libfmt-dev nlohmann-json3-dev libxxhash-dev libzstd-dev zstd xz-utils zlib1g-dev
   libzfp-dev
   clang libclang-rt-14-dev
-  help2man
+  help2man ccache
   pybind11-dev python3-dev python3-numpy python3-pytest python3-openvdb
   # the ParaView plugin (paraview/); pvpython is unpacked, not installed, by scripts/paraview_sdk.sh
   paraview-dev paraview

@@ -12,7 +12,13 @@ stage_done() {  # NAME: the time since the last stage, and in all
   echo "test.sh: $1 took $((now - stage_start)) s ($((now - started)) s in all)"
   stage_start=$now
 }
+# The compiler cache (CMakeLists.txt): its counts say how much was compiled.
+cache_counts() { command -v ccache > /dev/null && ccache --print-stats 2> /dev/null |
+    awk -F'\t' '$1 ~ /^(direct_cache_hit|preprocessed_cache_hit|cache_miss)$/ {n[$1] = $2}
+        END {printf "test.sh: ccache: %d objects from the cache, %d compiled\n", n["direct_cache_hit"] + n["preprocessed_cache_hit"], n["cache_miss"]}'; }
+command -v ccache > /dev/null && ccache --zero-stats > /dev/null
 VDBDAG_WERROR=ON scripts/setup.sh  # warnings of our own code are errors here
+cache_counts || true
 stage_done "setup and build"
 (cd build && ctest --output-on-failure --timeout 900 -j"$(nproc)")
 stage_done "the suite (ctest)"

@@ -24,6 +24,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "vdb_bridge/VdbImport.h"

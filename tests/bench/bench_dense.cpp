@@ -25,6 +25,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/format/SsvdagFile.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/util/AtomicFile.h"

@@ -35,6 +35,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "gpu/VulkanContext.h"
 #include "gpu/VulkanTracer.h"
 #include "src/pipeline/GridCodec.h"

@@ -12,6 +12,8 @@
 #include <iterator>
 #include <string>
 
+#include "tests/unit/BuildPaths.h"
+
 namespace vdbdag::testing {
 
 struct CommandResult {

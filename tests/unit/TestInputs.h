@@ -8,6 +8,7 @@
 #include <tuple>
 #include <vector>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/volume/GridTopology.h"
 
 namespace vdbdag::testing {

@@ -22,6 +22,7 @@
 #include <vtkXMLImageDataReader.h>
 #include <vtkXMLMultiBlockDataReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
+#include "tests/unit/BuildPaths.h"
 #include "tests/unit/CliRunner.h"
 
 namespace vtktest {

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <openvdb/openvdb.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "tests/unit/CliRunner.h"
 
 namespace fs = std::filesystem;

@@ -13,6 +13,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/bench/BenchPoint.h"
 #include "src/bench/ImageMetrics.h"
 

@@ -18,6 +18,7 @@
 
 #include <openvdb/openvdb.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "tests/unit/CliRunner.h"
 #include "vdb_bridge/DenseImport.h"
 

@@ -22,6 +22,7 @@
 #include <openvdb/openvdb.h>
 #include <zlib.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "tests/unit/CliRunner.h"
 #include "src/attributes/PredictedChannel.h"
 #include "src/attributes/PredictedWindows.h"

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/util/Error.h"
 #include "tests/unit/CliRunner.h"
 #include "vdb_bridge/DenseImport.h"

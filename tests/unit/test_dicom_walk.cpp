@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/util/Error.h"
 #include "tests/unit/CliRunner.h"
 #include "vdb_bridge/DenseVolume.h"

@@ -12,6 +12,7 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/LevelSetUtil.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/trace/Camera.h"
 #include "src/trace/CpuRenderer.h"

@@ -15,6 +15,7 @@
 #include <iterator>
 #include <tuple>
 
+#include "tests/unit/BuildPaths.h"
 #include "tests/unit/CliRunner.h"
 #include "tests/unit/VdbTreeCompare.h"
 

@@ -14,6 +14,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "tests/tools/ForgedDicom.h"
 #include "tests/unit/CliRunner.h"
 

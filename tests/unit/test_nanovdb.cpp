@@ -18,6 +18,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/io/File.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "tests/unit/CliRunner.h"
 #include "tests/unit/VdbTreeCompare.h"
 

@@ -29,11 +29,8 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "tests/unit/CliRunner.h"
-
-#ifndef VDBDAG_VDB_PROBE
-#error "VDBDAG_VDB_PROBE (the path of vdbdag_vdb_probe) must be defined by the build"
-#endif
 
 namespace fs = std::filesystem;
 

@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
 #include "src/util/OutputPath.h"

@@ -15,6 +15,7 @@
 
 #include <tbb/global_control.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/attributes/PredictedWindows.h"
 #include "src/util/Error.h"
 

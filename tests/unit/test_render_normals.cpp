@@ -15,6 +15,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/pipeline/GridCodec.h"
 #include "src/trace/Camera.h"
 #include "src/trace/CpuRenderer.h"

@@ -18,6 +18,7 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <vdbdag/vdbdag.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/format/FrameSequence.h"
 #include "src/format/SsvdagFile.h"
 #include "src/util/Error.h"

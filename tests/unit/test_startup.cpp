@@ -14,6 +14,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "tests/unit/CliRunner.h"
 
 namespace fs = std::filesystem;

@@ -18,6 +18,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/format/SsvdagFile.h"
 #include "tests/unit/TestInputs.h"
 #include "src/pipeline/CubeEncoder.h"

@@ -12,6 +12,7 @@
 #include <openvdb/openvdb.h>
 #include <tbb/global_control.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "src/format/SsvdagFile.h"
 #include "tests/unit/TestInputs.h"
 #include "src/pipeline/GridCodec.h"

@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/BuildPaths.h"
 #include "gpu/ComputePipeline.h"
 #include "gpu/DeviceArray.h"
 #include "gpu/DeviceBuffer.h"

@@ -22,6 +22,7 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/LevelSetUtil.h>
 
+#include "tests/unit/BuildPaths.h"
 #include "gpu/VulkanContext.h"
 #include "tests/unit/VulkanTestSupport.h"
 #include "gpu/VulkanTracer.h"
