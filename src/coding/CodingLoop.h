@@ -4,6 +4,7 @@
 // (lossless modulo the range, or quantised for near-lossless), decoding
 // reads it. One loop for both coders, so their streams follow one rule.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -24,6 +25,49 @@ inline void checkRange(const IntCoderOptions& options) {
     if (options.model < 0 || options.model > kLatestModel)
         throw Error("value coder: model generation " + std::to_string(options.model) + " (0 to " + std::to_string(kLatestModel) + ")");
 }
+
+// The models of one walk. Each thread keeps the models of its last walk per
+// generation and restarts them in place for the next (Models::restart):
+// building them anew cost a small walk more than the walk itself (1.9 MB of
+// generation 4 allocated, faulted in and cleared per window; the integer
+// coder's fuzz target spent half its time there). A walk started while
+// another on the same thread holds them builds its own.
+class ModelsLease {
+public:
+    explicit ModelsLease(int generation) {
+        Kept& kept = keptModels()[size_t(generation)];
+        if (kept.busy) {
+            own_ = std::make_unique<Models>(generation);
+            models_ = own_.get();
+            return;
+        }
+        if (kept.models) kept.models->restart();
+        else kept.models = std::make_unique<Models>(generation);
+        kept.busy = true;
+        models_ = kept.models.get();
+        kept_ = &kept;
+    }
+    ~ModelsLease() {
+        if (kept_) kept_->busy = false;
+    }
+    ModelsLease(const ModelsLease&) = delete;
+    ModelsLease& operator=(const ModelsLease&) = delete;
+    Models& operator*() const { return *models_; }
+    Models* operator->() const { return models_; }
+
+private:
+    struct Kept {
+        std::unique_ptr<Models> models;
+        bool busy = false;
+    };
+    static std::array<Kept, kLatestModel + 1>& keptModels() {
+        thread_local std::array<Kept, kLatestModel + 1> kept;
+        return kept;
+    }
+    std::unique_ptr<Models> own_;
+    Models* models_ = nullptr;
+    Kept* kept_ = nullptr;
+};
 
 // One sample as the walk leaves it to the range coder: the floor flag's
 // model (-1: none) and bit, and the residual with the models that code it
@@ -48,7 +92,7 @@ template <typename Walk>
 std::vector<uint8_t> encodeSamples(std::span<const int32_t> samples, const IntCoderOptions& options, std::vector<int32_t>* reconstructed, Walk&& walk) {
     checkRange(options);
     std::vector<uint8_t> out;
-    auto models = std::make_unique<Models>(options.model);
+    const ModelsLease models(options.model);
     const int64_t step = 2 * int64_t(options.near) + 1;
     if (reconstructed) reconstructed->resize(samples.size());
     const auto code = [&](const Prediction& pr, uint64_t at, auto&& emit) {
@@ -90,7 +134,7 @@ template <typename Walk>
 void decodeSamples(std::span<const uint8_t> bytes, const IntCoderOptions& options, std::span<int32_t> out, const std::string& what, Walk&& walk) {
     checkRange(options);
     RangeDecoder rc(bytes);
-    auto models = std::make_unique<Models>(options.model);
+    const ModelsLease models(options.model);
     const int64_t step = 2 * int64_t(options.near) + 1;
     try {
         walk(*models, [&](const Prediction& pr, uint64_t at) {

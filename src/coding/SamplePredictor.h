@@ -60,9 +60,21 @@ inline constexpr int kLatestModel = kLatestIntModel;
 
 struct Models {
     explicit Models(int generation)
-        : textureBias(generation >= 1), leastSquares(generation >= 2), farActivity(generation >= 3), intensityBands(generation >= 4),
-          bands(intensityBands ? kBands : 1), ctx(size_t(kContexts) * bands), bias(size_t(kContexts) * kTextures * bands) {
-        for (LeastSquaresFit& f : fit) f.shape = generation >= 3 ? kLsGeneration3 : kLsGeneration2;
+        : generation(generation), textureBias(generation >= 1), leastSquares(generation >= 2), farActivity(generation >= 3),
+          intensityBands(generation >= 4), bands(intensityBands ? kBands : 1), ctx(size_t(kContexts) * bands),
+          bias(size_t(kContexts) * kTextures * bands) {
+        restart();
+    }
+    // Back to the state a walk starts from, in place (ModelsLease, CodingLoop.h).
+    void restart() {
+        std::fill(ctx.begin(), ctx.end(), ContextModels{});
+        for (auto& row : low) row.fill(BitModel{});
+        std::fill(bias.begin(), bias.end(), BiasCell{});
+        for (LeastSquaresFit& f : fit) {
+            f = LeastSquaresFit{};
+            f.shape = generation >= 3 ? kLsGeneration3 : kLsGeneration2;
+        }
+        floor.fill(BitModel{});
         if (intensityBands) {  // 16 times the residual models: each learns its first bits fast (BitModel::warmUp)
             for (ContextModels& c : ctx) {
                 for (BitModel& m : c.zero) m.warmUp();
@@ -76,6 +88,7 @@ struct Models {
             for (BitModel& m : floor) m.warmUp();
         }
     }
+    int generation;
     bool textureBias;   // generations 1-3: the bias corrections below, not the contexts' own
     bool leastSquares;  // generations 2, 3: the fits below predict, and the floor flags
     // Generation 3: the activity also counts the residuals at WW, NN and NEE

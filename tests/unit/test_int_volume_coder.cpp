@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "src/coding/IntVolumeCoder.h"
@@ -212,6 +213,31 @@ TEST(IntVolumeCoder, ThePreviousVolumeOfASeriesAsNeighbours) {
 // undefined (x86 gave INT64_MIN, ARM saturates: two machines would decode
 // differently); it is now the range's minimum, defined, and the samples
 // come back (UBSan in scripts/sanitize.sh runs this).
+// A thread keeps its walk's models for the next walk (CodingLoop.h's
+// ModelsLease): a walk after others on the same thread, of other volumes,
+// generations and directions, and after a walk a corrupt stream stopped,
+// must code as a thread that never coded before.
+TEST(IntVolumeCoder, AWalkCodesAsOnAFreshThreadWhateverTheThreadCodedBefore) {
+    const IntVolumeShape shape{19, 13, 7}, other{31, 5, 3};
+    const std::vector<int32_t> v = phantom(shape, 7), w = phantom(other, 11);
+    for (int model = 0; model <= kLatestIntModel; ++model) {
+        IntCoderOptions o;
+        o.minValue = -1100, o.maxValue = 2600, o.model = model;
+        std::vector<uint8_t> fresh;
+        std::thread([&] { fresh = encodeIntVolume(v, shape, o); }).join();
+        IntCoderOptions n = o;
+        n.near = 2;
+        const std::vector<uint8_t> wBytes = encodeIntVolume(w, other, n);  // other samples, near-lossless
+        std::vector<int32_t> back(v.size());
+        decodeIntVolume(wBytes, other, n, std::span<int32_t>(back.data(), w.size()));
+        std::vector<uint8_t> cut(wBytes.begin(), wBytes.begin() + std::ptrdiff_t(wBytes.size() / 2));
+        EXPECT_THROW(decodeIntVolume(cut, other, n, std::span<int32_t>(back.data(), w.size())), Error);  // stopped half way
+        EXPECT_EQ(encodeIntVolume(v, shape, o), fresh) << "generation " << model;
+        decodeIntVolume(fresh, shape, o, back);
+        EXPECT_EQ(back, v) << "generation " << model;
+    }
+}
+
 TEST(IntVolumeCoder, APredictionPastInt64IsTheMinimumOnEveryMachine) {
     const IntVolumeShape s{20000, 1, 1};
     std::vector<int32_t> reference(s.count(), INT32_MIN), samples(s.count(), INT32_MIN);
