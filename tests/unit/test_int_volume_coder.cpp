@@ -207,12 +207,6 @@ TEST(IntVolumeCoder, ThePreviousVolumeOfASeriesAsNeighbours) {
     EXPECT_THROW(decodeIntVolume(second, s, o, out), Error);
 }
 
-// A prediction past int64 (found by review): a reference tap that mostly
-// differs by 1 from its W teaches the fit a weight near 1.4e9, then jumps by
-// 2^32 - 1, and the prediction is about 2^64. Converting that to int64 was
-// undefined (x86 gave INT64_MIN, ARM saturates: two machines would decode
-// differently); it is now the range's minimum, defined, and the samples
-// come back (UBSan in scripts/sanitize.sh runs this).
 // A thread keeps its walk's models for the next walk (CodingLoop.h's
 // ModelsLease): a walk after others on the same thread, of other volumes,
 // generations and directions, and after a walk a corrupt stream stopped,
@@ -238,6 +232,12 @@ TEST(IntVolumeCoder, AWalkCodesAsOnAFreshThreadWhateverTheThreadCodedBefore) {
     }
 }
 
+// A prediction past int64 (found by review): a reference tap that mostly
+// differs by 1 from its W teaches the fit a weight near 1.4e9, then jumps by
+// 2^32 - 1, and the prediction is about 2^64. Converting that to int64 was
+// undefined (x86 gave INT64_MIN, ARM saturates: two machines would decode
+// differently); it is now the range's minimum, defined, and the samples
+// come back (UBSan in scripts/sanitize.sh runs this).
 TEST(IntVolumeCoder, APredictionPastInt64IsTheMinimumOnEveryMachine) {
     const IntVolumeShape s{20000, 1, 1};
     std::vector<int32_t> reference(s.count(), INT32_MIN), samples(s.count(), INT32_MIN);
