@@ -14,6 +14,7 @@
 #include "src/coding/CodeAside.h"
 #include "src/coding/IntVolumeCoder.h"
 #include "src/coding/SamplePredictor.h"
+#include "src/coding/ThreadLease.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::coding::detail {
@@ -26,47 +27,10 @@ inline void checkRange(const IntCoderOptions& options) {
         throw Error("value coder: model generation " + std::to_string(options.model) + " (0 to " + std::to_string(kLatestModel) + ")");
 }
 
-// The models of one walk. Each thread keeps the models of its last walk per
-// generation and restarts them in place for the next (Models::restart):
-// building them anew cost a small walk more than the walk itself (1.9 MB of
-// generation 4 allocated, faulted in and cleared per window; the integer
-// coder's fuzz target spent half its time there). A walk started while
-// another on the same thread holds them builds its own.
-class ModelsLease {
+// The models of one walk, kept per thread and generation (ThreadLease.h).
+class ModelsLease : public ThreadLease<Models, kLatestModel + 1> {
 public:
-    explicit ModelsLease(int generation) {
-        Kept& kept = keptModels()[size_t(generation)];
-        if (kept.busy) {
-            own_ = std::make_unique<Models>(generation);
-            models_ = own_.get();
-            return;
-        }
-        if (kept.models) kept.models->restart();
-        else kept.models = std::make_unique<Models>(generation);
-        kept.busy = true;
-        models_ = kept.models.get();
-        kept_ = &kept;
-    }
-    ~ModelsLease() {
-        if (kept_) kept_->busy = false;
-    }
-    ModelsLease(const ModelsLease&) = delete;
-    ModelsLease& operator=(const ModelsLease&) = delete;
-    Models& operator*() const { return *models_; }
-    Models* operator->() const { return models_; }
-
-private:
-    struct Kept {
-        std::unique_ptr<Models> models;
-        bool busy = false;
-    };
-    static std::array<Kept, kLatestModel + 1>& keptModels() {
-        thread_local std::array<Kept, kLatestModel + 1> kept;
-        return kept;
-    }
-    std::unique_ptr<Models> own_;
-    Models* models_ = nullptr;
-    Kept* kept_ = nullptr;
+    explicit ModelsLease(int generation) : ThreadLease(size_t(generation), generation) {}
 };
 
 // One sample as the walk leaves it to the range coder: the floor flag's

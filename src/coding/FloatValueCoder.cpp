@@ -7,10 +7,10 @@
 #include <cfloat>
 #include <cmath>
 #include <limits>
-#include <memory>
 
 #include "src/coding/PlacedWalk.h"
 #include "src/coding/RangeCoder.h"
+#include "src/coding/ThreadLease.h"
 #include "src/util/Error.h"
 
 namespace vdbdag::coding {
@@ -32,6 +32,13 @@ struct FloatModels {
     std::array<std::array<BitModel, 64>, kContexts> length;  // the bit length's tree, nodes 1..63
     std::array<BitModel, kContexts> sign;
     std::array<std::array<std::array<BitModel, 4>, kMaxLength + 1>, kContexts> high;  // two bits below the leading one, as a prefix tree
+    // Back to a new walk's state, in place (ThreadLease.h).
+    void restart() {
+        for (auto& tree : length) tree.fill(BitModel{});
+        sign.fill(BitModel{});
+        for (auto& byLength : high)
+            for (auto& tree : byLength) tree.fill(BitModel{});
+    }
 };
 
 // Float bits as an unsigned integer in the floats' order, and back.
@@ -238,7 +245,7 @@ std::vector<uint8_t> encodeComponents(std::span<const uint32_t> bits, std::span<
     std::vector<uint8_t> out{kModelGeneration};
     for (const unsigned shift : shifts) out.push_back(uint8_t(shift));
     RangeEncoder rc(out);
-    auto models = std::make_unique<FloatModels>();
+    const detail::ThreadLease<FloatModels> models(0);
     walkFloats<C>(layout, places, bits.size() / C, shifts, [&](int c, int context, uint32_t predicted, uint64_t entry) {
         const uint32_t u = bits[size_t(entry) * C + size_t(c)];
         putResidual(rc, *models, context, int64_t(ordered(u) >> shifts[size_t(c)]) - int64_t(predicted));
@@ -263,7 +270,7 @@ void decodeComponents(std::span<const uint8_t> payload, std::span<const uint64_t
     if (out.size() % C) throw Error(what + ": internal error: components do not fill the entries");
     const std::span<const uint8_t> stream = payload.subspan(1 + C);
     RangeDecoder rc(stream);
-    auto models = std::make_unique<FloatModels>();
+    const detail::ThreadLease<FloatModels> models(0);
     try {
         walkFloats<C>(layout, places, out.size() / C, shifts, [&](int c, int context, uint32_t predicted, uint64_t entry) {
             const int64_t q = int64_t(predicted) + getResidual(rc, *models, context);

@@ -6,7 +6,8 @@
 // bit; half floats lose their 13 zero bits; the decoder gives the same bits
 // with flush-to-zero and denormals-are-zero set (as a host application may
 // leave them); corrupt payloads are refused without reading out of bounds;
-// a vec3s window codes each component (coding 9).
+// a vec3s window codes each component (coding 9); a thread's kept models
+// code as a fresh thread's.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <thread>
 #include <vector>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -173,6 +175,26 @@ TEST(FloatValueCoder, CorruptPayloadsAreRefused) {
         } catch (const Error&) {
         }
     }
+}
+
+// Each thread keeps its models from one window to the next (ThreadLease.h):
+// a window codes as on a fresh thread, whatever the thread coded before (a
+// noisy window, vectors, a decode that a cut payload stopped half way).
+TEST(FloatValueCoder, AWindowCodesAsOnAFreshThreadWhateverTheThreadCodedBefore) {
+    const FloatChannel c = sphereBand(8);
+    std::vector<uint8_t> fresh;
+    std::thread([&] { fresh = encodePlacedFloats(c.bits, c.layout, c.places); }).join();
+    std::mt19937 rng(13);
+    FloatChannel noise = c;
+    for (uint32_t& u : noise.bits) u = uint32_t(rng());
+    const std::vector<uint8_t> noisy = encodePlacedFloats(noise.bits, noise.layout, noise.places);
+    std::vector<uint32_t> out(c.bits.size());
+    EXPECT_THROW(decodePlacedFloats(std::span(noisy).first(noisy.size() / 2), c.layout, c.places, out, "cut"), Error);
+    std::vector<uint32_t> vectors(3 * c.bits.size());
+    for (uint32_t& u : vectors) u = std::bit_cast<uint32_t>(float(rng() % 1000) * 0.25f);
+    encodePlacedFloatVectors(vectors, c.layout, c.places);
+    EXPECT_EQ(encodePlacedFloats(c.bits, c.layout, c.places), fresh);
+    EXPECT_EQ(roundTrip(c, fresh), c.bits);
 }
 
 // Through the predicted windows: a float channel's window is coding 8 and
