@@ -30,6 +30,7 @@
 #include "src/volume/SignedFill.h"
 #include "vdb_bridge/detail/ImportGrids.h"
 #include "vdb_bridge/detail/LeafBricks.h"
+#include "vdb_bridge/detail/LeafSignedFill.h"
 #include "vdb_bridge/detail/NormalEstimation.h"
 #include "vdb_bridge/detail/OpenVdbSupport.h"
 #include "vdb_bridge/detail/VdbFile.h"
@@ -534,7 +535,7 @@ private:
                         record.insert(record.end(), p, p + size_t(count[l]) * sizeof(uint64_t));
                     }
                     if constexpr (kFillable)
-                        if (fillable) leafFill[i] = fillOf(*leaves[i], background);
+                        if (fillable) leafFill[i] = detail::leafSignedFill(*leaves[i], background);
                     sameValues[i - begin] = 0;
                     for (unsigned l = 0; l < 2; ++l) {
                         if (detail::allSameValue(valuesOf[l], valueSize(header_.valueType))) sameValues[i - begin] |= uint8_t(1u << l);
@@ -574,24 +575,6 @@ private:
         inactive.tiles = tiles_[1].tiles;
         summary_[1].voxels = inactive.activeVoxelCount();
         for (uint64_t n : inactiveVoxels) summary_[1].voxels += n;
-    }
-
-    // A leaf's inactive values against the signed flood fill of its active
-    // ones: bit 0 set when they are it (every inactive value -|background|
-    // inside, the background outside), bits 1 and 2 the signs of its first
-    // and last values (for the fill of the nodes above).
-    static uint8_t fillOf(const LeafT& leaf, ValueT background) {
-        const ValueT* data = leaf.buffer().data();
-        SignedFillTree::LeafBits active{}, negative{};  // the value mask's words are LeafBits' (bit n & 63 of word n >> 6)
-        for (unsigned w = 0; w < 8; ++w) active[w] = leaf.getValueMask().template getWord<uint64_t>(w);
-        for (openvdb::Index n = 0; n < LeafT::SIZE; ++n)
-            if (SignedFillTree::test(active, n) && data[n] < ValueT(0)) SignedFillTree::set(negative, n);
-        if (active == SignedFillTree::LeafBits{}) return 0;  // the fill of such a leaf reads what it overwrites
-        const SignedFillTree::LeafFill fill = SignedFillTree::fillLeaf(active, negative);
-        const ValueT inside = -background;
-        for (openvdb::Index n = 0; n < LeafT::SIZE; ++n)
-            if (!SignedFillTree::test(active, n) && !detail::sameBits(data[n], SignedFillTree::test(fill.inside, n) ? inside : background)) return 0;
-        return uint8_t(1u | unsigned(fill.first) << 1 | unsigned(fill.last) << 2);
     }
 
     // Whether every leaf is its fill and the inactive tiles off the
