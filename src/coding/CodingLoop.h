@@ -4,9 +4,7 @@
 // (lossless modulo the range, or quantised for near-lossless), decoding
 // reads it. One loop for both coders, so their streams follow one rule.
 #pragma once
-#include <array>
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <string>
 #include <vector>

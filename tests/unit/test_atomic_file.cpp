@@ -20,18 +20,13 @@
 #include "src/format/SsvdagContainer.h"
 #include "src/util/AtomicFile.h"
 #include "src/util/Error.h"
+#include "tests/unit/CliRunner.h"
 
 namespace fs = std::filesystem;
 using namespace vdbdag;
+using vdbdag::testing::testFolder;
 
 namespace {
-
-fs::path freshDir(const std::string& tag) {
-    const fs::path dir = fs::temp_directory_path() / ("vdbdag_" + tag + "_" + std::to_string(getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
 
 std::vector<std::string> listDir(const fs::path& dir) {
     std::vector<std::string> names;
@@ -55,7 +50,7 @@ std::vector<uint8_t> randomBytes(size_t n, uint64_t seed) {
 } // namespace
 
 TEST(ReadFileBytes, ReadsFilesAndNamesTheProblem) {
-    const fs::path dir = freshDir("read");
+    const fs::path dir = testFolder("read");
     const auto data = randomBytes(100000, 4);
     std::ofstream(dir / "f.bin", std::ios::binary).write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size()));
     EXPECT_EQ(format::readFileBytes((dir / "f.bin").string()), data);
@@ -97,7 +92,7 @@ TEST(ReadFileBytes, ReadsFilesAndNamesTheProblem) {
 }
 
 TEST(AtomicFile, WritesAndReplacesWithoutLeavingTemporaries) {
-    const fs::path dir = freshDir("atomic");
+    const fs::path dir = testFolder("atomic");
     const fs::path target = dir / "out.bin";
     const auto a = randomBytes(10, 5), b = randomBytes(20000, 6);
     writeFileAtomically(target.string(), a);
@@ -124,7 +119,7 @@ TEST(AtomicFile, WritesAndReplacesWithoutLeavingTemporaries) {
 }
 
 TEST(AtomicFile, FailuresLeaveNothingBehind) {
-    const fs::path dir = freshDir("atomic_fail");
+    const fs::path dir = testFolder("atomic_fail");
     const auto a = randomBytes(10, 7);
     try {
         writeFileAtomically((dir / "missing" / "x.bin").string(), a);
@@ -165,7 +160,7 @@ TEST(AtomicFile, FailuresLeaveNothingBehind) {
 }
 
 TEST(AtomicFile, WriteViaTemporary) {
-    const fs::path dir = freshDir("via_tmp");
+    const fs::path dir = testFolder("via_tmp");
     const fs::path target = dir / "grid.vdb";
     std::string seen;
     writeViaTemporary(target.string(), [&](const std::string& tmp) {
